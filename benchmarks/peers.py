@@ -1,0 +1,366 @@
+"""Peers for the simulator benchmark: general-purpose integrators given the same problem.
+
+Every peer integrates the oscillator of MODEL.md (x'' + 2 zeta x' + x = r(tau), wall at
+x = delta, restitution eps) under a piecewise-linear random force r(tau) sampled every `dt`
+(no harmonic part), and returns the impacts it found as ``(impact_time, impact_velocity)``
+float64 arrays, impact_velocity being the approach velocity u_{j-0} > 0.
+
+- `solve_ivp_impacts`: scipy.integrate.solve_ivp restarted at every force sample (so no step
+  ever straddles a kink of r) and after every impact (a terminal event on x - delta).
+- `rk4_clamp_impacts`: classical fixed-step RK4 with the wall imposed by clamping, compiled by
+  numba so that the comparison measures the method, not the interpreter.
+
+Also here: the bare recurrence that bounds any exact simulator from below
+(`linear_recurrence_floor`), the error measure against a reference (`impact_errors`) and the
+work-precision figure (`plot_work_precision`).
+"""
+import math
+
+import numpy as np
+import scipy.integrate
+import scipy.linalg
+from numba import njit
+
+V_STICK = 1e-7
+"""Rebound speed below which the solve_ivp peer ends a chatter sequence by sticking.
+
+The rest of the sequence (at most ~2 V_STICK / ((1 - eps) (r - delta)) of time) is skipped;
+its impacts are far below the velocity floor that `impact_errors` compares."""
+
+
+def _check_problem(zeta, eps, delta, noise, dt):
+    if not 0.0 < zeta < 1.0:
+        raise ValueError(f"zeta must lie in (0, 1), got {zeta!r}")
+    if not 0.0 <= eps <= 1.0:
+        raise ValueError(f"eps must lie in [0, 1], got {eps!r}")
+    if not math.isfinite(delta):
+        raise ValueError(f"delta must be a finite number, got {delta!r}")
+    if not dt > 0.0:
+        raise ValueError(f"dt must be positive, got {dt!r}")
+    noise = np.ascontiguousarray(noise, dtype=np.float64)
+    if noise.ndim != 1 or noise.size < 2:
+        raise ValueError(f"noise must be a 1-D array of at least 2 samples, got shape {noise.shape}")
+    return noise
+
+
+def _n_intervals(noise, dt, t_end):
+    """Number of sample intervals to integrate, and the end time."""
+    if t_end is None:
+        t_end = (noise.size - 1) * dt
+    n = int(math.ceil(t_end / dt - 1e-9))
+    if n > noise.size - 1:
+        raise ValueError(f"t_end={t_end} lies beyond the last noise sample at {(noise.size - 1) * dt}")
+    return n, t_end
+
+
+# ---------------------------------------------------------------------------------------------
+# scipy.integrate.solve_ivp with per-sample restarts and terminal impact events
+# ---------------------------------------------------------------------------------------------
+
+def _make_rhs(zeta, t_a, r0, b):
+    """Right-hand side on one sample interval, where r(tau) = r0 + b (tau - t_a)."""
+    two_zeta = 2.0 * zeta
+
+    def rhs(t, y):
+        return np.array([y[1], r0 + b * (t - t_a) - y[0] - two_zeta * y[1]])
+
+    return rhs
+
+
+def _make_wall_event(delta, t_start):
+    """Terminal event x - delta = 0 crossed upwards.
+
+    The integration restarts on the wall after every impact (g = 0 there); scipy would report
+    that starting point as a root as soon as a first step jumps over a short flight, so the
+    start is given g = -1: the only sign change is then the real arrival at the wall."""
+
+    def wall(t, y):
+        return y[0] - delta if t > t_start else -1.0
+
+    wall.terminal = True
+    wall.direction = 1.0
+    return wall
+
+
+def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, atol=None,
+                      x0=None, v0=0.0, t_end=None, v_stick=V_STICK):
+    """Impacts found by `scipy.integrate.solve_ivp` restarted at every force sample.
+
+    Parameters
+    ----------
+    zeta, eps, delta : float
+        Damping ratio, restitution coefficient, wall position (MODEL.md).
+    noise : ndarray of float64, shape (n,)
+        r[k] = r(k dt); r is linear in between.
+    dt : float
+        Sample step.
+    method : {"RK45", "DOP853", "LSODA", ...}
+        Passed to `solve_ivp`.
+    rtol, atol : float
+        Tolerances; atol defaults to rtol (the state is O(1)).
+    x0, v0 : float
+        Initial state; x0=None means min(0, delta), the static rest position.
+    t_end : float, optional
+        End time; default (n - 1) dt.
+    v_stick : float
+        A rebound slower than this, with r - delta > 0 pushing the mass onto the wall, ends the
+        chatter sequence: the mass sticks until r - delta turns negative (an exact linear root).
+
+    Returns
+    -------
+    impact_time, impact_velocity : ndarray of float64
+        Impact instants and approach velocities u_{j-0} > 0.
+
+    Notes
+    -----
+    One `solve_ivp` call per sample interval (or per flight within it): a step across a kink of
+    r would lose the method's order there. The impact map is eq. 7 of the paper.
+    """
+    noise = _check_problem(zeta, eps, delta, noise, dt)
+    n, t_end = _n_intervals(noise, dt, t_end)
+    atol = rtol if atol is None else atol
+    x = min(0.0, delta) if x0 is None else float(x0)
+    v = float(v0)
+    stuck = x == delta and v == 0.0 and (noise[0] - delta > 0.0
+                                          or (noise[0] == delta and noise[1] > noise[0]))
+    times, velocities = [], []
+    for k in range(n):
+        t_a = k * dt
+        t_b = min((k + 1) * dt, t_end)
+        r0 = noise[k]
+        b = (noise[k + 1] - r0) / dt
+        rhs = _make_rhs(zeta, t_a, r0, b)
+        t = t_a
+        while t < t_b:
+            if stuck:
+                if r0 + b * (t_b - t_a) - delta >= 0.0:
+                    break
+                t = max(t, t_a + (delta - r0) / b)
+                stuck = False
+                x, v = delta, 0.0
+                continue
+            sol = scipy.integrate.solve_ivp(rhs, (t, t_b), [x, v], method=method, rtol=rtol,
+                                            atol=atol, events=_make_wall_event(delta, t))
+            if sol.status != 1:
+                if sol.status != 0:
+                    raise RuntimeError(f"solve_ivp failed at tau={t}: {sol.message}")
+                x, v = sol.y[0, -1], sol.y[1, -1]
+                break
+            t = sol.t_events[0][0]
+            u = sol.y_events[0][0][1]
+            times.append(t)
+            velocities.append(u)
+            x = delta
+            v = -eps * u
+            if -v < v_stick and r0 + b * (t - t_a) - delta > 0.0:
+                stuck = True
+                v = 0.0
+    return np.array(times), np.array(velocities)
+
+
+# ---------------------------------------------------------------------------------------------
+# Fixed-step RK4 with clamping at the wall
+# ---------------------------------------------------------------------------------------------
+
+@njit(cache=True)
+def _rk4_clamp_kernel(noise, dt, m, n_intervals, zeta, eps, delta, x0, v0,
+                      impact_time, impact_velocity):
+    """RK4 with m steps per sample; x > delta is clamped to delta, and v > 0 there reversed."""
+    h = dt / m
+    two_zeta = 2.0 * zeta
+    x = x0
+    v = v0
+    n_impacts = 0
+    capacity = impact_time.size
+    for k in range(n_intervals):
+        r0 = noise[k]
+        b = (noise[k + 1] - r0) / dt
+        for j in range(m):
+            s = j * h
+            f1 = r0 + b * s
+            f2 = f1 + b * 0.5 * h
+            f3 = f1 + b * h
+            k1x = v
+            k1v = f1 - x - two_zeta * v
+            xa = x + 0.5 * h * k1x
+            va = v + 0.5 * h * k1v
+            k2x = va
+            k2v = f2 - xa - two_zeta * va
+            xb = x + 0.5 * h * k2x
+            vb = v + 0.5 * h * k2v
+            k3x = vb
+            k3v = f2 - xb - two_zeta * vb
+            xc = x + h * k3x
+            vc = v + h * k3v
+            k4x = vc
+            k4v = f3 - xc - two_zeta * vc
+            x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x)
+            v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
+            if x > delta:
+                x = delta
+                if v > 0.0:
+                    if n_impacts < capacity:
+                        impact_time[n_impacts] = k * dt + s + h
+                        impact_velocity[n_impacts] = v
+                    n_impacts += 1
+                    v = -eps * v
+    return n_impacts, x, v
+
+
+def rk4_clamp_impacts(zeta, eps, delta, noise, dt, steps_per_sample=1, x0=None, v0=0.0,
+                      t_end=None):
+    """Impacts found by fixed-step RK4 with the wall imposed by clamping.
+
+    Parameters
+    ----------
+    zeta, eps, delta, noise, dt, x0, v0, t_end
+        As in `solve_ivp_impacts`.
+    steps_per_sample : int
+        RK4 steps per sample interval (step h = dt / steps_per_sample; every stage then sees the
+        force's own linear piece, so the only inexactness is RK4's and the wall's).
+
+    Returns
+    -------
+    impact_time, impact_velocity : ndarray of float64
+        Impact time = end of the step that crossed the wall (an O(h) error); velocity = the
+        step's end velocity before reversal.
+    """
+    noise = _check_problem(zeta, eps, delta, noise, dt)
+    n, t_end = _n_intervals(noise, dt, t_end)
+    m = int(steps_per_sample)
+    if m < 1:
+        raise ValueError(f"steps_per_sample must be a positive integer, got {steps_per_sample!r}")
+    x = min(0.0, delta) if x0 is None else float(x0)
+    capacity = max(16, n // 8)
+    while True:
+        impact_time = np.empty(capacity)
+        impact_velocity = np.empty(capacity)
+        n_impacts, _, _ = _rk4_clamp_kernel(noise, dt, m, n, zeta, eps, delta, x, float(v0),
+                                            impact_time, impact_velocity)
+        if n_impacts <= capacity:
+            return impact_time[:n_impacts], impact_velocity[:n_impacts]
+        capacity = n_impacts
+
+
+# ---------------------------------------------------------------------------------------------
+# The floor: the bare dependent recurrence, no wall
+# ---------------------------------------------------------------------------------------------
+
+def linear_propagator(zeta, dt):
+    """Exact one-sample propagator of the free oscillator under a linear force.
+
+    Returns ``(phi, g0, g1)``: y_{k+1} = phi @ y_k + g0 r_k + g1 r_{k+1} for y = (x, v), from the
+    matrix exponential of the system augmented with (r, r')."""
+    a = np.zeros((4, 4))
+    a[0, 1] = 1.0
+    a[1, 0] = -1.0
+    a[1, 1] = -2.0 * zeta
+    a[1, 2] = 1.0
+    a[2, 3] = 1.0
+    e = scipy.linalg.expm(a * dt)
+    phi = np.ascontiguousarray(e[:2, :2])
+    g1 = e[:2, 3] / dt
+    g0 = e[:2, 2] - g1
+    return phi, np.ascontiguousarray(g0), np.ascontiguousarray(g1)
+
+
+@njit(cache=True)
+def _recurrence_kernel(noise, n_steps, p00, p01, p10, p11, g00, g01, g10, g11, x, v):
+    for k in range(n_steps):
+        r0 = noise[k]
+        r1 = noise[k + 1]
+        x, v = (p00 * x + p01 * v + g00 * r0 + g10 * r1,
+                p10 * x + p11 * v + g01 * r0 + g11 * r1)
+    return x, v
+
+
+def linear_recurrence_floor(zeta, noise, dt, x0=0.0, v0=0.0):
+    """Run the bare recurrence y_{k+1} = phi y_k + g0 r_k + g1 r_{k+1} over the whole record.
+
+    Every step depends on the last, so this chain of multiply-adds is the least work per sample
+    step that any exact simulator of this model can do. Returns the final (x, v)."""
+    phi, g0, g1 = linear_propagator(zeta, dt)
+    return _recurrence_kernel(noise, noise.size - 1, phi[0, 0], phi[0, 1], phi[1, 0], phi[1, 1],
+                              g0[0], g0[1], g1[0], g1[1], float(x0), float(v0))
+
+
+# ---------------------------------------------------------------------------------------------
+# Error against a reference, and the work-precision figure
+# ---------------------------------------------------------------------------------------------
+
+def impact_errors(ref_time, ref_velocity, time, velocity, n_impacts, u_min=1e-3):
+    """Error of an impact sequence against a reference, over its first `n_impacts` impacts.
+
+    The reference impacts compared are the first `n_impacts` with u >= u_min (a chatter tail's
+    slower impacts are ill-conditioned in relative velocity, and simulators end those tails by
+    different, equally valid, rules). Each is paired with the peer impact nearest in time, so a
+    missed or spurious impact shows up as a large error instead of shifting every later pair.
+
+    Returns
+    -------
+    err_time : float
+        max |tau_peer - tau_ref| (time units); inf when the peer found no impact.
+    err_velocity : float
+        max |u_peer - u_ref| / u_ref.
+    t_last : float
+        Time of the last reference impact compared.
+    """
+    ref_time = np.asarray(ref_time, dtype=np.float64)
+    ref_velocity = np.asarray(ref_velocity, dtype=np.float64)
+    keep = np.flatnonzero(ref_velocity >= u_min)[:n_impacts]
+    if keep.size < n_impacts:
+        raise ValueError(f"the reference has only {keep.size} impacts with u >= {u_min}, "
+                         f"{n_impacts} asked")
+    rt, ru = ref_time[keep], ref_velocity[keep]
+    time = np.asarray(time, dtype=np.float64)
+    velocity = np.asarray(velocity, dtype=np.float64)
+    if time.size == 0:
+        return math.inf, math.inf, rt[-1]
+    j = np.clip(np.searchsorted(time, rt), 1, time.size - 1) if time.size > 1 else np.zeros(
+        rt.size, dtype=np.int64)
+    if time.size > 1:
+        left_nearer = np.abs(time[j - 1] - rt) <= np.abs(time[j] - rt)
+        j = np.where(left_nearer, j - 1, j)
+    err_time = float(np.max(np.abs(time[j] - rt)))
+    err_velocity = float(np.max(np.abs(velocity[j] - ru) / ru))
+    return err_time, err_velocity, float(rt[-1])
+
+
+def plot_work_precision(table):
+    """Work-precision diagram: run time per unit of simulated time against impact error.
+
+    Parameters
+    ----------
+    table : sequence of dict
+        One row per run, with keys ``delta``, ``method`` (a label: the series), ``setting``
+        (tolerance or steps, as text), ``error`` (max of time and relative velocity error,
+        dimensionless) and ``cost`` (seconds of run time per unit of simulated time).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per delta, one line per method.
+    """
+    import matplotlib.pyplot as plt
+
+    deltas = sorted({row["delta"] for row in table}, reverse=True)
+    methods = list(dict.fromkeys(row["method"] for row in table))
+    fig, axes = plt.subplots(1, len(deltas), figsize=(4.2 * len(deltas), 4.0), sharey=True,
+                             squeeze=False, layout="constrained")
+    markers = dict(zip(methods, "os^vD*Ph"))
+    for ax, delta in zip(axes[0], deltas):
+        for method in methods:
+            rows = [r for r in table if r["delta"] == delta and r["method"] == method]
+            rows = [r for r in rows if math.isfinite(r["error"]) and r["error"] > 0.0]
+            if not rows:
+                continue
+            ax.loglog([r["error"] for r in rows], [r["cost"] for r in rows],
+                      marker=markers.get(method, "o"), ms=7 if len(rows) == 1 else 4,
+                      ls="-" if len(rows) > 1 else "none", label=method)
+        ax.set_title(f"delta = {delta:g}")
+        ax.set_xlabel("max error of impact time and relative velocity (1)")
+        ax.grid(True, which="major", alpha=0.3)
+    axes[0, 0].set_ylabel("run time per unit simulated time (s)")
+    axes[0, -1].legend(fontsize=8, loc="best")
+    fig.suptitle("Work-precision, piecewise-linear random force, zeta=0.05, eps=0.5")
+    return fig

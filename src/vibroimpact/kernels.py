@@ -1,0 +1,669 @@
+"""Numba kernels: exact event-driven motion of the impact oscillator.
+
+Pure functions of numpy arrays and scalars: no I/O, no random numbers, no allocation per
+step. The Python driver (:mod:`vibroimpact.simulate`) validates input, allocates the
+output buffers and wraps the results.
+
+Model (MODEL.md, paper eqs. 2-7)::
+
+    x'' + 2 zeta x' + x = f(tau) = A sin(beta tau) + r(tau),   x <= delta,
+    impact at x = delta with u = x'(tau-) > 0:  x'(tau+) = -eps u,
+
+with r linear between the samples r_k = r(k h). Between samples and impacts the motion is
+the closed form ``x = p_lin + p_h + y``: ``p_lin(s) = r0 + b s - 2 zeta b`` for the linear
+force, ``p_h = A q sin(beta tau - phi)`` for the harmonic force and the damped free response
+``y = exp(-zeta s) (c1 cos(omega s) + c2 sin(omega s))``, ``omega = sqrt(1 - zeta^2)``.
+
+Impact detection is rigorous: ``|x''| <= A q beta^2 + R`` over a segment, with ``R`` the
+amplitude of ``y`` at the segment's start (``p_lin'' = 0`` and every derivative of ``y`` has
+amplitude ``<= R exp(-zeta s)``). A step is free of impacts when the bound on ``max x``
+from its end values (``max(x0, x1) + M h^2 / 8``) stays below the wall; otherwise the first
+root is approached from the left by steps that the same bound proves root-free, and refined
+by a bracketed Newton iteration once the bound proves the root unique. Grazing double
+crossings inside one step are therefore found, never jumped over.
+
+Time is kept as a sample index ``k`` plus an offset ``s`` in ``[0, h]``; the harmonic phase
+``beta (k h + s) mod 2 pi`` is computed in double-double arithmetic so that it stays exact
+on records of 1e9 samples.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+# --- numerical thresholds (the only ones in the package's simulator) -------------------
+#: Relative inflation of every derivative bound, covering round-off in the bound itself.
+BOUND_SAFETY = 1.0 + 1e-12
+#: Resynchronise the rotated harmonic phase used by the fast exclusion test every so many steps.
+RESYNC_EVERY = 1024
+#: Maximum number of root-search iterations in one segment (never reached in practice: the
+#: search converges quadratically; a near-grazing approach takes ~30).
+MAX_SEARCH = 400
+#: Estimated error (in time) below which the remaining geometric tail of a chatter sequence is
+#: summed in closed form and the mass is set sticking at the accumulation point.
+CHATTER_TIME_TOL = 1e-12
+#: Elastic (eps = 1) micro-bounces shorter than this are taken as resting contact.
+ELASTIC_MICRO_FLIGHT = 1e-10
+#: Impacts and sticking events one step may write; the driver flushes buffers before a step
+#: when less room than this is left.
+STEP_HEADROOM = 1 << 16
+
+TWO_PI_HI = 6.283185307179586
+TWO_PI_LO = 2.4492935982947064e-16
+EPS64 = 2.220446049250313e-16
+
+# status codes returned by run_steps
+OK = 0
+BUFFER_FULL = 1
+TOO_MANY_EVENTS = 2
+BAD_NOISE = 3
+
+# modes
+FREE = 0
+STUCK = 1
+
+# search results
+NO_ROOT = 0
+ROOT = 1
+TOUCH = 2   # reaches the wall with zero velocity (grazing within round-off)
+PRESSED = 3  # at the wall, at rest, pushed into it: sticks
+
+
+@njit(cache=True)
+def _split(a):
+    c = 134217729.0 * a
+    hi = c - (c - a)
+    return hi, a - hi
+
+
+@njit(cache=True)
+def two_prod(a, b):
+    """Error-free product: ``a * b = p + e`` exactly (Dekker)."""
+    p = a * b
+    ah, al = _split(a)
+    bh, bl = _split(b)
+    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return p, e
+
+
+@njit(cache=True)
+def phase(k, s, bh_hi, bh_lo, beta):
+    """``beta * (k h + s)`` reduced to about ``[-pi, pi]``, exact to round-off for any ``k``.
+
+    ``bh_hi + bh_lo`` is the exact product ``beta * h`` (double-double).
+    """
+    kf = float(k)
+    p, e = two_prod(kf, bh_hi)
+    e += kf * bh_lo
+    n = math.floor(p / TWO_PI_HI + 0.5)
+    q, qe = two_prod(n, TWO_PI_HI)
+    return ((p - q) - qe) + (e - n * TWO_PI_LO) + beta * s
+
+
+@njit(cache=True)
+def segment(x0, v0, s, r0, b, theta_k, P):
+    """Coefficients of the closed-form motion from state ``(x0, v0)`` at offset ``s`` of a step.
+
+    ``P`` is the parameter vector built by :func:`vibroimpact.simulate.kernel_parameters`.
+    Returns a tuple used by :func:`seg_eval` and the bounds of the search.
+    """
+    zeta, omega, delta = P[0], P[1], P[3]
+    A, beta, Aq, phi = P[5], P[6], P[7], P[8]
+    P0 = r0 + b * s - 2.0 * zeta * b
+    if Aq != 0.0:
+        psi0 = theta_k + beta * s - phi
+        sp = math.sin(psi0)
+        cp = math.cos(psi0)
+    else:
+        sp = 0.0
+        cp = 1.0
+    y0 = x0 - P0 - Aq * sp
+    yv0 = v0 - b - Aq * beta * cp
+    c2 = (yv0 + zeta * y0) / omega
+    d2 = (y0 + zeta * yv0) / omega
+    R = math.sqrt(y0 * y0 + c2 * c2) * BOUND_SAFETY
+    # force at the segment start: sin(theta) = sin(psi0 + phi)
+    sin_t = sp * P[9] + cp * P[10]
+    cos_t = cp * P[9] - sp * P[10]
+    F0 = r0 + b * s + A * sin_t - delta       # f - delta: the push into the wall at x = delta
+    dF0 = b + A * beta * cos_t
+    g2 = F0 + delta - 2.0 * zeta * v0 - x0      # x'' at the start
+    g3 = dF0 - 2.0 * zeta * g2 - v0            # x''' at the start
+    return (x0 - delta, v0, b, sp, cp, y0, yv0, c2, d2, R, g2, g3, F0, dF0, sin_t, cos_t,
+            r0 + b * s)
+
+
+@njit(cache=True)
+def seg_eval(sig, c, P):
+    """``(x - delta, x', x'')`` at ``sig`` after the segment start, in difference form.
+
+    Written as ``x(sig) - x0`` plus ``x0 - delta`` with ``expm1`` and half-angle sines so that
+    short flights (chatter) keep full relative accuracy; ``x''`` follows from eq. (2).
+    """
+    zeta, omega, delta = P[0], P[1], P[3]
+    A, beta, Aq = P[5], P[6], P[7]
+    g0, b, sp, cp, y0, yv0, c2, d2 = c[0], c[2], c[3], c[4], c[5], c[6], c[7], c[8]
+    em1 = math.expm1(-zeta * sig)
+    E = em1 + 1.0
+    sh = math.sin(0.5 * omega * sig)
+    ch = math.cos(0.5 * omega * sig)
+    S = 2.0 * sh * ch
+    C = 1.0 - 2.0 * sh * sh
+    dx = b * sig + y0 * (em1 * C - 2.0 * sh * sh) + c2 * E * S
+    v = b + E * (yv0 * C - d2 * S)
+    f = c[16] + b * sig
+    if Aq != 0.0:
+        sb = math.sin(0.5 * beta * sig)
+        cb = math.cos(0.5 * beta * sig)
+        cos_b = 1.0 - 2.0 * sb * sb
+        sin_b = 2.0 * sb * cb
+        dx += 2.0 * Aq * (cp * cb - sp * sb) * sb
+        v += Aq * beta * (cp * cos_b - sp * sin_b)
+        f += A * (c[14] * cos_b + c[15] * sin_b)
+    g = g0 + dx
+    return g, v, f - 2.0 * zeta * v - (g + delta)
+
+
+@njit(cache=True)
+def _bounds(c, P):
+    """Bounds on ``|x''|, |x'''|, |x''''|`` over a segment, and scales for tolerances."""
+    Aq, beta = abs(P[7]), P[6]
+    R = c[9]
+    M2 = Aq * beta * beta * BOUND_SAFETY + R
+    M3 = Aq * beta * beta * beta * BOUND_SAFETY + R
+    M4 = Aq * beta * beta * beta * beta * BOUND_SAFETY + R
+    vscale = abs(c[2]) + Aq * beta + R + abs(c[1]) + 1e-300
+    return M2, M3, M4, vscale
+
+
+@njit(cache=True)
+def _hermite_guess(w, glo, vlo, ghi, vhi):
+    """Root in ``(0, w)`` of the cubic Hermite interpolant of ``g`` (a start for Newton)."""
+    t = glo / (glo - ghi)
+    for _ in range(4):
+        t2 = t * t
+        t3 = t2 * t
+        p = ((2.0 * t3 - 3.0 * t2 + 1.0) * glo + (t3 - 2.0 * t2 + t) * w * vlo
+             + (-2.0 * t3 + 3.0 * t2) * ghi + (t3 - t2) * w * vhi)
+        dp = ((6.0 * t2 - 6.0 * t) * (glo - ghi) + (3.0 * t2 - 4.0 * t + 1.0) * w * vlo
+              + (3.0 * t2 - 2.0 * t) * w * vhi)
+        if dp <= 0.0:
+            break
+        t_new = t - p / dp
+        if not (0.0 < t_new < 1.0):
+            break
+        t = t_new
+    return t * w
+
+
+@njit(cache=True)
+def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, c, P):
+    """Unique root of the increasing ``g`` in ``[lo, hi]`` (``g(lo) < 0 <= g(hi)``) to round-off.
+
+    Newton from the cubic Hermite guess, kept inside the bracket by bisection.
+    """
+    s = lo + _hermite_guess(hi - lo, glo, vlo, ghi, vhi)
+    if not (lo < s < hi):
+        s = 0.5 * (lo + hi)
+    g, v, _ = seg_eval(s, c, P)
+    for _ in range(100):
+        if g < 0.0:
+            lo = s
+        elif g > 0.0:
+            hi = s
+        else:
+            break
+        s_new = s - g / v if v > 0.0 else 0.5 * (lo + hi)
+        if not (lo < s_new < hi):
+            s_new = 0.5 * (lo + hi)
+        if abs(s_new - s) <= 2.0 * EPS64 * abs(s) or hi - lo <= 2.0 * EPS64 * abs(hi):
+            break
+        s = s_new
+        g, v, _ = seg_eval(s, c, P)
+        if abs(g) <= tolg:
+            break
+    if g < 0.0 and hi - s <= 4.0 * EPS64 * abs(hi) + 1e-300:
+        s = hi          # g changes sign between s and the next float
+        g, v, _ = seg_eval(s, c, P)
+    return s, v
+
+
+@njit(cache=True)
+def _quad_root(ga, va, K):
+    """First positive root of ``ga + va s + K s^2 / 2`` with ``ga <= 0`` (``inf`` if none)."""
+    if ga == 0.0:
+        if va < 0.0:
+            return -2.0 * va / K if K > 0.0 else np.inf
+        return np.inf if (va == 0.0 and K < 0.0) else 0.0
+    disc = va * va - 2.0 * K * ga
+    if disc < 0.0:
+        return np.inf
+    den = va + math.sqrt(disc)
+    return -2.0 * ga / den if den > 0.0 else np.inf
+
+
+@njit(cache=True)
+def safe_step(ga, va, acc, M3, wmax):
+    """Longest ``s <= wmax`` proved free of contact from a point where ``g = ga <= 0``.
+
+    On ``[0, W]`` the acceleration is at most ``acc + W M3`` (``M3`` bounds the jerk), so
+    ``g(s) <= ga + va s + (acc + W M3) s^2 / 2``; the best ``W`` is the fixed point of
+    ``W = first root of that quadratic``, approached in a few cheap iterations.
+    """
+    W = wmax
+    best = 0.0
+    for _ in range(6):
+        K = (acc + W * M3) * BOUND_SAFETY + EPS64 * abs(acc)
+        s = _quad_root(ga, va, K)
+        if s >= W:
+            return max(best, W)
+        best = max(best, s)
+        W = s
+    return best
+
+
+@njit(cache=True)
+def _newton_from(a, ga, va, acc, M3, H):
+    """Length ``d`` of an interval ``[a, a + d]`` proved to hold exactly one root, or 0.
+
+    From ``g(a) = ga < 0`` and ``g'(a) = va > 0``: on ``[a, a + d]`` the acceleration is at
+    least ``-(max(-acc, 0) + d M3)``, which with ``d = -2 ga / va`` keeps ``g'`` positive and
+    forces ``g(a + d) > 0``.
+    """
+    if va <= 0.0:
+        return 0.0
+    d = -2.0 * ga / va
+    if a + d > H:
+        return 0.0
+    K = (max(-acc, 0.0) + d * M3) * BOUND_SAFETY
+    if va - K * d > 0.0 and -ga - 0.5 * K * d * d > 0.0:
+        return d
+    return 0.0
+
+
+@njit(cache=True)
+def _newton_unique(lo, hi, g, v, acc, tolg, c, P):
+    """Root of ``g`` in ``[lo, hi]``, where it is proved unique with ``g' > 0``; start at ``lo``.
+
+    Stops when the step is below round-off in ``s`` or ``|g|`` is below its evaluation
+    round-off ``tolg``.
+    """
+    s = lo
+    for _ in range(100):
+        # Halley's step (x'' comes free with each evaluation): cubic convergence
+        den = 2.0 * v * v - g * acc
+        s_new = s - 2.0 * g * v / den if (v > 0.0 and den > 0.0) else 0.5 * (lo + hi)
+        if not (lo <= s_new <= hi):
+            s_new = 0.5 * (lo + hi)
+        if abs(s_new - s) <= 2.0 * EPS64 * abs(s) or hi - lo <= 2.0 * EPS64 * abs(hi):
+            break
+        s = s_new
+        g, v, acc = seg_eval(s, c, P)
+        if abs(g) <= tolg:
+            break
+        if g < 0.0:
+            lo = s
+        else:
+            hi = s
+    return s, v
+
+
+@njit(cache=True)
+def first_contact(c, P, H, at_wall):
+    """Smallest ``sig`` in ``(0, H]`` where the segment's motion reaches the wall.
+
+    Parameters
+    ----------
+    c : tuple
+        Segment coefficients from :func:`segment`.
+    P : ndarray
+        Kernel parameters.
+    H : float
+        Length of the segment (to the end of the force sample step).
+    at_wall : bool
+        The segment starts on the wall (``x0 == delta``, ``x'0 <= 0``).
+
+    Returns
+    -------
+    code : int
+        ``NO_ROOT``, ``ROOT`` (impact with ``u > 0``), ``TOUCH`` (reaches the wall with zero
+        velocity within round-off) or ``PRESSED`` (starts at rest on the wall, pushed into it).
+    sig, u : float
+        Instant (from the segment start) and velocity there; with ``NO_ROOT``, ``H`` and
+        the state ``(x - delta, x')`` at ``H`` in ``u, gH``.
+    gH : float
+        ``x - delta`` at ``H`` for ``NO_ROOT``.
+
+    Notes
+    -----
+    Every point skipped is proved free of contact by a Taylor bound (:func:`safe_step`, or
+    the quartic bound on leaving the wall at a release), and Newton runs only on an interval
+    where the root is proved unique, so the root found is the first one, including a double
+    crossing inside one step with no sign change at its ends.
+    """
+    M2, M3, M4, vscale = _bounds(c, P)
+    a = 0.0
+    ga = c[0]
+    va = c[1]
+    acc = c[10]
+    if at_wall:
+        tolv = 64.0 * EPS64 * vscale
+        tola = 64.0 * EPS64 * M2
+        if va > tolv:
+            return ROOT, 0.0, va, 0.0           # starts on the wall moving into it
+        if va < -tolv or acc < -tola:
+            sa = safe_step(0.0, min(va, 0.0), acc, M3, H)
+        elif abs(acc) <= tola and c[11] < 0.0:
+            # leaving on release (f - delta = 0, turning negative): g <= g3 s^3/6 + M4 s^4/24
+            sa = min(-2.0 * c[11] / M4, H)
+        else:
+            return PRESSED, 0.0, 0.0, 0.0
+        a = sa
+        ga, va, acc = seg_eval(a, c, P)
+        if a >= H:
+            if ga < 0.0:
+                return NO_ROOT, H, va, ga
+            return (ROOT if va > 0.0 else TOUCH), H, va, 0.0
+        if ga >= 0.0:       # only by round-off: the bound says ga < 0
+            ga = -EPS64 * abs(P[3])
+    have_end = False
+    gH = 0.0
+    vH = 0.0
+    for _ in range(MAX_SEARCH):
+        w = H - a
+        d = _newton_from(a, ga, va, acc, M3, H)
+        if d > 0.0:
+            tolg = 4.0 * EPS64 * (abs(c[0]) + (a + d) * vscale)
+            s, u = _newton_unique(a, a + d, ga, va, acc, tolg, c, P)
+            return ROOT, s, u, 0.0
+        if not have_end:
+            gH, vH, _ = seg_eval(H, c, P)
+            have_end = True
+        if max(ga, gH) + 0.125 * M2 * w * w < 0.0:
+            return NO_ROOT, H, vH, gH
+        if gH >= 0.0 and 0.5 * (va + vH) - 0.5 * M2 * w > 0.0:
+            tolg = 4.0 * EPS64 * (abs(c[0]) + H * vscale)
+            s, u = _newton_bracket(a, H, ga, va, gH, vH, tolg, c, P)
+            return ROOT, s, u, 0.0
+        step = safe_step(ga, va, acc, M3, w)
+        if step >= w:
+            if gH >= 0.0:
+                return (ROOT if vH > 0.0 else TOUCH), H, vH, 0.0
+            return NO_ROOT, H, vH, gH
+        if step <= 2.0 * EPS64 * a:
+            # no progress is possible in floating point: we are at the root
+            return (ROOT if va > 0.0 else TOUCH), a, va, 0.0
+        a = a + step
+        ga, va, acc = seg_eval(a, c, P)
+        if ga >= -8.0 * EPS64 * (abs(c[0]) + a * vscale):
+            if va <= 64.0 * EPS64 * vscale:
+                return TOUCH, a, va, 0.0
+            if ga >= 0.0:
+                return ROOT, a, va, 0.0
+    return TOUCH, a, va, 0.0
+
+
+@njit(cache=True)
+def push_eval(sig, c, P):
+    """``F = f - delta`` and ``dF/dtau`` at ``sig`` after the segment start, in difference form."""
+    A, beta = P[5], P[6]
+    F = c[12] + c[2] * sig
+    dF = c[2]
+    if A != 0.0:
+        sb = math.sin(beta * sig)
+        cb = math.cos(beta * sig)
+        F += A * (c[15] * sb - c[14] * (1.0 - cb))
+        dF += A * beta * (c[15] * cb - c[14] * sb)
+    return F, dF
+
+
+@njit(cache=True)
+def release_time(c, P, H):
+    """First ``sig`` in ``[0, H]`` after which ``f - delta`` turns negative (the mass leaves).
+
+    Returns ``-1.0`` when the mass stays on the wall through ``H``. ``f`` is linear plus a
+    sinusoid, so ``|F''| <= A beta^2`` bounds the safe steps as in :func:`first_contact`.
+    """
+    A, beta = P[5], P[6]
+    MF = abs(A) * beta * beta * BOUND_SAFETY
+    a = 0.0
+    Fa, dFa = c[12], c[13]
+    if Fa < 0.0 or (Fa == 0.0 and dFa < 0.0):
+        return 0.0
+    FH, dFH = push_eval(H, c, P)
+    scale = abs(c[12]) + abs(P[3]) + abs(A) + abs(c[2]) * H + 1e-300
+    for _ in range(MAX_SEARCH):
+        w = H - a
+        if min(Fa, FH) - 0.125 * MF * w * w > 0.0 or (MF == 0.0 and FH >= 0.0):
+            return -1.0
+        if FH < 0.0 and 0.5 * (dFa + dFH) + 0.5 * MF * w < 0.0:
+            lo, hi = a, H
+            # F is strictly decreasing on [lo, hi]: bisection-safeguarded Newton on F
+            s = lo + Fa * (hi - lo) / (Fa - FH)
+            for _ in range(100):
+                F, dF = push_eval(s, c, P)
+                if F > 0.0:
+                    lo = s
+                elif F < 0.0:
+                    hi = s
+                else:
+                    break
+                s_new = s - F / dF if dF < 0.0 else 0.5 * (lo + hi)
+                if not (lo < s_new < hi):
+                    s_new = 0.5 * (lo + hi)
+                if abs(s_new - s) <= 2.0 * EPS64 * abs(s) or hi - lo <= 2.0 * EPS64 * abs(hi):
+                    break
+                s = s_new
+            return s
+        if MF == 0.0:
+            step = Fa / -dFa if dFa < 0.0 else w
+        else:
+            disc = math.sqrt(dFa * dFa + 2.0 * MF * Fa)
+            step = 2.0 * Fa / (disc - dFa) if dFa < 0.0 else (dFa + disc) / MF
+        if a + step >= H:
+            return -1.0 if FH >= 0.0 else H
+        if step <= 2.0 * EPS64 * max(a, 1e-300) + 1e-300:
+            a = a + max(step, 1e-12 * H)   # tangency of f with delta: no sign change here
+        else:
+            a = a + step
+        Fa, dFa = push_eval(a, c, P)
+        if Fa < 0.0:
+            return a
+        if Fa <= 8.0 * EPS64 * scale and dFa < 0.0:
+            return a
+    return a
+
+
+@njit(cache=True)
+def _record_event(buf_step, buf_off, buf_val, n, k, s, val):
+    buf_step[n] = k
+    buf_off[n] = s
+    buf_val[n] = val
+
+
+@njit(cache=True)
+def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+              stk_kind, cnt, ftot):
+    """Advance one force sample step ``[k h, k h + H]`` through every event in it.
+
+    ``x, v, mode`` is the state at the step's start. Impacts are appended to
+    ``imp_*``, sticking starts (kind 1) and ends (kind 0) to ``stk_*``; ``cnt`` holds
+    ``[n_impacts, n_stick_events, n_chatter]`` and ``ftot[0]`` the time in contact.
+    Returns the state at the step's end and a status.
+    """
+    zeta, eps, delta = P[0], P[2], P[3]
+    theta_k = phase(k, 0.0, P[11], P[12], P[6]) if P[5] != 0.0 else 0.0
+    s = 0.0
+    n_events = 0
+    at_wall = x >= delta
+    if at_wall:
+        x = delta
+    just_hit = False
+    while True:
+        n_events += 1
+        if n_events > STEP_HEADROOM - 2:
+            return x, v, mode, TOO_MANY_EVENTS
+        c = segment(x, v, s, r0, b, theta_k, P)
+        Hs = H - s
+        if just_hit and v < 0.0 and c[12] > 0.0:
+            # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
+            # sum the tail in closed form once its neglected terms are below CHATTER_TIME_TOL
+            wv, F, dF = -v, c[12], c[13]
+            if eps < 1.0:
+                tail = 2.0 * wv / (F * (1.0 - eps))
+                ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_TIME_TOL
+            else:
+                tail = 2.0 * wv / F
+                ok = tail <= ELASTIC_MICRO_FLIGHT
+            F_end = F + dF * tail - 0.5 * abs(P[5]) * P[6] * P[6] * tail * tail
+            if ok and tail <= Hs and F_end > 0.0:
+                s = s + tail
+                cnt[2] += 1
+                mode = STUCK
+                _record_event(stk_step, stk_off, stk_kind, cnt[1], k, s, 1.0)
+                cnt[1] += 1
+                v = 0.0
+                just_hit = False
+                continue
+        just_hit = False
+        if mode == STUCK:
+            sig = release_time(c, P, Hs)
+            if sig < 0.0:
+                ftot[0] += Hs
+                return delta, 0.0, STUCK, OK
+            ftot[0] += sig
+            s = min(s + sig, H)
+            _record_event(stk_step, stk_off, stk_kind, cnt[1], k, s, 0.0)
+            cnt[1] += 1
+            mode = FREE
+            x = delta
+            v = 0.0
+            at_wall = True
+            continue
+        code, sig, u, gH = first_contact(c, P, Hs, at_wall)
+        if code == NO_ROOT:
+            return gH + delta, u, FREE, OK
+        if code == PRESSED:
+            mode = STUCK
+            _record_event(stk_step, stk_off, stk_kind, cnt[1], k, s, 1.0)
+            cnt[1] += 1
+            x = delta
+            v = 0.0
+            continue
+        s = min(s + sig, H)
+        x = delta
+        at_wall = True
+        if code == ROOT and u <= 64.0 * EPS64 * (abs(b) + abs(P[7]) * P[6] + c[9] + abs(v)):
+            code = TOUCH          # arrives with zero velocity within round-off: grazing touch
+        if code == TOUCH:
+            v = min(u, 0.0)
+            continue
+        _record_event(imp_step, imp_off, imp_u, cnt[0], k, s, u)
+        cnt[0] += 1
+        v = -eps * u
+        just_hit = True
+    return x, v, mode, OK
+
+
+@njit(cache=True)
+def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+              stk_kind, cnt, ftot, grid, stride, grid_n):
+    """Advance the oscillator over the force samples ``r`` (``r[0]`` is sample ``k_begin``).
+
+    ``state = [w, w', mode, sin(psi), cos(psi)]`` at sample ``k_begin``, with ``w = x - p_h``
+    the displacement less the harmonic particular solution (so the fast recurrence never
+    touches the harmonic part) and ``psi = beta k h - phi``. Steps ``k_begin .. k_end - 1``
+    are taken unless an output buffer runs short, in which case the function returns early.
+    ``grid`` receives ``a = delta - x`` at every sample with ``k % stride == 0`` (``stride``
+    0: none), counted in ``grid_n[0]``.
+
+    Returns ``(status, k)``: the sample reached.
+    """
+    zeta, delta, h = P[0], P[3], P[4]
+    Aq, beta = P[7], P[6]
+    a11, a12, a21, a22 = P[13], P[14], P[15], P[16]
+    inv_h, inv_omega = P[17], P[18]
+    cbh, sbh = P[19], P[20]
+    h2_8 = 0.125 * h * h
+    M0 = abs(Aq) * beta * beta * BOUND_SAFETY
+    margin = 1e-11 * abs(Aq) + 1e-300
+    has_h = Aq != 0.0
+    w = state[0]
+    wv = state[1]
+    mode = int(state[2])
+    sp = state[3]
+    cp = state[4]
+    cap_imp = imp_step.shape[0]
+    cap_stk = stk_step.shape[0]
+    for k in range(k_begin, k_end):
+        if cnt[0] + STEP_HEADROOM > cap_imp or cnt[1] + STEP_HEADROOM > cap_stk:
+            state[0] = w
+            state[1] = wv
+            state[2] = mode
+            state[3] = sp
+            state[4] = cp
+            return BUFFER_FULL, k
+        if has_h and k % RESYNC_EVERY == 0:
+            psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+            sp = math.sin(psi)
+            cp = math.cos(psi)
+        if stride > 0 and k % stride == 0:
+            if mode == STUCK:
+                grid[grid_n[0]] = 0.0
+            elif has_h:
+                grid[grid_n[0]] = delta - (w + Aq * math.sin(phase(k, 0.0, P[11], P[12], beta) - P[8]))
+            else:
+                grid[grid_n[0]] = delta - w
+            grid_n[0] += 1
+        r0 = r[k - k_begin]
+        r1 = r[k - k_begin + 1]
+        b = (r1 - r0) * inv_h
+        if has_h:
+            sp1 = sp * cbh + cp * sbh
+            cp1 = cp * cbh - sp * sbh
+        else:
+            sp1 = 0.0
+            cp1 = 1.0
+        if mode == FREE:
+            y0 = w - (r0 - 2.0 * zeta * b)
+            yv = wv - b
+            w1 = r1 - 2.0 * zeta * b + a11 * y0 + a12 * yv
+            wv1 = b + a21 * y0 + a22 * yv
+            xmax = max(w + Aq * sp, w1 + Aq * sp1)
+            R = abs(y0) + abs(yv + zeta * y0) * inv_omega
+            if xmax + (M0 + R) * h2_8 + margin < delta:
+                w = w1
+                wv = wv1
+                sp = sp1
+                cp = cp1
+                continue
+            x = w
+            v = wv
+            if has_h:
+                psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+                x = w + Aq * math.sin(psi)
+                v = wv + Aq * beta * math.cos(psi)
+        else:
+            x = delta
+            v = 0.0
+        # a non-finite sample always fails the exclusion test, so it is caught here at no cost
+        if not (math.isfinite(r0) and math.isfinite(r1)):
+            return BAD_NOISE, k
+        x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u,
+                                       stk_step, stk_off, stk_kind, cnt, ftot)
+        if status != OK:
+            return status, k
+        if has_h:
+            psi = phase(k + 1, 0.0, P[11], P[12], beta) - P[8]
+            sp1 = math.sin(psi)
+            cp1 = math.cos(psi)
+        w = x - Aq * sp1
+        wv = v - Aq * beta * cp1
+        sp = sp1
+        cp = cp1
+    state[0] = w
+    state[1] = wv
+    state[2] = mode
+    state[3] = sp
+    state[4] = cp
+    return OK, k_end

@@ -1,0 +1,296 @@
+"""Periodic (m/n) impact motions under the harmonic force alone (paper section 4, Fig. 16).
+
+An (m/n) motion has period ``z = 2 pi n / beta`` and exactly m impacts per period. This module
+finds every one of them at a parameter point (``periodic_orbits``) and classifies a whole
+``(1/beta, delta)`` grid (``orbit_map``). Flights are closed form; the kernels live in
+``vibroimpact.orbit_kernels``.
+
+Method
+------
+- (1/n): the equations reduce to ``cos(psi_0 - chi) = kappa`` in the impact phase: both roots in
+  closed form (``orbit_kernels.solve_m1``).
+- (2/n), (3/n): for fixed intervals the equations are linear in the impact phase's
+  ``(sin, cos)`` and the velocities; the solutions are the zeros of a smooth scalar circle
+  condition over the intervals (a 1-D scan for m = 2, a 2-D one for m = 3). Every bracket seeds
+  Newton on the full 2m-equation system with its analytic Jacobian
+  (``orbit_kernels.solve_general``). m >= 4 is not supported.
+- Admissibility: the exact largest interior maximum of x on every flight, from the zeros of
+  the velocity (``orbit_kernels.flight_max``).
+- Stability: the analytic one-period Jacobian ``T = T_m ... T_1`` of the impact map, whose
+  determinant is ``eps^(2m) exp(-2 zeta z)``.
+
+eps = 0: every impact leaves the mass on the wall at rest; the motion is still a free flight
+when the force pulls it off at once, and only then is it an orbit here (a flight whose
+acceleration leaves the wall upward has an interior maximum above delta and is inadmissible;
+impact-stick motions are not returned). The map is then rank one: ``T`` has a zero column,
+``det T = 0``, one multiplier is 0 and ``lam = |tr T|^(1/m)``.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from vibroimpact import orbit_kernels as ok
+
+__all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "REASON_CODES"]
+
+REASON_CODES = {
+    0: "a stable admissible solution exists",
+    1: "no solution of eqs. (10)-(11) with positive intervals and velocities",
+    2: "solutions exist but none is admissible (a flight crosses the wall, eq. 13)",
+    3: "admissible solutions exist but none is stable (eq. 22)",
+}
+MAX_M = 3
+
+
+@dataclass(frozen=True, eq=False)
+class PeriodicOrbit:
+    """One (m/n) periodic impact motion under ``sin(beta tau)``.
+
+    Attributes
+    ----------
+    m, n : int
+        Impacts per period and forcing cycles per period.
+    beta, delta, zeta, eps : float
+        The parameter point.
+    tau0 : float
+        Instant of an impact reduced modulo ``2 pi / beta``; of the m impacts, the one with the
+        smallest reduced phase.
+    intervals : ndarray, shape (m,)
+        Flight times ``z_1..z_m`` starting at ``tau0``; they sum to ``z = 2 pi n / beta``.
+    velocities : ndarray, shape (m,)
+        Approach velocities ``u_{j-0} > 0``; ``velocities[j]`` is at the impact that ends
+        ``intervals[j]`` (so the impact at ``tau0`` has ``velocities[-1]``).
+    multipliers : ndarray, complex, shape (2,)
+        Eigenvalues ``mu`` of the one-period Jacobian, largest modulus first (eq. 19).
+    jacobian : ndarray, shape (2, 2)
+        The one-period Jacobian ``T`` of ``(tau, u) -> (tau, u)`` at the impact ``tau0``.
+    lam : float
+        ``max|mu|^(1/m)`` (eq. 20: ``mu = lambda^m``).
+    S : float
+        Degree of stability ``100 (1 - lam)`` in percent (eq. 24).
+    stable : bool
+        ``lam < 1`` (eq. 22).
+    margin : float
+        ``delta - max x`` over the interior local maxima of every flight (``inf`` if none);
+        admissible orbits have ``margin >= 0`` (grazing is ``margin = 0``).
+    admissible : bool
+        No flight crosses the wall (eq. 13).
+    """
+
+    m: int
+    n: int
+    beta: float
+    delta: float
+    zeta: float
+    eps: float
+    tau0: float
+    intervals: np.ndarray
+    velocities: np.ndarray
+    multipliers: np.ndarray
+    jacobian: np.ndarray
+    lam: float
+    S: float
+    stable: bool
+    margin: float
+    admissible: bool
+
+    @property
+    def period(self) -> float:
+        """Period ``z = 2 pi n / beta`` of the motion."""
+        return 2.0 * math.pi * self.n / self.beta
+
+    @property
+    def impact_times(self) -> np.ndarray:
+        """Impact instants ``tau0, tau0 + z_1, ...`` over one period, shape (m,)."""
+        return self.tau0 + np.concatenate(([0.0], np.cumsum(self.intervals)[:-1]))
+
+    def state(self, tau):
+        """Displacement and velocity ``(x, v)`` of the motion at the instants ``tau`` (any real).
+
+        Just after an impact the velocity is the rebound ``-eps u``.
+        """
+        tau = np.asarray(tau, dtype=float)
+        z = self.period
+        starts = self.impact_times
+        rel = np.mod(tau - self.tau0, z)
+        j = np.searchsorted(np.cumsum(self.intervals), rel, side="right")
+        j = np.minimum(j, self.m - 1)
+        offset = rel - (starts[j] - self.tau0)
+        flight_start = tau - offset            # the impact that began the current flight
+        u_a = self.velocities[(j - 1) % self.m]
+        wd, q, phi = ok.harmonic_constants(self.beta, self.zeta)
+        x = np.empty_like(tau)
+        v = np.empty_like(tau)
+        for idx in np.ndindex(tau.shape):
+            xs, vs = ok.flight(flight_start[idx], u_a[idx], offset[idx], self.beta, self.delta,
+                               self.zeta, self.eps, wd, q, phi)[:2]
+            x[idx] = xs
+            v[idx] = vs
+        return x, v
+
+
+def _check_int(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
+        raise ValueError(f"{name} must be a positive integer, got {value!r}")
+    return int(value)
+
+
+def _check_real(name, value):
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _validate(m, n, beta, delta, zeta, eps):
+    m = _check_int("m", m)
+    n = _check_int("n", n)
+    if m > MAX_M:
+        raise NotImplementedError(f"m must be at most {MAX_M} (m = {m} is not supported)")
+    beta = _check_real("beta", beta)
+    if beta <= 0.0:
+        raise ValueError(f"beta must be > 0, got {beta!r}")
+    delta = _check_real("delta", delta)
+    zeta = _check_real("zeta", zeta)
+    if not 0.0 < zeta < 1.0:
+        raise ValueError(f"zeta must be in (0, 1), got {zeta!r}")
+    eps = _check_real("eps", eps)
+    if not 0.0 <= eps <= 1.0:
+        raise ValueError(f"eps must be in [0, 1], got {eps!r}")
+    return m, n, beta, delta, zeta, eps
+
+
+def _raw_solutions(m, n, beta, delta, zeta, eps):
+    """Rows ``(tau_0..tau_{m-1}, u_0..u_{m-1})`` of every solution of eqs. (10)-(11)."""
+    sols = np.empty((ok.MAX_SOLUTIONS, 2 * m))
+    seeds = np.empty((1, 2 * m))
+    step = ok.SCAN_STEP_M2 if m == 2 else ok.SCAN_STEP_M3
+    count = ok.solve_type(m, n, beta, delta, zeta, eps, seeds, 0, step, sols)
+    return sols[:count]
+
+
+def _make_orbit(y, m, n, beta, delta, zeta, eps):
+    """Canonical ``PeriodicOrbit`` from a raw solution row (any first impact, any period)."""
+    tf = 2.0 * math.pi / beta
+    z = n * tf
+    tau = np.asarray(y[:m], dtype=float)
+    u = np.asarray(y[m:], dtype=float)
+    phases = np.mod(tau, tf)
+    phases[phases >= tf] = 0.0
+    r = int(np.argmin(phases))
+    order = (np.arange(m) + r) % m
+    tau_c = tau[order] + np.where(order < r, z, 0.0)   # increasing instants from impact r
+    u_c = u[order]
+    tau0 = float(phases[r])
+    tau_c = tau_c - tau_c[0] + tau0
+    intervals = np.diff(np.append(tau_c, tau_c[0] + z))
+    y_c = np.concatenate((tau_c, u_c))
+    tmat = np.empty((2, 2))
+    ok.monodromy(y_c, m, z, beta, delta, zeta, eps, tmat)
+    mult = np.linalg.eigvals(tmat).astype(complex)
+    mult = mult[np.argsort(-np.abs(mult), kind="stable")]
+    lam = float(np.abs(mult[0]) ** (1.0 / m))
+    margin = float(ok.orbit_margin(y_c, m, z, beta, delta, zeta, eps, np.empty((64, 2))))
+    return PeriodicOrbit(
+        m=m, n=n, beta=beta, delta=delta, zeta=zeta, eps=eps, tau0=tau0,
+        intervals=intervals, velocities=np.roll(u_c, -1), multipliers=mult, jacobian=tmat,
+        lam=lam, S=100.0 * (1.0 - lam), stable=bool(lam < 1.0), margin=margin,
+        admissible=bool(margin >= -ok.ADMISSIBLE_TOL),
+    )
+
+
+def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False):
+    """Every (m/n) periodic impact motion at one parameter point (paper section 4).
+
+    Parameters
+    ----------
+    m, n : int
+        Impacts per period and forcing cycles per period (m <= 3).
+    beta : float
+        Forcing frequency ratio (> 0); the force is ``sin(beta tau)``.
+    delta : float
+        Wall position (play), any finite value.
+    zeta : float
+        Damping ratio in (0, 1).
+    eps : float
+        Restitution coefficient in [0, 1].
+    include_inadmissible : bool, optional
+        Also return solutions whose flights cross the wall (``admissible=False``).
+
+    Returns
+    -------
+    list of PeriodicOrbit
+        Sorted by ``tau0``; no duplicates, no shorter orbit traversed repeatedly.
+
+    Notes
+    -----
+    Eqs. (10)-(11) with positive intervals and velocities, filtered by eq. (13); stability by
+    eqs. (14)-(24). See the module docstring for the method and for eps = 0.
+    """
+    m, n, beta, delta, zeta, eps = _validate(m, n, beta, delta, zeta, eps)
+    orbits = [_make_orbit(y, m, n, beta, delta, zeta, eps)
+              for y in _raw_solutions(m, n, beta, delta, zeta, eps)]
+    if not include_inadmissible:
+        orbits = [o for o in orbits if o.admissible]
+    return sorted(orbits, key=lambda o: o.tau0)
+
+
+def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), zeta=0.05,
+              eps=0.5):
+    """Existence and stability of (m/n) motions over a ``(1/beta, delta)`` grid (Fig. 16).
+
+    Parameters
+    ----------
+    inv_beta : array_like, shape (nb,)
+        Values of ``1/beta`` (> 0).
+    delta : array_like, shape (nd,)
+        Values of the play ``delta``.
+    types : sequence of (m, n)
+        Motion types (m <= 3).
+    zeta, eps : float
+        Damping ratio and restitution coefficient.
+
+    Returns
+    -------
+    dict of ndarray
+        ``exists`` bool, ``n_solutions`` int (admissible), ``n_stable`` int, ``lam`` float
+        (smallest ``lam`` among admissible solutions, NaN if none), ``S`` float
+        (``100 (1 - lam)``), ``reason`` int8 (``REASON_CODES``), each of shape
+        (n_types, nb, nd); and the coordinates ``inv_beta``, ``delta``, ``types`` (n_types, 2).
+
+    Notes
+    -----
+    Each row of constant ``1/beta`` is one parallel task; along it the solutions of the previous
+    ``delta`` seed Newton (branch following) in addition to the global interval scan, so a
+    branch lost by the scan near a fold is still followed.
+    """
+    inv_beta = np.ascontiguousarray(inv_beta, dtype=float).ravel()
+    deltas = np.ascontiguousarray(delta, dtype=float).ravel()
+    if inv_beta.size == 0 or not np.all(np.isfinite(inv_beta)) or np.any(inv_beta <= 0):
+        raise ValueError("inv_beta must be a non-empty array of finite positive numbers")
+    if deltas.size == 0 or not np.all(np.isfinite(deltas)):
+        raise ValueError("delta must be a non-empty array of finite numbers")
+    tarr = []
+    for t in types:
+        if len(t) != 2:
+            raise ValueError(f"types must be (m, n) pairs, got {t!r}")
+        mm, nn, *_ = _validate(t[0], t[1], 1.0, 0.0, zeta, eps)
+        tarr.append((mm, nn))
+    _validate(1, 1, 1.0, 0.0, zeta, eps)
+    tarr = np.array(tarr, dtype=np.int64).reshape(-1, 2)
+    shape = (tarr.shape[0], inv_beta.size, deltas.size)
+    exists = np.zeros(shape, dtype=np.bool_)
+    n_sol = np.zeros(shape, dtype=np.int64)
+    n_stab = np.zeros(shape, dtype=np.int64)
+    lam = np.full(shape, np.nan)
+    reason = np.zeros(shape, dtype=np.int8)
+    ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), exists, n_sol, n_stab, lam,
+                  reason)
+    return {
+        "exists": exists, "n_solutions": n_sol, "n_stable": n_stab, "lam": lam,
+        "S": 100.0 * (1.0 - lam), "reason": reason,
+        "inv_beta": inv_beta, "delta": deltas, "types": tarr,
+    }

@@ -1,0 +1,369 @@
+"""Public entry point of the exact simulator: :func:`simulate` and :func:`simulate_chunks`.
+
+The numerics live in :mod:`vibroimpact.kernels`; this module validates the input, builds
+the kernel's parameter vector, streams the force record through the kernel in chunks
+(bounded memory on records of any length) and wraps the events in a
+:class:`SimulationResult`.
+"""
+from dataclasses import dataclass, field
+import math
+import numbers
+
+import numpy as np
+
+from vibroimpact import kernels
+
+_BUFFER = 2 * kernels.STEP_HEADROOM
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Events and counters of one simulation (or one chunk of it).
+
+    Attributes
+    ----------
+    impact_time : ndarray of float64, shape (n,)
+        Impact instants tau_j (dimensionless time), increasing.
+    impact_velocity : ndarray of float64, shape (n,)
+        Approach velocities u_{j-0} > 0 (paper eq. 6); the velocity after impact is
+        ``-eps * impact_velocity`` (eq. 7).
+    impact_step, impact_offset : ndarray, shape (n,)
+        ``impact_time = impact_step * dt + impact_offset`` with ``0 <= offset <= dt``: the
+        full-precision form, for intervals on long records.
+    stick_start, stick_end : ndarray of float64, shape (n_stick,)
+        Intervals during which the mass rests on the wall (after a chatter sequence, a
+        plastic impact, or a start at rest on the wall).
+    grid_time, a : ndarray of float64
+        ``a(tau) = delta - x(tau)`` (the paper's displacement from the wall) every
+        ``record_every`` samples; empty unless asked for.
+    n_steps, n_impacts, n_chatter : int
+        Force sample steps taken, impacts, chatter sequences closed at their accumulation point.
+    contact_time : float
+        Total time spent resting on the wall.
+    t_end, x_end, v_end : float
+        Final time and state; ``stuck_end`` tells whether the mass rests on the wall there.
+    params : dict
+        The physical inputs.
+    """
+
+    impact_time: np.ndarray
+    impact_velocity: np.ndarray
+    impact_step: np.ndarray
+    impact_offset: np.ndarray
+    stick_start: np.ndarray
+    stick_end: np.ndarray
+    grid_time: np.ndarray
+    a: np.ndarray
+    n_steps: int
+    n_impacts: int
+    n_chatter: int
+    contact_time: float
+    t_end: float
+    x_end: float
+    v_end: float
+    stuck_end: bool
+    params: dict = field(default_factory=dict)
+
+
+def _finite(name, value):
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
+        raise ValueError(f"{name} must be a finite real number, got {value!r}")
+    value = float(value)
+    if not math.isfinite(value):
+        raise ValueError(f"{name} must be a finite real number, got {value!r}")
+    return value
+
+
+def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
+                  chunk_size):
+    zeta = _finite("zeta", zeta)
+    if not 0.0 < zeta < 1.0:
+        raise ValueError(f"zeta must lie in the open interval (0, 1), got {zeta!r}")
+    eps = _finite("eps", eps)
+    if not 0.0 <= eps <= 1.0:
+        raise ValueError(f"eps must lie in [0, 1], got {eps!r}")
+    delta = _finite("delta", delta)
+    dt = _finite("dt", dt)
+    if dt <= 0.0:
+        raise ValueError(f"dt must be > 0, got {dt!r}")
+    amplitude = _finite("amplitude", amplitude)
+    beta = _finite("beta", beta)
+    if beta <= 0.0:
+        raise ValueError(f"beta must be > 0, got {beta!r}")
+    x0 = min(0.0, delta) if x0 is None else _finite("x0", x0)
+    if x0 > delta:
+        raise ValueError(f"x0 must satisfy x0 <= delta (the mass lives in x <= delta), got x0={x0!r} > delta={delta!r}")
+    v0 = _finite("v0", v0)
+    if noise is not None:
+        if getattr(noise, "ndim", 1) != 1 or len(noise) < 2:
+            raise ValueError("noise must be a 1-D array of at least 2 samples (or None)")
+    if t_end is None:
+        if noise is None:
+            raise ValueError("t_end is required when noise is None")
+        t_end = (len(noise) - 1) * dt
+    t_end = _finite("t_end", t_end)
+    if t_end <= 0.0:
+        raise ValueError(f"t_end must be > 0, got {t_end!r}")
+    if noise is not None and t_end > (len(noise) - 1) * dt * (1.0 + 1e-12):
+        raise ValueError(f"t_end must not exceed (len(noise) - 1) * dt = {(len(noise) - 1) * dt!r}, got {t_end!r}")
+    if isinstance(record_every, bool) or not isinstance(record_every, (numbers.Integral, np.integer)) or record_every < 0:
+        raise ValueError(f"record_every must be an integer >= 0, got {record_every!r}")
+    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (numbers.Integral, np.integer)) or chunk_size < 1:
+        raise ValueError(f"chunk_size must be an integer >= 1, got {chunk_size!r}")
+    return zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end
+
+
+def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
+    """The parameter vector ``P`` read by the kernels (see :mod:`vibroimpact.kernels`)."""
+    omega = math.sqrt(1.0 - zeta * zeta)
+    q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
+    phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
+    E = math.exp(-zeta * dt)
+    C, S = math.cos(omega * dt), math.sin(omega * dt)
+    bh_hi, bh_lo = kernels.two_prod(beta, dt)
+    return np.array([
+        zeta, omega, eps, delta, dt, amplitude, beta, amplitude * q, phi,
+        math.cos(phi), math.sin(phi), bh_hi, bh_lo,
+        E * (C + zeta * S / omega), E * S / omega, -E * S / omega, E * (C - zeta * S / omega),
+        1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt),
+    ])
+
+
+def _split_steps(t_end, dt):
+    ratio = t_end / dt
+    n_full = int(round(ratio))
+    if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
+        n_full = int(math.floor(ratio))
+    n_full = max(n_full, 0)
+    rem = t_end - n_full * dt
+    if rem <= 1e-12 * dt:
+        rem = 0.0
+    return n_full, rem
+
+
+class _Buffers:
+    def __init__(self, n_grid):
+        self.imp_step = np.empty(_BUFFER, np.int64)
+        self.imp_off = np.empty(_BUFFER)
+        self.imp_u = np.empty(_BUFFER)
+        self.stk_step = np.empty(_BUFFER, np.int64)
+        self.stk_off = np.empty(_BUFFER)
+        self.stk_kind = np.empty(_BUFFER)
+        self.cnt = np.zeros(3, np.int64)
+        self.ftot = np.zeros(1)
+        self.grid = np.empty(max(n_grid, 1))
+        self.grid_n = np.zeros(1, np.int64)
+
+    def drain(self, parts):
+        n, m = int(self.cnt[0]), int(self.cnt[1])
+        parts["imp_step"].append(self.imp_step[:n].copy())
+        parts["imp_off"].append(self.imp_off[:n].copy())
+        parts["imp_u"].append(self.imp_u[:n].copy())
+        parts["stk_step"].append(self.stk_step[:m].copy())
+        parts["stk_off"].append(self.stk_off[:m].copy())
+        parts["stk_kind"].append(self.stk_kind[:m].copy())
+        parts["n_chatter"] += int(self.cnt[2])
+        self.cnt[:] = 0
+
+
+def _raise_status(status, k, dt, r=None, k0=0):
+    if status == kernels.BAD_NOISE:
+        bad = k + 1 if np.isfinite(r[k - k0]) else k
+        raise ValueError(f"noise must be finite: noise[{bad}] = {float(r[bad - k0])!r}")
+    if status == kernels.TOO_MANY_EVENTS:
+        raise RuntimeError(f"more than {kernels.STEP_HEADROOM} events in the force step at tau = {k * dt!r}: "
+                           "an impact sequence that neither ends nor accumulates (eps very close to 1?)")
+
+
+def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None,
+                    v0=0.0, t_end=None, *, record_every=0, chunk_size=2**20):
+    """Simulate chunk by chunk; yield one :class:`SimulationResult` per chunk of samples.
+
+    Same arguments as :func:`simulate`. Each chunk carries the events of its stretch of
+    time; counters are per chunk; ``t_end, x_end, v_end, stuck_end`` are the chunk's last
+    state. Memory is bounded by the chunk size whatever the record's length.
+    """
+    zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end = _check_inputs(
+        zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size)
+    P = kernel_parameters(zeta, eps, delta, dt, amplitude, beta)
+    params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
+                  x0=x0, v0=v0)
+    Aq, phi = P[7], P[8]
+    state = np.array([x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE,
+                      -math.sin(phi), math.cos(phi)])
+    n_full, rem = _split_steps(t_end, dt)
+    stride = int(record_every)
+    zeros = None if noise is not None else np.zeros(min(chunk_size, n_full + 1) + 1)
+    stick_open = [None]  # start time of an unfinished sticking interval
+    k0 = 0
+    while True:
+        k1 = min(k0 + chunk_size, n_full)
+        if noise is None:
+            r = zeros[: k1 - k0 + 1]
+        else:
+            r = np.ascontiguousarray(noise[k0 : k1 + 1], dtype=np.float64)
+        final = k1 == n_full
+        n_grid = 0
+        if stride:
+            n_grid = (k1 - 1) // stride - (k0 - 1) // stride if k1 > k0 else 0
+            n_grid += 1 if final and n_full % stride == 0 else 0
+        buf = _Buffers(n_grid)
+        parts = dict(imp_step=[], imp_off=[], imp_u=[], stk_step=[], stk_off=[], stk_kind=[], n_chatter=0)
+        k = k0
+        while k < k1:
+            status, k = kernels.run_steps(r[k - k0 :], k, k1, state, P, buf.imp_step, buf.imp_off,
+                                          buf.imp_u, buf.stk_step, buf.stk_off, buf.stk_kind,
+                                          buf.cnt, buf.ftot, buf.grid, stride, buf.grid_n)
+            if status == kernels.BUFFER_FULL:
+                buf.drain(parts)
+            else:
+                _raise_status(status, k, dt, r, k0)
+        t_chunk = k1 * dt
+        x, v, mode = _state_at(state, P, k1)
+        if final and stride and n_full % stride == 0:
+            buf.grid[buf.grid_n[0]] = delta - x
+            buf.grid_n[0] += 1
+        if final and rem > 0.0:
+            if noise is None:
+                r_last = (0.0, 0.0)
+            else:
+                r_last = tuple(float(z) for z in noise[n_full : n_full + 2])
+                if not all(map(math.isfinite, r_last)):
+                    raise ValueError(f"noise must be finite near sample {n_full}")
+            b = (r_last[1] - r_last[0]) / dt
+            x, v, mode, status = kernels.slow_step(
+                n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
+                buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
+            _raise_status(status, n_full, dt)
+            t_chunk = t_end
+        buf.drain(parts)
+        yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final)
+        k0 = k1
+        if final:
+            return
+
+
+def _state_at(state, P, k):
+    """Displacement, velocity and mode at sample ``k`` from the kernel's state vector."""
+    delta, beta, Aq = P[3], P[6], P[7]
+    if int(state[2]) == kernels.STUCK:
+        return delta, 0.0, kernels.STUCK
+    if Aq == 0.0:
+        return state[0], state[1], kernels.FREE
+    psi = kernels.phase(k, 0.0, P[11], P[12], beta) - P[8]
+    return state[0] + Aq * math.sin(psi), state[1] + Aq * beta * math.cos(psi), kernels.FREE
+
+
+def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final):
+    cat = lambda key, dtype: np.concatenate(parts[key]) if parts[key] else np.empty(0, dtype)
+    imp_step = cat("imp_step", np.int64)
+    imp_off = cat("imp_off", np.float64)
+    stk_time = cat("stk_step", np.int64) * dt + cat("stk_off", np.float64)
+    stk_kind = cat("stk_kind", np.float64)
+    starts, ends = [], []
+    for t, kind in zip(stk_time, stk_kind):
+        if kind == 1.0:
+            stick_open[0] = t
+        elif stick_open[0] is not None:
+            starts.append(stick_open[0])
+            ends.append(t)
+            stick_open[0] = None
+    stuck = mode == kernels.STUCK
+    if final and stick_open[0] is not None:
+        starts.append(stick_open[0])   # still resting on the wall at the record's end
+        ends.append(t_chunk)
+        stick_open[0] = None
+    n = int(buf.grid_n[0])
+    grid_time = (np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt if stride else np.empty(0)
+    return SimulationResult(
+        impact_time=imp_step * dt + imp_off,
+        impact_velocity=cat("imp_u", np.float64),
+        impact_step=imp_step,
+        impact_offset=imp_off,
+        stick_start=np.asarray(starts, dtype=np.float64),
+        stick_end=np.asarray(ends, dtype=np.float64),
+        grid_time=grid_time,
+        a=buf.grid[:n].copy(),
+        n_steps=k1 - k0 + (1 if t_chunk > k1 * dt else 0),
+        n_impacts=len(imp_step),
+        n_chatter=parts["n_chatter"],
+        contact_time=float(buf.ftot[0]),
+        t_end=t_chunk,
+        x_end=float(x),
+        v_end=float(v),
+        stuck_end=bool(stuck),
+        params=params,
+    )
+
+
+def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None, v0=0.0,
+             t_end=None, *, record_every=0, chunk_size=2**20):
+    """Exact motion of the impact oscillator under a sampled random force plus a harmonic force.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio, ``0 < zeta < 1`` (paper eq. 2).
+    eps : float
+        Restitution coefficient, ``0 <= eps <= 1`` (eq. 7).
+    delta : float
+        Dimensionless play: the wall stands at ``x = delta``; negative values pre-load it.
+    noise : array_like of float, shape (N,), or None
+        ``noise[k]`` is the random force at ``tau = k * dt``; the force between samples is the
+        straight line between them. Any sliceable 1-D array (an ``np.memmap`` or a netCDF
+        variable works: it is read chunk by chunk). ``None``: no random force.
+    dt : float
+        Sample step of ``noise``; with ``noise=None`` the step of the internal grid and of
+        the recorded ``a(tau)``.
+    amplitude, beta : float
+        Harmonic force ``amplitude * sin(beta * tau)``, treated exactly; ``beta > 0``.
+    x0, v0 : float
+        State at ``tau = 0``. ``x0=None`` starts at rest in the static position
+        ``min(0, delta)``: pressed on the wall when the play is negative.
+    t_end : float, optional
+        Final time; default ``(len(noise) - 1) * dt``; required when ``noise`` is None.
+    record_every : int, keyword-only
+        Record ``a(tau) = delta - x(tau)`` every ``record_every`` samples (0: do not record).
+    chunk_size : int, keyword-only
+        Samples per chunk streamed through the kernel.
+
+    Returns
+    -------
+    SimulationResult
+
+    Raises
+    ------
+    ValueError
+        For non-finite or out-of-range input, naming the argument.
+
+    Notes
+    -----
+    Between samples and impacts the motion is the closed-form solution (MODEL.md; the
+    paper's eqs. 3-6); each impact is the smallest root of ``x - delta`` in its step, found
+    by a rigorous exclusion bound and refined to round-off, so grazing double crossings
+    inside a step are caught. A chatter sequence is followed impact by impact until its
+    remaining geometric tail is summed in closed form to within ``CHATTER_TIME_TOL``
+    (see :mod:`vibroimpact.kernels`); the mass then sticks until ``f(tau) - delta`` turns
+    negative (the release instant is an exact root).
+    """
+    chunks = list(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
+                                  beta=beta, x0=x0, v0=v0, t_end=t_end,
+                                  record_every=record_every, chunk_size=chunk_size))
+    return concatenate_results(chunks)
+
+
+def concatenate_results(chunks):
+    """Join consecutive chunk results into one :class:`SimulationResult`."""
+    last = chunks[-1]
+    cat = lambda name: np.concatenate([getattr(c, name) for c in chunks])
+    return SimulationResult(
+        impact_time=cat("impact_time"), impact_velocity=cat("impact_velocity"),
+        impact_step=cat("impact_step"), impact_offset=cat("impact_offset"),
+        stick_start=cat("stick_start"), stick_end=cat("stick_end"),
+        grid_time=cat("grid_time"), a=cat("a"),
+        n_steps=sum(c.n_steps for c in chunks), n_impacts=sum(c.n_impacts for c in chunks),
+        n_chatter=sum(c.n_chatter for c in chunks),
+        contact_time=float(sum(c.contact_time for c in chunks)),
+        t_end=last.t_end, x_end=last.x_end, v_end=last.v_end, stuck_end=last.stuck_end,
+        params=last.params,
+    )

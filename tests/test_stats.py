@@ -1,0 +1,300 @@
+"""Tests of vibroimpact.stats: spectra, densities, batch means, impact-motion types, oracles.
+
+Every assertion states its tolerance; random inputs come from fixed seeds, so the outcomes
+are deterministic, and each statistical tolerance is several standard errors wide.
+"""
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+from scipy import integrate, linalg, signal
+from scipy import stats as sps
+
+from vibroimpact.stats import (
+    WelchAccumulator, batch_means, classify_impact_intervals, density, elastic_impact_rate,
+    impact_intervals, impact_motion_probabilities, interval_ratio, linear_psd_response,
+    linear_response_std, rayleigh_pdf, truncated_gaussian_pdf, variance_from_psd,
+    velocity_after_impact, welch_psd,
+)
+
+
+def _ar1(rng, phi, n, reps=None, sigma_e=1.0):
+    """AR(1) x_k = phi x_{k-1} + e_k started in its stationary distribution."""
+    shape = (n,) if reps is None else (reps, n)
+    e = sigma_e * rng.standard_normal(shape)
+    e[..., 0] /= np.sqrt(1.0 - phi**2)
+    return signal.lfilter([1.0], [1.0, -phi], e, axis=-1)
+
+
+# --------------------------------------------------------------------------------- spectra
+
+@settings(max_examples=25, deadline=None)
+@given(cuts=st.lists(st.integers(0, 20_000), max_size=12),
+       nperseg=st.sampled_from([64, 127, 256]),
+       detrend=st.sampled_from(["constant", "linear", False]))
+def test_streaming_welch_equals_scipy_on_concatenation(cuts, nperseg, detrend):
+    # Tolerance: 1e-12 relative to the largest bin (round-off only; chunking must not matter).
+    x = 1.5 + _ar1(np.random.default_rng(0), 0.8, 20_000)
+    acc = WelchAccumulator(0.3, nperseg, detrend=detrend)
+    for chunk in np.split(x, sorted(cuts)):
+        acc.feed(chunk)
+    f, P = acc.onesided_density()
+    f_ref, P_ref = signal.welch(x, fs=1 / 0.3, nperseg=nperseg, detrend=detrend)
+    np.testing.assert_allclose(f, f_ref, rtol=1e-14)
+    np.testing.assert_allclose(P, P_ref, rtol=1e-12, atol=1e-12 * P_ref.max())
+    assert acc.n_segments == (x.size - nperseg) // (nperseg - nperseg // 2) + 1
+    assert acc.n_samples == x.size
+
+
+def test_welch_rejects_bad_input_and_empty_result():
+    with pytest.raises(ValueError, match="dt"):
+        WelchAccumulator(0.0, 64)
+    with pytest.raises(ValueError, match="nperseg"):
+        WelchAccumulator(0.1, 1)
+    with pytest.raises(ValueError, match="detrend"):
+        WelchAccumulator(0.1, 64, detrend="quadratic")
+    acc = WelchAccumulator(0.1, 64).feed(np.zeros(63))
+    with pytest.raises(ValueError, match="no complete segment"):
+        acc.result()
+    with pytest.raises(ValueError, match="NaN"):
+        acc.feed([0.0, np.nan])
+
+
+def test_white_noise_level_and_variance_in_paper_convention():
+    # White sequence of variance s2 at spacing dt has S(beta) = s2 * dt (eq. 9, two-sided angular)
+    # and (1/pi) int_0^{pi/dt} S dbeta = s2. Tolerance 1 %: statistical error of the mean level
+    # over ~500 bins x ~1900 segments is ~0.1 %; per-segment mean removal costs 2/(3 nperseg).
+    rng = np.random.default_rng(1)
+    s2, dt = 2.25, 0.2
+    x = np.sqrt(s2) * rng.standard_normal(500_000)
+    beta, S, n_eff = welch_psd(x, dt, 1024)
+    assert beta[-1] == pytest.approx(np.pi / dt, rel=1e-14)
+    assert np.mean(S[1:-1]) == pytest.approx(s2 * dt, rel=0.01)
+    assert variance_from_psd(beta, S) == pytest.approx(s2, rel=0.01)
+    # One-sided per-Hz density is twice S inside the band (module docstring).
+    f, P = WelchAccumulator(dt, 1024).feed(x).onesided_density()
+    np.testing.assert_allclose(P[1:-1], 2 * S[1:-1], rtol=1e-14)
+    np.testing.assert_allclose(f, beta / (2 * np.pi), rtol=1e-14)
+
+
+def test_sinusoid_variance_and_peak_location():
+    # A sin(beta0 tau): variance A^2/2 recovered to < 1 %, peak within one bin of beta0.
+    A, beta0, dt = 1.7, 1.1, 0.1
+    tau = dt * np.arange(400_000)
+    beta, S, _ = welch_psd(A * np.sin(beta0 * tau), dt, 4096)
+    assert variance_from_psd(beta, S) == pytest.approx(A**2 / 2, rel=0.01)
+    assert abs(beta[np.argmax(S)] - beta0) <= beta[1]
+
+
+def test_ar1_spectrum_shape_and_scatter_match_theory():
+    # AR(1) with innovation variance 1 at spacing dt: S(beta) = dt / |1 - phi e^{-j beta dt}|^2.
+    # Mean ratio estimate/theory within 2 %; the bin-to-bin scatter of that ratio within 15 % of
+    # 1/sqrt(K_eff) (chi-square with 2 K_eff dof); both would fail with a wrong factor or K_eff.
+    phi, dt = 0.7, 0.5
+    x = _ar1(np.random.default_rng(2), phi, 300_000)
+    acc = WelchAccumulator(dt, 512).feed(x)
+    beta, S = acc.result()
+    theory = dt / np.abs(1 - phi * np.exp(-1j * beta * dt)) ** 2
+    ratio = S[1:-1] / theory[1:-1]
+    assert np.mean(ratio) == pytest.approx(1.0, abs=0.02)
+    assert np.std(ratio) == pytest.approx(1 / np.sqrt(acc.n_effective), rel=0.15)
+    assert acc.n_segments / 1.1 < acc.n_effective < acc.n_segments
+
+
+def test_linear_response_variance_equals_closed_form_for_white_force():
+    # (1/pi) int_0^inf |H|^2 S0 dbeta = S0 / (4 zeta): fine grid to beta = 200 plus the
+    # analytic tail S0/(3 pi B^3) of |H|^2 ~ beta^-4; tolerance 1e-4 relative.
+    S0, zeta = 0.8, 0.05
+    beta = np.linspace(0.0, 200.0, 2_000_001)
+    var = variance_from_psd(beta, linear_psd_response(beta, S0, zeta)) + S0 / (3 * np.pi * 200**3)
+    assert var == pytest.approx(S0 / (4 * zeta), rel=1e-4)
+
+
+def test_linear_response_std_matches_lyapunov_and_quadrature():
+    # Time-domain check of sigma_x^2 = sigma_v^2 = S0/(4 zeta): the stationary covariance of
+    # x'' + 2 zeta x' + x = w with E[w(t) w(t')] = S0 delta(t - t') solves A P + P A^T + Q = 0.
+    # Tolerances: 1e-10 (closed form vs Lyapunov), 1e-7 (quad vs closed form).
+    S0, zeta = 1.3, 0.05
+    A = np.array([[0.0, 1.0], [-1.0, -2 * zeta]])
+    P = linalg.solve_continuous_lyapunov(A, -np.array([[0.0, 0.0], [0.0, S0]]))
+    sx, sv = linear_response_std(S0, zeta)
+    assert sx**2 == pytest.approx(P[0, 0], rel=1e-10)
+    assert sv**2 == pytest.approx(P[1, 1], rel=1e-10)
+    qx, qv = linear_response_std(lambda b: S0, zeta)
+    assert (qx, qv) == (pytest.approx(sx, rel=1e-7), pytest.approx(sv, rel=1e-7))
+    # Coloured force: Lorentzian S_f = 2 c s2 / (c^2 + beta^2) is the OU force of variance s2,
+    # x'' + 2 zeta x' + x = y, y' = -c y + sqrt(2 c s2) w; augmented Lyapunov equation, 1e-7.
+    c, s2 = 0.7, 0.4
+    A3 = np.array([[0.0, 1.0, 0.0], [-1.0, -2 * zeta, 1.0], [0.0, 0.0, -c]])
+    Q3 = np.zeros((3, 3))
+    Q3[2, 2] = 2 * c * s2
+    P3 = linalg.solve_continuous_lyapunov(A3, -Q3)
+    qx, qv = linear_response_std(lambda b: 2 * c * s2 / (c**2 + b**2), zeta)
+    assert qx**2 == pytest.approx(P3[0, 0], rel=1e-7)
+    assert qv**2 == pytest.approx(P3[1, 1], rel=1e-7)
+
+
+# ------------------------------------------------------------------ densities and intervals
+
+def test_density_normalised_and_binomial_error_matches_replicate_spread():
+    # Integral of the density = 1 to 1e-12; the quoted stderr equals the spread of the density
+    # over 1000 independent replicates within 10 % (bins with >= 50 expected counts; the spread
+    # itself is known to ~2.2 %, so 10 % is > 4 of its standard errors).
+    rng = np.random.default_rng(3)
+    bins = np.linspace(-3, 3, 25)
+    reps = [density(rng.standard_normal(2000), bins) for _ in range(1000)]
+    d0 = reps[0]
+    assert np.sum(d0.density * np.diff(bins)) == pytest.approx(1.0, abs=1e-12)
+    spread = np.std([r.density for r in reps], axis=0, ddof=1)
+    quoted = np.mean([r.stderr for r in reps], axis=0)
+    well_filled = np.mean([r.density for r in reps], axis=0) * np.diff(bins) * 2000 > 50
+    np.testing.assert_allclose(quoted[well_filled], spread[well_filled], rtol=0.10)
+    empty = density([], bins)
+    assert empty.n == 0 and np.all(np.isnan(empty.density))
+
+
+def test_impact_intervals_exact_on_long_records():
+    # Intervals from (step, offset) are exact to round-off of the offsets (1e-15 absolute) even
+    # at tau ~ 1e9, where differences of impact_time would lose ~1e-7.
+    dt = 0.1
+    step = np.array([10**10, 10**10 + 3, 10**10 + 3, 10**10 + 17], dtype=np.int64)
+    offset = np.array([0.01, 0.0625, 0.07, 0.1])
+    expected = np.array([3 * dt + 0.0525, 0.0075, 14 * dt + 0.03])
+    np.testing.assert_allclose(impact_intervals(step, offset, dt), expected, rtol=0, atol=1e-15)
+    assert impact_intervals(step[:1], offset[:1], dt).size == 0
+    with pytest.raises(ValueError, match="step and offset"):
+        impact_intervals(step, offset[:2], dt)
+    np.testing.assert_allclose(velocity_after_impact([2.0, 0.5], 0.5), [1.0, 0.25], rtol=1e-15)
+    with pytest.raises(ValueError, match="eps"):
+        velocity_after_impact([1.0], 1.5)
+
+
+# -------------------------------------------------------------------------------- batch means
+
+def test_batch_means_interval_covers_truth_at_nominal_rate():
+    # AR(1), phi = 0.9, mean 3: 400 replications of 20 000 values. The 95 % batch-means
+    # t-interval must cover the true mean in 92-98 % of them (binomial sd 1.1 %); the naive
+    # iid interval, for contrast, covers far less (< 60 %), so this test can tell them apart.
+    rng = np.random.default_rng(4)
+    mu, phi, n, reps = 3.0, 0.9, 20_000, 400
+    x = mu + _ar1(rng, phi, n, reps)
+    results = [batch_means(row, n_batches=20) for row in x]
+    lo, hi = np.array([r.interval(0.95) for r in results]).T
+    coverage = np.mean((lo < mu) & (mu < hi))
+    assert 0.92 <= coverage <= 0.98
+    naive = np.abs(x.mean(axis=1) - mu) < 1.96 * x.std(axis=1) / np.sqrt(n)
+    assert np.mean(naive) < 0.6
+    # Stderr matches the exact std of the mean, sqrt(var/n (1 + phi)/(1 - phi)), within 10 %.
+    exact = np.sqrt(1 / (1 - phi**2) / n * (1 + phi) / (1 - phi))
+    assert np.mean([r.stderr for r in results]) == pytest.approx(exact, rel=0.10)
+    assert abs(np.mean([r.lag1 for r in results])) < 0.1
+    assert all(r.n_batches == 20 for r in results)
+
+
+def test_batch_means_short_and_invalid():
+    short = batch_means(np.arange(5.0), n_batches=20)
+    assert short.mean == 2.0 and np.isnan(short.stderr) and short.n_batches == 0
+    assert np.isnan(batch_means([]).mean)
+    # Leading remainder is dropped: 41 values in 20 batches of 2 use x[1:].
+    assert batch_means(np.r_[1000.0, np.ones(40)]).mean == 1.0
+    with pytest.raises(ValueError, match="n_batches"):
+        batch_means(np.ones(100), n_batches=1)
+
+
+# --------------------------------------------------------------------- impact-motion types
+
+BETA = 1.1
+Z = 2 * np.pi / BETA
+
+
+def _probs(r, **kw):
+    return impact_motion_probabilities(np.asarray(r) * Z, BETA, **kw)
+
+
+def test_pure_motions_are_fully_classified():
+    # Exact fractions (1e-12): pure sequences of each type cover all the recorded time.
+    rng = np.random.default_rng(5)
+    p = _probs(1 + rng.uniform(-0.09, 0.09, 200))
+    assert p == {"1/1": pytest.approx(1.0, abs=1e-12), "2/1": 0.0, "1/2": 0.0}
+    p = _probs(np.tile([0.3, 0.7], 100))
+    assert p == {"1/1": 0.0, "2/1": pytest.approx(1.0, abs=1e-12), "1/2": 0.0}
+    p = _probs(2 + rng.uniform(-0.09, 0.09, 50))
+    assert p == {"1/1": 0.0, "2/1": 0.0, "1/2": pytest.approx(1.0, abs=1e-12)}
+
+
+def test_mixture_fractions_and_total_time():
+    # 10 x (1/1) = 10 z, 5 (2/1) pairs = 5 z, 3 x (1/2) = 6 z, two unclassified 1.5 z = 3 z.
+    r = np.r_[np.ones(10), np.tile([0.4, 0.6], 5), 1.5, 2.0, 2.0, 1.5, 2.0]
+    p = _probs(r)
+    expected = {"1/1": 10 / 24, "2/1": 5 / 24, "1/2": 6 / 24}
+    assert p == {k: pytest.approx(v, abs=1e-12) for k, v in expected.items()}
+    p = _probs(r, total_time=48 * Z)  # a record twice as long as the impacts span
+    assert p == {k: pytest.approx(v / 2, abs=1e-12) for k, v in expected.items()}
+    with pytest.raises(ValueError, match="total_time"):
+        _probs(r, total_time=10 * Z)
+    assert _probs([]) == {"1/1": 0.0, "2/1": 0.0, "1/2": 0.0}
+
+
+def test_overlapping_pairs_are_taken_greedily_and_counted_once():
+    # Three intervals of z/2: two candidate (2/1) pairs overlap; the first is taken.
+    assert list(classify_impact_intervals([0.5, 0.5, 0.5])) == [1, 1, -1]
+    assert _probs([0.5] * 7)["2/1"] == pytest.approx(6 / 7, abs=1e-12)
+    # A chatter-like short interval before a (2/1) record shifts the pairing, not the coverage.
+    assert list(classify_impact_intervals([0.05, 0.3, 0.7, 0.3, 0.7])) == [-1, 1, 1, 1, 1]
+    # Window edges are strict: |r - 1| = w is not (1/1); a pair needs both below 1 - w.
+    assert list(classify_impact_intervals([0.85, 0.9 + 1e-9, 1.9 + 1e-9])) == [-1, 0, 2]
+    assert list(classify_impact_intervals([0.95, 0.05])) == [0, -1]
+    with pytest.raises(ValueError, match="window"):
+        classify_impact_intervals([1.0], window=0.7)
+
+
+def test_generic_motion_three_over_one():
+    labels = classify_impact_intervals(np.tile([0.3, 0.3, 0.4], 4), motions=[(3, 1), (1, 1)])
+    assert list(labels) == [0] * 12
+    p = _probs(np.r_[np.tile([0.3, 0.3, 0.4], 4), np.ones(4)], motions=[(3, 1), (1, 1)])
+    assert p == {"3/1": pytest.approx(0.5, abs=1e-12), "1/1": pytest.approx(0.5, abs=1e-12)}
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.lists(st.floats(0.01, 3.0), max_size=60))
+def test_probabilities_are_fractions_summing_to_at_most_one(r):
+    p = _probs(r)
+    assert all(0.0 <= v <= 1.0 for v in p.values())
+    assert sum(p.values()) <= 1.0 + 1e-12
+    np.testing.assert_allclose(interval_ratio(np.asarray(r) * Z, BETA), r, rtol=1e-14)
+
+
+# ------------------------------------------------------------- exact elastic-impact oracles
+
+@pytest.mark.parametrize("delta", [-3.0, -0.5, 0.0, 1.2, 4.0])
+def test_truncated_gaussian_normalised(delta):
+    # Integral over x <= delta equals 1 to 1e-8; zero beyond the wall.
+    sx = 1.7
+    total = integrate.quad(truncated_gaussian_pdf, -np.inf, delta, args=(sx, delta))[0]
+    assert total == pytest.approx(1.0, abs=1e-8)
+    assert truncated_gaussian_pdf(delta + 1e-9, sx, delta) == 0.0
+
+
+def test_rayleigh_normalised_with_known_mean():
+    # Integral 1 and mean sigma_v sqrt(pi/2), both to 1e-8.
+    sv = 0.6
+    assert integrate.quad(rayleigh_pdf, 0, np.inf, args=(sv,))[0] == pytest.approx(1.0, abs=1e-8)
+    mean = integrate.quad(lambda u: u * rayleigh_pdf(u, sv), 0, np.inf)[0]
+    assert mean == pytest.approx(sv * np.sqrt(np.pi / 2), rel=1e-8)
+    assert rayleigh_pdf(-0.1, sv) == 0.0
+
+
+def test_impact_rate_is_flux_into_wall_and_tends_to_rice():
+    # nu(delta) = int_0^inf v p_x(delta) p_v(v) dv with p_x the truncated Gaussian (1e-8);
+    # for delta = 4 sigma_x it equals Rice's up-crossing rate within 1e-4 (1/Phi(4) - 1 = 3e-5);
+    # it vanishes as delta -> +inf and stays finite and growing as delta -> -inf.
+    sx, sv = 1.3, 0.9
+    for delta in (-2.0, 0.0, 1.0, 4 * sx):
+        p_x = sps.norm.pdf(delta, scale=sx) / sps.norm.cdf(delta / sx)
+        flux = p_x * integrate.quad(lambda v: v * sps.norm.pdf(v, scale=sv), 0, np.inf)[0]
+        assert elastic_impact_rate(delta, sx, sv) == pytest.approx(flux, rel=1e-8)
+    rice = sv / sx / (2 * np.pi) * np.exp(-0.5 * 16)
+    assert elastic_impact_rate(4 * sx, sx, sv) == pytest.approx(rice, rel=1e-4)
+    rates = elastic_impact_rate(np.array([10.0, 20.0, 40.0]) * sx, sx, sv)
+    assert rates[0] < 1e-20 and rates[2] == 0.0 and np.all(np.diff(rates) <= 0)
+    far = elastic_impact_rate(np.array([-5.0, -50.0]) * sx, sx, sv)
+    assert np.all(np.isfinite(far)) and far[1] > far[0] > 0
