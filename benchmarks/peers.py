@@ -67,15 +67,15 @@ def _make_rhs(zeta, t_a, r0, b):
     return rhs
 
 
-def _make_wall_event(delta, t_start):
-    """Terminal event x - delta = 0 crossed upwards.
+def _make_wall_event(delta, t_quiet):
+    """Terminal event x - delta = 0 crossed upwards, ignored up to time t_quiet.
 
     The integration restarts on the wall after every impact (g = 0 there); scipy would report
-    that starting point as a root as soon as a first step jumps over a short flight, so the
-    start is given g = -1: the only sign change is then the real arrival at the wall."""
+    that starting point as a root as soon as a first step jumps over a short flight, so g is
+    -1 until t_quiet (at least the start): the only sign change left is a real arrival."""
 
     def wall(t, y):
-        return y[0] - delta if t > t_start else -1.0
+        return y[0] - delta if t > t_quiet else -1.0
 
     wall.terminal = True
     wall.direction = 1.0
@@ -93,7 +93,7 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
     noise : ndarray of float64, shape (n,)
         r[k] = r(k dt); r is linear in between.
     dt : float
-        Sample step.
+        Sample step, < pi.
     method : {"RK45", "DOP853", "LSODA", ...}
         Passed to `solve_ivp`.
     rtol, atol : float
@@ -103,8 +103,9 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
     t_end : float, optional
         End time; default (n - 1) dt.
     v_stick : float
-        A rebound slower than this, with r - delta > 0 pushing the mass onto the wall, ends the
-        chatter sequence: the mass sticks until r - delta turns negative (an exact linear root).
+        A rebound slower than this leaves the mass at rest on the wall (the end of a chatter
+        sequence): it sticks while r - delta > 0 and leaves where r - delta turns negative (an
+        exact linear root).
 
     Returns
     -------
@@ -115,14 +116,22 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
     -----
     One `solve_ivp` call per sample interval (or per flight within it): a step across a kink of
     r would lose the method's order there. The impact map is eq. 7 of the paper.
+
+    A mass leaving the wall from rest cannot come back while r < delta: y = delta - x obeys
+    y'' + 2 zeta y' + y = delta - r > 0 from y = y' = 0, and the impulse response is positive
+    for a half period pi / omega_d > dt. Wall events are therefore ignored until r returns to
+    delta or the sample ends; otherwise a loose solver drifting across the wall right after a
+    release would register endless spurious contacts.
     """
     noise = _check_problem(zeta, eps, delta, noise, dt)
+    if dt >= math.pi:
+        raise ValueError(f"dt must be < pi for the release rule, got {dt!r}")
     n, t_end = _n_intervals(noise, dt, t_end)
     atol = rtol if atol is None else atol
     x = min(0.0, delta) if x0 is None else float(x0)
     v = float(v0)
-    stuck = x == delta and v == 0.0 and (noise[0] - delta > 0.0
-                                          or (noise[0] == delta and noise[1] > noise[0]))
+    resting = x == delta and v == 0.0
+    stuck = False
     times, velocities = [], []
     for k in range(n):
         t_a = k * dt
@@ -131,16 +140,25 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
         b = (noise[k + 1] - r0) / dt
         rhs = _make_rhs(zeta, t_a, r0, b)
         t = t_a
+        t_quiet = t_a
         while t < t_b:
+            if resting:
+                push = r0 + b * (t - t_a) - delta
+                resting = False
+                stuck = push > 0.0 or (push == 0.0 and b > 0.0)
+                if not stuck:  # leaves at once; quiet until r comes back to delta
+                    t_quiet = t_b if b <= 0.0 else min(t_b, t_a + (delta - r0) / b)
             if stuck:
                 if r0 + b * (t_b - t_a) - delta >= 0.0:
                     break
                 t = max(t, t_a + (delta - r0) / b)
                 stuck = False
                 x, v = delta, 0.0
+                t_quiet = t_b
                 continue
             sol = scipy.integrate.solve_ivp(rhs, (t, t_b), [x, v], method=method, rtol=rtol,
-                                            atol=atol, events=_make_wall_event(delta, t))
+                                            atol=atol,
+                                            events=_make_wall_event(delta, max(t, t_quiet)))
             if sol.status != 1:
                 if sol.status != 0:
                     raise RuntimeError(f"solve_ivp failed at tau={t}: {sol.message}")
@@ -152,9 +170,9 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
             velocities.append(u)
             x = delta
             v = -eps * u
-            if -v < v_stick and r0 + b * (t - t_a) - delta > 0.0:
-                stuck = True
+            if -v < v_stick:
                 v = 0.0
+                resting = True
     return np.array(times), np.array(velocities)
 
 

@@ -28,7 +28,8 @@ import math
 
 from mpmath import mp, mpf
 
-__all__ = ["reference_impacts", "linear_peak", "agreeing_prefix", "filtered_impacts"]
+__all__ = ["reference_impacts", "linear_peak", "agreeing_prefix", "comparable_impacts",
+           "chatter_tail_mask"]
 
 # Rebound velocity below which a chatter sequence is summed in closed form (flight times are
 # geometric with ratio eps to O(velocity), so the neglected error is O(velocity^2) ~ 1e-24).
@@ -265,6 +266,25 @@ def _safe_start(fl: _Flight, after_release: bool):
     return max(cands) / 2
 
 
+def _release_time(rel: _Release, L):
+    """First s in [0, L] at which a mass stuck on the wall leaves (f - delta turns negative),
+    None if it stays. Consistent with _classify_rest: at f = delta (to round-off) it leaves
+    only if f is decreasing."""
+    G0, G1, G2 = rel.eval(mpf(0))
+    scale = 1 + abs(rel.P.delta) + abs(rel.r0) + abs(rel.P.A)
+    if abs(G0) <= 64 * mp.eps * scale:
+        if G1 > 0 or (G1 == 0 and G2 > 0):
+            return mpf(0)
+        # G <= G1 s + G2 s^2/2 + M3 s^3/6 < 0 just after 0: start the search there
+        start = -G1 / rel.M[2] if G1 < 0 else (-G2 / rel.M[3] if G2 < 0 else None)
+        if start is None or start >= L:
+            return None
+        return _smallest_root(rel.eval, rel.M, start, L)
+    if G0 > 0:
+        return mpf(0)
+    return _smallest_root(rel.eval, rel.M, mpf(0), L)
+
+
 def _classify_rest(fl: _Flight):
     """Mass on the wall at rest: True if the force holds it there (stick), False if it leaves."""
     f = fl.force(mpf(0)) - fl.P.delta
@@ -276,7 +296,7 @@ def _classify_rest(fl: _Flight):
 
 def reference_impacts(zeta, eps, delta, noise, dt, amplitude=0.0, beta=1.0, x0=None, v0=0.0,
                       t_end=None, max_impacts=None, dps=34, record=False,
-                      chatter_velocity=CHATTER_VELOCITY):
+                      chatter_velocity=CHATTER_VELOCITY, prec=None):
     """Simulate the vibro-impact oscillator in multiprecision arithmetic.
 
     Parameters
@@ -296,7 +316,9 @@ def reference_impacts(zeta, eps, delta, noise, dt, amplitude=0.0, beta=1.0, x0=N
     max_impacts : int, optional
         Stop after this many impacts.
     dps : int
-        Decimal digits of working precision (16 imitates float64 round-off).
+        Decimal digits of working precision (16 is close to float64: 56 bits).
+    prec : int, optional
+        Working precision in bits, overriding ``dps`` (53 imitates float64 exactly).
     record : bool
         Also return x at every sample time.
     chatter_velocity : float
@@ -308,11 +330,12 @@ def reference_impacts(zeta, eps, delta, noise, dt, amplitude=0.0, beta=1.0, x0=N
         ``time``, ``velocity`` (approach velocities u_{j-0} > 0), ``acceleration`` (x'' just
         before each impact) as lists of mpf;
         ``stick_start``, ``stick_end`` (lists of mpf); ``sticking_reached`` (bool, a chatter
-        sequence was summed); ``chatter_end`` (accumulation times); with ``record``,
+        sequence was summed); ``chatter_end`` (accumulation times); ``truncated`` (stopped
+        by ``max_impacts``, possibly inside a chatter sequence); with ``record``,
         ``grid_time``, ``x`` and ``v`` at every sample; ``t_end``, ``x_end``, ``v_end``,
         ``stuck_end``.
     """
-    with mp.workdps(dps):
+    with (mp.workprec(prec) if prec is not None else mp.workdps(dps)):
         return _run(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, max_impacts,
                     record, mpf(chatter_velocity))
 
@@ -379,10 +402,7 @@ def _run(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, max_impact
             r0 = r_at(k) + b * (t - tk)
             if stuck:
                 rel = _Release(P, t, r0, b)
-                G0 = rel.eval(mpf(0))[0]
-                s = None if G0 >= 0 else _smallest_root(rel.eval, rel.M, mpf(0), tk1 - t)
-                if G0 >= 0:
-                    s = mpf(0)
+                s = _release_time(rel, tk1 - t)
                 if s is None:
                     t = tk1
                     break
@@ -443,40 +463,60 @@ def _run(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, max_impact
         grid_t.append(T)
         grid_x.append(x)
         grid_v.append(v)
-    out.update(t_end=t, x_end=x, v_end=v, stuck_end=stuck)
+    out.update(t_end=t, x_end=x, v_end=v, stuck_end=stuck, truncated=done)
     if record:
         out.update(grid_time=grid_t, x=grid_x, v=grid_v)
     return out
 
 
-def agreeing_prefix(ref_a, ref_b, tol=1e-9, min_velocity=1e-6):
-    """Number of leading impacts (velocity >= min_velocity) on which two references agree.
+def chatter_tail_mask(time, velocity, stick_start, stick_end, u_tail=1e-4, open_end=False):
+    """Boolean mask of the impacts that close a chatter sequence.
 
-    Agreement: |time difference| <= tol and |relative velocity difference| <= tol.
+    Walking back from each sticking start (and from the end of the record if ``open_end``,
+    i.e. a run cut inside a chatter sequence), the impacts whose speeds grow backwards
+    (geometric chatter) while staying below ``u_tail`` are tail impacts. Simulators close a
+    chatter sequence in closed form below thresholds of their own, so these impacts are not
+    comparable one by one; the sequence's accumulation point (the sticking start) is.
     """
-    ta, ua = _filtered(ref_a, min_velocity)
-    tb, ub = _filtered(ref_b, min_velocity)
+    time = [float(t) for t in time]
+    velocity = [float(u) for u in velocity]
+    starts = [float(s) for s in stick_start] + ([math.inf] if open_end else [])
+    ends = [float(e) for e in stick_end]
+    tail = [False] * len(time)
+    j_max = -1
+    for i, s in enumerate(starts):
+        floor = ends[i - 1] if 0 < i <= len(ends) else -math.inf
+        while j_max + 1 < len(time) and time[j_max + 1] <= s:
+            j_max += 1
+        j = j_max
+        while j >= 0 and time[j] >= floor and velocity[j] < u_tail and (
+                j == j_max or velocity[j] > velocity[j + 1]):
+            tail[j] = True
+            j -= 1
+    return tail
+
+
+def comparable_impacts(ref, u_tail=1e-4):
+    """(times, velocities, accelerations) of a reference run as float lists, chatter-tail
+    impacts (see chatter_tail_mask) removed."""
+    tail = chatter_tail_mask(ref["time"], ref["velocity"], ref["stick_start"],
+                             ref["stick_end"], u_tail, open_end=ref["truncated"])
+    rows = [(float(t), float(u), float(a)) for t, u, a, drop in
+            zip(ref["time"], ref["velocity"], ref["acceleration"], tail) if not drop]
+    return tuple([row[i] for row in rows] for i in range(3))
+
+
+def agreeing_prefix(ref_a, ref_b, tol=1e-9, u_tail=1e-4):
+    """Number of leading comparable impacts on which two reference runs agree:
+    |time difference| <= tol and |relative velocity difference| <= tol."""
+    ta, ua, _ = comparable_impacts(ref_a, u_tail)
+    tb, ub, _ = comparable_impacts(ref_b, u_tail)
     n = 0
     for t1, u1, t2, u2 in zip(ta, ua, tb, ub):
         if abs(t1 - t2) > tol or abs(u1 - u2) > tol * abs(u2):
             break
         n += 1
     return n
-
-
-def _filtered(ref, min_velocity, with_acceleration=False):
-    rows = [(float(t), float(u), float(a))
-            for t, u, a in zip(ref["time"], ref["velocity"], ref["acceleration"])
-            if u >= min_velocity]
-    cols = [[row[i] for row in rows] for i in range(3)]
-    return tuple(cols) if with_acceleration else tuple(cols[:2])
-
-
-def filtered_impacts(ref, min_velocity=1e-6, with_acceleration=False):
-    """(times, velocities[, accelerations]) as float lists, chatter-tail impacts
-    (u < min_velocity) removed."""
-    return _filtered(ref, min_velocity, with_acceleration)
-
 
 
 def linear_peak(zeta, noise, dt, amplitude=0.0, beta=1.0, x0=0.0, v0=0.0, t_end=None, dps=34):

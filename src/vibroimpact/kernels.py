@@ -567,15 +567,15 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
 
 @njit(cache=True)
 def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-              stk_kind, cnt, ftot, grid, stride, grid_n):
+              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n):
     """Advance the oscillator over the force samples ``r`` (``r[0]`` is sample ``k_begin``).
 
     ``state = [w, w', mode, sin(psi), cos(psi)]`` at sample ``k_begin``, with ``w = x - p_h``
     the displacement less the harmonic particular solution (so the fast recurrence never
     touches the harmonic part) and ``psi = beta k h - phi``. Steps ``k_begin .. k_end - 1``
     are taken unless an output buffer runs short, in which case the function returns early.
-    ``grid`` receives ``a = delta - x`` at every sample with ``k % stride == 0`` (``stride``
-    0: none), counted in ``grid_n[0]``.
+    ``grid`` and ``grid_v`` receive ``a = delta - x`` and ``x'`` at every sample with
+    ``k % stride == 0`` (``stride`` 0: none), counted in ``grid_n[0]``.
 
     Returns ``(status, k)``: the sample reached.
     """
@@ -610,10 +610,14 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
         if stride > 0 and k % stride == 0:
             if mode == STUCK:
                 grid[grid_n[0]] = 0.0
+                grid_v[grid_n[0]] = 0.0
             elif has_h:
-                grid[grid_n[0]] = delta - (w + Aq * math.sin(phase(k, 0.0, P[11], P[12], beta) - P[8]))
+                psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+                grid[grid_n[0]] = delta - (w + Aq * math.sin(psi))
+                grid_v[grid_n[0]] = wv + Aq * beta * math.cos(psi)
             else:
                 grid[grid_n[0]] = delta - w
+                grid_v[grid_n[0]] = wv
             grid_n[0] += 1
         r0 = r[k - k_begin]
         r1 = r[k - k_begin + 1]

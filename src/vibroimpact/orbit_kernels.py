@@ -17,7 +17,7 @@ from math import acos, atan2, ceil, cos, exp, floor, hypot, pi, sin, sqrt
 from numba import njit, prange
 
 # Numerical thresholds (one place).
-NEWTON_MAXIT = 40
+NEWTON_MAXIT = 30
 NEWTON_RTOL = 1e-12          # residual tolerance, relative to the problem's displacement scale
 SAME_ORBIT_RTOL = 1e-7       # two solutions closer than this (phase/T_f, velocity/scale) are one
 ADMISSIBLE_TOL = 1e-12       # margin >= -tol counts as admissible (grazing is the edge, included)
@@ -28,6 +28,7 @@ SCAN_STEP_M2 = 0.02
 SCAN_STEP_M3 = 0.12
 MAP_SCAN_STEP_M2 = 0.05
 MAP_SCAN_STEP_M3 = 0.25
+MAP_SCAN_EVERY = 4           # map: global scan at every 4th delta; branches followed in between
 FLIGHT_PHASE_STEP = 0.5      # admissibility: initial bracketing step (radians), refined by bounds
 FLIGHT_MIN_STEP = 1e-9       # admissibility: smallest bracket before giving up refinement
 
@@ -308,7 +309,7 @@ def newton(y, m, z, beta, delta, zeta, eps, scale, res, jac, dy, ytry):
             return nr <= tol
         step = 1.0
         accepted = False
-        for _ in range(12):
+        for _ in range(8):
             for i in range(nn):
                 ytry[i] = y[i] + step * dy[i]
             _residual_jacobian(ytry, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac)
@@ -549,17 +550,28 @@ def _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, uscale, sols, count, 
 
 
 @njit(cache=True)
-def _circle_defect(nvec, ncol, delta, q):
-    """Scale-free circle condition ``(d^2 (w_S^2 + w_C^2) - q^2 w_t^2) / (same with +)``."""
-    p = delta * delta * (nvec[0] * nvec[0] + nvec[1] * nvec[1])
-    t = q * q * nvec[ncol - 1] * nvec[ncol - 1]
-    return (p - t) / (p + t) if p + t > 0.0 else 0.0
+def _circle_factors(nvec, ncol, delta, q):
+    """The two factors ``(q w_t -+ delta |w_SC|) / norm`` of the circle condition.
+
+    A null vector ``w`` of K is a solution when ``w`` scaled to ``t = delta`` puts
+    ``(S0, C0)`` on the circle of radius q: ``q w_t = +delta |w_SC|`` (scale ``+q/|w_SC|``) or
+    ``q w_t = -delta |w_SC|`` (scale ``-q/|w_SC|``). Each factor has simple zeros, also at
+    ``delta = 0`` where the product degenerates into the square ``-q^2 w_t^2``.
+    """
+    r = abs(delta) * hypot(nvec[0], nvec[1])
+    t = q * nvec[ncol - 1]
+    if delta < 0.0:
+        r = -r
+    norm = hypot(r, t)
+    if norm == 0.0:
+        return 0.0, 0.0
+    return (t - r) / norm, (t + r) / norm
 
 
 @njit(cache=True)
-def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, kmat, sub, nvec, y, sols, count,
-                          work, jac):
-    """Newton from the linear solution at fixed intervals ``zs`` (both signs of the scale)."""
+def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub, nvec, y, sols,
+                          count, work, jac):
+    """Newton from the linear solution at fixed intervals ``zs``, scaled by ``sign q/|w_SC|``."""
     wd, q, phi = harmonic_constants(beta, zeta)
     z = 2.0 * pi * n / beta
     tf = 2.0 * pi / beta
@@ -567,10 +579,9 @@ def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, kmat, sub, nvec, y, 
     ncol = m + 3
     _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
     _cofactors(kmat, 2 * m - ncol + 1, ncol, sub, nvec)
-    for sign in (1.0, -1.0):
-        if _guess_from_null(nvec, m, zs, q, phi, beta, sign, y):
-            count = _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, scale, sols, count,
-                               work, jac)
+    if _guess_from_null(nvec, m, zs, q, phi, beta, sign, y):
+        count = _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, scale, sols, count,
+                           work, jac)
     return count
 
 
@@ -619,34 +630,37 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     zs = np.empty(m)
     if m == 2:
         npt = max(16, int(ceil(z * fast / scan_step)))
-        hval = np.empty(npt + 1)
+        gval = np.empty((2, npt + 1))
         for k in range(npt + 1):
             zs[0] = z * k / npt
             zs[1] = z - zs[0]
             _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
             _cofactors(kmat, 0, ncol, sub, nvec)
-            hval[k] = _circle_defect(nvec, ncol, delta, q)
-        for k in range(npt):
-            h0 = hval[k]
-            h1 = hval[k + 1]
-            cand = -1.0
-            if h0 * h1 <= 0.0 and h0 != h1:
-                cand = (k + h0 / (h0 - h1)) / npt
-            elif 0 < k and abs(h0) < 0.5 and abs(h0) <= abs(hval[k - 1]) and abs(h0) <= abs(h1):
-                cand = k / npt
-            if cand <= 0.0 or cand >= 1.0:
-                continue
-            zs[0] = z * cand
-            zs[1] = z - zs[0]
-            count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps, kmat, sub, nvec, y,
-                                          sols, count, work, jac)
+            gval[0, k], gval[1, k] = _circle_factors(nvec, ncol, delta, q)
+        for f in range(2):
+            sign = 1.0 if f == 0 else -1.0
+            for k in range(npt):
+                h0 = gval[f, k]
+                h1 = gval[f, k + 1]
+                cand = -1.0
+                if h0 * h1 <= 0.0 and h0 != h1:
+                    cand = (k + h0 / (h0 - h1)) / npt
+                elif (0 < k and abs(h0) < 0.3 and abs(h0) <= abs(gval[f, k - 1])
+                      and abs(h0) <= abs(h1)):
+                    cand = k / npt
+                if cand <= 0.0 or cand >= 1.0:
+                    continue
+                zs[0] = z * cand
+                zs[1] = z - zs[0]
+                count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub,
+                                              nvec, y, sols, count, work, jac)
         return count
     # m == 3: 2-D scan over (z_1, z_2), z_3 = z - z_1 - z_2. The nodes are offset by a third
     # of a step from the edges of the triangle, where a zero-length flight makes K singular.
     npt = max(12, int(ceil(z * fast / scan_step)))
     hz = z / npt
     f1 = np.empty((npt, npt))
-    f2 = np.empty((npt, npt))
+    f2 = np.empty((2, npt, npt))
     for i in range(npt):
         for k in range(npt - i):
             zs[0] = (i + 1.0 / 3.0) * hz
@@ -663,26 +677,29 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
                 rn += kmat[0, c] * kmat[0, c]
             norm = sqrt(cn * rn)
             f1[i, k] = det / norm if norm > 0.0 else 0.0
-            f2[i, k] = _circle_defect(nvec, ncol, delta, q)
+            f2[0, i, k], f2[1, i, k] = _circle_factors(nvec, ncol, delta, q)
     for i in range(npt - 1):
         for k in range(npt - 1 - i):
+            inner = i + k + 2 < npt
             a0, a1, a2 = f1[i, k], f1[i + 1, k], f1[i, k + 1]
-            a3 = f1[i + 1, k + 1] if i + k + 2 < npt else a0
+            a3 = f1[i + 1, k + 1] if inner else a0
             if min(min(a0, a1), min(a2, a3)) > 0.0 or max(max(a0, a1), max(a2, a3)) < 0.0:
                 continue
-            b0, b1, b2 = f2[i, k], f2[i + 1, k], f2[i, k + 1]
-            b3 = f2[i + 1, k + 1] if i + k + 2 < npt else b0
-            lo2 = min(min(b0, b1), min(b2, b3))
-            hi2 = max(max(b0, b1), max(b2, b3))
-            if (lo2 > 0.0 or hi2 < 0.0) and min(abs(lo2), abs(hi2)) > 0.2:
-                continue
-            zs[0] = (i + 5.0 / 6.0) * hz
-            zs[1] = (k + 5.0 / 6.0) * hz
-            zs[2] = z - zs[0] - zs[1]
-            if zs[2] <= 0.0:
-                continue
-            count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps, kmat, sub, nvec, y,
-                                          sols, count, work, jac)
+            for f in range(2):
+                b0, b1, b2 = f2[f, i, k], f2[f, i + 1, k], f2[f, i, k + 1]
+                b3 = f2[f, i + 1, k + 1] if inner else b0
+                lo2 = min(min(b0, b1), min(b2, b3))
+                hi2 = max(max(b0, b1), max(b2, b3))
+                if (lo2 > 0.0 or hi2 < 0.0) and min(abs(lo2), abs(hi2)) > 0.1:
+                    continue
+                zs[0] = (i + 5.0 / 6.0) * hz
+                zs[1] = (k + 5.0 / 6.0) * hz
+                zs[2] = z - zs[0] - zs[1]
+                if zs[2] <= 0.0:
+                    continue
+                count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps,
+                                              1.0 if f == 0 else -1.0, kmat, sub, nvec, y,
+                                              sols, count, work, jac)
     return count
 
 
@@ -711,27 +728,74 @@ def lam_of(tmat, m):
 
 
 @njit(cache=True)
+def _follow_back(y0, m, n, beta, deltas, d_from, d_stop, zeta, eps, sols, counts, work, jac):
+    """Continue the solution ``y0`` (at ``deltas[d_from]``) down to ``d_stop``, adding it where
+    it is missing; stops when Newton fails or the branch is already known there."""
+    wd, q, phi = harmonic_constants(beta, zeta)
+    z = 2.0 * pi * n / beta
+    tf = 2.0 * pi / beta
+    nn = 2 * m
+    y = np.empty(nn)
+    for c in range(nn):
+        y[c] = y0[c]
+    for dd in range(d_from - 1, d_stop - 1, -1):
+        delta = deltas[dd]
+        scale = 1.0 + abs(delta) + q * (1.0 + beta)
+        if not newton(y, m, z, beta, delta, zeta, eps, scale, work[0], jac, work[1], work[2]):
+            return
+        before = counts[dd]
+        counts[dd] = _accept(y, m, z, tf, scale, sols[dd], before)
+        if counts[dd] == before:
+            return
+
+
+@njit(cache=True)
 def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best, reason):
+    """One row of the map: all types at ``beta`` for every delta.
+
+    For m >= 2 the global interval scan runs every ``MAP_SCAN_EVERY`` points of delta (and at
+    the last); in between, the solutions of the previous point seed Newton (branch following
+    upward in delta), and every solution found by a scan is followed back down to the previous
+    scan, so a branch born between two scans is filled in as well.
+    """
     nd = deltas.shape[0]
+    stack = np.empty((64, 2))
+    tmat = np.empty((2, 2))
     for t in range(types.shape[0]):
         m = types[t, 0]
         n = types[t, 1]
         nn = 2 * m
         z = 2.0 * pi * n / beta
-        sols = np.empty((MAX_SOLUTIONS, nn))
-        seeds = np.empty((MAX_SOLUTIONS, nn))
-        nseed = 0
-        stack = np.empty((64, 2))
-        tmat = np.empty((2, 2))
+        sols = np.empty((nd, MAX_SOLUTIONS, nn))
+        counts = np.zeros(nd, dtype=np.int64)
+        work = np.empty((3, nn))
+        jac = np.empty((nn, nn))
         scan_step = MAP_SCAN_STEP_M2 if m == 2 else MAP_SCAN_STEP_M3
+        last_scan = 0
+        for d in range(nd):
+            prev = d - 1 if d > 0 else 0
+            nseed = counts[prev] if d > 0 else 0
+            scan = d % MAP_SCAN_EVERY == 0 or d == nd - 1
+            counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
+                                   scan_step if scan else 0.0, sols[d])
+            if m > 1 and not scan and counts[d] < nseed:
+                # a branch ended (fold or an impact velocity reaching zero): others may start
+                scan = True
+                counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
+                                       scan_step, sols[d])
+            if scan and m > 1 and d > 0:
+                d_stop = max(0, last_scan)
+                last_scan = d
+                for s in range(counts[d]):
+                    _follow_back(sols[d, s], m, n, beta, deltas, d, d_stop, zeta, eps, sols,
+                                 counts, work, jac)
         for d in range(nd):
             delta = deltas[d]
-            cnt = solve_type(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols)
             n_adm = 0
             n_st = 0
             best = np.inf
-            for s in range(cnt):
-                y = sols[s]
+            for s in range(counts[d]):
+                y = sols[d, s]
                 if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
                     continue
                 n_adm += 1
@@ -740,17 +804,13 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
                 if lam < 1.0:
                     n_st += 1
                 best = min(best, lam)
-            for s in range(cnt):
-                for c in range(nn):
-                    seeds[s, c] = sols[s, c]
-            nseed = cnt
             exists[t, ib, d] = n_adm > 0
             n_sol[t, ib, d] = n_adm
             n_stab[t, ib, d] = n_st
             lam_best[t, ib, d] = best if n_adm > 0 else np.nan
             if n_st > 0:
                 reason[t, ib, d] = 0
-            elif cnt == 0:
+            elif counts[d] == 0:
                 reason[t, ib, d] = 1
             elif n_adm == 0:
                 reason[t, ib, d] = 2

@@ -33,9 +33,9 @@ class SimulationResult:
     stick_start, stick_end : ndarray of float64, shape (n_stick,)
         Intervals during which the mass rests on the wall (after a chatter sequence, a
         plastic impact, or a start at rest on the wall).
-    grid_time, a : ndarray of float64
-        ``a(tau) = delta - x(tau)`` (the paper's displacement from the wall) every
-        ``record_every`` samples; empty unless asked for.
+    grid_time, a, v : ndarray of float64
+        ``a(tau) = delta - x(tau)`` (the paper's displacement from the wall) and the velocity
+        ``x'(tau)`` every ``record_every`` samples; empty unless asked for.
     n_steps, n_impacts, n_chatter : int
         Force sample steps taken, impacts, chatter sequences closed at their accumulation point.
     contact_time : float
@@ -54,6 +54,7 @@ class SimulationResult:
     stick_end: np.ndarray
     grid_time: np.ndarray
     a: np.ndarray
+    v: np.ndarray
     n_steps: int
     n_impacts: int
     n_chatter: int
@@ -152,6 +153,7 @@ class _Buffers:
         self.cnt = np.zeros(3, np.int64)
         self.ftot = np.zeros(1)
         self.grid = np.empty(max(n_grid, 1))
+        self.grid_v = np.empty(max(n_grid, 1))
         self.grid_n = np.zeros(1, np.int64)
 
     def drain(self, parts):
@@ -213,7 +215,8 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
         while k < k1:
             status, k = kernels.run_steps(r[k - k0 :], k, k1, state, P, buf.imp_step, buf.imp_off,
                                           buf.imp_u, buf.stk_step, buf.stk_off, buf.stk_kind,
-                                          buf.cnt, buf.ftot, buf.grid, stride, buf.grid_n)
+                                          buf.cnt, buf.ftot, buf.grid, buf.grid_v, stride,
+                                          buf.grid_n)
             if status == kernels.BUFFER_FULL:
                 buf.drain(parts)
             else:
@@ -222,6 +225,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
         x, v, mode = _state_at(state, P, k1)
         if final and stride and n_full % stride == 0:
             buf.grid[buf.grid_n[0]] = delta - x
+            buf.grid_v[buf.grid_n[0]] = v
             buf.grid_n[0] += 1
         if final and rem > 0.0:
             if noise is None:
@@ -284,6 +288,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         stick_end=np.asarray(ends, dtype=np.float64),
         grid_time=grid_time,
         a=buf.grid[:n].copy(),
+        v=buf.grid_v[:n].copy(),
         n_steps=k1 - k0 + (1 if t_chunk > k1 * dt else 0),
         n_impacts=len(imp_step),
         n_chatter=parts["n_chatter"],
@@ -360,7 +365,7 @@ def concatenate_results(chunks):
         impact_time=cat("impact_time"), impact_velocity=cat("impact_velocity"),
         impact_step=cat("impact_step"), impact_offset=cat("impact_offset"),
         stick_start=cat("stick_start"), stick_end=cat("stick_end"),
-        grid_time=cat("grid_time"), a=cat("a"),
+        grid_time=cat("grid_time"), a=cat("a"), v=cat("v"),
         n_steps=sum(c.n_steps for c in chunks), n_impacts=sum(c.n_impacts for c in chunks),
         n_chatter=sum(c.n_chatter for c in chunks),
         contact_time=float(sum(c.contact_time for c in chunks)),

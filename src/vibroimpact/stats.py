@@ -307,10 +307,10 @@ class Density(NamedTuple):
     centres: np.ndarray  #: bin centres, shape (nbins,)
     density: np.ndarray  #: probability density, integrates to 1 over the bins
     stderr: np.ndarray   #: standard error of `density` per bin (binomial)
-    n: int               #: number of values inside the bins
+    n: int               #: number of values the density is normalised by (inside the bins unless `total`)
 
 
-def density(values, bins, range=None) -> Density:
+def density(values, bins, range=None, total=None) -> Density:
     """Probability density of `values` by histogram, with binomial standard errors.
 
     Parameters
@@ -321,6 +321,10 @@ def density(values, bins, range=None) -> Density:
         Passed to ``numpy.histogram``.
     range : (float, float), optional
         Passed to ``numpy.histogram``.
+    total : int, optional
+        Normalise by this many values instead of the count inside the bins, so that values
+        beyond the bins keep their share of probability (the density then integrates to the
+        fraction inside). Must be >= the count inside.
 
     Returns
     -------
@@ -340,6 +344,10 @@ def density(values, bins, range=None) -> Density:
     widths = np.diff(edges)
     centres = 0.5 * (edges[:-1] + edges[1:])
     n = int(counts.sum())
+    if total is not None:
+        if total < n:
+            raise ValueError(f"total must be >= the count inside the bins ({n}), got {total!r}")
+        n = int(total)
     if n == 0:
         nan = np.full(counts.shape, np.nan)
         return Density(centres, nan, nan.copy(), 0)

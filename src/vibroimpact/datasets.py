@@ -1,0 +1,134 @@
+"""xarray datasets of the workflow: per-tile cell results and their per-study aggregates.
+
+The layouts are documented in ``docs/datasets.md``; every variable carries ``long_name``
+and ``units`` (plots take their labels from them).
+"""
+import numpy as np
+import pandas as pd
+import xarray as xr
+
+from vibroimpact import stats
+from vibroimpact.cells import MOTIONS
+
+#: long_name and units of every variable the datasets hold.
+META = {
+    "inv_beta": ("inverse forcing frequency ratio 1/beta_f", "1"),
+    "delta": ("play delta", "1"),
+    "cell": ("cell index", "1"),
+    "v_after": ("velocity after impact", "1"),
+    "interval": ("interval between adjacent impacts z_j", "1"),
+    "ratio": ("interval ratio z_j / z", "1"),
+    "motion": ("impact motion (m/n)", "1"),
+    "beta": ("frequency ratio beta = omega/omega_0", "1"),
+    "n_impacts": ("number of impacts", "1"),
+    "impact_rate": ("impacts per unit time", "1"),
+    "simulated_time": ("record length after the transient", "1"),
+    "v_after_mean": ("mean velocity after impact", "1"),
+    "v_after_stderr": ("standard error of the mean velocity after impact (batch means)", "1"),
+    "interval_mean": ("mean interval between adjacent impacts", "1"),
+    "interval_stderr": ("standard error of the mean interval (batch means)", "1"),
+    "contact_fraction": ("fraction of time resting on the wall", "1"),
+    "n_chatter": ("chatter sequences ended by sticking", "1"),
+    "v_after_density": ("probability density of the velocity after impact", "1"),
+    "v_after_density_stderr": ("standard error of the velocity density", "1"),
+    "interval_density": ("probability density of the interval between impacts", "1"),
+    "interval_density_stderr": ("standard error of the interval density", "1"),
+    "ratio_density": ("probability density of z_j / z", "1"),
+    "motion_probability": ("probability of the impact motion (fraction of time)", "1"),
+    "S_a": ("power spectral density of a(tau) (two-sided, eq. 9)", "1"),
+    "S_f": ("power spectral density of the input f(tau) (estimate, two-sided)", "1"),
+    "S_lin": ("linear response |H|^2 S_f (no wall)", "1"),
+    "n_segments": ("Welch segments averaged", "1"),
+    "tau": ("dimensionless time tau", "1"),
+    "r": ("random force r(tau)", "1"),
+    "f": ("input force f(tau)", "1"),
+    "a": ("displacement from the wall a(tau)", "1"),
+    "x": ("displacement x(tau)", "1"),
+    "impact_time": ("impact instant", "1"),
+    "impact_velocity": ("approach velocity at impact", "1"),
+}
+
+_EVENT_SCALARS = ("n_impacts", "impact_rate", "simulated_time", "v_after_mean", "v_after_stderr",
+                  "interval_mean", "interval_stderr", "contact_fraction", "n_chatter")
+_EVENT_DENSITIES = (("v_after_density", "v_after"), ("v_after_density_stderr", "v_after"),
+                    ("interval_density", "interval"), ("interval_density_stderr", "interval"),
+                    ("ratio_density", "ratio"))
+
+
+def _annotate(ds):
+    for name in list(ds.variables):
+        if name in META:
+            ds[name].attrs.update(long_name=META[name][0], units=META[name][1])
+    return ds
+
+
+def bin_edges(bins_config):
+    """Histogram edges ``{"v_after", "interval", "ratio"}`` from ``{name: {max, n}}``."""
+    return {name: np.linspace(0.0, float(b["max"]), int(b["n"]) + 1)
+            for name, b in bins_config.items()}
+
+
+def events_tile(cells, results, edges, attrs):
+    """Dataset of one tile of event statistics, along dimension ``cell``."""
+    centres = {k: 0.5 * (e[1:] + e[:-1]) for k, e in edges.items()}
+    data = {name: ("cell", np.array([r[name] for r in results])) for name in _EVENT_SCALARS}
+    for name, dim in _EVENT_DENSITIES:
+        data[name] = (("cell", dim), np.stack([r[name] for r in results]))
+    data["motion_probability"] = (("cell", "motion"), np.stack([r["motion_probability"] for r in results]))
+    coords = dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
+                  delta_cell=("cell", [c.delta for c in cells]),
+                  motion=[f"{m}/{n}" for m, n in MOTIONS], **centres)
+    return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+
+
+def spectra_tile(cells, results, attrs):
+    """Dataset of one tile of spectra, along dimension ``cell``."""
+    data = dict(S_a=(("cell", "beta"), np.stack([r["S_a"] for r in results])),
+                S_f=(("cell", "beta"), np.stack([r["S_f"] for r in results])),
+                n_segments=("cell", np.array([r["n_segments"] for r in results])))
+    coords = dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
+                  delta_cell=("cell", [c.delta for c in cells]), beta=results[0]["beta"])
+    return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+
+
+def _to_grid(tiles, inv_beta, delta):
+    """Concatenate tiles along ``cell`` and reshape to ``(inv_beta, delta, ...)``."""
+    ds = xr.concat(tiles, dim="cell").sortby("cell")
+    n = len(inv_beta) * len(delta)
+    if ds.sizes["cell"] != n or not np.array_equal(ds["cell"].values, np.arange(n)):
+        raise ValueError(f"tiles cover cells {ds['cell'].values.tolist()}, expected 0..{n - 1}")
+    index = xr.Coordinates.from_pandas_multiindex(
+        pd.MultiIndex.from_product([inv_beta, delta], names=["inv_beta", "delta"]), "cell")
+    ds = ds.drop_vars(["cell", "inv_beta_cell", "delta_cell"]).assign_coords(index).unstack("cell")
+    return ds.transpose("inv_beta", "delta", ...)
+
+
+def aggregate_events(tiles, study, attrs):
+    """Events dataset of a study (``docs/datasets.md``) from its tiles."""
+    ds = _to_grid(tiles, study.inv_beta, study.delta)
+    ds.attrs = dict(attrs)
+    return _annotate(ds)
+
+
+def aggregate_spectra(tiles, study, spec, attrs):
+    """Spectra dataset of a study, with the linear reference ``S_lin = |H|^2 S_f``.
+
+    ``spec`` is the :class:`~vibroimpact.noise.NoiseSpec` of the random force; the reference
+    uses the spectrum of the piecewise-linear force the simulator integrates.
+    """
+    ds = _to_grid(tiles, study.inv_beta, study.spectra_delta)
+    beta = ds["beta"].values
+    S_lin = stats.linear_psd_response(beta, spec.psd_piecewise_linear(beta), study.zeta)
+    ds["S_lin"] = ("beta", S_lin)
+    ds.attrs = dict(attrs)
+    return _annotate(ds)
+
+
+def trace_dataset(tr, attrs):
+    """Dataset of a short sampled trace (Figs. 3 and 10)."""
+    ds = xr.Dataset(
+        dict(r=("tau", tr["r"]), f=("tau", tr["f"]), a=("tau", tr["a"]), x=("tau", tr["x"]),
+             impact_time=("impact", tr["impact_time"]),
+             impact_velocity=("impact", tr["impact_velocity"])),
+        coords=dict(tau=tr["tau"]), attrs=attrs)
+    return _annotate(ds)

@@ -1,0 +1,145 @@
+"""Files: atomic netCDF writes, provenance attributes, the noise record.
+
+A failed or interrupted write never leaves a file under the final name: everything is
+written to a temporary name in the same directory and renamed into place on success.
+"""
+from contextlib import contextmanager
+import hashlib
+import json
+import os
+import tempfile
+
+import netCDF4
+import numpy as np
+
+from vibroimpact import noise as noise_mod
+
+@contextmanager
+def atomic_path(path):
+    """Yield a temporary path beside ``path``; rename it to ``path`` only if the block succeeds."""
+    path = os.fspath(path)
+    directory = os.path.dirname(path) or "."
+    os.makedirs(directory, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=directory)
+    os.close(fd)
+    try:
+        yield tmp
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def write_dataset(ds, path):
+    """Write an ``xarray.Dataset`` to netCDF4 atomically."""
+    with atomic_path(path) as tmp:
+        ds.to_netcdf(tmp, engine="netcdf4")
+
+
+def config_digest(obj):
+    """SHA-256 of the canonical JSON form of a config fragment (provenance)."""
+    text = json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def provenance(config_digest, git_commit, seed=None):
+    """Global attributes every output carries."""
+    from vibroimpact import PAPER_REFERENCE, __version__
+
+    attrs = dict(package_version=__version__, git_commit=str(git_commit),
+                 config_digest=str(config_digest), paper_reference=PAPER_REFERENCE)
+    if seed is not None:
+        attrs["seed"] = int(seed)
+    return attrs
+
+
+def _var(nc, name, dims, data, long_name, units, dtype="f8"):
+    v = nc.createVariable(name, dtype, dims)
+    v[:] = data
+    v.setncatts(dict(long_name=long_name, units=units))
+    return v
+
+
+def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estimate=2**22,
+                nperseg=2048, max_lag=30.0):
+    """Generate a noise record chunk by chunk into ``path``, with its estimated statistics.
+
+    Parameters
+    ----------
+    spec : vibroimpact.noise.NoiseSpec
+    n_samples, seed : int
+    attrs : dict
+        Global attributes (provenance).
+    n_estimate : int
+        Samples (from the start) used for the estimated autocorrelation and PSD.
+    nperseg : int
+        Welch segment length of the PSD estimate.
+    max_lag : float
+        Largest lag tau* of the autocorrelation (time units).
+    """
+    with atomic_path(path) as tmp:
+        nc = netCDF4.Dataset(tmp, "w", format="NETCDF4")
+        try:
+            nc.createDimension("sample", n_samples)
+            r = nc.createVariable("r", "f8", ("sample",), chunksizes=(min(n_samples, 2**18),))
+            r.setncatts(dict(long_name="random force sample r_k = r(k dt)", units="1"))
+            head = []
+            k = 0
+            for chunk in noise_mod.generate(spec, n_samples, seed, chunk_size=chunk_size):
+                r[k : k + chunk.size] = chunk
+                if k < n_estimate:
+                    head.append(chunk[: n_estimate - k])
+                k += chunk.size
+            head = np.concatenate(head)
+            lag, phi = noise_mod.estimate_autocorrelation(head, spec.dt, max_lag)
+            beta, S = noise_mod.estimate_psd(head, spec.dt, min(nperseg, head.size))
+            nc.createDimension("lag", lag.size)
+            nc.createDimension("beta", beta.size)
+            _var(nc, "lag", ("lag",), lag, "time lag tau*", "1")
+            _var(nc, "phi_estimate", ("lag",), phi, "autocorrelation phi_f (estimate, eq. 8)", "1")
+            _var(nc, "phi_target", ("lag",), spec.autocorrelation(lag),
+                 "autocorrelation phi_f (target)", "1")
+            _var(nc, "beta", ("beta",), beta, "frequency ratio beta = omega/omega_0", "1")
+            _var(nc, "S_estimate", ("beta",), S,
+                 "power spectral density S_f (estimate, eq. 9, two-sided)", "1")
+            _var(nc, "S_target", ("beta",), spec.psd(beta),
+                 "power spectral density S_f (target, two-sided)", "1")
+            _var(nc, "S_target_linear", ("beta",), spec.psd_piecewise_linear(beta),
+                 "power spectral density of the piecewise-linear force (target)", "1")
+            nc.setncatts({**attrs, **{f"noise_{k}": v for k, v in spec.to_attrs().items()},
+                          "dt": spec.dt, "seed": int(seed), "n_samples": int(n_samples)})
+        finally:
+            nc.close()
+
+
+def noise_spec(nc_attrs):
+    """The :class:`~vibroimpact.noise.NoiseSpec` stored in a noise file's attributes."""
+    keys = ("kind", "rms", "dt", "beta_c", "zeta_f")
+    kwargs = {k: nc_attrs[f"noise_{k}"] for k in keys if f"noise_{k}" in nc_attrs}
+    for k in ("rms", "dt", "beta_c", "zeta_f"):
+        if k in kwargs:
+            kwargs[k] = float(kwargs[k])
+    return noise_mod.NoiseSpec(**kwargs)
+
+
+def read_noise_attrs(path):
+    """Global attributes of a noise file (its spec, seed and provenance)."""
+    with netCDF4.Dataset(os.fspath(path), "r") as nc:
+        return {k: nc.getncattr(k) for k in nc.ncattrs()}
+
+
+def read_noise(path, max_in_memory=2**26):
+    """Open a noise record: ``(samples, dt, attrs)``.
+
+    Records up to ``max_in_memory`` samples are read into memory once; longer ones are
+    returned as the netCDF variable, which the simulator reads chunk by chunk.
+    """
+    nc = netCDF4.Dataset(os.fspath(path), "r")
+    var = nc.variables["r"]
+    var.set_auto_mask(False)
+    attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
+    if var.shape[0] <= max_in_memory:
+        samples = var[:]
+        nc.close()
+        return samples, float(attrs["dt"]), attrs
+    return var, float(attrs["dt"]), attrs

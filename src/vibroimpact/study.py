@@ -1,0 +1,94 @@
+"""A study: the physical parameters and the (1/beta, delta) grid of cells, from its config entry.
+
+Pure functions of the config mapping (validated by ``config/schema.yaml``): the workflow
+uses them to enumerate cells and tiles, the cell jobs to find their parameters. Cells are
+addressed by an integer index; the files store both the index and the parameter values.
+"""
+from dataclasses import dataclass
+import math
+
+import numpy as np
+
+#: Decimals kept when a grid is given as start/stop/step (so 0.1 * 3 is 0.3, not 0.30000000000000004).
+GRID_DECIMALS = 10
+
+
+def grid_values(spec):
+    """Values of a grid given as a list or as ``{start, stop, step}`` (``stop`` included).
+
+    Parameters
+    ----------
+    spec : list of float or dict
+        Explicit values, or a mapping with ``start``, ``stop`` and ``step > 0``.
+
+    Returns
+    -------
+    ndarray of float64
+    """
+    if isinstance(spec, dict):
+        start, stop, step = float(spec["start"]), float(spec["stop"]), float(spec["step"])
+        if not step > 0.0:
+            raise ValueError(f"grid step must be > 0, got {step!r}")
+        if stop < start:
+            raise ValueError(f"grid stop must be >= start, got start={start!r}, stop={stop!r}")
+        n = int(math.floor((stop - start) / step + 1e-9)) + 1
+        return np.round(start + step * np.arange(n), GRID_DECIMALS)
+    values = np.asarray([float(v) for v in spec], dtype=float)
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise ValueError(f"grid must hold at least one finite value, got {spec!r}")
+    return values
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One parameter cell: its index in the study and its parameter values."""
+
+    index: int
+    i_inv_beta: int
+    i_delta: int
+    inv_beta: float
+    delta: float
+
+
+@dataclass(frozen=True)
+class Study:
+    """The parameters of one study and its grid of cells (inv_beta-major order)."""
+
+    name: str
+    zeta: float
+    eps: float
+    amplitude: float
+    inv_beta: np.ndarray
+    delta: np.ndarray
+    spectra_delta: np.ndarray
+    tile_size: int
+
+    @classmethod
+    def from_config(cls, name, entry):
+        """Build from a validated config entry ``studies[name]``."""
+        amplitude = float(entry.get("amplitude", 0.0))
+        inv_beta = grid_values(entry.get("inv_beta", [1.0])) if amplitude != 0.0 else np.array([1.0])
+        if np.any(inv_beta <= 0.0):
+            raise ValueError(f"studies.{name}.inv_beta must hold values > 0, got {inv_beta!r}")
+        spectra = entry.get("spectra") or {}
+        return cls(name=name, zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                   amplitude=amplitude, inv_beta=inv_beta, delta=grid_values(entry["delta"]),
+                   spectra_delta=grid_values(spectra["delta"]) if spectra.get("delta") else np.empty(0),
+                   tile_size=int(entry.get("tile_size", 16)))
+
+    def cells(self, kind="events"):
+        """All cells of the events grid (``inv_beta x delta``) or of the spectra grid."""
+        deltas = self.delta if kind == "events" else self.spectra_delta
+        return [Cell(i * len(deltas) + j, i, j, float(ib), float(d))
+                for i, ib in enumerate(self.inv_beta) for j, d in enumerate(deltas)]
+
+    def n_tiles(self, kind="events"):
+        """Number of tiles (jobs) covering the grid of ``kind``."""
+        return -(-len(self.cells(kind)) // self.tile_size)
+
+    def tile(self, t, kind="events"):
+        """The cells of tile ``t`` (consecutive indices)."""
+        cells = self.cells(kind)
+        if not 0 <= t < self.n_tiles(kind):
+            raise ValueError(f"tile must lie in [0, {self.n_tiles(kind) - 1}], got {t!r}")
+        return cells[t * self.tile_size : (t + 1) * self.tile_size]
