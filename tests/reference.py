@@ -276,8 +276,13 @@ def _release_time(rel: _Release, L):
         if G1 > 0 or (G1 == 0 and G2 > 0):
             return mpf(0)
         # G <= G1 s + G2 s^2/2 + M3 s^3/6 < 0 just after 0: start the search there
-        start = -G1 / rel.M[2] if G1 < 0 else (-G2 / rel.M[3] if G2 < 0 else None)
-        if start is None or start >= L:
+        if G1 < 0:
+            start = -G1 / rel.M[2] if rel.M[2] > 0 else mp.inf  # M2 = 0: G is linear
+        elif G2 < 0:
+            start = -G2 / rel.M[3] if rel.M[3] > 0 else mp.inf
+        else:
+            return None
+        if start >= L:
             return None
         return _smallest_root(rel.eval, rel.M, start, L)
     if G0 > 0:

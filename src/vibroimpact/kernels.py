@@ -250,8 +250,14 @@ def safe_step(ga, va, acc, M3, wmax):
     ``g(s) <= ga + va s + (acc + W M3) s^2 / 2``; the best ``W`` is the fixed point of
     ``W = first root of that quadratic``, approached in a few cheap iterations.
     """
-    W = wmax
     best = 0.0
+    if ga == 0.0 and va <= 0.0 and acc < 0.0:
+        # on the wall, not moving into it, pulled off it: g <= acc s^2/2 + M3 s^3/6 < 0 up to
+        # s = -3 acc / M3 (v s <= 0 only helps); half of it keeps a margin for round-off in acc
+        best = min(wmax, -1.5 * acc / M3)
+        if best >= wmax:
+            return wmax
+    W = wmax
     for _ in range(6):
         K = (acc + W * M3) * BOUND_SAFETY + EPS64 * abs(acc)
         s = _quad_root(ga, va, K)
@@ -309,6 +315,12 @@ def _newton_unique(lo, hi, g, v, acc, tolg, c, P):
 
 
 @njit(cache=True)
+def tolg_wall(c, P):
+    """Round-off of ``x - delta`` near the wall: separations below it are not resolvable."""
+    return 16.0 * EPS64 * (abs(P[3]) + abs(c[16]) + abs(P[7]) + c[9])
+
+
+@njit(cache=True)
 def first_contact(c, P, H, at_wall):
     """Smallest ``sig`` in ``(0, H]`` where the segment's motion reaches the wall.
 
@@ -327,7 +339,8 @@ def first_contact(c, P, H, at_wall):
     -------
     code : int
         ``NO_ROOT``, ``ROOT`` (impact with ``u > 0``), ``TOUCH`` (reaches the wall with zero
-        velocity within round-off) or ``PRESSED`` (starts at rest on the wall, pushed into it).
+        velocity within round-off) or ``PRESSED`` (at rest on the wall and pushed into it from
+        ``sig`` on: it sticks).
     sig, u : float
         Instant (from the segment start) and velocity there; with ``NO_ROOT``, ``H`` and
         the state ``(x - delta, x')`` at ``H`` in ``u, gH``.
@@ -351,6 +364,13 @@ def first_contact(c, P, H, at_wall):
         tola = 64.0 * EPS64 * M2
         if va > tolv:
             return ROOT, 0.0, va, 0.0           # starts on the wall moving into it
+        if va >= -tolv and acc < -tola and -acc * (-1.5 * acc / M3) ** 2 <= tolg_wall(c, P):
+            # pulled off the wall so weakly that the next safe step could not resolve the
+            # separation: if f - delta turns back before the mass gets a resolvable distance
+            # away, it simply stays on the wall (no creeping by microscopic steps)
+            sF = push_recovery(c, P, H)
+            if sF >= 0.0 and -acc * sF * sF <= tolg_wall(c, P):
+                return PRESSED, sF, 0.0, 0.0
         if va < -tolv or acc < -tola:
             sa = safe_step(0.0, min(va, 0.0), acc, M3, H)
         elif abs(acc) <= tola and c[11] < 0.0:
@@ -418,6 +438,27 @@ def push_eval(sig, c, P):
 
 
 @njit(cache=True)
+def push_recovery(c, P, H):
+    """First ``sig`` in ``(0, H]`` where ``F = f - delta`` (negative at the start) is back to
+    ``>= 0``, approached from the left by steps proved safe by ``|F''| <= A beta^2``; ``-1``
+    if it stays negative through ``H``."""
+    MF = abs(P[5]) * P[6] * P[6] * BOUND_SAFETY
+    tolF = 8.0 * EPS64 * (abs(c[16]) + abs(P[3]) + abs(P[5]) + abs(c[2]) * H + 1e-300)
+    a = 0.0
+    Fa, dFa = c[12], c[13]
+    for _ in range(MAX_SEARCH):
+        if Fa >= -tolF:
+            return a
+        step = _quad_root(Fa, dFa, MF)
+        if a + step >= H:
+            FH, _ = push_eval(H, c, P)
+            return H if FH >= -tolF else -1.0
+        a = a + step
+        Fa, dFa = push_eval(a, c, P)
+    return a
+
+
+@njit(cache=True)
 def release_time(c, P, H):
     """First ``sig`` in ``[0, H]`` after which ``f - delta`` turns negative (the mass leaves).
 
@@ -428,10 +469,12 @@ def release_time(c, P, H):
     MF = abs(A) * beta * beta * BOUND_SAFETY
     a = 0.0
     Fa, dFa = c[12], c[13]
-    if Fa < 0.0 or (Fa == 0.0 and dFa < 0.0):
+    scale = abs(c[16]) + abs(P[3]) + abs(A) + abs(c[2]) * H + 1e-300
+    tolF = 8.0 * EPS64 * scale
+    if Fa < -tolF or (Fa <= tolF and dFa < 0.0):
         return 0.0
+    Fa = max(Fa, 0.0)       # within round-off of zero and rising: still pressed
     FH, dFH = push_eval(H, c, P)
-    scale = abs(c[12]) + abs(P[3]) + abs(A) + abs(c[2]) * H + 1e-300
     for _ in range(MAX_SEARCH):
         w = H - a
         if min(Fa, FH) - 0.125 * MF * w * w > 0.0 or (MF == 0.0 and FH >= 0.0):
@@ -545,6 +588,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             return gH + delta, u, FREE, OK
         if code == PRESSED:
             mode = STUCK
+            s = min(s + sig, H)
             _record_event(stk_step, stk_off, stk_kind, cnt[1], k, s, 1.0)
             cnt[1] += 1
             x = delta

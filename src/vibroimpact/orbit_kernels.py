@@ -18,6 +18,8 @@ from numba import njit, prange
 
 # Numerical thresholds (one place).
 NEWTON_MAXIT = 30
+NEWTON_GIVE_UP_IT = 10       # a start still this far off after this many steps is abandoned
+NEWTON_GIVE_UP_RTOL = 1e-4
 NEWTON_RTOL = 1e-12          # residual tolerance, relative to the problem's displacement scale
 SAME_ORBIT_RTOL = 1e-7       # two solutions closer than this (phase/T_f, velocity/scale) are one
 ADMISSIBLE_TOL = 1e-12       # margin >= -tol counts as admissible (grazing is the edge, included)
@@ -297,7 +299,7 @@ def newton(y, m, z, beta, delta, zeta, eps, scale, res, jac, dy, ytry):
     nr = sqrt(nr)
     polished = 0
     for it in range(NEWTON_MAXIT):
-        if not np.isfinite(nr):
+        if not np.isfinite(nr) or (it >= NEWTON_GIVE_UP_IT and nr > NEWTON_GIVE_UP_RTOL * scale):
             return False
         if nr <= tol:
             polished += 1
@@ -586,6 +588,37 @@ def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub, nve
 
 
 @njit(cache=True)
+def _bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11):
+    """Common zero ``(s, t)`` of the bilinear interpolants of two functions on a unit cell.
+
+    Returns ``(found, s, t)``; ``found`` when Newton converges within the cell widened by a
+    quarter on each side. Screens scan cells whose zero curves pass near each other without
+    crossing (frequent along the edges of the interval triangle).
+    """
+    s = 0.5
+    t = 0.5
+    for _ in range(12):
+        fa = a00 + (a10 - a00) * s + (a01 - a00) * t + (a11 - a10 - a01 + a00) * s * t
+        fb = b00 + (b10 - b00) * s + (b01 - b00) * t + (b11 - b10 - b01 + b00) * s * t
+        ja_s = (a10 - a00) + (a11 - a10 - a01 + a00) * t
+        ja_t = (a01 - a00) + (a11 - a10 - a01 + a00) * s
+        jb_s = (b10 - b00) + (b11 - b10 - b01 + b00) * t
+        jb_t = (b01 - b00) + (b11 - b10 - b01 + b00) * s
+        det = ja_s * jb_t - ja_t * jb_s
+        if det == 0.0:
+            return False, s, t
+        ds = (fa * jb_t - fb * ja_t) / det
+        dt = (ja_s * fb - jb_s * fa) / det
+        s -= ds
+        t -= dt
+        if abs(s - 0.5) > 2.0 or abs(t - 0.5) > 2.0:
+            return False, s, t
+        if abs(ds) + abs(dt) < 1e-6:
+            break
+    return abs(s - 0.5) <= 0.75 and abs(t - 0.5) <= 0.75, s, t
+
+
+@njit(cache=True)
 def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     """All (m/n) solutions for m = 2, 3: interval scan (global) plus Newton from ``seeds``.
 
@@ -659,13 +692,13 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     # of a step from the edges of the triangle, where a zero-length flight makes K singular.
     npt = max(12, int(ceil(z * fast / scan_step)))
     hz = z / npt
-    f1 = np.empty((npt, npt))
-    f2 = np.empty((2, npt, npt))
-    for i in range(npt):
-        for k in range(npt - i):
+    f1 = np.empty((npt + 1, npt + 1))
+    f2 = np.empty((2, npt + 1, npt + 1))
+    for i in range(npt + 1):
+        for k in range(npt + 1 - i):
             zs[0] = (i + 1.0 / 3.0) * hz
             zs[1] = (k + 1.0 / 3.0) * hz
-            zs[2] = z - zs[0] - zs[1]
+            zs[2] = z - zs[0] - zs[1]            # slightly negative on the outer row: fine
             _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
             _cofactors(kmat, 1, ncol, sub, nvec)
             det = 0.0
@@ -678,24 +711,26 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
             norm = sqrt(cn * rn)
             f1[i, k] = det / norm if norm > 0.0 else 0.0
             f2[0, i, k], f2[1, i, k] = _circle_factors(nvec, ncol, delta, q)
-    for i in range(npt - 1):
-        for k in range(npt - 1 - i):
-            inner = i + k + 2 < npt
-            a0, a1, a2 = f1[i, k], f1[i + 1, k], f1[i, k + 1]
-            a3 = f1[i + 1, k + 1] if inner else a0
-            if min(min(a0, a1), min(a2, a3)) > 0.0 or max(max(a0, a1), max(a2, a3)) < 0.0:
+    for i in range(npt):
+        for k in range(npt - i):
+            a00, a10, a01 = f1[i, k], f1[i + 1, k], f1[i, k + 1]
+            a11 = f1[i + 1, k + 1] if i + k + 2 <= npt else a10 + a01 - a00
+            if min(min(a00, a10), min(a01, a11)) > 0.0 or max(max(a00, a10), max(a01, a11)) < 0.0:
                 continue
             for f in range(2):
-                b0, b1, b2 = f2[f, i, k], f2[f, i + 1, k], f2[f, i, k + 1]
-                b3 = f2[f, i + 1, k + 1] if inner else b0
-                lo2 = min(min(b0, b1), min(b2, b3))
-                hi2 = max(max(b0, b1), max(b2, b3))
+                b00, b10, b01 = f2[f, i, k], f2[f, i + 1, k], f2[f, i, k + 1]
+                b11 = f2[f, i + 1, k + 1] if i + k + 2 <= npt else b10 + b01 - b00
+                lo2 = min(min(b00, b10), min(b01, b11))
+                hi2 = max(max(b00, b10), max(b01, b11))
                 if (lo2 > 0.0 or hi2 < 0.0) and min(abs(lo2), abs(hi2)) > 0.1:
                     continue
-                zs[0] = (i + 5.0 / 6.0) * hz
-                zs[1] = (k + 5.0 / 6.0) * hz
+                ok_, si, ti = _bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11)
+                if not ok_:
+                    continue
+                zs[0] = (i + 1.0 / 3.0 + si) * hz
+                zs[1] = (k + 1.0 / 3.0 + ti) * hz
                 zs[2] = z - zs[0] - zs[1]
-                if zs[2] <= 0.0:
+                if zs[0] <= 0.0 or zs[1] <= 0.0 or zs[2] <= 0.0:
                     continue
                 count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps,
                                               1.0 if f == 0 else -1.0, kmat, sub, nvec, y,
