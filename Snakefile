@@ -15,6 +15,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/noise.smk"
 include: "workflow/rules/simulate.smk"
 include: "workflow/rules/aggregate.smk"
+include: "workflow/rules/orbits.smk"
 include: "workflow/rules/figures.smk"
 
 

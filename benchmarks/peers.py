@@ -21,7 +21,7 @@ import scipy.linalg
 from numba import njit
 
 V_STICK = 1e-7
-"""Rebound speed below which the solve_ivp peer ends a chatter sequence by sticking.
+"""Rebound speed below which the solve_ivp peer leaves the mass at rest on the wall.
 
 The rest of the sequence (~2 V_STICK / ((1 - eps) (r - delta)) of time) is skipped: its impacts
 are slower still, in the chatter tail that the benchmark does not compare impact by impact."""

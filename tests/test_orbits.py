@@ -61,7 +61,7 @@ def sampled_impact_map(tau, u, beta, delta, zeta, eps, smax, ds):
     return out_t, out_u
 
 
-def dop853_impact_map(tau, u, beta, delta, zeta, eps, smax):
+def dop853_impact_map(tau, u, beta, delta, zeta, eps, smax, max_step=0.01):
     """One impact-map step by scipy DOP853 (rtol = atol = 1e-12) with a crossing event.
 
     ``max_step`` keeps a low-velocity impact (a short excursion above delta) from slipping
@@ -74,7 +74,7 @@ def dop853_impact_map(tau, u, beta, delta, zeta, eps, smax):
         return y[0] - delta
     hit.terminal, hit.direction = True, 1.0
     sol = solve_ivp(rhs, (tau, tau + smax), [delta, -eps * u], method="DOP853", rtol=1e-12,
-                    atol=1e-12, events=hit, max_step=0.01)
+                    atol=1e-12, events=hit, max_step=max_step)
     return sol.t_events[0][0], sol.y_events[0][0][1]
 
 
@@ -120,6 +120,18 @@ def exhaustive_fixed_points(m, n, beta, delta, zeta, eps, nt, nu):
         a, b = pm(np.array([p[0]]), np.array([p[1]]))
         return [a[0] - p[0] - z, b[0] - p[1]]
 
+    def shorter(p):
+        # a fixed point of a shorter map (m/d impacts over n/d cycles) repeats a shorter orbit
+        for d in range(2, math.gcd(m, n) + 1):
+            if m % d or n % d:
+                continue
+            t, u = np.array([p[0]]), np.array([p[1]])
+            for _ in range(m // d):
+                t, u = sampled_impact_map(t, u, beta, delta, zeta, eps, 1.25 * z + 1.0, ds)
+            if abs(t[0] - p[0] - z / d) < 1e-7 and abs(u[0] - p[1]) < 1e-7:
+                return True
+        return False
+
     found = []
     for i in range(nt):
         for j in range(nu - 1):
@@ -130,7 +142,8 @@ def exhaustive_fixed_points(m, n, beta, delta, zeta, eps, nt, nu):
                 continue
             sol = root(resid, [taus[i] + 0.5 * tf / nt, us[j] + 0.5 * (us[1] - us[0])],
                        method="hybr", tol=1e-13)
-            if sol.success and np.max(np.abs(resid(sol.x))) < 1e-8 and sol.x[1] > 0:
+            if (sol.success and np.max(np.abs(resid(sol.x))) < 1e-8 and sol.x[1] > 0
+                    and not shorter(sol.x)):
                 p = (sol.x[0] % tf, sol.x[1])
                 if not any(circ_dist(p[0], q[0], tf) < 1e-6 and abs(p[1] - q[1]) < 1e-6
                            for q in found):
@@ -267,25 +280,38 @@ ORBIT_CASES = [  # (m, n, 1/beta, delta): points with admissible orbits, stable 
     (2, 1, 1.0, 0.1), (2, 1, 0.7, -0.3), (1, 2, 0.4, 0.3), (3, 1, 0.8, -0.4),
     (2, 2, 1.2, 2.1),
 ]
+FAST_ORBIT_CASES = [(1, 1, 1.2, 0.5), (1, 1, 1.3, 2.3), (2, 1, 1.5, 1.0), (3, 1, 0.8, -0.4)]
 
 
-def all_case_orbits(include_inadmissible=False):
-    for m, n, ib, d in ORBIT_CASES:
+def all_case_orbits(include_inadmissible=False, cases=ORBIT_CASES):
+    for m, n, ib, d in cases:
         orbits = periodic_orbits(m, n, 1 / ib, d, ZETA, EPS,
                                  include_inadmissible=include_inadmissible)
         assert orbits, (m, n, ib, d)
         yield from orbits
 
 
-def test_orbits_repeat_under_independent_impact_map():
-    """m DOP853 impact-map steps from (tau0, u) return to (tau0 + z, u): 1e-9 in time/velocity."""
-    for o in all_case_orbits():
+def _check_repeat(cases, max_step):
+    for o in all_case_orbits(cases=cases):
         tau, u = o.tau0, o.velocities[-1]
         for j in range(o.m):
-            tau, u = dop853_impact_map(tau, u, o.beta, o.delta, ZETA, EPS, 1.5 * o.period)
+            tau, u = dop853_impact_map(tau, u, o.beta, o.delta, ZETA, EPS, 1.5 * o.period,
+                                       max_step)
             assert tau - o.impact_times[0] - o.intervals[:j + 1].sum() == pytest.approx(
                 0.0, abs=1e-9)
             assert u == pytest.approx(o.velocities[j], abs=1e-9)
+
+
+def test_orbits_repeat_under_independent_impact_map():
+    """m DOP853 impact-map steps from (tau0, u) return to (tau0 + z, u): 1e-9 in time/velocity."""
+    _check_repeat(FAST_ORBIT_CASES, 0.05)
+
+
+@pytest.mark.slow
+def test_orbits_repeat_under_independent_impact_map_all_cases():
+    """Same on every case, including a (2/1) motion with an impact at u = 0.006 (small DOP853
+    steps, so its short excursion above the wall is not stepped over)."""
+    _check_repeat(ORBIT_CASES, 0.002)
 
 
 def test_jacobian_determinant_identity():
@@ -296,16 +322,14 @@ def test_jacobian_determinant_identity():
         assert np.prod(o.multipliers).real == pytest.approx(expected, rel=1e-9)
 
 
-def test_multipliers_match_finite_differences_of_independent_map():
-    """T from fourth-order central differences of the DOP853 impact map: entries and
-    multipliers to 1e-6 of the largest entry. The step shrinks with the smallest impact
-    velocity, since the map's curvature grows like 1/u."""
-    for o in all_case_orbits():
+def _check_fd(cases, max_step):
+    for o in all_case_orbits(cases=cases):
         h = 1e-5 * min(1.0, o.velocities.min())
 
         def period_map(t, u):
             for _ in range(o.m):
-                t, u = dop853_impact_map(t, u, o.beta, o.delta, ZETA, EPS, 1.5 * o.period)
+                t, u = dop853_impact_map(t, u, o.beta, o.delta, ZETA, EPS, 1.5 * o.period,
+                                         max_step)
             return np.array([t - o.period, u])
 
         def diff(f):
@@ -317,6 +341,18 @@ def test_multipliers_match_finite_differences_of_independent_map():
         np.testing.assert_allclose(o.jacobian, fd, atol=1e-6 * scale)
         mu_fd = np.sort_complex(np.linalg.eigvals(fd))
         np.testing.assert_allclose(np.sort_complex(o.multipliers), mu_fd, atol=1e-6 * scale)
+
+
+def test_multipliers_match_finite_differences_of_independent_map():
+    """T from fourth-order central differences of the DOP853 impact map: entries and
+    multipliers to 1e-6 of the largest entry. The step shrinks with the smallest impact
+    velocity, since the map's curvature grows like 1/u."""
+    _check_fd(FAST_ORBIT_CASES, 0.05)
+
+
+@pytest.mark.slow
+def test_multipliers_match_finite_differences_all_cases():
+    _check_fd(ORBIT_CASES, 0.002)
 
 
 def test_state_is_on_the_wall_at_impacts_and_below_it_between():
@@ -362,11 +398,11 @@ def test_grazing_edge_of_the_11_motion():
 # ------------------------------------------------------------------------------------------
 # completeness: nothing missed, nothing repeated
 
-FAST_EXHAUSTIVE = [(1, 1, 0.2, -0.6), (2, 1, 1.0, 0.1)]
+FAST_EXHAUSTIVE = [(1, 1, 0.2, -0.6), (2, 1, 0.7, -0.3)]
 SLOW_EXHAUSTIVE = [
     (1, 1, 1.2, 0.5), (1, 1, 2.0, 1.0), (1, 1, 0.3, -0.6), (2, 1, 1.5, 1.0), (2, 1, 0.7, -0.3),
     (2, 1, 1.0, 0.0), (2, 1, 3.0, 0.0), (1, 2, 0.4, 0.3), (1, 2, 0.2, -0.1), (1, 3, 0.3, 0.4),
-    (3, 1, 0.8, -0.4), (3, 1, 0.2, -0.6), (2, 2, 1.2, 2.1),
+    (3, 1, 0.8, -0.4), (3, 1, 0.2, -0.6), (2, 2, 1.2, 2.1), (2, 2, 1.2, 0.5), (2, 1, 1.0, 0.1),
 ]
 
 
@@ -385,8 +421,8 @@ def _check_exhaustive(m, n, ib, d, nt, nu):
 
 @pytest.mark.parametrize("m, n, ib, d", FAST_EXHAUSTIVE)
 def test_exhaustive_search_finds_nothing_missed(m, n, ib, d):
-    """Brute force over (phase, velocity) of the m-fold impact map (80 x 80 cells)."""
-    _check_exhaustive(m, n, ib, d, 80, 80)
+    """Brute force over (phase, velocity) of the m-fold impact map (70 x 70 cells)."""
+    _check_exhaustive(m, n, ib, d, 70, 70)
 
 
 @pytest.mark.slow
@@ -473,13 +509,17 @@ def test_eps_zero_rank_one_map():
 # the domain map
 
 def test_orbit_map_agrees_with_pointwise_calls():
-    """Every cell of a small map classifies exactly as periodic_orbits at that point."""
+    """The map's cells classify as periodic_orbits does at the same point: every cell for
+    m <= 2 (the map runs the same global scan there); for (3/1), whose map scans only every
+    4th delta and follows branches in between, at least 98% of the cells, and a cell may only
+    lack solutions, never invent them."""
     inv_beta = np.array([0.3, 0.8, 1.0, 1.5, 2.2])
-    delta = np.round(np.arange(-1.0, 2.01, 0.1), 10)
+    delta = np.round(np.arange(-1.0, 2.0, 0.02), 10)
     types = [(1, 1), (2, 1), (1, 2), (3, 1)]
     r = orbit_map(inv_beta, delta, types, ZETA, EPS)
     assert r["exists"].shape == (4, inv_beta.size, delta.size)
     for t, (m, n) in enumerate(types):
+        agree = 0
         for i, ib in enumerate(inv_beta):
             for j, d in enumerate(delta):
                 allsol = periodic_orbits(m, n, 1 / ib, d, ZETA, EPS, include_inadmissible=True)
@@ -487,16 +527,21 @@ def test_orbit_map_agrees_with_pointwise_calls():
                 stable = [o for o in adm if o.stable]
                 reason = 0 if stable else 1 if not allsol else 2 if not adm else 3
                 where = (m, n, ib, d)
-                assert r["n_solutions"][t, i, j] == len(adm), where
-                assert r["n_stable"][t, i, j] == len(stable), where
-                assert r["reason"][t, i, j] == reason, where
-                assert r["exists"][t, i, j] == bool(adm), where
-                if adm:
+                same = (r["n_solutions"][t, i, j] == len(adm)
+                        and r["n_stable"][t, i, j] == len(stable)
+                        and r["reason"][t, i, j] == reason
+                        and r["exists"][t, i, j] == bool(adm))
+                if m <= 2:
+                    assert same, where
+                assert r["n_solutions"][t, i, j] <= len(adm), where
+                agree += same
+                if same and adm:
                     lam = min(o.lam for o in adm)
                     assert r["lam"][t, i, j] == pytest.approx(lam, rel=1e-9)
                     assert r["S"][t, i, j] == pytest.approx(100 * (1 - lam), rel=1e-9)
-                else:
+                elif not r["exists"][t, i, j]:
                     assert np.isnan(r["lam"][t, i, j])
+        assert agree >= 0.98 * inv_beta.size * delta.size, (m, n, agree)
 
 
 def test_orbit_map_validates_input():

@@ -156,7 +156,7 @@ def test_start_at_rest_on_wall_zero_play(r0):
 # --------------------------------------------------------------------------------------------
 
 # |overshoot| (max of the impact-free x minus delta) below which either answer is accepted:
-# float64 evaluates x near the wall to a few ulp (X_ERR ~ 1e-15); 1e-12 is 1000 times that.
+# float64 evaluates x near the wall to ~1e-15 (a few ulp); 1e-12 is 1000 times that.
 # Above it, the impact's time and speed get the slow-impact allowance of _assert_impacts_match
 # (u = sqrt(2 |x''| overshoot)).
 GRAZE_AMBIGUOUS = 1e-12
@@ -271,7 +271,7 @@ def test_chatter_accumulates_sticks_and_releases(eps):
     # stick start = accumulation point; 1e-8 allows the simulator a closed-form tail from a
     # threshold speed u_c with error O(u_c^2 + round-off / u_c)
     assert abs(res.stick_start[0] - t_stick) <= 1e-8, (res.stick_start[0], t_stick)
-    # release: a linear crossing; float64 locates it to a few ulp of tau ~ 10 (1e-12 = 500 ulp)
+    # release: a linear crossing; float64 locates it to a few ulp of tau ~ 20 (1e-12 = 280 ulp)
     assert len(res.stick_end) >= 1
     assert abs(res.stick_end[0] - t_release) <= 1e-12, (res.stick_end[0], t_release)
     assert abs(float(ref["stick_end"][0]) - t_release) <= 1e-25
@@ -344,12 +344,21 @@ def _arrays(res):
             res.stick_start, res.stick_end, res.grid_time, res.a]
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+# derandomized: the same examples on every run (house habit 3); database off: no state
+@settings(max_examples=40, deadline=None, derandomize=True, database=None,
+          suppress_health_check=[HealthCheck.too_slow])
 @given(_runs())
 @example(dict(zeta=0.05, eps=0.0, delta=0.2, noise=np.full(50, 1.0), dt=0.1, amplitude=0.0,
               beta=1.0, x0=0.0, v0=0.0))
 @example(dict(zeta=0.05, eps=1.0, delta=0.2, noise=np.full(50, 0.0), dt=0.1, amplitude=1.0,
               beta=1.0, x0=None, v0=1.0))
+# found by hypothesis: plastic impact a hair above the rest position (delta = 1e-300)
+@example(dict(zeta=0.5, eps=0.0, delta=1e-300, noise=np.zeros(5), dt=0.05, amplitude=0.0,
+              beta=1.0, x0=0.0, v0=1.0))
+# found by hypothesis: plastic impact while the force pulls away from the wall
+@example(dict(zeta=0.5, eps=0.0, delta=0.0, noise=np.array(
+    [1.31510376, 0.35738041, -1.20831863, -0.00445413]), dt=0.05, amplitude=0.0, beta=1.0,
+    x0=-0.06551852748551895, v0=0.465048340015933))
 def test_invariants(run):
     res = simulate(**run, record_every=1)
     dt = run["dt"]
@@ -371,6 +380,17 @@ def test_invariants(run):
     for a, b in zip(_arrays(res), _arrays(again)):
         assert a.tobytes() == b.tobytes()  # bit-identical
     assert (res.x_end, res.v_end, res.stuck_end) == (again.x_end, again.v_end, again.stuck_end)
+
+
+def test_elastic_bounces_pressed_on_wall_terminate():
+    """eps = 1 with the force pressing the mass on the wall (f - delta = 0.6 > 0): damping
+    shrinks the bounces only like 1/k, so they do not accumulate in finite time but their
+    number grows like exp(2 zeta tau / 3); the simulator must still return (MODEL.md: never
+    hang) with the mass at the wall."""
+    res = simulate(0.6, 1.0, -0.6, np.zeros(401), 0.1, x0=-1.5, record_every=1)
+    assert np.all(res.a >= -1e-12)
+    # bounce heights w^2 / (2 F) with w ~ 3 F / (4 zeta k): far below 1e-3 after 1e4 bounces
+    assert res.a[-1] < 1e-3
 
 
 INVALID = [

@@ -12,7 +12,7 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
-FIGURES = [f"fig{n:02d}" for n in range(3, 10)]
+FIGURES = [f"fig{n:02d}" for n in range(3, 10)] + ["fig16"]
 
 
 def _workdir(tmp_path):
@@ -59,6 +59,11 @@ def test_dry_run_every_figure(workdir, fig):
 
 def test_fig04_needs_only_the_noise(workdir):
     assert scheduled_rules(workdir, "results/figures/fig04.png") == {"noise", "fig04", "paper_figure"}
+
+
+def test_fig16_runs_no_simulation(workdir):
+    assert scheduled_rules(workdir, "results/figures/fig16.png") == {
+        "orbit_tile", "aggregate_orbits", "fig16", "paper_figure"}
 
 
 def test_fig07_records_no_spectra(workdir):

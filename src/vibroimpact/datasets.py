@@ -132,3 +132,33 @@ def trace_dataset(tr, attrs):
              impact_velocity=("impact", tr["impact_velocity"])),
         coords=dict(tau=tr["tau"]), attrs=attrs)
     return _annotate(ds)
+
+
+ORBIT_META = {
+    "type": ("impact motion (m/n)", "1"),
+    "exists": ("an admissible periodic motion exists", "1"),
+    "n_solutions": ("number of admissible periodic motions", "1"),
+    "n_stable": ("number of stable admissible periodic motions", "1"),
+    "lam": ("|lambda| = max|mu|^(1/m) of the most stable admissible motion (eq. 20)", "1"),
+    "S": ("degree of stability S = 100 (1 - |lambda|) of the most stable motion (eq. 24)", "%"),
+    "reason": ("0 stable / 1 no solution / 2 only inadmissible / 3 only unstable", "1"),
+}
+
+
+def orbit_map_dataset(result, attrs):
+    """Dataset of :func:`vibroimpact.orbits.orbit_map` output over ``(type, inv_beta, delta)``."""
+    types = [f"{m}/{n}" for m, n in result["types"]]
+    dims = ("type", "inv_beta", "delta")
+    ds = xr.Dataset({name: (dims, result[name]) for name in ORBIT_META if name != "type"},
+                    coords=dict(type=types, inv_beta=result["inv_beta"], delta=result["delta"]),
+                    attrs=dict(attrs, reason_codes="0 stable, 1 no solution, 2 inadmissible, 3 unstable"))
+    ds["exists"] = ds["exists"].astype("int8")    # netCDF has no bool
+    for name, (long_name, units) in {**META, **ORBIT_META}.items():
+        if name in ds.variables:
+            ds[name].attrs.update(long_name=long_name, units=units)
+    return ds
+
+
+def concat_orbit_tiles(tiles):
+    """Join orbit-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
+    return xr.concat(tiles, dim="inv_beta").sortby("inv_beta")

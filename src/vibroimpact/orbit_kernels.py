@@ -28,7 +28,8 @@ MAX_SOLUTIONS = 64           # capacity per (m/n) type and parameter point
 # axis of a 2-D scan); the map also follows branches, so it affords a coarser scan.
 SCAN_STEP_M2 = 0.02
 SCAN_STEP_M3 = 0.12
-MAP_SCAN_STEP_M2 = 0.05
+EDGE_LEVELS = 6              # m = 2 scan: extra nodes at 10^-6 .. 10^-1 steps from both ends
+MAP_SCAN_STEP_M2 = SCAN_STEP_M2   # m = 2 scans are cheap: the map scans every point
 MAP_SCAN_STEP_M3 = 0.25
 MAP_SCAN_EVERY = 4           # map: global scan at every 4th delta; branches followed in between
 FLIGHT_PHASE_STEP = 0.5      # admissibility: initial bracketing step (radians), refined by bounds
@@ -662,28 +663,37 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     nvec = np.empty(ncol)
     zs = np.empty(m)
     if m == 2:
+        # nodes: uniform inside, geometric towards both ends (z_1 -> 0 and z_2 -> 0), where a
+        # solution with a very short flight lives and a zero-length flight makes K singular
         npt = max(16, int(ceil(z * fast / scan_step)))
-        gval = np.empty((2, npt + 1))
-        for k in range(npt + 1):
-            zs[0] = z * k / npt
+        nodes = np.empty(npt + 2 * EDGE_LEVELS)
+        for k in range(EDGE_LEVELS):
+            nodes[k] = z / npt * 10.0 ** (k - EDGE_LEVELS)
+            nodes[npt + 2 * EDGE_LEVELS - 1 - k] = z - nodes[k]
+        for k in range(npt):
+            nodes[EDGE_LEVELS + k] = z * (k + 0.5) / npt
+        nnode = nodes.shape[0]
+        gval = np.empty((2, nnode))
+        for k in range(nnode):
+            zs[0] = nodes[k]
             zs[1] = z - zs[0]
             _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
             _cofactors(kmat, 0, ncol, sub, nvec)
             gval[0, k], gval[1, k] = _circle_factors(nvec, ncol, delta, q)
         for f in range(2):
             sign = 1.0 if f == 0 else -1.0
-            for k in range(npt):
+            for k in range(nnode - 1):
                 h0 = gval[f, k]
                 h1 = gval[f, k + 1]
                 cand = -1.0
                 if h0 * h1 <= 0.0 and h0 != h1:
-                    cand = (k + h0 / (h0 - h1)) / npt
+                    cand = nodes[k] + (nodes[k + 1] - nodes[k]) * h0 / (h0 - h1)
                 elif (0 < k and abs(h0) < 0.3 and abs(h0) <= abs(gval[f, k - 1])
                       and abs(h0) <= abs(h1)):
-                    cand = k / npt
-                if cand <= 0.0 or cand >= 1.0:
+                    cand = nodes[k]
+                if cand <= 0.0 or cand >= z:
                     continue
-                zs[0] = z * cand
+                zs[0] = cand
                 zs[1] = z - zs[0]
                 count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub,
                                               nvec, y, sols, count, work, jac)
@@ -788,8 +798,9 @@ def _follow_back(y0, m, n, beta, deltas, d_from, d_stop, zeta, eps, sols, counts
 def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best, reason):
     """One row of the map: all types at ``beta`` for every delta.
 
-    For m >= 2 the global interval scan runs every ``MAP_SCAN_EVERY`` points of delta (and at
-    the last); in between, the solutions of the previous point seed Newton (branch following
+    For m = 2 the global interval scan runs at every point, as in ``periodic_orbits``. For
+    m = 3 it runs every ``MAP_SCAN_EVERY`` points of delta (and at the last, and wherever a
+    branch ends); in between, the solutions of the previous point seed Newton (branch following
     upward in delta), and every solution found by a scan is followed back down to the previous
     scan, so a branch born between two scans is filled in as well.
     """
@@ -810,7 +821,7 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
         for d in range(nd):
             prev = d - 1 if d > 0 else 0
             nseed = counts[prev] if d > 0 else 0
-            scan = d % MAP_SCAN_EVERY == 0 or d == nd - 1
+            scan = m == 2 or d % MAP_SCAN_EVERY == 0 or d == nd - 1
             counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
                                    scan_step if scan else 0.0, sols[d])
             if m > 1 and not scan and counts[d] < nseed:

@@ -118,3 +118,31 @@ def figure(name, inputs, out_png, **options):
     with plotting.style():
         fig = getattr(plotting, name)(*[xr.load_dataset(p) for p in inputs], **options)
         plotting.save(fig, out_png)
+
+
+def orbit_rows(entry):
+    """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
+    from vibroimpact.study import grid_values
+
+    rows = grid_values(entry["inv_beta"])
+    return rows, -(-rows.size // int(entry["tile_rows"]))
+
+
+def orbit_tile(entry, tile, out, provenance):
+    """Rule ``orbit_tile``: existence and stability of (m/n) motions on some ``inv_beta`` rows."""
+    from vibroimpact.orbits import orbit_map
+    from vibroimpact.study import grid_values
+
+    rows, n_tiles = orbit_rows(entry)
+    result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
+                       types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
+                       eps=float(entry["eps"]))
+    attrs = dict(provenance, zeta=float(entry["zeta"]), eps=float(entry["eps"]), amplitude=1.0)
+    io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
+
+
+def aggregate_orbits(tiles, out, provenance):
+    """Rule ``aggregate_orbits``: the orbit map of one entry from its tiles."""
+    ds = datasets.concat_orbit_tiles([xr.load_dataset(p) for p in tiles])
+    ds.attrs.update(provenance)
+    io.write_dataset(ds, out)

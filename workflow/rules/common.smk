@@ -3,6 +3,7 @@ import subprocess
 
 from vibroimpact.io import config_digest, provenance
 from vibroimpact.study import Study
+from vibroimpact.tasks import orbit_rows
 
 
 wildcard_constraints:
@@ -18,11 +19,13 @@ def _check_references():
         if entry["noise"] not in config["noises"]:
             raise ValueError(f"studies.{name}.noise: unknown noise {entry['noise']!r}; "
                              f"allowed: {sorted(config['noises'])}")
+    owners = {**config["studies"], **config["orbits"]}
     for fig, name in config.get("paper_figures", {}).items():
-        if name not in config["studies"]:
-            raise ValueError(f"paper_figures.{fig}: unknown study {name!r}; allowed: {sorted(config['studies'])}")
-        if fig not in config["studies"][name]["figures"]:
-            raise ValueError(f"paper_figures.{fig}: study {name!r} does not list {fig} in its figures")
+        if name not in owners:
+            raise ValueError(f"paper_figures.{fig}: unknown study or orbits entry {name!r}; "
+                             f"allowed: {sorted(owners)}")
+        if fig not in owners[name]["figures"]:
+            raise ValueError(f"paper_figures.{fig}: {name!r} does not list {fig} in its figures")
 
 
 _check_references()
@@ -75,8 +78,21 @@ def paper_figure_sources(wildcards):
     return {ext: f"results/figures/{study}/{wildcards.fig}.{ext}" for ext in ("png", "pdf")}
 
 
+def orbits_entry(wildcards):
+    return config["orbits"][wildcards.study]
+
+
+def orbits_provenance(wildcards):
+    return provenance(config_digest(config["orbits"][wildcards.study]), GIT_COMMIT)
+
+
+def orbit_tiles(wildcards):
+    _, n = orbit_rows(config["orbits"][wildcards.study])
+    return [f"results/orbits/{wildcards.study}/tiles/{t}.nc" for t in range(n)]
+
+
 def all_targets():
     targets = [f"results/figures/{fig}.png" for fig in config.get("paper_figures", {})]
-    for name, entry in config["studies"].items():
+    for name, entry in {**config["studies"], **config["orbits"]}.items():
         targets += [f"results/figures/{name}/{fig}.png" for fig in entry["figures"]]
     return targets

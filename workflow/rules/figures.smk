@@ -134,3 +134,20 @@ rule paper_figure:
     shell:
         "(cp {input.png} {output.png}.tmp && cp {input.pdf} {output.pdf}.tmp"
         " && mv {output.png}.tmp {output.png} && mv {output.pdf}.tmp {output.pdf}) > {log} 2>&1"
+
+
+rule fig16:
+    input:
+        "results/orbits/{study}.nc",
+    output:
+        png="results/figures/{study}/fig16.png",
+        pdf="results/figures/{study}/fig16.pdf",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/figures/{study}/fig16.log",
+    params:
+        figure="fig16",
+        options={},
+    script:
+        "../scripts/figure.py"
