@@ -42,8 +42,14 @@ MAX_SEARCH = 400
 #: Estimated error (in time) below which the remaining geometric tail of a chatter sequence is
 #: summed in closed form and the mass is set sticking at the accumulation point.
 CHATTER_TIME_TOL = 1e-12
-#: Elastic (eps = 1) micro-bounces shorter than this are taken as resting contact.
-ELASTIC_MICRO_FLIGHT = 1e-10
+#: Elastic (eps = 1) micro-bounces shorter than this are taken as resting contact: with eps = 1
+#: a pressed mass loses bounce energy only to damping, so bounces shrink like 1/k and never
+#: accumulate; a flight of 1e-6 rises ~1e-13 F above the wall.
+ELASTIC_MICRO_FLIGHT = 1e-6
+#: After this many events in one step (eps very close to 1: chatter of ~1e5 impacts spread over
+#: many steps), rebounds lower than MICRO_HEIGHT * (1 + |delta|) are taken as resting contact.
+MANY_EVENTS = 4096
+MICRO_HEIGHT = 1e-12
 #: Impacts and sticking events one step may write; the driver flushes buffers before a step
 #: when less room than this is left.
 STEP_HEADROOM = 1 << 16
@@ -69,14 +75,14 @@ TOUCH = 2   # reaches the wall with zero velocity (grazing within round-off)
 PRESSED = 3  # at the wall, at rest, pushed into it: sticks
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _split(a):
     c = 134217729.0 * a
     hi = c - (c - a)
     return hi, a - hi
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def two_prod(a, b):
     """Error-free product: ``a * b = p + e`` exactly (Dekker)."""
     p = a * b
@@ -86,7 +92,7 @@ def two_prod(a, b):
     return p, e
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def phase(k, s, bh_hi, bh_lo, beta):
     """``beta * (k h + s)`` reduced to about ``[-pi, pi]``, exact to round-off for any ``k``.
 
@@ -100,7 +106,7 @@ def phase(k, s, bh_hi, bh_lo, beta):
     return ((p - q) - qe) + (e - n * TWO_PI_LO) + beta * s
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def sincos(x):
     """``(sin x, cos x)``: Taylor polynomials for ``|x| <= 0.25`` (error < 1e-19 relative,
     below round-off), libm beyond. Flights between samples have small arguments, and one
@@ -115,7 +121,7 @@ def sincos(x):
     return s, c
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def expm1(x):
     """``exp(x) - 1``: Taylor polynomial for ``|x| <= 0.0625`` (error < 1e-19), libm beyond."""
     if abs(x) > 0.0625:
@@ -124,7 +130,7 @@ def expm1(x):
         1.0 / 720 + x * (1.0 / 5040 + x * (1.0 / 40320 + x * (1.0 / 362880)))))))))
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def segment(x0, v0, s, r0, b, theta_k, P):
     """Coefficients of the closed-form motion from state ``(x0, v0)`` at offset ``s`` of a step.
 
@@ -157,7 +163,7 @@ def segment(x0, v0, s, r0, b, theta_k, P):
             r0 + b * s)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def seg_eval(sig, c, P):
     """``(x - delta, x', x'')`` at ``sig`` after the segment start, in difference form.
 
@@ -186,7 +192,7 @@ def seg_eval(sig, c, P):
     return g, v, f - 2.0 * zeta * v - (g + delta)
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _bounds(c, P):
     """Bounds on ``|x''|, |x'''|, |x''''|`` over a segment, and scales for tolerances."""
     Aq, beta = abs(P[7]), P[6]
@@ -198,7 +204,7 @@ def _bounds(c, P):
     return M2, M3, M4, vscale
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _hermite_guess(w, glo, vlo, ghi, vhi):
     """Root in ``(0, w)`` of the cubic Hermite interpolant of ``g`` (a start for Newton)."""
     t = glo / (glo - ghi)
@@ -218,7 +224,7 @@ def _hermite_guess(w, glo, vlo, ghi, vhi):
     return t * w
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, c, P):
     """Unique root of the increasing ``g`` in ``[lo, hi]`` (``g(lo) < 0 <= g(hi)``) to round-off.
 
@@ -250,7 +256,7 @@ def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, c, P):
     return s, v
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _quad_root(ga, va, K):
     """First positive root of ``ga + va s + K s^2 / 2`` with ``ga <= 0`` (``inf`` if none)."""
     if ga == 0.0:
@@ -264,7 +270,7 @@ def _quad_root(ga, va, K):
     return -2.0 * ga / den if den > 0.0 else np.inf
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def safe_step(ga, va, acc, M3, wmax):
     """Longest ``s <= wmax`` proved free of contact from a point where ``g = ga <= 0``.
 
@@ -292,7 +298,7 @@ def safe_step(ga, va, acc, M3, wmax):
     return best
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _newton_from(a, ga, va, acc, M3, H):
     """Length ``d`` of an interval ``[a, a + d]`` proved to hold exactly one root, or 0.
 
@@ -311,7 +317,7 @@ def _newton_from(a, ga, va, acc, M3, H):
     return 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _newton_unique(lo, hi, g, v, acc, tolg, c, P):
     """Root of ``g`` in ``[lo, hi]``, where it is proved unique with ``g' > 0``; start at ``lo``.
 
@@ -338,13 +344,13 @@ def _newton_unique(lo, hi, g, v, acc, tolg, c, P):
     return s, v
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def tolg_wall(c, P):
     """Round-off of ``x - delta`` near the wall: separations below it are not resolvable."""
     return 16.0 * EPS64 * (abs(P[3]) + abs(c[16]) + abs(P[7]) + c[9])
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def first_contact(c, P, H, at_wall):
     """Smallest ``sig`` in ``(0, H]`` where the segment's motion reaches the wall.
 
@@ -447,7 +453,7 @@ def first_contact(c, P, H, at_wall):
     return TOUCH, a, va, 0.0
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def push_eval(sig, c, P):
     """``F = f - delta`` and ``dF/dtau`` at ``sig`` after the segment start, in difference form."""
     A, beta = P[5], P[6]
@@ -461,7 +467,7 @@ def push_eval(sig, c, P):
     return F, dF
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def push_recovery(c, P, H):
     """First ``sig`` in ``(0, H]`` where ``F = f - delta`` (negative at the start) is back to
     ``>= 0``, approached from the left by steps proved safe by ``|F''| <= A beta^2``; ``-1``
@@ -482,7 +488,7 @@ def push_recovery(c, P, H):
     return a
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def release_time(c, P, H):
     """First ``sig`` in ``[0, H]`` after which ``f - delta`` turns negative (the mass leaves).
 
@@ -541,14 +547,14 @@ def release_time(c, P, H):
     return a
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def _record_event(buf_step, buf_off, buf_val, n, k, s, val):
     buf_step[n] = k
     buf_off[n] = s
     buf_val[n] = val
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
               stk_kind, cnt, ftot):
     """Advance one force sample step ``[k h, k h + H]`` through every event in it.
@@ -583,8 +589,10 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
                 tail = 2.0 * wv / F
                 ok = tail <= ELASTIC_MICRO_FLIGHT
             F_end = F + dF * tail - 0.5 * abs(P[5]) * P[6] * P[6] * tail * tail
-            if ok and tail <= Hs and F_end > 0.0:
-                s = s + tail
+            micro = n_events >= MANY_EVENTS and wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
+            if (ok and tail <= Hs and F_end > 0.0) or micro:
+                if not micro:
+                    s = s + tail
                 cnt[2] += 1
                 mode = STUCK
                 _record_event(stk_step, stk_off, stk_kind, cnt[1], k, s, 1.0)
@@ -633,7 +641,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
     return x, v, mode, OK
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")
 def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
               stk_kind, cnt, ftot, grid, grid_v, stride, grid_n):
     """Advance the oscillator over the force samples ``r`` (``r[0]`` is sample ``k_begin``).
@@ -716,6 +724,8 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             return BAD_NOISE, k
         # events are written only here: make sure the buffers have room for a whole step
         if cnt[0] + STEP_HEADROOM > cap_imp or cnt[1] + STEP_HEADROOM > cap_stk:
+            if stride > 0 and k % stride == 0:
+                grid_n[0] -= 1      # sample k is recorded again when the step is resumed
             state[0] = w
             state[1] = wv
             state[2] = mode

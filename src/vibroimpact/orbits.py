@@ -18,6 +18,15 @@ Method
   the velocity (``orbit_kernels.flight_max``).
 - Stability: the analytic one-period Jacobian ``T = T_m ... T_1`` of the impact map, whose
   determinant is ``eps^(2m) exp(-2 zeta z)``.
+- Map (``orbit_map``): rows of constant 1/beta run in parallel; along a row the solutions of
+  the previous delta seed Newton (branch following). m = 2 also runs the global scan at every
+  point; m = 3 runs it every ``orbit_kernels.MAP_SCAN_EVERY`` points, wherever a branch ends,
+  and follows every branch a scan finds back to the previous scan.
+
+Limits: for m = 3 the scan nodes keep a third of a step (~0.04 / max(beta, 1) in time) off the
+edges of the interval triangle, so a (3/n) solution with a flight shorter than that (an orbit
+at the edge of its existence, next to chatter) can be missed by a single call; the map may
+still reach it by following its branch.
 
 eps = 0: every impact leaves the mass on the wall at rest; the motion is still a free flight
 when the force pulls it off at once, and only then is it an orbit here (a flight whose
@@ -274,6 +283,8 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
     if deltas.size == 0 or not np.all(np.isfinite(deltas)):
         raise ValueError("delta must be a non-empty array of finite numbers")
     tarr = []
+    if len(types) == 0:
+        raise ValueError("types must hold at least one (m, n) pair")
     for t in types:
         if len(t) != 2:
             raise ValueError(f"types must be (m, n) pairs, got {t!r}")

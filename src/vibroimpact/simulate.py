@@ -228,6 +228,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             buf.grid_v[buf.grid_n[0]] = v
             buf.grid_n[0] += 1
         if final and rem > 0.0:
+            buf.drain(parts)       # the partial step may write up to STEP_HEADROOM events
             if noise is None:
                 r_last = (0.0, 0.0)
             else:
