@@ -865,8 +865,14 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
 
 
 @njit(cache=True, parallel=True)
-def map_kernel(inv_beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best, reason):
-    """Fill the domain-map arrays, one row of ``inv_beta`` per task, continuing along delta."""
-    for ib in prange(inv_beta.shape[0]):
+def map_kernel(inv_beta, deltas, types, zeta, eps, row_order, exists, n_sol, n_stab, lam_best,
+               reason):
+    """Fill the domain-map arrays, one row of ``inv_beta`` per task, continuing along delta.
+
+    ``row_order`` is a permutation of the rows: the cost of a row grows with 1/beta, so
+    interleaving the rows balances the threads' contiguous chunks.
+    """
+    for k in prange(row_order.shape[0]):
+        ib = row_order[k]
         _map_row(ib, 1.0 / inv_beta[ib], deltas, types, zeta, eps, exists, n_sol, n_stab,
                  lam_best, reason)

@@ -40,6 +40,7 @@ import math
 import numbers
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from vibroimpact import orbit_kernels as ok
@@ -298,8 +299,10 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
     n_stab = np.zeros(shape, dtype=np.int64)
     lam = np.full(shape, np.nan)
     reason = np.zeros(shape, dtype=np.int8)
-    ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), exists, n_sol, n_stab, lam,
-                  reason)
+    threads = numba.get_num_threads()
+    row_order = np.argsort(np.arange(inv_beta.size) % threads, kind="stable")
+    ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), row_order, exists, n_sol,
+                  n_stab, lam, reason)
     return {
         "exists": exists, "n_solutions": n_sol, "n_stable": n_stab, "lam": lam,
         "S": 100.0 * (1.0 - lam), "reason": reason,
