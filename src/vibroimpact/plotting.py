@@ -44,6 +44,8 @@ STYLE_FILE = Path(__file__).with_name("vibroimpact.mplstyle")
 #: Upper end of the frequency axis of the response spectra (figs 6, 11, 12): the resonance
 #: of the impacting system lies below 2.5 for every delta the studies use.
 SPECTRUM_BETA_MAX = 4.0
+#: Lower end of the log density axis of figs 7, 8, 13, 14, relative to the highest density.
+DENSITY_DECADES = 1e-5
 #: Confidence bars are +-Z_95 standard errors (normal 95 % quantile).
 Z_95 = 1.96
 #: Part of the colour map used for a family of curves (the top end of viridis is too pale).
@@ -297,9 +299,17 @@ def _density_figure(events, i_beta, var, title, params):
         ax.plot(cell[x], y, color=color, label=rf"$\delta$ = {_num(cell['delta'])}  ({impacts})")
         if band in cell:
             half = Z_95 * np.asarray(cell[band], dtype=float)
-            ax.fill_between(cell[x], np.clip(y - half, 0.0, None), y + half, color=color,
+            ax.fill_between(cell[x], np.clip(y - half, 1e-300, None), y + half, color=color,
                             alpha=0.2, lw=0)
-    ax.set_ylim(bottom=0.0)
+    # log scale: chatter puts a tall spike at small velocities and intervals, and the
+    # distributions' tails matter as much as their bulk
+    top = np.nanmax([np.nanmax(np.asarray(ds.isel(delta=k)[var], dtype=float), initial=0.0)
+                     for k in index] + [0.0])
+    if top > 0.0:
+        ax.set_yscale("log")
+        ax.set_ylim(top * DENSITY_DECADES, top * 3.0)
+    else:
+        ax.set_ylim(bottom=0.0)
     _bin_limits(ax, ds[x])
     ax.set_xlabel(axis_label(ds[x]))
     ax.set_ylabel(axis_label(ds[var]))
@@ -726,7 +736,7 @@ def fig16(orbits):
                Patch(facecolor="white", edgecolor="0.6", label="no solution (D, V, X)")]
     if filled is not None:
         fig.colorbar(filled, ax=axes[1:].tolist(), label="degree of stability S (%)", shrink=0.8)
-    fig.legend(handles=handles, loc="lower right", fontsize=7)
+    fig.legend(handles=handles, loc="outside lower center", ncols=3, fontsize=7)
     _header(fig, "Fig. 16  Parameter domains of stable periodic impact motions",
             rf"{_system_text(orbits)};  f($\tau$) = $\sin(\beta_f\tau)$; bold: stable domain, "
             "thin: contours of S (%)")

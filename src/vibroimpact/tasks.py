@@ -8,7 +8,7 @@ import logging
 
 import xarray as xr
 
-from vibroimpact import cells, datasets, io
+from vibroimpact import datasets, io
 from vibroimpact.noise import NoiseSpec
 from vibroimpact.study import Study
 
@@ -47,6 +47,8 @@ def _physics(study, cell):
 
 def events_tile(name, entry, tile, noise_path, out, provenance):
     """Rule ``simulate_events``: impact statistics of the cells of one tile."""
+    from vibroimpact import cells    # the simulator: only the jobs that simulate load it
+
     study = Study.from_config(name, entry)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     edges = datasets.bin_edges(entry["bins"])
@@ -64,6 +66,8 @@ def events_tile(name, entry, tile, noise_path, out, provenance):
 
 def spectra_tile(name, entry, tile, noise_path, out, provenance):
     """Rule ``simulate_spectra``: Welch spectra of a(tau) for the cells of one tile."""
+    from vibroimpact import cells    # the simulator: only the jobs that simulate load it
+
     study = Study.from_config(name, entry)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spectra = entry["spectra"]
@@ -78,6 +82,8 @@ def spectra_tile(name, entry, tile, noise_path, out, provenance):
 
 def trace(name, entry, noise_path, out, provenance):
     """Rule ``simulate_trace``: a short sampled record from rest (Figs. 3, 10)."""
+    from vibroimpact import cells    # the simulator: only the jobs that simulate load it
+
     study = Study.from_config(name, entry)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = entry["trace"]
