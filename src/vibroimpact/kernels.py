@@ -225,35 +225,43 @@ def _hermite_guess(w, glo, vlo, ghi, vhi):
 
 
 @njit(cache=True, error_model="numpy")
-def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, c, P):
-    """Unique root of the increasing ``g`` in ``[lo, hi]`` (``g(lo) < 0 <= g(hi)``) to round-off.
+def _polish(lo, hi, s, g, v, acc, tolg, c, P):
+    """Root of ``g`` in ``[lo, hi]``, where it is proved unique with ``g' > 0``, to round-off.
 
-    Newton from the cubic Hermite guess, kept inside the bracket by bisection.
+    Halley's iteration (``x''`` comes free with every evaluation: cubic convergence) from
+    ``s``, where ``(g, v, acc)`` are known, kept inside the bracket by bisection. Stops when
+    the step is below round-off in ``s`` or ``|g|`` below its evaluation round-off ``tolg``.
     """
-    s = lo + _hermite_guess(hi - lo, glo, vlo, ghi, vhi)
-    if not (lo < s < hi):
-        s = 0.5 * (lo + hi)
-    g, v, _ = seg_eval(s, c, P)
     for _ in range(100):
+        if abs(g) <= tolg:
+            break
         if g < 0.0:
             lo = s
-        elif g > 0.0:
-            hi = s
         else:
-            break
-        s_new = s - g / v if v > 0.0 else 0.5 * (lo + hi)
-        if not (lo < s_new < hi):
+            hi = s
+        den = 2.0 * v * v - g * acc
+        s_new = s - 2.0 * g * v / den if (v > 0.0 and den > 0.0) else 0.5 * (lo + hi)
+        if not (lo <= s_new <= hi):
             s_new = 0.5 * (lo + hi)
         if abs(s_new - s) <= 2.0 * EPS64 * abs(s) or hi - lo <= 2.0 * EPS64 * abs(hi):
             break
         s = s_new
-        g, v, _ = seg_eval(s, c, P)
-        if abs(g) <= tolg:
-            break
+        g, v, acc = seg_eval(s, c, P)
     if g < 0.0 and hi - s <= 4.0 * EPS64 * abs(hi) + 1e-300:
         s = hi          # g changes sign between s and the next float
-        g, v, _ = seg_eval(s, c, P)
+        g, v, acc = seg_eval(s, c, P)
     return s, v
+
+
+@njit(cache=True, error_model="numpy")
+def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, c, P):
+    """Unique root of the increasing ``g`` in ``[lo, hi]`` (``g(lo) < 0 <= g(hi)``) to round-off,
+    polished from the root of the cubic Hermite interpolant of the end values."""
+    s = lo + _hermite_guess(hi - lo, glo, vlo, ghi, vhi)
+    if not (lo < s < hi):
+        s = 0.5 * (lo + hi)
+    g, v, acc = seg_eval(s, c, P)
+    return _polish(lo, hi, s, g, v, acc, tolg, c, P)
 
 
 @njit(cache=True, error_model="numpy")
@@ -315,33 +323,6 @@ def _newton_from(a, ga, va, acc, M3, H):
     if va - K * d > 0.0 and -ga - 0.5 * K * d * d > 0.0:
         return d
     return 0.0
-
-
-@njit(cache=True, error_model="numpy")
-def _newton_unique(lo, hi, g, v, acc, tolg, c, P):
-    """Root of ``g`` in ``[lo, hi]``, where it is proved unique with ``g' > 0``; start at ``lo``.
-
-    Stops when the step is below round-off in ``s`` or ``|g|`` is below its evaluation
-    round-off ``tolg``.
-    """
-    s = lo
-    for _ in range(100):
-        # Halley's step (x'' comes free with each evaluation): cubic convergence
-        den = 2.0 * v * v - g * acc
-        s_new = s - 2.0 * g * v / den if (v > 0.0 and den > 0.0) else 0.5 * (lo + hi)
-        if not (lo <= s_new <= hi):
-            s_new = 0.5 * (lo + hi)
-        if abs(s_new - s) <= 2.0 * EPS64 * abs(s) or hi - lo <= 2.0 * EPS64 * abs(hi):
-            break
-        s = s_new
-        g, v, acc = seg_eval(s, c, P)
-        if abs(g) <= tolg:
-            break
-        if g < 0.0:
-            lo = s
-        else:
-            hi = s
-    return s, v
 
 
 @njit(cache=True, error_model="numpy")
@@ -424,7 +405,7 @@ def first_contact(c, P, H, at_wall):
         d = _newton_from(a, ga, va, acc, M3, H)
         if d > 0.0:
             tolg = 4.0 * EPS64 * (abs(c[0]) + (a + d) * vscale)
-            s, u = _newton_unique(a, a + d, ga, va, acc, tolg, c, P)
+            s, u = _polish(a, a + d, a, ga, va, acc, tolg, c, P)
             return ROOT, s, u, 0.0
         if not have_end:
             gH, vH, _ = seg_eval(H, c, P)
