@@ -39,6 +39,9 @@ META = {
     "S_f": ("power spectral density of the input f(tau) (estimate, two-sided)", "1"),
     "S_lin": ("linear response |H|^2 S_f (no wall)", "1"),
     "n_segments": ("Welch segments averaged", "1"),
+    "lag": ("time lag tau*", "1"),
+    "phi_r": ("autocorrelation of the random input (estimate, eq. 8)", "1"),
+    "phi_r_target": ("autocorrelation of the random input (target)", "1"),
     "tau": ("dimensionless time tau", "1"),
     "r": ("random force r(tau)", "1"),
     "f": ("input force f(tau)", "1"),
@@ -110,16 +113,21 @@ def aggregate_events(tiles, study, attrs):
     return _annotate(ds)
 
 
-def aggregate_spectra(tiles, study, spec, attrs):
+def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
     """Spectra dataset of a study, with the linear reference ``S_lin = |H|^2 S_f``.
 
     ``spec`` is the :class:`~vibroimpact.noise.NoiseSpec` of the random force; the reference
     uses the spectrum of the piecewise-linear force the simulator integrates.
+    ``input_correlation`` is ``(lag, estimate, target)`` of the random input (eq. 8).
     """
     ds = _to_grid(tiles, study.inv_beta, study.spectra_delta)
     beta = ds["beta"].values
     S_lin = stats.linear_psd_response(beta, spec.psd_piecewise_linear(beta), study.zeta)
     ds["S_lin"] = ("beta", S_lin)
+    lag, phi, phi_target = input_correlation
+    ds = ds.assign_coords(lag=lag)
+    ds["phi_r"] = ("lag", phi)
+    ds["phi_r_target"] = ("lag", phi_target)
     ds.attrs = dict(attrs)
     return _annotate(ds)
 

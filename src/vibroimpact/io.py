@@ -128,6 +128,12 @@ def read_noise_attrs(path):
         return {k: nc.getncattr(k) for k in nc.ncattrs()}
 
 
+def read_input_correlation(path):
+    """``(lag, phi_estimate, phi_target)``: the random input's autocorrelation (eq. 8)."""
+    with netCDF4.Dataset(os.fspath(path), "r") as nc:
+        return tuple(np.asarray(nc.variables[k][:]) for k in ("lag", "phi_estimate", "phi_target"))
+
+
 def read_noise(path, max_in_memory=2**26):
     """Open a noise record: ``(samples, dt, attrs)``.
 

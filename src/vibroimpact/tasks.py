@@ -106,7 +106,8 @@ def aggregate(name, entry, kind, tiles, out, provenance, noise_path=None):
         ds = datasets.aggregate_events(parts, study, attrs)
     else:
         spec = io.noise_spec(io.read_noise_attrs(noise_path))
-        ds = datasets.aggregate_spectra(parts, study, spec, attrs)
+        ds = datasets.aggregate_spectra(parts, study, spec, attrs,
+                                        input_correlation=io.read_input_correlation(noise_path))
     io.write_dataset(ds, out)
 
 
