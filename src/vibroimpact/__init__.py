@@ -6,7 +6,7 @@ system to random force", Bull. Fac. Eng. Hokkaido Univ. 72, 13-24.
 from importlib.metadata import PackageNotFoundError, version
 
 from vibroimpact.simulate import SimulationResult, simulate, simulate_chunks
-from vibroimpact.orbits import PeriodicOrbit, periodic_orbits
+from vibroimpact.orbits import PeriodicOrbit, orbit_map, periodic_orbits
 
 try:
     __version__ = version("vibroimpact")
@@ -20,5 +20,5 @@ PAPER_REFERENCE = (
 
 __all__ = [
     "simulate", "simulate_chunks", "SimulationResult",
-    "periodic_orbits", "PeriodicOrbit", "PAPER_REFERENCE", "__version__",
+    "periodic_orbits", "PeriodicOrbit", "orbit_map", "PAPER_REFERENCE", "__version__",
 ]

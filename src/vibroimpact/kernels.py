@@ -400,6 +400,7 @@ def first_contact(c, P, H, at_wall):
     have_end = False
     gH = 0.0
     vH = 0.0
+    accH = 0.0
     for _ in range(MAX_SEARCH):
         w = H - a
         d = _newton_from(a, ga, va, acc, M3, H)
@@ -408,11 +409,13 @@ def first_contact(c, P, H, at_wall):
             s, u = _polish(a, a + d, a, ga, va, acc, tolg, c, P)
             return ROOT, s, u, 0.0
         if not have_end:
-            gH, vH, _ = seg_eval(H, c, P)
+            gH, vH, accH = seg_eval(H, c, P)
             have_end = True
-        if max(ga, gH) + 0.125 * M2 * w * w < 0.0:
+        # |x''| on [a, H]: its larger end value plus |x'''| w / 2 (sharper than M2 for short w)
+        Mloc = min(M2, (max(abs(acc), abs(accH)) + 0.5 * M3 * w) * BOUND_SAFETY)
+        if max(ga, gH) + 0.125 * Mloc * w * w < 0.0:
             return NO_ROOT, H, vH, gH
-        if gH >= 0.0 and 0.5 * (va + vH) - 0.5 * M2 * w > 0.0:
+        if gH >= 0.0 and 0.5 * (va + vH) - 0.5 * Mloc * w > 0.0:
             tolg = 4.0 * EPS64 * (abs(c[0]) + H * vscale)
             s, u = _newton_bracket(a, H, ga, va, gH, vH, tolg, c, P)
             return ROOT, s, u, 0.0
@@ -685,7 +688,14 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             wv1 = b + a21 * y0 + a22 * yv
             xmax = max(w + Aq * sp, w1 + Aq * sp1)
             R = abs(y0) + abs(yv + zeta * y0) * inv_omega
-            if xmax + (M0 + R) * h2_8 + margin < delta:
+            # two tiers: |x''| <= A q beta^2 + R (R: amplitude of the free response) is cheap;
+            # near the wall, |w''| exceeds its larger end value by at most |w'''| h/2 <= R h/2
+            # is sharper when the force samples are steep (R large)
+            clear = xmax + (M0 + R) * h2_8 + margin < delta
+            if not clear and xmax + margin < delta:
+                acc = max(abs(r0 - 2.0 * zeta * wv - w), abs(r1 - 2.0 * zeta * wv1 - w1))
+                clear = xmax + (M0 + acc + 0.5 * h * R) * BOUND_SAFETY * h2_8 + margin < delta
+            if clear:
                 w = w1
                 wv = wv1
                 sp = sp1
