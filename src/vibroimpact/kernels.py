@@ -655,6 +655,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
     cp = state[4]
     cap_imp = imp_step.shape[0]
     cap_stk = stk_step.shape[0]
+    status, k_stop = OK, k_end
     for k in range(k_begin, k_end):
         if has_h and k % RESYNC_EVERY == 0:
             psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
@@ -717,12 +718,8 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
         if cnt[0] + STEP_HEADROOM > cap_imp or cnt[1] + STEP_HEADROOM > cap_stk:
             if stride > 0 and k % stride == 0:
                 grid_n[0] -= 1      # sample k is recorded again when the step is resumed
-            state[0] = w
-            state[1] = wv
-            state[2] = mode
-            state[3] = sp
-            state[4] = cp
-            return BUFFER_FULL, k
+            status, k_stop = BUFFER_FULL, k
+            break
         x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u,
                                        stk_step, stk_off, stk_kind, cnt, ftot)
         if status != OK:
@@ -740,4 +737,4 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
     state[2] = mode
     state[3] = sp
     state[4] = cp
-    return OK, k_end
+    return status, k_stop
