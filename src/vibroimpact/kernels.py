@@ -405,7 +405,7 @@ def first_contact(c, P, H, at_wall):
         w = H - a
         d = _newton_from(a, ga, va, acc, M3, H)
         if d > 0.0:
-            tolg = 4.0 * EPS64 * (abs(c[0]) + (a + d) * vscale)
+            tolg = EPS64 * (abs(c[0]) + (a + d) * vscale)
             s, u = _polish(a, a + d, a, ga, va, acc, tolg, c, P)
             return ROOT, s, u, 0.0
         if not have_end:
@@ -416,7 +416,7 @@ def first_contact(c, P, H, at_wall):
         if max(ga, gH) + 0.125 * Mloc * w * w < 0.0:
             return NO_ROOT, H, vH, gH
         if gH >= 0.0 and 0.5 * (va + vH) - 0.5 * Mloc * w > 0.0:
-            tolg = 4.0 * EPS64 * (abs(c[0]) + H * vscale)
+            tolg = EPS64 * (abs(c[0]) + H * vscale)
             s, u = _newton_bracket(a, H, ga, va, gH, vH, tolg, c, P)
             return ROOT, s, u, 0.0
         step = safe_step(ga, va, acc, M3, w)
