@@ -16,11 +16,12 @@ force, ``p_h = A q sin(beta tau - phi)`` for the harmonic force and the damped f
 
 Impact detection is rigorous: ``|x''| <= A q beta^2 + R`` over a segment, with ``R`` the
 amplitude of ``y`` at the segment's start (``p_lin'' = 0`` and every derivative of ``y`` has
-amplitude ``<= R exp(-zeta s)``). A step is free of impacts when the bound on ``max x``
+amplitude ``<= R exp(-zeta s)``); near the wall the sharper ``|x''| <= max(|x''| at the
+ends) + |x'''| h / 2`` is tried too. A step is free of impacts when the bound on ``max x``
 from its end values (``max(x0, x1) + M h^2 / 8``) stays below the wall; otherwise the first
-root is approached from the left by steps that the same bound proves root-free, and refined
-by a bracketed Newton iteration once the bound proves the root unique. Grazing double
-crossings inside one step are therefore found, never jumped over.
+root is approached from the left by steps that a Taylor bound proves contact-free
+(:func:`safe_step`), and polished by a bracketed Halley iteration once the root is proved
+unique. Grazing double crossings inside one step are therefore found, never jumped over.
 
 Time is kept as a sample index ``k`` plus an offset ``s`` in ``[0, h]``; the harmonic phase
 ``beta (k h + s) mod 2 pi`` is computed in double-double arithmetic so that it stays exact
@@ -622,7 +623,6 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         cnt[0] += 1
         v = -eps * u
         just_hit = True
-    return x, v, mode, OK
 
 
 @njit(cache=True, error_model="numpy")

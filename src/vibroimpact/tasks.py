@@ -101,7 +101,7 @@ def aggregate(name, entry, kind, tiles, out, provenance, noise_path=None):
     parts = [xr.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs, **provenance)
     if kind == "events":
-        attrs.update(density_delta=[float(d) for d in entry.get("density_delta", study.delta[:7])],
+        attrs.update(density_delta=[float(d) for d in (entry.get("density_delta") or study.delta[:7])],
                      motion_window=float(entry["motion_window"]))
         ds = datasets.aggregate_events(parts, study, attrs)
     else:
