@@ -48,7 +48,9 @@ CHATTER_TIME_TOL = 1e-12
 #: accumulate; a flight of 1e-6 rises ~1e-13 F above the wall.
 ELASTIC_MICRO_FLIGHT = 1e-6
 #: After this many events in one step (eps very close to 1: chatter of ~1e5 impacts spread over
-#: many steps), rebounds lower than MICRO_HEIGHT * (1 + |delta|) are taken as resting contact.
+#: many steps; eps = 1 pressed on the wall with long steps), rebounds lower than
+#: MICRO_HEIGHT * (1 + |delta|), or with flights too short for the rest of the step to hold
+#: fewer than STEP_HEADROOM / 16 more of them, are taken as resting contact.
 MANY_EVENTS = 4096
 MICRO_HEIGHT = 1e-12
 #: Impacts and sticking events one step may write; the driver flushes buffers before a step
@@ -574,7 +576,9 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
                 tail = 2.0 * wv / F
                 ok = tail <= ELASTIC_MICRO_FLIGHT
             F_end = F + dF * tail - 0.5 * abs(P[5]) * P[6] * P[6] * tail * tail
-            micro = n_events >= MANY_EVENTS and wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
+            micro = n_events >= MANY_EVENTS and (
+                wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
+                or 2.0 * wv / F <= 16.0 * H / STEP_HEADROOM)
             if (ok and tail <= Hs and F_end > 0.0) or micro:
                 if not micro:
                     s = s + tail
