@@ -228,12 +228,15 @@ def _hermite_guess(w, glo, vlo, ghi, vhi):
 
 
 @njit(cache=True, error_model="numpy")
-def _polish(lo, hi, s, g, v, acc, tolg, c, P):
+def _polish(lo, hi, s, g, v, acc, tolg, M3, c, P):
     """Root of ``g`` in ``[lo, hi]``, where it is proved unique with ``g' > 0``, to round-off.
 
     Halley's iteration (``x''`` comes free with every evaluation: cubic convergence) from
     ``s``, where ``(g, v, acc)`` are known, kept inside the bracket by bisection. Stops when
     the step is below round-off in ``s`` or ``|g|`` below its evaluation round-off ``tolg``.
+    A last Halley step ``d`` so small that the next error (~ d^3) is below 1e-18 and the
+    velocity's Taylor remainder ``M3 d^2 / 2`` (``M3`` bounds the jerk) below one ulp of ``v``
+    is taken without evaluating there: the root and ``v + acc d`` are exact to round-off.
     """
     for _ in range(100):
         if abs(g) <= tolg:
@@ -246,6 +249,10 @@ def _polish(lo, hi, s, g, v, acc, tolg, c, P):
         s_new = s - 2.0 * g * v / den if (v > 0.0 and den > 0.0) else 0.5 * (lo + hi)
         if not (lo <= s_new <= hi):
             s_new = 0.5 * (lo + hi)
+        elif v > 0.0 and den > 0.0:
+            d = s_new - s
+            if abs(d) <= 1e-6 and M3 * d * d <= 2.0 * EPS64 * v:
+                return s_new, v + acc * d
         if abs(s_new - s) <= 2.0 * EPS64 * abs(s) or hi - lo <= 2.0 * EPS64 * abs(hi):
             break
         s = s_new
@@ -257,14 +264,14 @@ def _polish(lo, hi, s, g, v, acc, tolg, c, P):
 
 
 @njit(cache=True, error_model="numpy")
-def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, c, P):
+def _newton_bracket(lo, hi, glo, vlo, ghi, vhi, tolg, M3, c, P):
     """Unique root of the increasing ``g`` in ``[lo, hi]`` (``g(lo) < 0 <= g(hi)``) to round-off,
     polished from the root of the cubic Hermite interpolant of the end values."""
     s = lo + _hermite_guess(hi - lo, glo, vlo, ghi, vhi)
     if not (lo < s < hi):
         s = 0.5 * (lo + hi)
     g, v, acc = seg_eval(s, c, P)
-    return _polish(lo, hi, s, g, v, acc, tolg, c, P)
+    return _polish(lo, hi, s, g, v, acc, tolg, M3, c, P)
 
 
 @njit(cache=True, error_model="numpy")
@@ -409,7 +416,7 @@ def first_contact(c, P, H, at_wall):
         d = _newton_from(a, ga, va, acc, M3, H)
         if d > 0.0:
             tolg = EPS64 * (abs(c[0]) + (a + d) * vscale)
-            s, u = _polish(a, a + d, a, ga, va, acc, tolg, c, P)
+            s, u = _polish(a, a + d, a, ga, va, acc, tolg, M3, c, P)
             return ROOT, s, u, 0.0
         if not have_end:
             gH, vH, accH = seg_eval(H, c, P)
@@ -420,7 +427,7 @@ def first_contact(c, P, H, at_wall):
             return NO_ROOT, H, vH, gH
         if gH >= 0.0 and 0.5 * (va + vH) - 0.5 * Mloc * w > 0.0:
             tolg = EPS64 * (abs(c[0]) + H * vscale)
-            s, u = _newton_bracket(a, H, ga, va, gH, vH, tolg, c, P)
+            s, u = _newton_bracket(a, H, ga, va, gH, vH, tolg, M3, c, P)
             return ROOT, s, u, 0.0
         step = safe_step(ga, va, acc, M3, w)
         if step >= w:
