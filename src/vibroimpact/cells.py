@@ -89,7 +89,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         v_after_density=v_dens.density, v_after_density_stderr=v_dens.stderr,
         interval_density=z_dens.density, interval_density_stderr=z_dens.stderr,
         ratio_density=ratio_dens.density,
-        motion_probability=np.array([motion[stats._motion_key(mn)] for mn in MOTIONS]),
+        motion_probability=np.array(list(motion.values())),   # in the order of MOTIONS
     )
 
 

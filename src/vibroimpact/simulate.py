@@ -197,6 +197,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     stride = int(record_every)
     zeros = None if noise is not None else np.zeros(min(chunk_size, n_full + 1) + 1)
     stick_open = [None]  # start time of an unfinished sticking interval
+    buf = _Buffers(chunk_size // stride + 2 if stride else 0)   # reused by every chunk
     k0 = 0
     while True:
         k1 = min(k0 + chunk_size, n_full)
@@ -205,11 +206,8 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
         else:
             r = np.ascontiguousarray(noise[k0 : k1 + 1], dtype=np.float64)
         final = k1 == n_full
-        n_grid = 0
-        if stride:
-            n_grid = (k1 - 1) // stride - (k0 - 1) // stride if k1 > k0 else 0
-            n_grid += 1 if final and n_full % stride == 0 else 0
-        buf = _Buffers(n_grid)
+        buf.grid_n[0] = 0
+        buf.ftot[0] = 0.0
         parts = dict(imp_step=[], imp_off=[], imp_u=[], stk_step=[], stk_off=[], stk_kind=[], n_chatter=0)
         k = k0
         while k < k1:

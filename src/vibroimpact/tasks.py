@@ -10,7 +10,7 @@ import xarray as xr
 
 from vibroimpact import datasets, io
 from vibroimpact.noise import NoiseSpec
-from vibroimpact.study import Study
+from vibroimpact.study import Study, grid_values
 
 log = logging.getLogger("vibroimpact")
 
@@ -129,8 +129,6 @@ def figure(name, inputs, out_png, **options):
 
 def orbit_rows(entry):
     """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
-    from vibroimpact.study import grid_values
-
     rows = grid_values(entry["inv_beta"])
     return rows, -(-rows.size // int(entry["tile_rows"]))
 
@@ -138,7 +136,6 @@ def orbit_rows(entry):
 def orbit_tile(entry, tile, out, provenance):
     """Rule ``orbit_tile``: existence and stability of (m/n) motions on some ``inv_beta`` rows."""
     from vibroimpact.orbits import orbit_map
-    from vibroimpact.study import grid_values
 
     rows, n_tiles = orbit_rows(entry)
     result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
