@@ -11,7 +11,7 @@ between; zeta = 0.05, eps = 0.5, start at rest at min(0, delta)):
    after every impact, atol = rtol) at rtol 1e-3 ... 1e-12, and a numba fixed-step RK4 that
    clamps x to the wall, at 1 ... 64 steps per sample. Error = max over the first N comparable
    impacts (chatter tails excluded) of |impact time error| and |relative velocity error|,
-   against the mpmath reference of tests/reference.py (34 digits); N is cut where a
+   against the mpmath reference of vibroimpact.validation.reference (34 digits); N is cut where a
    float64-precision run of the reference stops agreeing with it to 1e-10;
 3. the targets of the benchmark issue as ratios (printed, not asserted).
 
@@ -26,7 +26,6 @@ import os
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # before numba loads: one thread for everybody
 
 import argparse  # noqa: E402
-import importlib.util  # noqa: E402
 import math  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
@@ -56,12 +55,9 @@ TARGET_RTOL = 1e-10
 
 
 def load_reference():
-    """The mpmath reference simulator of tests/reference.py, imported by path."""
-    path = Path(__file__).resolve().parents[1] / "tests" / "reference.py"
-    spec = importlib.util.spec_from_file_location("vibroimpact_reference", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """The mpmath reference simulator (vibroimpact.validation.reference)."""
+    from vibroimpact.validation import reference
+    return reference
 
 
 def best_time(fn, repeats):

@@ -49,3 +49,51 @@ def test_elastic_micro_bounces_end_in_contact():
     the run must end (micro-bounces below ELASTIC_MICRO_FLIGHT are resting contact)."""
     res = simulate(0.6, 1.0, -0.6, np.zeros(401), 0.1, x0=-1.5)
     assert res.stuck_end and res.stick_start.size == 1
+
+
+RELEASE_NEAR_SAMPLE = [-0.13027803983693853, -0.11302993382683199, -0.12046318579457768,
+                       -0.15342973887650074, -0.2093737715719887, -0.28278417717873827,
+                       -0.3659625028322547, -0.45000001401856266, -0.52583421712982,
+                       -0.5852593079118741, -0.621774855594811, -0.6312052781403946,
+                       -0.612023088919565, -0.5653774225904354, -0.4948568488931359,
+                       -0.40602611112508824]
+
+
+@pytest.mark.parametrize("eps", [0.5, 0.8])
+def test_release_just_before_a_sample_point(eps):
+    """Regression (issue: a release from the wall near a sample point broke the simulator).
+    The mass rests on the wall at delta = -0.45; f - delta crosses zero 1.7e-7 dt before the
+    sample at tau = 0.7 (the sample misses delta by 1.4e-8). Before the fix the release left
+    a zero-length rest of the step that was never consumed: 'more than 65536 events'.
+    It must leave at the root of the linear force (to round-off) and match the 34-digit
+    reference: no impact, final state to 1e-12."""
+    from vibroimpact.validation.reference import reference_impacts
+    r = np.array(RELEASE_NEAR_SAMPLE)
+    res = simulate(zeta=0.02, eps=eps, delta=-0.45, noise=r, dt=0.1, x0=None, v0=0.0)
+    ref = reference_impacts(0.02, eps, -0.45, r, 0.1)
+    t_release = 0.6 + 0.1 * (r[6] + 0.45) / (r[6] - r[7])
+    assert res.stick_start.tolist() == [0.0]
+    assert res.stick_end[0] == pytest.approx(t_release, abs=1e-15)
+    assert res.stick_end[0] == pytest.approx(float(ref["stick_end"][0]), abs=1e-15)
+    assert res.n_impacts == len(ref["time"]) == 0
+    assert res.x_end == pytest.approx(float(ref["x_end"]), abs=1e-12)
+    assert res.v_end == pytest.approx(float(ref["v_end"]), abs=1e-12)
+
+
+def test_gave_up_message_says_what_it_saw():
+    """When the kernel gives up on a step, the message names the step, the state, the force
+    at the step's ends and the counts, and guesses no cause."""
+    from vibroimpact import kernels
+    from vibroimpact.simulate import _raise_status
+    diag = np.array([0.05, -1e-17, -2e-9, kernels.FREE, 40000, 25534])
+    P = np.zeros(21)
+    P[3] = -0.45
+    r = np.array([0.0, 0.1, 0.2, 0.3, -0.45, -0.5, 0.0, -0.45, -0.52])
+    with pytest.raises(RuntimeError) as info:
+        _raise_status(kernels.TOO_MANY_EVENTS, 7, 0.1, r, 0, diag, P)
+    msg = str(info.value)
+    for part in ("sample 7", "40000 impacts", "25534 sticking", "x - delta = -1e-17",
+                 "x' = -2e-09", "free", "r = (-0.45, -0.52)",
+                 "f - delta at the step's ends = (0.0, -0.07"):
+        assert part in msg, (part, msg)
+    assert "eps" not in msg

@@ -1,4 +1,4 @@
-"""vibroimpact.simulate against the independent mpmath reference (tests/reference.py).
+"""vibroimpact.simulate against the independent mpmath reference (vibroimpact.validation.reference).
 
 Every tolerance is stated where it is used, with the reason for its size. Heavier variants
 of the same checks are marked ``slow``.
@@ -13,8 +13,8 @@ from mpmath import mpf
 from scipy.signal import lsim
 
 from vibroimpact import simulate
-from reference import (agreeing_prefix, chatter_tail_mask, comparable_impacts, linear_peak,
-                       reference_impacts)
+from vibroimpact.validation.reference import (agreeing_prefix, chatter_tail_mask,
+                                              comparable_impacts, linear_peak, reference_impacts)
 
 ZETA, EPS, DT = 0.05, 0.5, 0.1  # the paper's random-force study (section 3)
 

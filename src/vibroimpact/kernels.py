@@ -70,6 +70,10 @@ BAD_NOISE = 3
 # modes
 FREE = 0
 STUCK = 1
+#: Free, and exactly on the wall (x = delta, x' <= 0) at the step's start: an impact, a touch
+#: or a release fell on the end of the previous step. Kept apart from FREE so that the state
+#: is handed on exactly, not through the round-off of ``w = x - p_h``.
+WALL = 2
 
 # search results
 NO_ROOT = 0
@@ -342,6 +346,38 @@ def tolg_wall(c, P):
 
 
 @njit(cache=True, error_model="numpy")
+def leave_wall(c, P, H, tolF, M3, M4):
+    """Length of a first stretch, from rest on the wall, that is proved free of contact.
+
+    The mass is at ``g = 0`` with ``g' = 0`` within round-off and ``f - delta`` negative, or
+    zero within ``tolF`` and falling (a release point). Returns the largest length (at most
+    ``H``) proved by ``g <= g2 s^2/2 + M3 s^3/6`` (pulled off, ``g2 = x'' < 0``) or, at a
+    release point where ``g2`` is only round-off, by ``g <= g3 s^3/6 + M4 s^4/24``
+    (``g3 = x'''``). When the separation so proved stays below round-off and ``f - delta``
+    turns back in the step, returns ``-sF`` (``sF`` the instant it is back to zero): the mass
+    stays on the wall.
+    """
+    F0, g2, g3 = c[12], c[10], c[11]
+    best = 0.0
+    if F0 < -tolF:
+        best = safe_step(0.0, 0.0, min(g2, F0), M3, H)
+    if g3 < 0.0:
+        best = max(best, min(-2.0 * g3 / M4, H))
+    if best < H:
+        # the separation reached over the proved stretch: below round-off it is not resolvable
+        gap = -(min(g2, F0, 0.0) * best * best / 2.0 + min(g3, 0.0) * best * best * best / 6.0)
+        if gap <= tolg_wall(c, P):
+            sF = push_recovery(c, P, H)
+            if sF >= 0.0:
+                return -sF
+    if best <= 0.0:
+        # no bound applies (f - delta zero within round-off and x''' >= 0): the force falls
+        # by less than round-off and the mass leaves by less than round-off over the step
+        best = H
+    return best
+
+
+@njit(cache=True, error_model="numpy")
 def first_contact(c, P, H, at_wall):
     """Smallest ``sig`` in ``(0, H]`` where the segment's motion reaches the wall.
 
@@ -382,23 +418,21 @@ def first_contact(c, P, H, at_wall):
     acc = c[10]
     if at_wall:
         tolv = 64.0 * EPS64 * vscale
-        tola = 64.0 * EPS64 * M2
         if va > tolv:
             return ROOT, 0.0, va, 0.0           # starts on the wall moving into it
-        if va >= -tolv and acc < -tola and -acc * (-1.5 * acc / M3) ** 2 <= tolg_wall(c, P):
-            # pulled off the wall so weakly that the next safe step could not resolve the
-            # separation: if f - delta turns back before the mass gets a resolvable distance
-            # away, it simply stays on the wall (no creeping by microscopic steps)
-            sF = push_recovery(c, P, H)
-            if sF >= 0.0 and -acc * sF * sF <= tolg_wall(c, P):
-                return PRESSED, sF, 0.0, 0.0
-        if va < -tolv or acc < -tola:
-            sa = safe_step(0.0, min(va, 0.0), acc, M3, H)
-        elif abs(acc) <= tola and c[11] < 0.0:
-            # leaving on release (f - delta = 0, turning negative): g <= g3 s^3/6 + M4 s^4/24
-            sa = min(-2.0 * c[11] / M4, H)
+        if va >= -tolv:
+            # at rest on the wall: held or leaving by the same rule as release_time
+            tolF = force_tol(c, P)
+            if stays_on_wall(c[12], c[13], tolF):
+                return PRESSED, 0.0, 0.0, 0.0
+            sa = leave_wall(c, P, H, tolF, M3, M4)
+            if sa < 0.0:
+                # pulled off so weakly that f - delta turns back before the mass gets a
+                # resolvable distance away: it simply stays on the wall (no creeping by
+                # microscopic steps)
+                return PRESSED, -sa, 0.0, 0.0
         else:
-            return PRESSED, 0.0, 0.0, 0.0
+            sa = safe_step(0.0, va, acc, M3, H)
         a = sa
         ga, va, acc = seg_eval(a, c, P)
         if a >= H:
@@ -448,6 +482,25 @@ def first_contact(c, P, H, at_wall):
 
 
 @njit(cache=True, error_model="numpy")
+def force_tol(c, P):
+    """Round-off of ``F = f - delta`` at a segment's start: ``|F|`` below it has no sign.
+
+    The one tolerance of every decision between staying on the wall and leaving it
+    (:func:`release_time`, :func:`first_contact`, :func:`push_recovery`), so that they always
+    agree: a mass they disagreed on would be released and stuck again forever. It depends
+    on the force's size and the step length ``h``, never on the time left in the step.
+    """
+    return 8.0 * EPS64 * (abs(c[16]) + abs(P[3]) + abs(P[5]) + abs(c[2]) * P[4] + 1e-300)
+
+
+@njit(cache=True, error_model="numpy")
+def stays_on_wall(F, dF, tolF):
+    """True when a mass at rest on the wall is held there: ``f - delta > 0``, or zero within
+    round-off and not falling (a force that touches ``delta`` without crossing holds it)."""
+    return F > tolF or (F >= -tolF and dF >= 0.0)
+
+
+@njit(cache=True, error_model="numpy")
 def push_eval(sig, c, P):
     """``F = f - delta`` and ``dF/dtau`` at ``sig`` after the segment start, in difference form."""
     A, beta = P[5], P[6]
@@ -467,7 +520,7 @@ def push_recovery(c, P, H):
     ``>= 0``, approached from the left by steps proved safe by ``|F''| <= A beta^2``; ``-1``
     if it stays negative through ``H``."""
     MF = abs(P[5]) * P[6] * P[6] * BOUND_SAFETY
-    tolF = 8.0 * EPS64 * (abs(c[16]) + abs(P[3]) + abs(P[5]) + abs(c[2]) * H + 1e-300)
+    tolF = force_tol(c, P)
     a = 0.0
     Fa, dFa = c[12], c[13]
     for _ in range(MAX_SEARCH):
@@ -493,9 +546,8 @@ def release_time(c, P, H):
     MF = abs(A) * beta * beta * BOUND_SAFETY
     a = 0.0
     Fa, dFa = c[12], c[13]
-    scale = abs(c[16]) + abs(P[3]) + abs(A) + abs(c[2]) * H + 1e-300
-    tolF = 8.0 * EPS64 * scale
-    if Fa < -tolF or (Fa <= tolF and dFa < 0.0):
+    tolF = force_tol(c, P)
+    if not stays_on_wall(Fa, dFa, tolF):
         return 0.0
     Fa = max(Fa, 0.0)       # within round-off of zero and rising: still pressed
     FH, dFH = push_eval(H, c, P)
@@ -536,7 +588,7 @@ def release_time(c, P, H):
         Fa, dFa = push_eval(a, c, P)
         if Fa < 0.0:
             return a
-        if Fa <= 8.0 * EPS64 * scale and dFa < 0.0:
+        if not stays_on_wall(Fa, dFa, tolF):
             return a
     return a
 
@@ -550,25 +602,41 @@ def _record_event(buf_step, buf_off, buf_val, n, k, s, val):
 
 @njit(cache=True, error_model="numpy")
 def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-              stk_kind, cnt, ftot):
+              stk_kind, cnt, ftot, diag):
     """Advance one force sample step ``[k h, k h + H]`` through every event in it.
 
     ``x, v, mode`` is the state at the step's start. Impacts are appended to
     ``imp_*``, sticking starts (kind 1) and ends (kind 0) to ``stk_*``; ``cnt`` holds
     ``[n_impacts, n_stick_events, n_chatter]`` and ``ftot[0]`` the time in contact.
-    Returns the state at the step's end and a status.
+    Returns the state at the step's end and a status. An event that falls on the step's end
+    (``s = H`` after rounding) leaves the rest to the next step, which starts in mode
+    ``WALL``: a release, sticking onset, impact or touch at a sample point goes through the
+    same logic as anywhere else. With ``TOO_MANY_EVENTS``, ``diag`` receives what the step
+    saw: ``[offset reached, x - delta, x', mode, impacts in the step, sticking events]``.
     """
     zeta, eps, delta = P[0], P[2], P[3]
     theta_k = phase(k, 0.0, P[11], P[12], P[6]) if P[5] != 0.0 else 0.0
     s = 0.0
     n_events = 0
+    if mode == WALL:
+        mode = FREE
     at_wall = x >= delta
     if at_wall:
         x = delta
     just_hit = False
+    imp0, stk0 = cnt[0], cnt[1]
     while True:
+        if s >= H:
+            # nothing of the step is left: every path here has set x = delta
+            return delta, v, (STUCK if mode == STUCK else WALL), OK
         n_events += 1
         if n_events > STEP_HEADROOM - 2:
+            diag[0] = s
+            diag[1] = x - delta
+            diag[2] = v
+            diag[3] = mode
+            diag[4] = cnt[0] - imp0
+            diag[5] = cnt[1] - stk0
             return x, v, mode, TOO_MANY_EVENTS
         c = segment(x, v, s, r0, b, theta_k, P)
         Hs = H - s
@@ -638,12 +706,13 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
 
 @njit(cache=True, error_model="numpy")
 def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n):
+              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n, diag):
     """Advance the oscillator over the force samples ``r`` (``r[0]`` is sample ``k_begin``).
 
     ``state = [w, w', mode, sin(psi), cos(psi)]`` at sample ``k_begin``, with ``w = x - p_h``
     the displacement less the harmonic particular solution (so the fast recurrence never
-    touches the harmonic part) and ``psi = beta k h - phi``. Steps ``k_begin .. k_end - 1``
+    touches the harmonic part) and ``psi = beta k h - phi``; with mode ``WALL``, ``x = delta``
+    exactly and ``w`` is not read. Steps ``k_begin .. k_end - 1``
     are taken unless an output buffer runs short, in which case the function returns early.
     ``grid`` and ``grid_v`` receive ``a = delta - x`` and ``x'`` at every sample with
     ``k % stride == 0`` (``stride`` 0: none), counted in ``grid_n[0]``.
@@ -676,6 +745,12 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             if mode == STUCK:
                 grid[grid_n[0]] = 0.0
                 grid_v[grid_n[0]] = 0.0
+            elif mode == WALL:
+                grid[grid_n[0]] = 0.0
+                grid_v[grid_n[0]] = wv
+                if has_h:
+                    psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+                    grid_v[grid_n[0]] = wv + Aq * beta * math.cos(psi)
             elif has_h:
                 psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
                 grid[grid_n[0]] = delta - (w + Aq * math.sin(psi))
@@ -719,6 +794,12 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
                 x = w + Aq * math.sin(psi)
                 v = wv + Aq * beta * math.cos(psi)
+        elif mode == WALL:
+            x = delta
+            v = wv
+            if has_h:
+                psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+                v = wv + Aq * beta * math.cos(psi)
         else:
             x = delta
             v = 0.0
@@ -732,7 +813,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             status, k_stop = BUFFER_FULL, k
             break
         x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u,
-                                       stk_step, stk_off, stk_kind, cnt, ftot)
+                                       stk_step, stk_off, stk_kind, cnt, ftot, diag)
         if status != OK:
             return status, k
         if has_h:

@@ -155,6 +155,7 @@ class _Buffers:
         self.grid = np.empty(max(n_grid, 1))
         self.grid_v = np.empty(max(n_grid, 1))
         self.grid_n = np.zeros(1, np.int64)
+        self.diag = np.zeros(6)
 
     def drain(self, parts):
         n, m = int(self.cnt[0]), int(self.cnt[1])
@@ -168,13 +169,23 @@ class _Buffers:
         self.cnt[:] = 0
 
 
-def _raise_status(status, k, dt, r=None, k0=0):
+def _raise_status(status, k, dt, r, k0, diag, P):
     if status == kernels.BAD_NOISE:
         bad = k + 1 if np.isfinite(r[k - k0]) else k
         raise ValueError(f"noise must be finite: noise[{bad}] = {float(r[bad - k0])!r}")
     if status == kernels.TOO_MANY_EVENTS:
-        raise RuntimeError(f"more than {kernels.STEP_HEADROOM} events in the force step at tau = {k * dt!r}: "
-                           "an impact sequence that neither ends nor accumulates (eps very close to 1?)")
+        s, gap, v, mode, n_imp, n_stk = (float(d) for d in diag)
+        delta, A, beta = (float(p) for p in (P[3], P[5], P[6]))
+        r0, r1 = float(r[k - k0]), float(r[k - k0 + 1])
+        f0 = r0 + A * math.sin(beta * k * dt)
+        f1 = r1 + A * math.sin(beta * (k + 1) * dt)
+        raise RuntimeError(
+            f"gave up in the force step [{k * dt!r}, {(k + 1) * dt!r}] (sample {k}) after "
+            f"{kernels.STEP_HEADROOM - 2} events ({int(n_imp)} impacts, {int(n_stk)} sticking "
+            f"starts and ends) without reaching its end: reached offset {s!r} with "
+            f"x - delta = {gap!r}, x' = {v!r}, {'resting on the wall' if mode == kernels.STUCK else 'free'}; "
+            f"force samples r = ({r0!r}, {r1!r}), f - delta at the step's ends = "
+            f"({f0 - delta!r}, {f1 - delta!r}). Please report these inputs as a bug.")
 
 
 def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None,
@@ -214,11 +225,11 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             status, k = kernels.run_steps(r[k - k0 :], k, k1, state, P, buf.imp_step, buf.imp_off,
                                           buf.imp_u, buf.stk_step, buf.stk_off, buf.stk_kind,
                                           buf.cnt, buf.ftot, buf.grid, buf.grid_v, stride,
-                                          buf.grid_n)
+                                          buf.grid_n, buf.diag)
             if status == kernels.BUFFER_FULL:
                 buf.drain(parts)
             else:
-                _raise_status(status, k, dt, r, k0)
+                _raise_status(status, k, dt, r, k0, buf.diag, P)
         t_chunk = k1 * dt
         x, v, mode = _state_at(state, P, k1)
         if final and stride and n_full % stride == 0:
@@ -236,8 +247,8 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             b = (r_last[1] - r_last[0]) / dt
             x, v, mode, status = kernels.slow_step(
                 n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
-                buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
-            _raise_status(status, n_full, dt)
+                buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot, buf.diag)
+            _raise_status(status, n_full, dt, r_last, n_full, buf.diag, P)
             t_chunk = t_end
         buf.drain(parts)
         yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final)
@@ -249,12 +260,17 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
 def _state_at(state, P, k):
     """Displacement, velocity and mode at sample ``k`` from the kernel's state vector."""
     delta, beta, Aq = P[3], P[6], P[7]
-    if int(state[2]) == kernels.STUCK:
+    mode = int(state[2])
+    if mode == kernels.STUCK:
         return delta, 0.0, kernels.STUCK
     if Aq == 0.0:
-        return state[0], state[1], kernels.FREE
-    psi = kernels.phase(k, 0.0, P[11], P[12], beta) - P[8]
-    return state[0] + Aq * math.sin(psi), state[1] + Aq * beta * math.cos(psi), kernels.FREE
+        x, v = state[0], state[1]
+    else:
+        psi = kernels.phase(k, 0.0, P[11], P[12], beta) - P[8]
+        x, v = state[0] + Aq * math.sin(psi), state[1] + Aq * beta * math.cos(psi)
+    if mode == kernels.WALL:
+        x = delta       # exactly on the wall, not through the round-off of w + p_h
+    return x, v, mode
 
 
 def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final):
