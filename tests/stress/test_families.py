@@ -1,0 +1,46 @@
+"""The simulator's stress campaign: constructed families of singular configurations, each
+case compared event by event with the independent 34-digit reference
+(vibroimpact.validation.families; allowances in vibroimpact.validation.compare).
+
+A family fails on any exception, missed or spurious impact or contact edge, or error above its
+allowance (the worst error is reported as a fraction of its allowance: <= 1 passes). Full size
+runs in the slow suite; a few cases of each run in the fast suite to keep the machinery honest.
+"""
+import pytest
+
+from vibroimpact.validation.families import FAMILIES, FULL_CASES as FULL, run_family
+
+SEED = 20261122
+
+
+def _check(report):
+    print(report.summary())
+    assert report.cases > 0 and report.compared > 0, report.summary()
+    assert report.exceptions == 0 and report.missed == 0 and report.spurious == 0, report.details()
+    assert report.worst_error <= report.tolerance, report.details()
+    assert report.ok, report.details()
+
+
+def test_every_family_has_a_full_size():
+    assert set(FULL) == set(FAMILIES)
+
+
+@pytest.mark.parametrize("name", sorted(FAMILIES))
+def test_family_quick_sample(name):
+    _check(run_family(name, 4, SEED))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(FAMILIES))
+def test_family_full_size(name):
+    _check(run_family(name, FULL[name], SEED))
+
+
+def test_same_seed_same_cases():
+    a, b = run_family("release", 3, 5), run_family("release", 3, 5)
+    assert a.worst_case == b.worst_case and a.compared == b.compared
+
+
+def test_unknown_family_is_named():
+    with pytest.raises(ValueError, match="family must be one of"):
+        run_family("releases", 1, 0)
