@@ -602,23 +602,29 @@ def _record_event(buf_step, buf_off, buf_val, n, k, s, val):
 
 @njit(cache=True, error_model="numpy")
 def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-              stk_kind, cnt, ftot, diag):
+              stk_kind, cnt, ftot):
     """Advance one force sample step ``[k h, k h + H]`` through every event in it.
 
-    ``x, v, mode`` is the state at the step's start. Impacts are appended to
+    ``x, v, mode`` is the state at the step's start (in mode ``WALL``, ``v`` is
+    ``w' = x' - p_h'``, as :func:`run_steps` keeps it). Impacts are appended to
     ``imp_*``, sticking starts (kind 1) and ends (kind 0) to ``stk_*``; ``cnt`` holds
     ``[n_impacts, n_stick_events, n_chatter]`` and ``ftot[0]`` the time in contact.
     Returns the state at the step's end and a status. An event that falls on the step's end
     (``s = H`` after rounding) leaves the rest to the next step, which starts in mode
     ``WALL``: a release, sticking onset, impact or touch at a sample point goes through the
-    same logic as anywhere else. With ``TOO_MANY_EVENTS``, ``diag`` receives what the step
-    saw: ``[offset reached, x - delta, x', mode, impacts in the step, sticking events]``.
+    same logic as anywhere else. With ``TOO_MANY_EVENTS``, ``ftot[1:7]`` receives what the
+    step saw: ``[offset reached, x - delta, x', mode, impacts in the step, sticking events]``
+    (kept in ``ftot`` rather than an argument of its own: every argument and branch added to
+    :func:`run_steps` slows its hot loop, measured by benchmarks/ab_no_impact.py).
     """
     zeta, eps, delta = P[0], P[2], P[3]
     theta_k = phase(k, 0.0, P[11], P[12], P[6]) if P[5] != 0.0 else 0.0
     s = 0.0
     n_events = 0
     if mode == WALL:
+        # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
+        if P[5] != 0.0:
+            v += P[7] * P[6] * math.cos(theta_k - P[8])
         mode = FREE
     at_wall = x >= delta
     if at_wall:
@@ -631,12 +637,12 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             return delta, v, (STUCK if mode == STUCK else WALL), OK
         n_events += 1
         if n_events > STEP_HEADROOM - 2:
-            diag[0] = s
-            diag[1] = x - delta
-            diag[2] = v
-            diag[3] = mode
-            diag[4] = cnt[0] - imp0
-            diag[5] = cnt[1] - stk0
+            ftot[1] = s
+            ftot[2] = x - delta
+            ftot[3] = v
+            ftot[4] = mode
+            ftot[5] = cnt[0] - imp0
+            ftot[6] = cnt[1] - stk0
             return x, v, mode, TOO_MANY_EVENTS
         c = segment(x, v, s, r0, b, theta_k, P)
         Hs = H - s
@@ -706,7 +712,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
 
 @njit(cache=True, error_model="numpy")
 def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n, diag):
+              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n):
     """Advance the oscillator over the force samples ``r`` (``r[0]`` is sample ``k_begin``).
 
     ``state = [w, w', mode, sin(psi), cos(psi)]`` at sample ``k_begin``, with ``w = x - p_h``
@@ -742,15 +748,10 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             sp = math.sin(psi)
             cp = math.cos(psi)
         if stride > 0 and k % stride == 0:
-            if mode == STUCK:
+            if mode != FREE:
+                # on the wall; STUCK keeps w' = -p_h' exactly, so x' = 0 there
                 grid[grid_n[0]] = 0.0
-                grid_v[grid_n[0]] = 0.0
-            elif mode == WALL:
-                grid[grid_n[0]] = 0.0
-                grid_v[grid_n[0]] = wv
-                if has_h:
-                    psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
-                    grid_v[grid_n[0]] = wv + Aq * beta * math.cos(psi)
+                grid_v[grid_n[0]] = wv + Aq * beta * cp
             elif has_h:
                 psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
                 grid[grid_n[0]] = delta - (w + Aq * math.sin(psi))
@@ -794,15 +795,9 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
                 x = w + Aq * math.sin(psi)
                 v = wv + Aq * beta * math.cos(psi)
-        elif mode == WALL:
-            x = delta
-            v = wv
-            if has_h:
-                psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
-                v = wv + Aq * beta * math.cos(psi)
         else:
             x = delta
-            v = 0.0
+            v = wv          # w': slow_step adds p_h' in mode WALL, ignores it when STUCK
         # a non-finite sample always fails the exclusion test, so it is caught here at no cost
         if not (math.isfinite(r0) and math.isfinite(r1)):
             return BAD_NOISE, k
@@ -813,7 +808,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             status, k_stop = BUFFER_FULL, k
             break
         x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u,
-                                       stk_step, stk_off, stk_kind, cnt, ftot, diag)
+                                       stk_step, stk_off, stk_kind, cnt, ftot)
         if status != OK:
             return status, k
         if has_h:

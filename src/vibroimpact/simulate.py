@@ -151,11 +151,10 @@ class _Buffers:
         self.stk_off = np.empty(_BUFFER)
         self.stk_kind = np.empty(_BUFFER)
         self.cnt = np.zeros(3, np.int64)
-        self.ftot = np.zeros(1)
+        self.ftot = np.zeros(7)       # [time in contact, what a step that gave up saw (6)]
         self.grid = np.empty(max(n_grid, 1))
         self.grid_v = np.empty(max(n_grid, 1))
         self.grid_n = np.zeros(1, np.int64)
-        self.diag = np.zeros(6)
 
     def drain(self, parts):
         n, m = int(self.cnt[0]), int(self.cnt[1])
@@ -225,11 +224,11 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             status, k = kernels.run_steps(r[k - k0 :], k, k1, state, P, buf.imp_step, buf.imp_off,
                                           buf.imp_u, buf.stk_step, buf.stk_off, buf.stk_kind,
                                           buf.cnt, buf.ftot, buf.grid, buf.grid_v, stride,
-                                          buf.grid_n, buf.diag)
+                                          buf.grid_n)
             if status == kernels.BUFFER_FULL:
                 buf.drain(parts)
             else:
-                _raise_status(status, k, dt, r, k0, buf.diag, P)
+                _raise_status(status, k, dt, r, k0, buf.ftot[1:], P)
         t_chunk = k1 * dt
         x, v, mode = _state_at(state, P, k1)
         if final and stride and n_full % stride == 0:
@@ -245,10 +244,11 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
                 if not all(map(math.isfinite, r_last)):
                     raise ValueError(f"noise must be finite near sample {n_full}")
             b = (r_last[1] - r_last[0]) / dt
+            mode = kernels.FREE if mode == kernels.WALL else mode   # x = delta, v is x' itself
             x, v, mode, status = kernels.slow_step(
                 n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
-                buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot, buf.diag)
-            _raise_status(status, n_full, dt, r_last, n_full, buf.diag, P)
+                buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
+            _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[1:], P)
             t_chunk = t_end
         buf.drain(parts)
         yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final)
