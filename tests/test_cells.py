@@ -2,7 +2,8 @@
 a(tau) is the linear |H|^2 S_f of the piecewise-linear input (MODEL.md)."""
 import numpy as np
 
-from vibroimpact import cells, noise, stats
+from vibroimpact import noise, stats
+from vibroimpact.pipeline import cells
 
 
 def test_psd_without_impacts_is_linear_response():

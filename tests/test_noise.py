@@ -244,11 +244,15 @@ def test_estimators_follow_the_paper_convention():
     direct = np.correlate(x, x, "full")[x.size - 1:][: tau.size] / x.size
     np.testing.assert_allclose(phi, direct, rtol=0, atol=1e-12)
     np.testing.assert_allclose(tau, 0.5 * np.arange(21))
-    x += 0.3  # a mean, which eq. 8 keeps: it must show at beta = 0
-    beta, s = estimate_psd(x, 0.5, x.size, window="boxcar")
+    x += 0.3  # a mean: kept with detrend=False (eq. 8), it must show at beta = 0
+    beta, s = estimate_psd(x, 0.5, x.size, window="boxcar", detrend=False)
     assert beta[-1] == pytest.approx(math.pi / 0.5)
     variance = (s[0] + 2 * np.sum(s[1:-1]) + s[-1]) * (beta[1] - beta[0]) / (2 * math.pi)
     assert variance == pytest.approx(np.mean(x**2), rel=1e-12)
+    # the package's convention (PSD_DETREND) removes the record's mean: Parseval gives var(x)
+    beta, s = estimate_psd(x, 0.5, x.size, window="boxcar")
+    variance = (s[0] + 2 * np.sum(s[1:-1]) + s[-1]) * (beta[1] - beta[0]) / (2 * math.pi)
+    assert variance == pytest.approx(np.var(x), rel=1e-12)
 
 
 # --- validation ----------------------------------------------------------------------------

@@ -83,8 +83,8 @@ def test_release_just_before_a_sample_point(eps):
 def test_gave_up_message_says_what_it_saw():
     """When the kernel gives up on a step, the message names the step, the state, the force
     at the step's ends and the counts, and guesses no cause."""
-    from vibroimpact import kernels
-    from vibroimpact.simulate import _raise_status
+    from vibroimpact.impact import kernels
+    from vibroimpact.impact.simulate import _raise_status
     diag = np.array([0.05, -1e-17, -2e-9, kernels.FREE, 40000, 25534])
     P = np.zeros(21)
     P[3] = -0.45

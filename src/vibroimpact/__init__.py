@@ -2,11 +2,14 @@
 
 Reproduces Irie, Yamada & Matsuzaki (1974), "On the dynamic response of a vibro-impact
 system to random force", Bull. Fac. Eng. Hokkaido Univ. 72, 13-24.
-"""
-from importlib.metadata import PackageNotFoundError, version
 
-from vibroimpact.simulate import SimulationResult, simulate, simulate_chunks
-from vibroimpact.orbits import PeriodicOrbit, orbit_map, periodic_orbits
+The public API is re-exported lazily: ``import vibroimpact`` loads neither numba nor the
+simulator; ``vibroimpact.simulate`` does, on first use. Subpackages (docs/api.md):
+``impact`` (the simulator), ``orbits`` (periodic motions), ``stats``, ``noise``,
+``plotting``, ``pipeline`` (the workflow-facing layer), ``validation``.
+"""
+import importlib
+from importlib.metadata import PackageNotFoundError, version
 
 try:
     __version__ = version("vibroimpact")
@@ -18,7 +21,26 @@ PAPER_REFERENCE = (
     "System to Random Force, Bull. Fac. Eng. Hokkaido Univ. 72, 13-24, hdl:2115/41224"
 )
 
-__all__ = [
-    "simulate", "simulate_chunks", "SimulationResult",
-    "periodic_orbits", "PeriodicOrbit", "orbit_map", "PAPER_REFERENCE", "__version__",
-]
+# public name -> module that defines it (imported on first access)
+_LAZY = {
+    "simulate": "vibroimpact.impact.simulate",
+    "simulate_chunks": "vibroimpact.impact.simulate",
+    "SimulationResult": "vibroimpact.impact.simulate",
+    "periodic_orbits": "vibroimpact.orbits",
+    "PeriodicOrbit": "vibroimpact.orbits",
+    "orbit_map": "vibroimpact.orbits",
+}
+
+__all__ = [*_LAZY, "PAPER_REFERENCE", "__version__"]
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(_LAZY[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_LAZY))

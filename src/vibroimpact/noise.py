@@ -26,13 +26,15 @@ and :meth:`NoiseSpec.psd_piecewise_linear` (use these for the linear reference
 from __future__ import annotations
 
 import math
-import operator
 from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.fft
 import scipy.signal
+
+from vibroimpact import _checks
+from vibroimpact.stats import spectra
 
 KINDS = ("white", "band_limited", "lowpass2")
 
@@ -102,8 +104,8 @@ class NoiseSpec:
     def __post_init__(self):
         if self.kind not in KINDS:
             raise ValueError(f"kind must be one of {KINDS}, got {self.kind!r}")
-        object.__setattr__(self, "rms", _finite("rms", self.rms, low=0.0, closed=True))
-        object.__setattr__(self, "dt", _finite("dt", self.dt, low=0.0, closed=False))
+        object.__setattr__(self, "rms", _checks.real("rms", self.rms, low=0.0))
+        object.__setattr__(self, "dt", _checks.real("dt", self.dt, low=0.0, low_open=True))
         needs = {"white": (), "band_limited": ("beta_c",), "lowpass2": ("beta_c", "zeta_f")}
         for name in ("beta_c", "zeta_f"):
             given = getattr(self, name) is not None
@@ -111,14 +113,14 @@ class NoiseSpec:
                 state = "is required" if not given else "must be None"
                 raise ValueError(f"{name} {state} for kind={self.kind!r}")
         if self.beta_c is not None:
-            beta_c = _finite("beta_c", self.beta_c, low=0.0, closed=False)
+            beta_c = _checks.real("beta_c", self.beta_c, low=0.0, low_open=True)
             if beta_c > self.nyquist * (1.0 + FULL_BAND_RTOL):
                 raise ValueError(
                     f"beta_c must be in (0, pi/dt] = (0, {self.nyquist!r}], got {beta_c!r}")
             object.__setattr__(self, "beta_c", min(beta_c, self.nyquist))
         if self.zeta_f is not None:
             object.__setattr__(self, "zeta_f",
-                               _finite("zeta_f", self.zeta_f, low=0.0, closed=False))
+                               _checks.real("zeta_f", self.zeta_f, low=0.0, low_open=True))
         if self.kind == "band_limited" and not self._full_band:
             numtaps = _fir_order(self.beta_c * self.dt)[0]
             if numtaps > FIR_MAX_TAPS:
@@ -301,8 +303,8 @@ def generate(spec: NoiseSpec, n_samples, seed, chunk_size=2**20) -> Iterator[np.
     """
     if not isinstance(spec, NoiseSpec):
         raise TypeError(f"spec must be a NoiseSpec, got {type(spec).__name__}")
-    n_samples = _count("n_samples", n_samples, low=0)
-    chunk_size = _count("chunk_size", chunk_size, low=1)
+    n_samples = _checks.integer("n_samples", n_samples, low=0)
+    chunk_size = _checks.integer("chunk_size", chunk_size, low=1)
     rng = _generator(seed)
     return _rechunk(_blocks(spec, rng), n_samples, chunk_size)
 
@@ -324,12 +326,12 @@ def generate_array(spec: NoiseSpec, n_samples, seed) -> np.ndarray:
     ndarray of float64, shape (n_samples,)
         Identical to the concatenated chunks of ``generate(spec, n_samples, seed)``.
     """
-    n_samples = _count("n_samples", n_samples, low=0)
+    n_samples = _checks.integer("n_samples", n_samples, low=0)
     chunks = list(generate(spec, n_samples, seed, chunk_size=max(n_samples, 1)))
     return chunks[0] if chunks else np.empty(0)
 
 
-def estimate_psd(x, dt, nperseg, window="hann", detrend=False):
+def estimate_psd(x, dt, nperseg, window="hann", detrend=spectra.PSD_DETREND):
     """Welch estimate of the two-sided angular PSD of eq. 9, for ``beta >= 0``.
 
     Parameters
@@ -343,8 +345,10 @@ def estimate_psd(x, dt, nperseg, window="hann", detrend=False):
     window : str or tuple, optional
         Window passed to ``scipy.signal.welch``.
     detrend : False or str, optional
-        ``False`` keeps the mean, as eq. 8 does (a non-zero mean shows as power at
-        ``beta = 0``); ``"constant"`` removes each segment's mean.
+        Per-segment detrending; the default is the package's one convention
+        (`vibroimpact.stats.spectra.PSD_DETREND`: the record's mean removed), shared with
+        the response spectra. ``False`` keeps the mean, as eq. 8 does; ``"constant"``
+        removes each segment's mean.
 
     Returns
     -------
@@ -361,14 +365,13 @@ def estimate_psd(x, dt, nperseg, window="hann", detrend=False):
     and (even ``nperseg``) ``f_N``, which welch does not double: there ``S = P_1``. With K
     half-overlapping Hann segments the relative standard error is ``~ sqrt(1.056 / K)``.
     """
-    f, p1 = scipy.signal.welch(np.asarray(x, dtype=float), fs=1.0 / dt, window=window,
+    x = np.asarray(x, dtype=float)
+    if detrend == "mean":
+        x, detrend = x - x.mean(), False
+    f, p1 = scipy.signal.welch(x, fs=1.0 / dt, window=window,
                                nperseg=nperseg, detrend=detrend, return_onesided=True,
                                scaling="density")
-    s = p1 / 2.0
-    s[0] = p1[0]
-    if nperseg % 2 == 0:
-        s[-1] = p1[-1]
-    return 2 * math.pi * f, s
+    return spectra.onesided_to_angular(f, p1, nperseg)
 
 
 def estimate_autocorrelation(x, dt, max_lag):
@@ -572,31 +575,6 @@ def _cubic_bspline(x):
     inner = 2.0 / 3.0 - ax**2 + ax**3 / 2.0
     outer = np.clip(2.0 - ax, 0.0, None) ** 3 / 6.0
     return np.where(ax < 1.0, inner, outer)
-
-
-def _finite(name, value, low, closed):
-    """``value`` as a float, checked finite and ``> low`` (``>= low`` if closed)."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    value = float(value)
-    ok = math.isfinite(value) and (value >= low if closed else value > low)
-    if not ok:
-        bound = f">= {low}" if closed else f"> {low}"
-        raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
-    return value
-
-
-def _count(name, value, low):
-    """``value`` as an int ``>= low``; integral floats (YAML's 1.0e8) are accepted."""
-    if isinstance(value, (float, np.floating)) and float(value).is_integer():
-        value = int(value)
-    try:
-        value = operator.index(value)
-    except TypeError:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}") from None
-    if value < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-    return value
 
 
 def _generator(seed):

@@ -1,9 +1,9 @@
 # Named helpers: studies, target lists, tile lists, provenance. No numerics here.
 import subprocess
 
-from vibroimpact.io import config_digest, provenance
-from vibroimpact.study import Study
-from vibroimpact.tasks import orbit_rows
+from vibroimpact.pipeline.io import config_digest, provenance
+from vibroimpact.pipeline.study import Study
+from vibroimpact.pipeline.tasks import orbit_rows
 
 
 wildcard_constraints:

@@ -1,5 +1,5 @@
 """Rule orbit_tile: existence and stability of periodic impact motions on some 1/beta rows."""
-from vibroimpact import tasks
+from vibroimpact.pipeline import tasks
 
 tasks.log_to(snakemake.log[0])
 tasks.orbit_tile(snakemake.params.entry, int(snakemake.wildcards.tile), snakemake.output[0],

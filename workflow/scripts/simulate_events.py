@@ -1,5 +1,5 @@
 """Rule simulate_events: impact statistics of the cells of one tile."""
-from vibroimpact import tasks
+from vibroimpact.pipeline import tasks
 
 tasks.log_to(snakemake.log[0])
 tasks.events_tile(snakemake.wildcards.study, snakemake.params.entry, int(snakemake.wildcards.tile),

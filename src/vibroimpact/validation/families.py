@@ -36,7 +36,7 @@ import time
 
 import numpy as np
 
-from vibroimpact.simulate import simulate
+from vibroimpact.impact import simulate
 from vibroimpact.validation import compare
 from vibroimpact.validation.reference import linear_peak, reference_impacts
 from vibroimpact.validation.report import FamilyReport

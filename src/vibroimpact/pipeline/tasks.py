@@ -8,9 +8,9 @@ import logging
 
 import xarray as xr
 
-from vibroimpact import datasets, io
+from vibroimpact.pipeline import datasets, io
 from vibroimpact.noise import NoiseSpec
-from vibroimpact.study import Study, grid_values
+from vibroimpact.pipeline.study import Study, grid_values
 
 log = logging.getLogger("vibroimpact")
 
@@ -47,7 +47,7 @@ def _physics(study, cell):
 
 def events_tile(name, entry, tile, noise_path, out, provenance):
     """Rule ``simulate_events``: impact statistics of the cells of one tile."""
-    from vibroimpact import cells    # the simulator: only the jobs that simulate load it
+    from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
     study = Study.from_config(name, entry)
     samples, dt, noise_attrs = io.read_noise(noise_path)
@@ -66,7 +66,7 @@ def events_tile(name, entry, tile, noise_path, out, provenance):
 
 def spectra_tile(name, entry, tile, noise_path, out, provenance):
     """Rule ``simulate_spectra``: Welch spectra of a(tau) for the cells of one tile."""
-    from vibroimpact import cells    # the simulator: only the jobs that simulate load it
+    from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
     study = Study.from_config(name, entry)
     samples, dt, noise_attrs = io.read_noise(noise_path)
@@ -82,7 +82,7 @@ def spectra_tile(name, entry, tile, noise_path, out, provenance):
 
 def trace(name, entry, noise_path, out, provenance):
     """Rule ``simulate_trace``: a short sampled record from rest (Figs. 3, 10)."""
-    from vibroimpact import cells    # the simulator: only the jobs that simulate load it
+    from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
     study = Study.from_config(name, entry)
     samples, dt, noise_attrs = io.read_noise(noise_path)

@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from vibroimpact import stats
-from vibroimpact.simulate import simulate_chunks
+from vibroimpact.impact import simulate_chunks
 
 MOTIONS = stats.DEFAULT_MOTIONS
 

@@ -3,32 +3,15 @@
 A failed or interrupted write never leaves a file under the final name: everything is
 written to a temporary name in the same directory and renamed into place on success.
 """
-from contextlib import contextmanager
 import hashlib
 import json
 import os
-import tempfile
 
 import netCDF4
 import numpy as np
 
 from vibroimpact import noise as noise_mod
-
-@contextmanager
-def atomic_path(path):
-    """Yield a temporary path beside ``path``; rename it to ``path`` only if the block succeeds."""
-    path = os.fspath(path)
-    directory = os.path.dirname(path) or "."
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=os.path.basename(path), dir=directory)
-    os.close(fd)
-    try:
-        yield tmp
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-
+from vibroimpact._files import atomic_path
 
 def write_dataset(ds, path):
     """Write an ``xarray.Dataset`` to netCDF4 atomically."""

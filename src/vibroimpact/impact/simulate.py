@@ -1,17 +1,17 @@
 """Public entry point of the exact simulator: :func:`simulate` and :func:`simulate_chunks`.
 
-The numerics live in :mod:`vibroimpact.kernels`; this module validates the input, builds
+The numerics live in :mod:`vibroimpact.impact.kernels`; this module validates the input, builds
 the kernel's parameter vector, streams the force record through the kernel in chunks
 (bounded memory on records of any length) and wraps the events in a
 :class:`SimulationResult`.
 """
 from dataclasses import dataclass, field
 import math
-import numbers
 
 import numpy as np
 
-from vibroimpact import kernels
+from vibroimpact import _checks
+from vibroimpact.impact import kernels
 
 _BUFFER = 2 * kernels.STEP_HEADROOM
 
@@ -66,35 +66,18 @@ class SimulationResult:
     params: dict = field(default_factory=dict)
 
 
-def _finite(name, value):
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
-        raise ValueError(f"{name} must be a finite real number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite real number, got {value!r}")
-    return value
-
-
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
                   chunk_size):
-    zeta = _finite("zeta", zeta)
-    if not 0.0 < zeta < 1.0:
-        raise ValueError(f"zeta must lie in the open interval (0, 1), got {zeta!r}")
-    eps = _finite("eps", eps)
-    if not 0.0 <= eps <= 1.0:
-        raise ValueError(f"eps must lie in [0, 1], got {eps!r}")
-    delta = _finite("delta", delta)
-    dt = _finite("dt", dt)
-    if dt <= 0.0:
-        raise ValueError(f"dt must be > 0, got {dt!r}")
-    amplitude = _finite("amplitude", amplitude)
-    beta = _finite("beta", beta)
-    if beta <= 0.0:
-        raise ValueError(f"beta must be > 0, got {beta!r}")
-    x0 = min(0.0, delta) if x0 is None else _finite("x0", x0)
+    zeta = _checks.zeta(zeta)
+    eps = _checks.eps(eps)
+    delta = _checks.real("delta", delta)
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    amplitude = _checks.real("amplitude", amplitude)
+    beta = _checks.real("beta", beta, low=0.0, low_open=True)
+    x0 = min(0.0, delta) if x0 is None else _checks.real("x0", x0)
     if x0 > delta:
         raise ValueError(f"x0 must satisfy x0 <= delta (the mass lives in x <= delta), got x0={x0!r} > delta={delta!r}")
-    v0 = _finite("v0", v0)
+    v0 = _checks.real("v0", v0)
     if noise is not None:
         if getattr(noise, "ndim", 1) != 1 or len(noise) < 2:
             raise ValueError("noise must be a 1-D array of at least 2 samples (or None)")
@@ -102,20 +85,16 @@ def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, r
         if noise is None:
             raise ValueError("t_end is required when noise is None")
         t_end = (len(noise) - 1) * dt
-    t_end = _finite("t_end", t_end)
-    if t_end <= 0.0:
-        raise ValueError(f"t_end must be > 0, got {t_end!r}")
+    t_end = _checks.real("t_end", t_end, low=0.0, low_open=True)
     if noise is not None and t_end > (len(noise) - 1) * dt * (1.0 + 1e-12):
         raise ValueError(f"t_end must not exceed (len(noise) - 1) * dt = {(len(noise) - 1) * dt!r}, got {t_end!r}")
-    if isinstance(record_every, bool) or not isinstance(record_every, (numbers.Integral, np.integer)) or record_every < 0:
-        raise ValueError(f"record_every must be an integer >= 0, got {record_every!r}")
-    if isinstance(chunk_size, bool) or not isinstance(chunk_size, (numbers.Integral, np.integer)) or chunk_size < 1:
-        raise ValueError(f"chunk_size must be an integer >= 1, got {chunk_size!r}")
-    return zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end
+    record_every = _checks.integer("record_every", record_every, low=0)
+    chunk_size = _checks.integer("chunk_size", chunk_size, low=1)
+    return zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size
 
 
 def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
-    """The parameter vector ``P`` read by the kernels (see :mod:`vibroimpact.kernels`)."""
+    """The parameter vector ``P`` read by the kernels (see :mod:`vibroimpact.impact.kernels`)."""
     omega = math.sqrt(1.0 - zeta * zeta)
     q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
     phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
@@ -195,7 +174,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     time; counters are per chunk; ``t_end, x_end, v_end, stuck_end`` are the chunk's last
     state. Memory is bounded by the chunk size whatever the record's length.
     """
-    zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end = _check_inputs(
+    zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size = _check_inputs(
         zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size)
     P = kernel_parameters(zeta, eps, delta, dt, amplitude, beta)
     params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
@@ -363,7 +342,7 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
     by a rigorous exclusion bound and refined to round-off, so grazing double crossings
     inside a step are caught. A chatter sequence is followed impact by impact until its
     remaining geometric tail is summed in closed form to within ``CHATTER_TIME_TOL``
-    (see :mod:`vibroimpact.kernels`); the mass then sticks until ``f(tau) - delta`` turns
+    (see :mod:`vibroimpact.impact.kernels`); the mass then sticks until ``f(tau) - delta`` turns
     negative (the release instant is an exact root).
     """
     chunks = list(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,

@@ -8,7 +8,6 @@ import pandas as pd
 import xarray as xr
 
 from vibroimpact import stats
-from vibroimpact.cells import MOTIONS
 
 #: long_name and units of every variable the datasets hold.
 META = {
@@ -80,7 +79,7 @@ def events_tile(cells, results, edges, attrs):
     data["motion_probability"] = (("cell", "motion"), np.stack([r["motion_probability"] for r in results]))
     coords = dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
                   delta_cell=("cell", [c.delta for c in cells]),
-                  motion=[f"{m}/{n}" for m, n in MOTIONS], **centres)
+                  motion=[f"{m}/{n}" for m, n in stats.DEFAULT_MOTIONS], **centres)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 

@@ -1,0 +1,31 @@
+"""The paper's figures, one function each: data in, :class:`matplotlib.figure.Figure` out.
+
+Every function takes already opened :class:`xarray.Dataset` objects laid out as in
+``docs/datasets.md`` and returns a Figure; none of them touches a file. :func:`save` is the
+only writer (the workflow's figure rule calls it). Axis labels come from each variable's
+``long_name`` and ``units`` attributes; the look comes from the one style file
+``vibroimpact.mplstyle``, applied by :func:`style`. Every figure prints the parameters it
+was computed with (zeta, eps, delta, the input's rms and spectrum, the harmonic forcing).
+
+Datasets and the figures that read them (docs/figures.md)::
+
+    results/noise/{noise}.nc            fig04, fig05           (random)
+    results/traces/{study}.nc           fig03, fig10           (random, harmonic)
+    results/datasets/{study}_spectra.nc fig06, fig11, fig12    (random, harmonic)
+    results/datasets/{study}_events.nc  fig07, fig08, fig09, fig13, fig14
+    results/orbits/{name}.nc            fig16                  (orbits)
+
+Plotting never imports the simulator or the orbit solver; it may use small helpers of
+`vibroimpact.stats`.
+"""
+from vibroimpact.plotting._common import STYLE_FILE, axis_label, save, style
+from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
+from vibroimpact.plotting.orbits import fig16
+from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fig06, fig07,
+                                         fig08, fig09)
+
+__all__ = [
+    "STYLE_FILE", "style", "axis_label", "critical_delta", "save",
+    "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
+    "fig10", "fig11", "fig12", "fig13", "fig14", "fig16",
+]

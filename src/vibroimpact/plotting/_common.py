@@ -1,0 +1,344 @@
+"""Style and the helpers every figure shares: labels from CF attributes, parameter lines, save.
+
+Figures are built on the non-interactive Agg canvas without pyplot, so nothing here changes
+the process-wide backend or keeps figures alive in a global registry.
+"""
+from __future__ import annotations
+
+import contextlib
+import functools
+from pathlib import Path
+
+import matplotlib
+import matplotlib.style
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from vibroimpact._files import atomic_path
+
+#: The house style sheet (the only place rcParams are set).
+STYLE_FILE = Path(__file__).with_name("vibroimpact.mplstyle")
+#: Upper end of the frequency axis of the response spectra (figs 6, 11, 12): the resonance
+#: of the impacting system lies below 2.5 for every delta the studies use.
+SPECTRUM_BETA_MAX = 4.0
+#: Lower end of the log density axis of figs 7, 8, 13, 14, relative to the highest density.
+DENSITY_DECADES = 1e-5
+#: Confidence bars are +-Z_95 standard errors (normal 95 % quantile).
+Z_95 = 1.96
+#: Part of the colour map used for a family of curves (the top end of viridis is too pale).
+COLOR_SPAN = (0.0, 0.88)
+#: Units that mean "dimensionless" (CF writes "1") and are left out of axis labels.
+DIMENSIONLESS = ("1", "", "-")
+#: Height (inches) of the figures with two stacked panels; one-panel figures use the style's.
+TWO_PANEL_HEIGHT = 5.5
+#: Fraction of the data range added above the data so a legend does not hide it.
+LEGEND_HEADROOM = 0.35
+#: Frequency axis of the input PSD (fig05) ends at 1.25 x the last beta where the target
+#: exceeds this fraction of its peak (the rest is the empty stop band).
+STOP_BAND_LEVEL = 1e-3
+
+
+# --------------------------------------------------------------------------------------------
+# Style and small helpers
+# --------------------------------------------------------------------------------------------
+
+@contextlib.contextmanager
+def style():
+    """Context in which the house style sheet is active (figures must be built inside it)."""
+    with matplotlib.style.context(STYLE_FILE):
+        yield
+
+
+def _styled(func):
+    """Build the figure of `func` inside :func:`style`."""
+    @functools.wraps(func)
+    def wrapper(*args, **kwargs):
+        with style():
+            return func(*args, **kwargs)
+    return wrapper
+
+
+def _figure(nrows=1, sharex=True, height_ratios=None):
+    """A new Figure on an Agg canvas, with `nrows` stacked axes (a list)."""
+    fig = Figure()
+    FigureCanvasAgg(fig)
+    if nrows > 1:
+        fig.set_figheight(TWO_PANEL_HEIGHT)
+    axes = fig.subplots(nrows, 1, sharex=sharex, squeeze=False,
+                        gridspec_kw={"height_ratios": height_ratios})[:, 0]
+    return fig, list(axes)
+
+
+def axis_label(da, extra=""):
+    """Axis label ``"long_name [units]"`` of a DataArray (units omitted when dimensionless).
+
+    Parameters
+    ----------
+    da : xarray.DataArray
+        Variable or coordinate with CF attributes ``long_name`` and ``units``; the variable
+        name stands in for a missing ``long_name``.
+    extra : str, optional
+        Appended after the name, before the units (e.g. a convention note).
+    """
+    name = str(da.attrs.get("long_name", da.name)) + extra
+    units = da.attrs.get("units")
+    if units is None or str(units) in DIMENSIONLESS:
+        return name
+    return f"{name} [{units}]"
+
+
+def _psd_label(da):
+    """PSD axis label stating the convention of paper eq. (9) unless long_name already does."""
+    name = str(da.attrs.get("long_name", da.name))
+    return axis_label(da, "" if "two-sided" in name else " (two-sided, angular)")
+
+
+def _num(value):
+    """A parameter value printed with 4 significant digits (never 0.30000000000000004)."""
+    return f"{float(value):.4g}"
+
+
+def _attr(ds, name):
+    """Required global attribute `name` of a dataset, with an error naming it."""
+    try:
+        return ds.attrs[name]
+    except KeyError:
+        raise KeyError(f"dataset lacks the global attribute {name!r} that the figure prints; "
+                       f"attributes present: {sorted(ds.attrs)}") from None
+
+
+def _colors(n):
+    """`n` colours along the style's colour map (one per curve of a family)."""
+    cmap = matplotlib.colormaps[matplotlib.rcParams["image.cmap"]]
+    return cmap(np.linspace(*COLOR_SPAN, max(n, 1)))
+
+
+def _nearest(coord, value):
+    """Index of the entry of a 1-D coordinate nearest to `value` (no monotonicity needed)."""
+    return int(np.argmin(np.abs(np.asarray(coord, dtype=float) - float(value))))
+
+
+def _headroom(ax):
+    """Extend the y axis upwards so a legend in an upper corner leaves the data visible."""
+    low, high = ax.get_ylim()
+    ax.set_ylim(low, high + LEGEND_HEADROOM * (high - low))
+
+
+def _bin_limits(ax, centres):
+    """x limits at the outer bin edges of evenly spaced bin centres."""
+    c = np.asarray(centres, dtype=float)
+    half = 0.5 * (c[1] - c[0]) if c.size > 1 else 0.5
+    ax.set_xlim(c[0] - half, c[-1] + half)
+
+
+def _header(fig, title, params):
+    fig.suptitle(f"{title}\n{params}")
+
+
+def _panel_tag(ax, tag):
+    ax.text(0.005, 1.02, tag, transform=ax.transAxes, ha="left", va="bottom",
+            fontweight="bold")
+
+
+# --------------------------------------------------------------------------------------------
+# The parameter line every figure prints
+# --------------------------------------------------------------------------------------------
+
+def _system_text(ds):
+    return rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
+
+
+def _noise_text(ds):
+    """``rms r = ...`` and the noise's name, from whichever attributes the dataset carries."""
+    rms = ds.attrs.get("noise_rms")
+    if rms is None and "r" in ds.variables:
+        rms = ds["r"].attrs.get("rms")
+    parts = [] if rms is None else [f"rms$_r$ = {_num(rms)}"]
+    name = ds.attrs.get("noise")
+    if isinstance(name, str) and name:
+        parts.append(f"noise '{name}'")
+    return ", ".join(parts)
+
+
+def _forcing_text(ds, beta_f=None, inv_beta=None):
+    """``f(tau) = A sin(...) + r(tau)``; the harmonic written as sin(tau/inv_beta) if given."""
+    amplitude = float(_attr(ds, "amplitude"))
+    if amplitude == 0.0:
+        harmonic = ""
+    else:
+        arg = rf"\tau/{_num(inv_beta)}" if inv_beta is not None else rf"{_num(beta_f)}\,\tau"
+        scale = "" if amplitude == 1.0 else f"{_num(amplitude)}"
+        harmonic = rf"{scale}$\sin({arg})$ + "
+    noise = _noise_text(ds)
+    return rf"f($\tau$) = {harmonic}r($\tau$)" + (f" ({noise})" if noise else "")
+
+
+def _spectrum_text(r):
+    """Description of a random force from the attributes of the noise variable ``r``."""
+    attrs = r.attrs
+    parts = [f"{attrs['kind']} noise"] if "kind" in attrs else []
+    symbols = (("rms", "rms"), ("dt", r"$\Delta\tau$"), ("beta_c", r"$\beta_c$"),
+               ("zeta_f", r"$\zeta_f$"))
+    parts += [f"{sym} = {_num(attrs[key])}" for key, sym in symbols if key in attrs]
+    if "seed" in attrs:
+        parts.append(f"seed {attrs['seed']}")
+    parts.append(f"{r.size} samples")
+    return ", ".join(parts)
+
+
+# --------------------------------------------------------------------------------------------
+# Shared figure bodies
+# --------------------------------------------------------------------------------------------
+
+def _trace_figure(trace, title, harmonic):
+    """Input force (a) and a(tau) with the impacts (b) of one short simulation."""
+    fig, (ax_f, ax_a) = _figure(2, height_ratios=(1.0, 1.3))
+    tau = trace["tau"]
+    force = trace["f"] if harmonic else trace["r"]
+    ax_f.axhline(0.0, color="0.5", lw=0.6)
+    ax_f.plot(tau, force, color="C0", lw=0.9, label=force.attrs.get("long_name", force.name))
+    if harmonic:
+        ax_f.plot(tau, trace["f"] - trace["r"], color="0.35", lw=0.9, ls="--",
+                  label="harmonic part")
+        _headroom(ax_f)
+        ax_f.legend(loc="upper right", ncols=2)
+    ax_f.set_ylabel(axis_label(force))
+    _panel_tag(ax_f, "(a)")
+
+    ax_a.plot(tau, trace["a"], color="C0", lw=1.0)
+    ax_a.axhline(0.0, color="0.2", lw=1.4, label="wall (a = 0)")
+    t_imp = np.asarray(trace["impact_time"])
+    t_imp = t_imp[(t_imp >= float(tau[0])) & (t_imp <= float(tau[-1]))]
+    ax_a.plot(t_imp, np.zeros_like(t_imp), ls="none", marker="v", color="C3",
+              markersize=5, label=f"impact ({t_imp.size})")
+    ax_a.set_ylim(bottom=min(-0.06 * float(trace["a"].max()), float(trace["a"].min())))
+    _headroom(ax_a)
+    ax_a.set_ylabel(axis_label(trace["a"]))
+    ax_a.set_xlabel(axis_label(tau))
+    ax_a.legend(loc="upper right", ncols=2)
+    _panel_tag(ax_a, "(b)")
+
+    beta_f = trace.attrs.get("beta_f")
+    params = (f"{_system_text(trace)}, $\\delta$ = {_num(_attr(trace, 'delta'))};  "
+              f"{_forcing_text(trace, beta_f=beta_f)}")
+    _header(fig, title, params)
+    return fig
+
+
+def _response_spectra(spectra, i_beta, title, params, beta_max, lin_label):
+    """S_a for every delta of the dataset (log y), with the linear reference S_lin."""
+    fig, (ax,) = _figure()
+    ds = spectra.isel(inv_beta=i_beta)
+    ds = ds.isel(beta=np.flatnonzero(np.asarray(ds["beta"]) <= beta_max))
+    deltas = np.asarray(ds["delta"], dtype=float)
+    order = np.argsort(deltas)[::-1]
+    for color, k in zip(_colors(deltas.size), order):
+        ax.plot(ds["beta"], ds["S_a"].isel(delta=k), color=color,
+                label=rf"$\delta$ = {_num(deltas[k])}")
+    ax.plot(ds["beta"], ds["S_lin"], color="k", ls="--", lw=1.1, label=lin_label)
+    if float(_attr(spectra, "amplitude")) != 0.0:
+        _mark_forcing(ax, float(spectra["inv_beta"][i_beta]))
+    ax.set_yscale("log")
+    ax.set_xlim(0.0, float(ds["beta"].max()))
+    ax.set_xlabel(axis_label(ds["beta"]))
+    ax.set_ylabel(_psd_label(ds["S_a"]))
+    ax.legend(loc="upper right", ncols=1 if deltas.size < 7 else 2)
+    _header(fig, title, params)
+    return fig
+
+
+def _mark_forcing(ax, inv_beta):
+    """Dotted vertical line at the forcing frequency beta_f = 1/inv_beta."""
+    ax.axvline(1.0 / inv_beta, color="0.4", ls=":", lw=1.0,
+               label=rf"forcing $\beta_f$ = 1/{_num(inv_beta)} = {_num(1.0 / inv_beta)}")
+
+
+def _density_deltas(events):
+    """Indices of the dataset deltas nearest to attribute ``density_delta``, largest first."""
+    wanted = np.atleast_1d(np.asarray(_attr(events, "density_delta"), dtype=float))
+    index = list(dict.fromkeys(_nearest(events["delta"], d) for d in wanted))
+    deltas = np.asarray(events["delta"], dtype=float)
+    return sorted(index, key=lambda k: -deltas[k])
+
+
+def _density_figure(events, i_beta, var, title, params):
+    """One density curve (with a 95 % band) per density delta, at inv_beta index `i_beta`."""
+    fig, (ax,) = _figure()
+    ds = events.isel(inv_beta=i_beta)
+    index = _density_deltas(events)
+    x = ds[var].dims[-1]
+    band = f"{var}_stderr"
+    for color, k in zip(_colors(len(index)), index):
+        cell = ds.isel(delta=k)
+        n = int(cell["n_impacts"])
+        y = np.asarray(cell[var], dtype=float)
+        impacts = f"{n:,} impacts" if n else "no impacts"
+        ax.plot(cell[x], y, color=color, label=rf"$\delta$ = {_num(cell['delta'])}  ({impacts})")
+        if band in cell:
+            half = Z_95 * np.asarray(cell[band], dtype=float)
+            ax.fill_between(cell[x], np.clip(y - half, 1e-300, None), y + half, color=color,
+                            alpha=0.2, lw=0)
+    # log scale: chatter puts a tall spike at small velocities and intervals, and the
+    # distributions' tails matter as much as their bulk
+    top = np.nanmax([np.nanmax(np.asarray(ds.isel(delta=k)[var], dtype=float), initial=0.0)
+                     for k in index] + [0.0])
+    if top > 0.0:
+        ax.set_yscale("log")
+        ax.set_ylim(top * DENSITY_DECADES, top * 3.0)
+    else:
+        ax.set_ylim(bottom=0.0)
+    _bin_limits(ax, ds[x])
+    ax.set_xlabel(axis_label(ds[x]))
+    ax.set_ylabel(axis_label(ds[var]))
+    ax.legend(loc="upper right", title="bands: 95 % confidence" if band in ds else None)
+    _header(fig, title, params)
+    return fig, ax
+
+
+def _events_params(events, i_beta):
+    """Parameter line of an events/spectra dataset at inv_beta index `i_beta`."""
+    inv_beta = float(events["inv_beta"][i_beta])
+    harmonic = float(_attr(events, "amplitude")) != 0.0
+    return f"{_system_text(events)};  " + _forcing_text(
+        events, inv_beta=inv_beta if harmonic else None)
+
+
+# --------------------------------------------------------------------------------------------
+
+
+# --------------------------------------------------------------------------------------------
+# The only writer
+# --------------------------------------------------------------------------------------------
+
+def save(fig, path_png):
+    """Write `fig` to ``path_png`` and its vector twin ``.pdf`` next to it, atomically.
+
+    Each file is rendered to a temporary name in the target directory and moved into place
+    with :func:`os.replace`, so a reader never sees a half-written figure and an interrupted
+    run leaves no partial output.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        A figure returned by one of the ``figNN`` functions.
+    path_png : str or os.PathLike
+        Target ending in ``.png``; the PDF goes to the same path with suffix ``.pdf``.
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        The PNG and PDF paths written.
+    """
+    png = Path(path_png)
+    if png.suffix.lower() != ".png":
+        raise ValueError(f"path_png must end in .png, got {str(path_png)!r}")
+    png.parent.mkdir(parents=True, exist_ok=True)
+    pdf = png.with_suffix(".pdf")
+    # Fixed metadata: the same figure gives the same bytes on every run.
+    metadata = {"png": {"Software": None}, "pdf": {"CreationDate": None, "Producer": None}}
+    with style():
+        for path, fmt in ((png, "png"), (pdf, "pdf")):
+            with atomic_path(path) as tmp:
+                fig.savefig(tmp, format=fmt, metadata=metadata[fmt])
+    return png, pdf

@@ -1,0 +1,125 @@
+"""Figures of the harmonic-plus-random study (paper section 5): Figs. 10-14."""
+from __future__ import annotations
+
+import numpy as np
+
+from vibroimpact.plotting._common import (
+    SPECTRUM_BETA_MAX, _density_figure, _events_params, _figure, _header, _mark_forcing,
+    _nearest, _psd_label, _response_spectra, _styled, _trace_figure, axis_label)
+
+
+def fig10(trace):
+    """Fig. 10: (a) the input sin(beta_f tau) + r(tau); (b) a(tau) with the impacts.
+
+    Parameters
+    ----------
+    trace : xarray.Dataset
+        As for :func:`fig03`, with ``f(tau)`` the total force and attribute ``beta_f``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two stacked axes sharing tau; (a) also shows the harmonic part f - r dashed.
+    """
+    return _trace_figure(trace, "Fig. 10  Harmonic plus random input and the motion of the mass",
+                         harmonic=True)
+
+
+@_styled
+def fig11(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
+    """Fig. 11: PSD of the total input sin(beta_f tau) + r(tau) at one forcing frequency.
+
+    Parameters
+    ----------
+    spectra : xarray.Dataset
+        Spectra dataset of the harmonic study: ``S_f(inv_beta, beta)``.
+    inv_beta : float
+        1/beta_f; the nearest value of the dataset is shown (and printed).
+    beta_max : float, optional
+        Upper end of the frequency axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One log-y axes with S_f and a dotted line at the forcing frequency.
+    """
+    fig, (ax,) = _figure()
+    i = _nearest(spectra["inv_beta"], inv_beta)
+    ds = spectra.isel(inv_beta=i)
+    ds = ds.isel(beta=np.flatnonzero(np.asarray(ds["beta"]) <= beta_max))
+    ax.plot(ds["beta"], ds["S_f"], color="C0", label="estimate from the simulated record")
+    _mark_forcing(ax, float(ds["inv_beta"]))
+    ax.set_yscale("log")
+    ax.set_xlim(0.0, float(ds["beta"].max()))
+    ax.set_xlabel(axis_label(ds["beta"]))
+    ax.set_ylabel(_psd_label(ds["S_f"]))
+    ax.legend(loc="upper right")
+    _header(fig, "Fig. 11  Power spectral density of the harmonic plus random input",
+            _events_params(spectra, i))
+    return fig
+
+
+@_styled
+def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
+    """Fig. 12: PSD of a(tau) under sin(tau/inv_beta) + r(tau), one curve per delta.
+
+    Parameters
+    ----------
+    spectra : xarray.Dataset
+        Spectra dataset of the harmonic study.
+    inv_beta : float
+        1/beta_f; the nearest value of the dataset is shown.
+    beta_max : float, optional
+        Upper end of the frequency axis.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        As :func:`fig06`; S_lin (random part only) dashed, the forcing frequency dotted.
+    """
+    i = _nearest(spectra["inv_beta"], inv_beta)
+    return _response_spectra(
+        spectra, i, "Fig. 12  Power spectral density of the displacement a(τ) of the mass",
+        _events_params(spectra, i), beta_max, r"linear $|H|^2 S_r$ (random part only)")
+
+
+@_styled
+def fig13(events, inv_beta):
+    """Fig. 13: probability density of z_j / z (z = 2 pi / beta_f), one curve per density delta.
+
+    Parameters
+    ----------
+    events : xarray.Dataset
+        Events dataset of the harmonic study: ``ratio_density(inv_beta, delta, ratio)``.
+    inv_beta : float
+        1/beta_f; the nearest value of the dataset is shown.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes: one line per density delta, a dash-dot line at z_j/z = 1/2 (the symmetry
+        axis of the (2/1) motion) and dotted marks at 1 ((1/1) motion) and 2 ((1/2) motion).
+    """
+    i = _nearest(events["inv_beta"], inv_beta)
+    fig, ax = _density_figure(
+        events, i, "ratio_density",
+        r"Fig. 13  Probability density of $z_j/z$, the interval over the forcing period",
+        _events_params(events, i))
+    marks = ((0.5, "-.", "(2/1)"), (1.0, ":", "(1/1)"), (2.0, ":", "(1/2)"))
+    for x, ls, _ in marks:
+        ax.axvline(x, color="0.3", ls=ls, lw=1.0)
+    motions = ax.secondary_xaxis("top")
+    motions.set_xticks([x for x, _, _ in marks], labels=[m for _, _, m in marks], fontsize=8)
+    motions.tick_params(length=0, colors="0.3")
+    motions.spines["top"].set_visible(False)
+    return fig
+
+
+@_styled
+def fig14(events, inv_beta):
+    """Fig. 14: density of the velocity after impact under sin(tau/inv_beta) + r(tau)."""
+    i = _nearest(events["inv_beta"], inv_beta)
+    fig, _ = _density_figure(events, i, "v_after_density",
+                             "Fig. 14  Probability density of the velocity after impact",
+                             _events_params(events, i))
+    return fig

@@ -1,0 +1,44 @@
+"""Response statistics: spectra, impact events, the (m/n) motion classification, exact theory.
+
+Pure numpy/scipy on arrays: no file I/O, no simulation, no randomness. The simulator produces
+the impact events and the sampled record a(tau); these modules turn them into the quantities
+the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracles.
+
+- `spectra`: Welch PSDs in the paper's convention (eqs. 8, 9) and the one conversion helper;
+- `events`: intervals, velocities after impact, densities, batch means;
+- `motions`: the (m/n) classification of intervals and the probabilities of motions;
+- `theory`: the wall-free linear response, elastic impacts under white noise.
+
+Every public name is re-exported here lazily (``vibroimpact.stats.density``), so a job that
+needs one helper does not import the others' scipy modules.
+"""
+import importlib
+
+_SUBMODULES = ("spectra", "events", "motions", "theory")
+_WHERE = {
+    "PSD_DETREND": "spectra", "WelchAccumulator": "spectra", "welch_psd": "spectra",
+    "onesided_to_angular": "spectra", "variance_from_psd": "spectra",
+    "linear_psd_response": "spectra",
+    "DEFAULT_N_BATCHES": "events", "impact_intervals": "events",
+    "velocity_after_impact": "events", "interval_ratio": "events", "Density": "events",
+    "density": "events", "BatchMeans": "events", "batch_means": "events",
+    "DEFAULT_MOTION_WINDOW": "motions", "DEFAULT_MOTIONS": "motions",
+    "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
+    "linear_response_std": "theory", "elastic_impact_rate": "theory", "rayleigh_pdf": "theory",
+    "truncated_gaussian_pdf": "theory",
+}
+__all__ = list(_WHERE)
+
+
+def __getattr__(name):
+    if name in _SUBMODULES:
+        return importlib.import_module(f"{__name__}.{name}")
+    if name not in _WHERE:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted(list(globals()) + __all__ + list(_SUBMODULES))

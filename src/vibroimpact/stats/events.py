@@ -1,0 +1,170 @@
+"""Impact events: intervals, velocities after impact, densities and batch means (Figs. 7-9)."""
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from scipy import stats as _sps
+
+from vibroimpact import _checks
+
+__all__ = ["DEFAULT_N_BATCHES", "impact_intervals", "velocity_after_impact", "interval_ratio",
+           "Density", "density", "BatchMeans", "batch_means"]
+
+#: Batches in a batch-means standard error; >= 20 keeps the t-quantile close to the normal one.
+DEFAULT_N_BATCHES = 20
+
+
+def impact_intervals(step, offset, dt: float) -> np.ndarray:
+    """Intervals between adjacent impacts, z_j, from the simulator's split impact times.
+
+    Parameters
+    ----------
+    step : array_like of int, shape (n,)
+        ``SimulationResult.impact_step``.
+    offset : array_like of float, shape (n,)
+        ``SimulationResult.impact_offset`` (0 <= offset <= dt).
+    dt : float
+        The simulation's sample step.
+
+    Returns
+    -------
+    ndarray of float, shape (max(n - 1, 0),)
+        ``z_j = (k_{j+1} - k_j) dt + (o_{j+1} - o_j)``: the integer difference is exact, so
+        short intervals keep full precision on long records where ``impact_time`` would not.
+        Intervals that contain a sticking phase include the time spent on the wall.
+    """
+    step = np.asarray(step, dtype=np.int64)
+    offset = np.asarray(offset, dtype=float)
+    if step.shape != offset.shape or step.ndim != 1:
+        raise ValueError(f"step and offset must be 1-D of equal length, got {step.shape} "
+                         f"and {offset.shape}")
+    return np.diff(step).astype(float) * float(dt) + np.diff(offset)
+
+
+def velocity_after_impact(u_minus, eps: float) -> np.ndarray:
+    """Speed just after impact, ``eps * u_{j-0}`` (paper eq. 7: u_{j+0} = -eps u_{j-0}).
+
+    Returned as a positive speed (the rebound velocity itself is its negative).
+    """
+    _checks.eps(eps)
+    return eps * np.asarray(u_minus, dtype=float)
+
+
+def interval_ratio(intervals, beta: float) -> np.ndarray:
+    """``r_j = z_j / z`` with the forcing period ``z = 2 pi / beta`` (Fig. 13)."""
+    _checks.real("beta", beta, low=0.0, low_open=True)
+    return np.asarray(intervals, dtype=float) * (beta / (2.0 * np.pi))
+
+
+class Density(NamedTuple):
+    """A histogram density estimate with per-bin standard errors."""
+
+    centres: np.ndarray  #: bin centres, shape (nbins,)
+    density: np.ndarray  #: probability density, integrates to 1 over the bins
+    stderr: np.ndarray   #: standard error of `density` per bin (binomial)
+    n: int               #: number of values the density is normalised by (inside the bins unless `total`)
+
+
+def density(values, bins, range=None, total=None) -> Density:
+    """Probability density of `values` by histogram, with binomial standard errors.
+
+    Parameters
+    ----------
+    values : array_like of float
+        Samples (e.g. velocities after impact, intervals, z_j / z).
+    bins : int or array_like
+        Passed to ``numpy.histogram``.
+    range : (float, float), optional
+        Passed to ``numpy.histogram``.
+    total : int, optional
+        Normalise by this many values instead of the count inside the bins, so that values
+        beyond the bins keep their share of probability (the density then integrates to the
+        fraction inside). Must be >= the count inside.
+
+    Returns
+    -------
+    Density
+        ``density_i = c_i / (n w_i)`` with c_i the count in bin i of width w_i and n the
+        count inside all bins (values outside are ignored, as ``numpy.histogram`` does);
+        ``stderr_i = sqrt(p_i (1 - p_i) / n) / w_i`` with ``p_i = c_i / n``. With no value in
+        the bins the density and its error are NaN.
+
+    Notes
+    -----
+    The binomial error assumes independent samples. Successive impacts are correlated, so it
+    is a lower bound; for a mean use `batch_means`.
+    """
+    values = np.asarray(values, dtype=float)
+    counts, edges = np.histogram(values, bins=bins, range=range)
+    widths = np.diff(edges)
+    centres = 0.5 * (edges[:-1] + edges[1:])
+    n = int(counts.sum())
+    if total is not None:
+        if total < n:
+            raise ValueError(f"total must be >= the count inside the bins ({n}), got {total!r}")
+        n = int(total)
+    if n == 0:
+        nan = np.full(counts.shape, np.nan)
+        return Density(centres, nan, nan.copy(), 0)
+    p = counts / n
+    return Density(centres, p / widths, np.sqrt(p * (1.0 - p) / n) / widths, n)
+
+
+class BatchMeans(NamedTuple):
+    """Mean of a correlated sequence with its batch-means standard error."""
+
+    mean: float       #: mean of the values used (all batches)
+    stderr: float     #: standard error of `mean`; NaN when fewer values than batches
+    n_batches: int    #: batches used (0 when the sequence was too short)
+    lag1: float       #: lag-1 autocorrelation of the batch means (should be near 0)
+
+    def interval(self, level: float = 0.95) -> tuple[float, float]:
+        """Two-sided Student-t confidence interval for the mean (n_batches - 1 dof)."""
+        if self.n_batches < 2:
+            return (np.nan, np.nan)
+        half = _sps.t.ppf(0.5 + 0.5 * level, self.n_batches - 1) * self.stderr
+        return (self.mean - half, self.mean + half)
+
+
+def batch_means(x, n_batches: int = DEFAULT_N_BATCHES) -> BatchMeans:
+    """Mean and standard error of a stationary but correlated sequence by batch means.
+
+    Parameters
+    ----------
+    x : array_like of float, shape (n,)
+        The sequence in time order (e.g. velocities after successive impacts).
+    n_batches : int, optional
+        Number B of contiguous batches of equal length ``n // B`` (>= 2; default 20). The
+        first ``n mod B`` values are dropped (they are the earliest, closest to the transient).
+
+    Returns
+    -------
+    BatchMeans
+        ``mean`` of the values used, ``stderr = std(batch means, ddof=1) / sqrt(B)``, B, and the
+        lag-1 autocorrelation of the batch means. If ``n < B`` the stderr is NaN and B = 0.
+
+    Notes
+    -----
+    Successive impacts are strongly correlated (an impact's velocity sets the next flight),
+    so ``std(x) / sqrt(n)`` understates the error by the factor ``sqrt(2 tau_int)``. Means
+    of long contiguous batches are nearly independent and normal once the batch length is
+    much longer than the correlation length, so their spread gives an honest error. With
+    B >= 20 the t-interval (`BatchMeans.interval`) is close to the normal one; a lag-1
+    correlation of the batch means clearly above ~2/sqrt(B) says the batches are too short.
+    """
+    x = np.asarray(x, dtype=float)
+    n_batches = _checks.integer("n_batches", n_batches, low=2)
+    if x.ndim != 1:
+        raise ValueError(f"x must be one-dimensional, got shape {x.shape}")
+    n_batches = int(n_batches)
+    if x.size < n_batches:
+        mean = float(x.mean()) if x.size else np.nan
+        return BatchMeans(mean, np.nan, 0, np.nan)
+    size = x.size // n_batches
+    means = x[x.size - size * n_batches:].reshape(n_batches, size).mean(axis=1)
+    d = means - means.mean()
+    denom = np.dot(d, d)
+    lag1 = float(np.dot(d[:-1], d[1:]) / denom) if denom > 0 else np.nan
+    return BatchMeans(float(means.mean()), float(means.std(ddof=1) / np.sqrt(n_batches)),
+                      n_batches, lag1)

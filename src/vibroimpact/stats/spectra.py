@@ -1,0 +1,281 @@
+"""Power spectral densities in the paper's convention (eqs. 8, 9).
+
+Conventions (paper eqs. 8, 9)
+-----------------------------
+Autocorrelation ``phi(t) = lim (1/T) int f(tau) f(tau + t) dtau`` and two-sided angular power
+spectral density ``S(beta) = int phi(t) exp(-j beta t) dt``, so that
+
+    variance = phi(0) = (1/2pi) int_{-inf}^{inf} S(beta) dbeta = (1/pi) int_0^inf S(beta) dbeta.
+
+With ``beta = 2 pi f``, ``(1/2pi) dbeta = df``, hence S(beta) equals the two-sided per-Hz
+density G(f) at ``f = beta / 2pi``. scipy's one-sided density doubles G at every bin except
+the zero frequency and (for even ``nperseg``) the Nyquist bin, so
+
+    S(beta_k) = P_onesided(f_k) / 2   for 0 < f_k < f_Nyquist,
+    S(beta_k) = P_onesided(f_k)       at f_k = 0 and f_k = f_Nyquist.
+
+Directly from the samples: ``S(beta_k) = dt <|sum_n w_n x_n exp(-j beta_k n dt)|^2> / sum_n w_n^2``
+(``<>`` = mean over Welch segments). A white sequence of variance s^2 at spacing dt has the
+flat level ``S = s^2 dt`` on ``|beta| <= pi / dt``.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
+from scipy import integrate, signal
+
+from vibroimpact import _checks
+
+__all__ = ["PSD_DETREND", "WelchAccumulator", "welch_psd", "onesided_to_angular",
+           "variance_from_psd", "linear_psd_response"]
+
+#: Detrending of every PSD estimate in the package (input force and response alike): the mean
+#: of the whole record is removed, nothing per segment, so S is the spectrum of the fluctuation
+#: about the mean. The response a(tau) of a mass against a wall has a non-zero mean that would
+#: otherwise fill the beta = 0 bin and leak into its neighbours; per-segment detrending
+#: ("constant", scipy's default) would instead bias the lowest bins of every spectrum low
+#: (it removes the power of all variations slower than a segment).
+PSD_DETREND = "mean"
+_DETRENDS = ("mean", "constant", "linear", False)
+
+# Segments processed per FFT batch: bounds the memory of one feed() to ~_BATCH * nperseg floats.
+_BATCH = 256
+
+class WelchAccumulator:
+    """Streaming Welch estimate of the two-sided angular PSD of a long sampled signal.
+
+    Feed the signal chunk by chunk (e.g. the simulator's ``a`` grid, one chunk per
+    `simulate_chunks` result); the estimate equals ``scipy.signal.welch`` applied to the
+    concatenated signal (Hann window, 50 % overlap, mean averaging), to round-off.
+
+    Parameters
+    ----------
+    dt : float
+        Sample spacing of the signal, in units of tau (for the simulator's record:
+        ``record_every * dt``).
+    nperseg : int
+        Segment length in samples (>= 2). The frequency resolution is
+        ``dbeta = 2 pi / (nperseg dt)``.
+    detrend : {'mean', 'constant', 'linear', False}, optional
+        ``'mean'`` (default, `PSD_DETREND`): the mean of everything fed is removed, exactly
+        (the estimate equals scipy's with ``detrend=False`` on ``x - mean(x)``). The others
+        are per-segment, as in ``scipy.signal.welch``: ``'constant'`` removes
+        each segment's mean, so the PSD is that of the fluctuation about the mean.
+
+    Notes
+    -----
+    Segments start at multiples of ``step = nperseg - nperseg // 2``; the samples after the
+    last complete segment are carried to the next `feed`, so chunk boundaries do not matter.
+    Trailing samples that never fill a segment are dropped, exactly as scipy does.
+
+    The returned S is the paper's eq. (9) two-sided angular density on beta >= 0; see the
+    module docstring for its relation to scipy's one-sided per-Hz density. Relative standard
+    deviation of each bin (0 < beta < Nyquist) is about ``1 / sqrt(n_effective)``.
+    """
+
+    def __init__(self, dt: float, nperseg: int, detrend: str | bool = PSD_DETREND):
+        dt = _checks.real("dt", dt, low=0.0, low_open=True)
+        nperseg = _checks.integer("nperseg", nperseg, low=2)
+        if detrend not in _DETRENDS:
+            raise ValueError(f"detrend must be one of {_DETRENDS}, got {detrend!r}")
+        self.dt = dt
+        self.nperseg = int(nperseg)
+        self.noverlap = self.nperseg // 2
+        self.step = self.nperseg - self.noverlap
+        self.detrend = detrend
+        self.window = signal.get_window("hann", self.nperseg)
+        self._win_energy = float(np.sum(self.window**2))
+        self._sum_power = np.zeros(self.nperseg // 2 + 1)
+        # detrend "mean": sum of the segments' windowed spectra and of all samples, from which
+        # the spectrum of (x - mean) follows exactly once the mean is known (see `result`)
+        self._sum_spectrum = np.zeros(self.nperseg // 2 + 1, dtype=complex)
+        self._sum_x = 0.0
+        self._leftover = np.empty(0)
+        self._n_segments = 0
+        self._n_samples = 0
+
+    @property
+    def n_segments(self) -> int:
+        """Number of complete Welch segments averaged so far (K)."""
+        return self._n_segments
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples fed so far."""
+        return self._n_samples
+
+    @property
+    def n_effective(self) -> float:
+        """Equivalent number of independent segments, K_eff (Welch 1967, eq. for overlap).
+
+        ``K_eff = K / (1 + 2 sum_{l=1}^{K-1} (1 - l/K) rho(l))`` with
+        ``rho(l) = (sum_n w_n w_{n + l step})^2 / (sum_n w_n^2)^2``, the correlation of
+        periodograms of overlapping segments of a white signal. The relative standard
+        deviation of a PSD bin is ``1 / sqrt(K_eff)`` (Hann, 50 % overlap: K_eff ~ K / 1.06).
+        """
+        k = self._n_segments
+        if k == 0:
+            return 0.0
+        w = self.window
+        lags = np.arange(1, min(k, -(-self.nperseg // self.step)))
+        rho = np.array([np.dot(w[l * self.step:], w[:self.nperseg - l * self.step])
+                        for l in lags]) ** 2 / self._win_energy**2
+        return k / (1.0 + 2.0 * np.sum((1.0 - lags / k) * rho))
+
+    def feed(self, chunk) -> "WelchAccumulator":
+        """Append the next stretch of the signal.
+
+        Parameters
+        ----------
+        chunk : array_like of float, shape (n,)
+            Consecutive samples, continuing the previous chunk without gap or overlap.
+
+        Returns
+        -------
+        WelchAccumulator
+            ``self``, so feeds can be chained.
+        """
+        chunk = np.asarray(chunk, dtype=float)
+        if chunk.ndim != 1:
+            raise ValueError(f"chunk must be one-dimensional, got shape {chunk.shape}")
+        if not np.all(np.isfinite(chunk)):
+            raise ValueError("chunk contains NaN or inf")
+        self._n_samples += chunk.size
+        self._sum_x += float(chunk.sum())
+        buf = np.concatenate([self._leftover, chunk])
+        if buf.size < self.nperseg:
+            self._leftover = buf
+            return self
+        n_seg = (buf.size - self.nperseg) // self.step + 1
+        segments = sliding_window_view(buf, self.nperseg)[::self.step][:n_seg]
+        for start in range(0, n_seg, _BATCH):
+            self._sum_power += self._periodogram_sum(segments[start:start + _BATCH])
+        self._n_segments += n_seg
+        self._leftover = buf[n_seg * self.step:].copy()
+        return self
+
+    def _periodogram_sum(self, segments: np.ndarray) -> np.ndarray:
+        if self.detrend in ("constant", "linear"):
+            segments = signal.detrend(segments, type=self.detrend, axis=-1)
+        spectrum = np.fft.rfft(segments * self.window, axis=-1)
+        if self.detrend == "mean":
+            self._sum_spectrum += spectrum.sum(axis=0)
+        return np.sum(spectrum.real**2 + spectrum.imag**2, axis=0)
+
+    def _power(self) -> np.ndarray:
+        """Summed periodograms; for "mean", those of ``x - mean(x)`` (mean of all samples fed):
+        ``sum_s |X_s - m W|^2 = sum_s |X_s|^2 - 2 m Re(conj(W) sum_s X_s) + K m^2 |W|^2``."""
+        if self.detrend != "mean":
+            return self._sum_power
+        m = self._sum_x / self._n_samples
+        w = np.fft.rfft(self.window)
+        cross = np.real(np.conj(w) * self._sum_spectrum)
+        power = self._sum_power - 2.0 * m * cross + self._n_segments * m * m * np.abs(w) ** 2
+        return np.maximum(power, 0.0)
+
+    def _check_ready(self):
+        if self._n_segments == 0:
+            raise ValueError(f"no complete segment yet: {self._n_samples} samples fed, "
+                             f"nperseg={self.nperseg}")
+
+    def result(self) -> tuple[np.ndarray, np.ndarray]:
+        """The paper's two-sided angular PSD on beta >= 0 (eq. 9).
+
+        Returns
+        -------
+        beta : ndarray, shape (nperseg // 2 + 1,)
+            Angular frequency (in units of the natural frequency), ``2 pi k / (nperseg dt)``.
+        S : ndarray, same shape
+            ``S(beta) = dt <|sum_n w_n x_n e^{-j beta n dt}|^2> / sum_n w_n^2``, so that
+            ``variance = (1/pi) int_0^{pi/dt} S dbeta`` (see `variance_from_psd`).
+        """
+        self._check_ready()
+        beta = 2.0 * np.pi * np.fft.rfftfreq(self.nperseg, d=self.dt)
+        S = self._power() / self._n_segments * (self.dt / self._win_energy)
+        return beta, S
+
+    def onesided_density(self) -> tuple[np.ndarray, np.ndarray]:
+        """scipy's convention: frequency f (cycles per unit tau) and one-sided density P(f).
+
+        Equal to ``scipy.signal.welch(x, fs=1/dt, nperseg=nperseg, detrend=detrend)`` on the
+        concatenated signal. ``P = 2 S`` except at f = 0 and (even nperseg) at Nyquist.
+        """
+        beta, S = self.result()
+        P = 2.0 * S
+        P[0] = S[0]
+        if self.nperseg % 2 == 0:
+            P[-1] = S[-1]
+        return beta / (2.0 * np.pi), P
+
+
+def onesided_to_angular(f, P, nperseg: int):
+    """scipy's one-sided per-Hz density ``P(f)`` as the paper's two-sided angular ``S(beta)``.
+
+    The one place the convention is converted (module docstring): ``beta = 2 pi f`` and
+    ``S = P / 2``, except at ``f = 0`` and, for even ``nperseg``, at Nyquist, which
+    ``scipy.signal.welch`` does not double.
+
+    Parameters
+    ----------
+    f, P : ndarray, shape (nperseg // 2 + 1,)
+        Frequencies (cycles per unit tau) and density, as ``scipy.signal.welch`` returns them
+        with ``return_onesided=True, scaling="density"``.
+    nperseg : int
+        Segment length used.
+
+    Returns
+    -------
+    beta, S : ndarray
+    """
+    S = np.asarray(P, dtype=float) / 2.0
+    S[0] = P[0]
+    if nperseg % 2 == 0:
+        S[-1] = P[-1]
+    return 2.0 * np.pi * np.asarray(f, dtype=float), S
+
+
+def welch_psd(x, dt: float, nperseg: int, detrend: str | bool = PSD_DETREND):
+    """Two-sided angular PSD (paper eq. 9) of a whole record; see `WelchAccumulator`.
+
+    Returns
+    -------
+    beta, S : ndarray
+        As `WelchAccumulator.result`.
+    n_effective : float
+        Equivalent number of independent segments; relative std of S is 1/sqrt(n_effective).
+    """
+    acc = WelchAccumulator(dt, nperseg, detrend).feed(x)
+    beta, S = acc.result()
+    return beta, S, acc.n_effective
+
+
+def variance_from_psd(beta, S) -> float:
+    """Variance carried by a two-sided angular PSD given on beta >= 0.
+
+    ``sigma^2 = (1/2pi) int_{-inf}^{inf} S dbeta = (1/pi) int_0^{beta_max} S dbeta``
+    (trapezoid rule). On the Welch grid with even nperseg this is exactly scipy's
+    ``sum(P) df`` (the end bins carry half weight on both sides).
+    """
+    return float(integrate.trapezoid(np.asarray(S, float), np.asarray(beta, float)) / np.pi)
+
+
+def linear_psd_response(beta, S_f, zeta: float):
+    """PSD of the wall-free linear response, ``S_x(beta) = |H(beta)|^2 S_f(beta)``.
+
+    Parameters
+    ----------
+    beta : array_like of float
+        Angular frequency ratio (beta = omega / omega_0).
+    S_f : array_like of float or float
+        Force PSD at `beta`, in the paper's eq. (9) convention.
+    zeta : float
+        Damping ratio, 0 < zeta < 1.
+
+    Notes
+    -----
+    ``H(beta) = 1 / (1 - beta^2 + 2 j zeta beta)`` (MODEL.md, linear reference), so
+    ``|H|^2 = 1 / ((1 - beta^2)^2 + (2 zeta beta)^2)``.
+    """
+    _checks.zeta(zeta)
+    beta = np.asarray(beta, dtype=float)
+    return np.asarray(S_f, dtype=float) / ((1.0 - beta**2) ** 2 + (2.0 * zeta * beta) ** 2)
