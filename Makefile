@@ -1,5 +1,6 @@
 # `make` installs into .venv and builds every figure and report of the default config;
-# `make test` installs and runs the fast suite, then the slow (stress/convergence) suite.
+# `make test` installs and runs the fast suite, the slow (stress/convergence) suite, the
+# end-to-end workflow suite, and the import-layer contract.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -19,6 +20,8 @@ $(STAMP): environment.txt pyproject.toml
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 	$(BIN)/python -m pytest -q -m slow
+	$(BIN)/python -m pytest -q -m workflow
+	$(BIN)/lint-imports
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py

@@ -142,7 +142,7 @@ def make_events(inv_beta=(1.0,), amplitude=0.0, deltas=DELTAS, critical=CRITICAL
                 "ratio": _var("ratio", ratio, "interval over forcing period z_j/z"),
                 "motion": _var("motion", np.array(["1/1", "2/1", "1/2"]), "impact motion")},
         attrs={**PROVENANCE, "zeta": ZETA, "eps": EPS, "amplitude": amplitude,
-               "noise": "band5", "noise_rms": RMS, "density_delta": np.array(DENSITY_DELTA),
+               "noise": "band5", "noise_rms": RMS,
                "motion_window": 0.1})
 
 
@@ -243,7 +243,7 @@ def test_fig06_one_curve_per_delta_and_linear_reference(data):
                                        ("fig08", "interval_density")])
 def test_density_figures_draw_the_nearest_density_deltas(data, name, var):
     events = data["events"]
-    (ax,) = getattr(plotting, name)(events).axes
+    (ax,) = getattr(plotting, name)(events, density_delta=DENSITY_DELTA).axes
     assert len(_data_lines(ax)) == len(DENSITY_DELTA)
     shown = [t.split("=")[1].split()[0] for t in _legend_texts(ax)]
     assert shown == ["1.5", "0.5", "0", "-0.5"]                  # nearest, largest first
@@ -252,9 +252,8 @@ def test_density_figures_draw_the_nearest_density_deltas(data, name, var):
 
 
 def test_density_delta_without_impacts_keeps_its_line(data):
-    events = data["events"].copy()
-    events.attrs["density_delta"] = np.array([2.0, 0.0])       # 2.0 > CRITICAL: no impacts
-    (ax,) = plotting.fig07(events).axes
+    events = data["events"]
+    (ax,) = plotting.fig07(events, density_delta=[2.0, 0.0]).axes   # 2.0 > CRITICAL: no impacts
     assert len(_data_lines(ax)) == 2
     assert "no impacts" in _legend_texts(ax)[0]
 
@@ -302,7 +301,7 @@ def test_fig11_fig12_select_the_nearest_forcing_frequency(data):
 
 def test_fig13_ratio_density_with_motion_marks(data):
     events = data["events_h"]
-    (ax,) = plotting.fig13(events, inv_beta=1.1).axes
+    (ax,) = plotting.fig13(events, inv_beta=1.1, density_delta=DENSITY_DELTA).axes
     assert len(_data_lines(ax)) == len(DENSITY_DELTA)
     assert _vlines_at(ax) == [0.5, 1.0, 2.0]
     chain = [ln for ln in ax.get_lines() if ln.get_linestyle() == "-."]
@@ -311,7 +310,7 @@ def test_fig13_ratio_density_with_motion_marks(data):
 
 
 def test_fig14_velocity_density_at_one_forcing_frequency(data):
-    (ax,) = plotting.fig14(data["events_h"], inv_beta=1.4).axes
+    (ax,) = plotting.fig14(data["events_h"], inv_beta=1.4, density_delta=DENSITY_DELTA).axes
     assert len(_data_lines(ax)) == len(DENSITY_DELTA)
     assert r"\sin(\tau/1.4)" in ax.figure._suptitle.get_text()
 
@@ -343,12 +342,10 @@ def test_missing_parameter_attribute_is_named(data):
 
 
 def test_netcdf_round_trip_is_plottable(data, tmp_path):
-    # netCDF returns a one-element attribute as a scalar: density_delta must still work.
-    events = data["events"].copy()
-    events.attrs["density_delta"] = np.array([0.5])
-    events.to_netcdf(tmp_path / "events.nc")
+    # a dataset read back from netCDF draws the same figure as the one written
+    data["events"].to_netcdf(tmp_path / "events.nc")
     with xr.open_dataset(tmp_path / "events.nc") as ds:
-        assert len(_data_lines(plotting.fig07(ds).axes[0])) == 1
+        assert len(_data_lines(plotting.fig07(ds, density_delta=[0.5]).axes[0])) == 1
 
 
 def test_style_is_scoped_to_the_figure_functions(data):

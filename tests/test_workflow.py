@@ -54,16 +54,17 @@ def test_lint(workdir):
 @pytest.mark.parametrize("fig", FIGURES)
 def test_dry_run_every_figure(workdir, fig):
     rules = scheduled_rules(workdir, f"results/figures/{fig}.png")
-    assert fig in rules and "paper_figure" in rules
+    assert {"draw_figure", "copy_paper_figure"} <= rules
 
 
 def test_fig04_needs_only_the_noise(workdir):
-    assert scheduled_rules(workdir, "results/figures/fig04.png") == {"noise", "fig04", "paper_figure"}
+    assert scheduled_rules(workdir, "results/figures/fig04.png") == {
+        "generate_noise", "draw_figure", "copy_paper_figure"}
 
 
 def test_fig16_runs_no_simulation(workdir):
     assert scheduled_rules(workdir, "results/figures/fig16.png") == {
-        "orbit_tile", "aggregate_orbits", "fig16", "paper_figure"}
+        "solve_orbit_tile", "aggregate_orbits", "draw_figure", "copy_paper_figure"}
 
 
 def test_fig07_records_no_spectra(workdir):
@@ -95,10 +96,12 @@ def test_bad_config_fails_before_any_job(workdir, tmp_path, path, value, key):
 
 @pytest.fixture(scope="module")
 def built(workdir):
+    """The test config built end to end (only for tests marked ``workflow``)."""
     run(workdir)            # rule all with the test config
     return workdir
 
 
+@pytest.mark.workflow
 def test_end_to_end(built):
     for fig in FIGURES:
         for ext in ("png", "pdf"):
@@ -108,14 +111,16 @@ def test_end_to_end(built):
         assert var.attrs.get("long_name") and "units" in var.attrs, name
     for key in ("package_version", "git_commit", "config_digest", "seed", "paper_reference"):
         assert key in ds.attrs
-    assert not list(built.rglob(".tmp-*")), "temporary files left behind"
+    assert not list(built.rglob("results/**/*.tmp")), "temporary files left behind"
 
 
+@pytest.mark.workflow
 def test_rerun_does_nothing(built):
     out = run(built, "-n")
     assert "Nothing to be done" in out.stdout + out.stderr
 
 
+@pytest.mark.workflow
 def test_same_config_same_datasets(built, tmp_path):
     again = _workdir(tmp_path)
     run(again, "results/datasets/random_events.nc", "results/datasets/random_spectra.nc")
@@ -137,6 +142,7 @@ def spectra(built):
     return xr.load_dataset(built / "results" / "datasets" / "random_spectra.nc").isel(inv_beta=0)
 
 
+@pytest.mark.workflow
 def test_finding1_psd_peak_moves_up_and_falls_with_delta(spectra):
     """PSD of a(tau): as delta decreases the peak frequency rises and its level falls;
     at delta = 0 no marked peak remains (peak < 3x the median over 0.2 <= beta <= 3)."""
@@ -154,6 +160,7 @@ def _impacting(events, minimum=1000):
     return events.sel(delta=events.delta[events.n_impacts >= minimum])
 
 
+@pytest.mark.workflow
 def test_finding2_velocities_shrink_as_delta_decreases(events):
     ev = _impacting(events)
     assert ev.delta.size >= 5
@@ -162,6 +169,7 @@ def test_finding2_velocities_shrink_as_delta_decreases(events):
     assert np.all(negative < 0.1 * float(ev.v_after_mean.max())), "markedly small for negative play"
 
 
+@pytest.mark.workflow
 def test_finding3_intervals_follow_the_same_trend(events):
     """Holds for delta >= -0.5; deeper pre-load makes the mass stick on the wall for long
     stretches, which lengthens the intervals again (README, "What the reproduction shows")."""
@@ -170,6 +178,7 @@ def test_finding3_intervals_follow_the_same_trend(events):
     assert np.all(np.diff(ev.interval_mean.values) > 0), ev.interval_mean.values
 
 
+@pytest.mark.workflow
 def test_finding4_means_grow_until_impacts_cease(events):
     """The mean interval grows without bound as delta rises: the impact rate falls by orders
     of magnitude, towards the critical delta past which no impact happens in the record."""

@@ -1,3 +1,10 @@
+# Aggregation reads small tiles and writes one dataset: cheap, run where Snakemake runs.
+localrules:
+    aggregate_events,
+    aggregate_spectra,
+    aggregate_orbits,
+
+
 rule aggregate_events:
     input:
         tiles("events"),
@@ -7,9 +14,15 @@ rule aggregate_events:
         "../envs/vibroimpact.yaml"
     log:
         "results/logs/aggregate_events/{study}.log",
+    benchmark:
+        "results/benchmarks/aggregate_events/{study}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
     params:
-        entry=study_entry,
-        provenance=study_provenance,
+        block=study_block("events"),
+        code=CODE["aggregate"],
     script:
         "../scripts/aggregate_events.py"
 
@@ -24,8 +37,14 @@ rule aggregate_spectra:
         "../envs/vibroimpact.yaml"
     log:
         "results/logs/aggregate_spectra/{study}.log",
+    benchmark:
+        "results/benchmarks/aggregate_spectra/{study}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
     params:
-        entry=study_entry,
-        provenance=study_provenance,
+        block=study_block("spectra"),
+        code=CODE["aggregate"],
     script:
         "../scripts/aggregate_spectra.py"

@@ -1,153 +1,47 @@
-# One rule per figure of the paper: each reads only what it draws.
+# One rule draws every figure: its inputs and options come from the figure table
+# (vibroimpact.pipeline.figures) through common.smk. Drawing is cheap: run locally.
+localrules:
+    draw_figure,
+    copy_paper_figure,
 
 
-rule fig03:
+rule draw_figure:
     input:
-        "results/traces/{study}.nc",
+        figure_inputs,
     output:
-        png="results/figures/{study}/fig03.png",
-        pdf="results/figures/{study}/fig03.pdf",
+        png="results/figures/{owner}/{fig}.png",
+        pdf="results/figures/{owner}/{fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"
     log:
-        "results/logs/figures/{study}/fig03.log",
+        "results/logs/draw_figure/{owner}/{fig}.log",
+    benchmark:
+        "results/benchmarks/draw_figure/{owner}/{fig}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
     params:
-        figure="fig03",
-        options={},
+        options=figure_options,
+        code=CODE["figure"],
     script:
-        "../scripts/figure.py"
+        "../scripts/draw_figure.py"
 
 
-rule fig04:
+rule copy_paper_figure:
     input:
-        study_noise,
+        unpack(paper_figure_source),
     output:
-        png="results/figures/{study}/fig04.png",
-        pdf="results/figures/{study}/fig04.pdf",
+        png="results/figures/{paper_fig}.png",
+        pdf="results/figures/{paper_fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"
     log:
-        "results/logs/figures/{study}/fig04.log",
-    params:
-        figure="fig04",
-        options={},
-    script:
-        "../scripts/figure.py"
-
-
-rule fig05:
-    input:
-        study_noise,
-    output:
-        png="results/figures/{study}/fig05.png",
-        pdf="results/figures/{study}/fig05.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/{study}/fig05.log",
-    params:
-        figure="fig05",
-        options={},
-    script:
-        "../scripts/figure.py"
-
-
-rule fig06:
-    input:
-        "results/datasets/{study}_spectra.nc",
-    output:
-        png="results/figures/{study}/fig06.png",
-        pdf="results/figures/{study}/fig06.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/{study}/fig06.log",
-    params:
-        figure="fig06",
-        options={},
-    script:
-        "../scripts/figure.py"
-
-
-rule fig07:
-    input:
-        "results/datasets/{study}_events.nc",
-    output:
-        png="results/figures/{study}/fig07.png",
-        pdf="results/figures/{study}/fig07.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/{study}/fig07.log",
-    params:
-        figure="fig07",
-        options={},
-    script:
-        "../scripts/figure.py"
-
-
-rule fig08:
-    input:
-        "results/datasets/{study}_events.nc",
-    output:
-        png="results/figures/{study}/fig08.png",
-        pdf="results/figures/{study}/fig08.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/{study}/fig08.log",
-    params:
-        figure="fig08",
-        options={},
-    script:
-        "../scripts/figure.py"
-
-
-rule fig09:
-    input:
-        "results/datasets/{study}_events.nc",
-    output:
-        png="results/figures/{study}/fig09.png",
-        pdf="results/figures/{study}/fig09.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/{study}/fig09.log",
-    params:
-        figure="fig09",
-        options={},
-    script:
-        "../scripts/figure.py"
-
-
-rule paper_figure:
-    input:
-        unpack(paper_figure_sources),
-    output:
-        png="results/figures/{fig}.png",
-        pdf="results/figures/{fig}.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/paper_{fig}.log",
-    localrule: True
+        "results/logs/copy_paper_figure/{paper_fig}.log",
+    threads: 1
+    resources:
+        mem_mb=100,
+        runtime=1,
     shell:
         "(cp {input.png} {output.png}.tmp && cp {input.pdf} {output.pdf}.tmp"
         " && mv {output.png}.tmp {output.png} && mv {output.pdf}.tmp {output.pdf}) > {log} 2>&1"
-
-
-rule fig16:
-    input:
-        "results/orbits/{study}.nc",
-    output:
-        png="results/figures/{study}/fig16.png",
-        pdf="results/figures/{study}/fig16.pdf",
-    conda:
-        "../envs/vibroimpact.yaml"
-    log:
-        "results/logs/figures/{study}/fig16.log",
-    params:
-        figure="fig16",
-        options={},
-    script:
-        "../scripts/figure.py"

@@ -1,14 +1,18 @@
-rule noise:
+rule generate_noise:
     output:
         "results/noise/{noise}.nc",
     conda:
         "../envs/vibroimpact.yaml"
     log:
-        "results/logs/noise/{noise}.log",
+        "results/logs/generate_noise/{noise}.log",
     benchmark:
-        "results/benchmarks/noise/{noise}.tsv"
+        "results/benchmarks/generate_noise/{noise}.tsv"
+    threads: 1
+    resources:
+        mem_mb=noise_mem_mb,
+        runtime=20,
     params:
         entry=noise_entry,
-        provenance=noise_provenance,
+        code=CODE["noise"],
     script:
-        "../scripts/noise.py"
+        "../scripts/generate_noise.py"

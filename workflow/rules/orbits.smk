@@ -1,29 +1,41 @@
-rule orbit_tile:
+rule solve_orbit_tile:
     output:
-        "results/orbits/{study}/tiles/{tile}.nc",
+        "results/orbits/{orbits}/tiles/{tile}.nc",
     conda:
         "../envs/vibroimpact.yaml"
     log:
-        "results/logs/orbit_tile/{study}/{tile}.log",
+        "results/logs/solve_orbit_tile/{orbits}/{tile}.log",
     benchmark:
-        "results/benchmarks/orbit_tile/{study}/{tile}.tsv"
+        "results/benchmarks/solve_orbit_tile/{orbits}/{tile}.tsv"
+    # rows run in parallel numba threads: exactly the rule's threads (tasks.orbit_tile)
+    threads: 2
+    resources:
+        mem_mb=BASE_MEM_MB + 200,
+        runtime=30,
     params:
         entry=orbits_entry,
-        provenance=orbits_provenance,
+        code=CODE["orbits"],
     script:
-        "../scripts/orbit_tile.py"
+        "../scripts/solve_orbit_tile.py"
 
 
 rule aggregate_orbits:
     input:
         orbit_tiles,
     output:
-        "results/orbits/{study}.nc",
+        "results/orbits/{orbits}.nc",
     conda:
         "../envs/vibroimpact.yaml"
     log:
-        "results/logs/aggregate_orbits/{study}.log",
+        "results/logs/aggregate_orbits/{orbits}.log",
+    benchmark:
+        "results/benchmarks/aggregate_orbits/{orbits}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
     params:
-        provenance=orbits_provenance,
+        entry=orbits_entry,
+        code=CODE["aggregate"],
     script:
         "../scripts/aggregate_orbits.py"

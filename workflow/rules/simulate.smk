@@ -9,9 +9,13 @@ rule simulate_events:
         "results/logs/simulate_events/{study}/{tile}.log",
     benchmark:
         "results/benchmarks/simulate_events/{study}/{tile}.tsv"
+    threads: 1
+    resources:
+        mem_mb=simulate_mem_mb,
+        runtime=simulate_runtime("events"),
     params:
-        entry=study_entry,
-        provenance=study_provenance,
+        block=study_block("events"),
+        code=CODE["simulate"],
     script:
         "../scripts/simulate_events.py"
 
@@ -27,9 +31,13 @@ rule simulate_spectra:
         "results/logs/simulate_spectra/{study}/{tile}.log",
     benchmark:
         "results/benchmarks/simulate_spectra/{study}/{tile}.tsv"
+    threads: 1
+    resources:
+        mem_mb=simulate_mem_mb,
+        runtime=simulate_runtime("spectra"),
     params:
-        entry=study_entry,
-        provenance=study_provenance,
+        block=study_block("spectra"),
+        code=CODE["simulate"],
     script:
         "../scripts/simulate_spectra.py"
 
@@ -43,8 +51,14 @@ rule simulate_trace:
         "../envs/vibroimpact.yaml"
     log:
         "results/logs/simulate_trace/{study}.log",
+    benchmark:
+        "results/benchmarks/simulate_trace/{study}.tsv"
+    threads: 1
+    resources:
+        mem_mb=simulate_mem_mb,
+        runtime=simulate_runtime("trace"),
     params:
-        entry=study_entry,
-        provenance=study_provenance,
+        block=study_block("trace"),
+        code=CODE["simulate"],
     script:
         "../scripts/simulate_trace.py"

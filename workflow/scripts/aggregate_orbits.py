@@ -1,5 +1,5 @@
-"""Rule aggregate_orbits: one orbit map from its tiles."""
+"""Rule aggregate_orbits: the orbit map of one `orbits` entry from its tiles."""
 from vibroimpact.pipeline import tasks
 
-tasks.log_to(snakemake.log[0])
-tasks.aggregate_orbits(list(snakemake.input), snakemake.output[0], snakemake.params.provenance)
+with tasks.logged(snakemake.log[0]):
+    tasks.aggregate_orbits(snakemake.params.entry, list(snakemake.input), snakemake.output[0])

@@ -3,8 +3,6 @@
 A failed or interrupted write never leaves a file under the final name: everything is
 written to a temporary name in the same directory and renamed into place on success.
 """
-import hashlib
-import json
 import os
 
 import netCDF4
@@ -17,23 +15,6 @@ def write_dataset(ds, path):
     """Write an ``xarray.Dataset`` to netCDF4 atomically."""
     with atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")
-
-
-def config_digest(obj):
-    """SHA-256 of the canonical JSON form of a config fragment (provenance)."""
-    text = json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
-def provenance(config_digest, git_commit, seed=None):
-    """Global attributes every output carries."""
-    from vibroimpact import PAPER_REFERENCE, __version__
-
-    attrs = dict(package_version=__version__, git_commit=str(git_commit),
-                 config_digest=str(config_digest), paper_reference=PAPER_REFERENCE)
-    if seed is not None:
-        attrs["seed"] = int(seed)
-    return attrs
 
 
 def _var(nc, name, dims, data, long_name, units, dtype="f8"):

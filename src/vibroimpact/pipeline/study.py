@@ -65,14 +65,16 @@ class Study:
 
     @classmethod
     def from_config(cls, name, entry):
-        """Build from a validated config entry ``studies[name]``."""
+        """Build from a validated config entry ``studies[name]``, or the part of it a job
+        reads (an entry without ``delta`` has an empty events grid)."""
         amplitude = float(entry.get("amplitude", 0.0))
         inv_beta = grid_values(entry.get("inv_beta", [1.0])) if amplitude != 0.0 else np.array([1.0])
         if np.any(inv_beta <= 0.0):
             raise ValueError(f"studies.{name}.inv_beta must hold values > 0, got {inv_beta!r}")
         spectra = entry.get("spectra") or {}
         return cls(name=name, zeta=float(entry["zeta"]), eps=float(entry["eps"]),
-                   amplitude=amplitude, inv_beta=inv_beta, delta=grid_values(entry["delta"]),
+                   amplitude=amplitude, inv_beta=inv_beta,
+                   delta=grid_values(entry["delta"]) if "delta" in entry else np.empty(0),
                    spectra_delta=grid_values(spectra["delta"]) if spectra.get("delta") else np.empty(0),
                    tile_size=int(entry.get("tile_size", 16)))
 
@@ -96,3 +98,9 @@ class Study:
         if not 0 <= t < n:
             raise ValueError(f"tile must lie in [0, {n - 1}], got {t!r}")
         return self.cells(kind)[t::n]
+
+
+def orbit_rows(entry):
+    """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
+    rows = grid_values(entry["inv_beta"])
+    return rows, -(-rows.size // int(entry["tile_rows"]))

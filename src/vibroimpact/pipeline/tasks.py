@@ -1,20 +1,40 @@
-"""The workflow's units of work as plain functions of config entries and paths.
+"""The workflow's units of work as plain functions of config blocks and paths.
 
-Each task reads its inputs, calls the numerical modules and writes one output atomically.
-They know nothing of Snakemake: the scripts under ``workflow/scripts`` only unpack
-``snakemake.*`` into these calls, and the tests call them directly.
+Each task reads its inputs, calls the numerical modules, records its provenance at run time
+(`vibroimpact.pipeline.provenance`) and writes one output atomically. They know nothing of
+Snakemake: the scripts under ``workflow/scripts`` only unpack ``snakemake.*`` into these
+calls, inside `logged`, and the tests call them directly. ``block`` is the part of a config
+entry the task reads (the workflow passes nothing else, so nothing else can rerun it).
 """
+import contextlib
 import logging
 
 import xarray as xr
 
-from vibroimpact.pipeline import datasets, io
 from vibroimpact.noise import NoiseSpec
-from vibroimpact.pipeline.study import Study, grid_values
+from vibroimpact.pipeline import datasets, io
+from vibroimpact.pipeline.figures import figure_variant
+from vibroimpact.pipeline.provenance import provenance
+from vibroimpact.pipeline.study import Study, grid_values, orbit_rows
 
 log = logging.getLogger("vibroimpact")
 
 _NOISE_FIELDS = ("kind", "rms", "dt", "beta_c", "zeta_f")
+
+
+@contextlib.contextmanager
+def logged(path):
+    """Send this job's log messages, warnings and, on failure, its traceback to ``path``."""
+    logging.basicConfig(filename=path, level=logging.INFO, force=True,
+                        format="%(asctime)s %(levelname)s %(message)s")
+    logging.captureWarnings(True)
+    try:
+        yield
+    except BaseException:
+        log.exception("job failed")
+        raise
+    finally:
+        logging.shutdown()
 
 
 def noise_spec(entry):
@@ -22,21 +42,20 @@ def noise_spec(entry):
     return NoiseSpec(**{k: entry[k] for k in _NOISE_FIELDS if entry.get(k) is not None})
 
 
-def make_noise(entry, out, provenance):
-    """Rule ``noise``: generate the record of a ``noises`` entry into ``out``."""
+def make_noise(entry, out):
+    """Rule ``generate_noise``: the record of a ``noises`` entry, into ``out``."""
     spec = noise_spec(entry)
     log.info("generating %d samples of %s", entry["n_samples"], spec)
     io.write_noise(out, spec, int(entry["n_samples"]), int(entry["seed"]),
-                   attrs=provenance, nperseg=int(entry.get("nperseg", 2048)))
+                   attrs=provenance(entry, entry["seed"]), nperseg=int(entry.get("nperseg", 2048)))
 
 
-def _study_attrs(study, entry, noise_attrs, provenance):
-    attrs = dict(provenance, study=study.name, zeta=study.zeta, eps=study.eps,
-                 amplitude=study.amplitude, noise=entry["noise"],
-                 noise_rms=float(noise_attrs["noise_rms"]), noise_kind=str(noise_attrs["noise_kind"]),
-                 seed=int(noise_attrs["seed"]), dt=float(noise_attrs["dt"]))
-    if noise_attrs.get("noise_beta_c") is not None:
-        attrs["noise_beta_c"] = float(noise_attrs["noise_beta_c"])
+def _study_attrs(study, block, noise_attrs):
+    noise = {k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}
+    attrs = dict(provenance([block, noise], int(noise_attrs["seed"])), study=study.name,
+                 zeta=study.zeta, eps=study.eps, amplitude=study.amplitude,
+                 noise=block["noise"], dt=float(noise_attrs["dt"]))
+    attrs.update(noise)
     return attrs
 
 
@@ -45,64 +64,66 @@ def _physics(study, cell):
                 beta_f=1.0 / cell.inv_beta)
 
 
-def events_tile(name, entry, tile, noise_path, out, provenance):
+def events_tile(name, block, tile, noise_path, out):
     """Rule ``simulate_events``: impact statistics of the cells of one tile."""
     from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
-    study = Study.from_config(name, entry)
+    study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
-    edges = datasets.bin_edges(entry["bins"])
+    edges = datasets.bin_edges(block["bins"])
     results = []
     for cell in study.tile(tile, "events"):
         log.info("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
         results.append(cells.event_statistics(
-            samples, dt, **_physics(study, cell), transient=float(entry["transient"]),
-            t_end=entry.get("t_end"), bins=edges, n_batches=int(entry["n_batches"]),
-            motion_window=float(entry["motion_window"])))
+            samples, dt, **_physics(study, cell), transient=float(block["transient"]),
+            t_end=block.get("t_end"), bins=edges, n_batches=int(block["n_batches"]),
+            motion_window=float(block["motion_window"])))
     ds = datasets.events_tile(study.tile(tile, "events"), results, edges,
-                              _study_attrs(study, entry, noise_attrs, provenance))
+                              dict(_study_attrs(study, block, noise_attrs),
+                                   motion_window=float(block["motion_window"])))
     io.write_dataset(ds, out)
 
 
-def spectra_tile(name, entry, tile, noise_path, out, provenance):
+def spectra_tile(name, block, tile, noise_path, out):
     """Rule ``simulate_spectra``: Welch spectra of a(tau) for the cells of one tile."""
     from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
-    study = Study.from_config(name, entry)
+    study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
-    spectra = entry["spectra"]
-    results = [cells.spectra_statistics(samples, dt, **_physics(study, cell),
-                                        transient=float(entry["transient"]),
-                                        t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"]))
-               for cell in study.tile(tile, "spectra")]
+    spectra = block["spectra"]
+    results = []
+    for cell in study.tile(tile, "spectra"):
+        log.info("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
+        results.append(cells.spectra_statistics(
+            samples, dt, **_physics(study, cell), transient=float(block["transient"]),
+            t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"])))
     ds = datasets.spectra_tile(study.tile(tile, "spectra"), results,
-                               _study_attrs(study, entry, noise_attrs, provenance))
+                               _study_attrs(study, block, noise_attrs))
     io.write_dataset(ds, out)
 
 
-def trace(name, entry, noise_path, out, provenance):
+def trace(name, block, noise_path, out):
     """Rule ``simulate_trace``: a short sampled record from rest (Figs. 3, 10)."""
     from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
-    study = Study.from_config(name, entry)
+    study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
-    spec = entry["trace"]
+    spec = block["trace"]
     inv_beta = float(spec.get("inv_beta", study.inv_beta[0]))
     tr = cells.trace(samples, dt, zeta=study.zeta, eps=study.eps, delta=float(spec["delta"]),
                      amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
-    attrs = dict(_study_attrs(study, entry, noise_attrs, provenance), delta=float(spec["delta"]),
+    attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
                  beta_f=1.0 / inv_beta)
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
 
 
-def aggregate(name, entry, kind, tiles, out, provenance, noise_path=None):
+def aggregate(name, block, kind, tiles, out, noise_path=None):
     """Rules ``aggregate_events`` / ``aggregate_spectra``: one dataset per study."""
-    study = Study.from_config(name, entry)
+    study = Study.from_config(name, block)
     parts = [xr.load_dataset(p) for p in tiles]
-    attrs = dict(parts[0].attrs, **provenance)
+    attrs = dict(parts[0].attrs)
+    attrs.update(provenance(block, attrs.get("seed")))
     if kind == "events":
-        attrs.update(density_delta=[float(d) for d in (entry.get("density_delta") or study.delta[:7])],
-                     motion_window=float(entry["motion_window"]))
         ds = datasets.aggregate_events(parts, study, attrs)
     else:
         spec = io.noise_spec(io.read_noise_attrs(noise_path))
@@ -111,42 +132,43 @@ def aggregate(name, entry, kind, tiles, out, provenance, noise_path=None):
     io.write_dataset(ds, out)
 
 
-def log_to(path):
-    """Send this job's log messages and warnings to ``path`` (the rule's ``log:`` file)."""
-    logging.basicConfig(filename=path, level=logging.INFO, force=True,
-                        format="%(asctime)s %(levelname)s %(message)s")
-    logging.captureWarnings(True)
+def figure(target, inputs, out_png, options):
+    """Rule ``draw_figure``: ``plotting.<fig>(*datasets, **options)`` saved to ``out_png``.
 
-
-def figure(name, inputs, out_png, **options):
-    """Figure rules: ``vibroimpact.plotting.<name>(*datasets, **options)`` saved to ``out_png``."""
+    ``target`` is ``fig07`` or ``fig13-1`` (`vibroimpact.pipeline.figures`); ``options``
+    come from the owner's config entry through the figure table (`figure_options`).
+    """
     from vibroimpact import plotting
 
+    name, _ = figure_variant(target)
+    log.info("drawing %s from %s with %s", target, inputs, options)
     with plotting.style():
         fig = getattr(plotting, name)(*[xr.load_dataset(p) for p in inputs], **options)
         plotting.save(fig, out_png)
 
 
-def orbit_rows(entry):
-    """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
-    rows = grid_values(entry["inv_beta"])
-    return rows, -(-rows.size // int(entry["tile_rows"]))
+def orbit_tile(entry, tile, out, threads=None):
+    """Rule ``solve_orbit_tile``: existence and stability of (m/n) motions on some rows.
 
+    ``threads``: numba threads of the row-parallel map (the rule's ``threads``).
+    """
+    import numba
 
-def orbit_tile(entry, tile, out, provenance):
-    """Rule ``orbit_tile``: existence and stability of (m/n) motions on some ``inv_beta`` rows."""
     from vibroimpact.orbits import orbit_map
 
+    if threads is not None:
+        numba.set_num_threads(int(threads))
     rows, n_tiles = orbit_rows(entry)
     result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
                        types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
                        eps=float(entry["eps"]))
-    attrs = dict(provenance, zeta=float(entry["zeta"]), eps=float(entry["eps"]), amplitude=1.0)
+    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                 amplitude=1.0)
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
 
-def aggregate_orbits(tiles, out, provenance):
+def aggregate_orbits(entry, tiles, out):
     """Rule ``aggregate_orbits``: the orbit map of one entry from its tiles."""
     ds = datasets.concat_orbit_tiles([xr.load_dataset(p) for p in tiles])
-    ds.attrs.update(provenance)
+    ds.attrs.update(provenance(entry))
     io.write_dataset(ds, out)

@@ -254,19 +254,28 @@ def _mark_forcing(ax, inv_beta):
                label=rf"forcing $\beta_f$ = 1/{_num(inv_beta)} = {_num(1.0 / inv_beta)}")
 
 
-def _density_deltas(events):
-    """Indices of the dataset deltas nearest to attribute ``density_delta``, largest first."""
-    wanted = np.atleast_1d(np.asarray(_attr(events, "density_delta"), dtype=float))
-    index = list(dict.fromkeys(_nearest(events["delta"], d) for d in wanted))
+#: Curves drawn by a density figure when no deltas are given (the largest deltas of the grid).
+DENSITY_CURVES = 7
+
+
+def _density_deltas(events, density_delta):
+    """Indices of the dataset deltas nearest to ``density_delta``, largest first.
+
+    ``None`` or empty: the `DENSITY_CURVES` largest deltas of the dataset.
+    """
     deltas = np.asarray(events["delta"], dtype=float)
+    if density_delta is None or len(density_delta) == 0:
+        return list(np.argsort(-deltas)[:DENSITY_CURVES])
+    wanted = np.atleast_1d(np.asarray(density_delta, dtype=float))
+    index = list(dict.fromkeys(_nearest(events["delta"], d) for d in wanted))
     return sorted(index, key=lambda k: -deltas[k])
 
 
-def _density_figure(events, i_beta, var, title, params):
+def _density_figure(events, i_beta, var, title, params, density_delta=None):
     """One density curve (with a 95 % band) per density delta, at inv_beta index `i_beta`."""
     fig, (ax,) = _figure()
     ds = events.isel(inv_beta=i_beta)
-    index = _density_deltas(events)
+    index = _density_deltas(events, density_delta)
     x = ds[var].dims[-1]
     band = f"{var}_stderr"
     for color, k in zip(_colors(len(index)), index):

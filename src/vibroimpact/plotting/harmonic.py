@@ -84,7 +84,7 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
 
 
 @_styled
-def fig13(events, inv_beta):
+def fig13(events, inv_beta, density_delta=None):
     """Fig. 13: probability density of z_j / z (z = 2 pi / beta_f), one curve per density delta.
 
     Parameters
@@ -104,7 +104,7 @@ def fig13(events, inv_beta):
     fig, ax = _density_figure(
         events, i, "ratio_density",
         r"Fig. 13  Probability density of $z_j/z$, the interval over the forcing period",
-        _events_params(events, i))
+        _events_params(events, i), density_delta)
     marks = ((0.5, "-.", "(2/1)"), (1.0, ":", "(1/1)"), (2.0, ":", "(1/2)"))
     for x, ls, _ in marks:
         ax.axvline(x, color="0.3", ls=ls, lw=1.0)
@@ -116,10 +116,10 @@ def fig13(events, inv_beta):
 
 
 @_styled
-def fig14(events, inv_beta):
+def fig14(events, inv_beta, density_delta=None):
     """Fig. 14: density of the velocity after impact under sin(tau/inv_beta) + r(tau)."""
     i = _nearest(events["inv_beta"], inv_beta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",
-                             _events_params(events, i))
+                             _events_params(events, i), density_delta)
     return fig

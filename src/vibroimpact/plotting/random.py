@@ -122,14 +122,16 @@ def fig06(spectra, beta_max=SPECTRUM_BETA_MAX):
 
 
 @_styled
-def fig07(events):
+def fig07(events, density_delta=None):
     """Fig. 7: probability density of the velocity after impact, one curve per density delta.
 
     Parameters
     ----------
     events : xarray.Dataset
-        ``results/datasets/{study}_events.nc``; inv_beta index 0; the deltas shown are those
-        of the dataset nearest to the attribute ``density_delta``.
+        ``results/datasets/{study}_events.nc``; inv_beta index 0.
+    density_delta : sequence of float, optional
+        Deltas to draw (the dataset's nearest values; config key ``density_delta``); default
+        the largest seven of the dataset.
 
     Returns
     -------
@@ -138,16 +140,16 @@ def fig07(events):
     """
     fig, _ = _density_figure(events, 0, "v_after_density",
                              "Fig. 7  Probability density of the velocity after impact",
-                             _events_params(events, 0))
+                             _events_params(events, 0), density_delta)
     return fig
 
 
 @_styled
-def fig08(events):
+def fig08(events, density_delta=None):
     """Fig. 8: probability density of the interval between adjacent impacts (as fig07)."""
     fig, _ = _density_figure(events, 0, "interval_density",
                              "Fig. 8  Probability density of the interval between impacts",
-                             _events_params(events, 0))
+                             _events_params(events, 0), density_delta)
     return fig
 
 

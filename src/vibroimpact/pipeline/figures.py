@@ -1,0 +1,88 @@
+"""The figure table: which datasets each figure draws and which config keys are its options.
+
+One table for the one figure rule (``draw_figure``): a figure's inputs are the datasets listed
+under ``reads``, its drawing options come from its owner's config entry (keys listed under
+``options``, figure-only keys that never reach a simulation) and from the figure's own item
+in the entry's ``figures`` list. A figure that names a ``per`` parameter is drawn once per
+listed value: the item ``{name: fig13, inv_beta: [0.8, 1.25]}`` gives the targets
+``fig13-0`` and ``fig13-1`` (an index, never a float in a file name).
+"""
+import re
+
+__all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item"]
+
+FIGURES = {
+    "fig03": dict(owner="study", reads=("trace",)),
+    "fig04": dict(owner="study", reads=("noise",)),
+    "fig05": dict(owner="study", reads=("noise",)),
+    "fig06": dict(owner="study", reads=("spectra",)),
+    "fig07": dict(owner="study", reads=("events",), options=("density_delta",)),
+    "fig08": dict(owner="study", reads=("events",), options=("density_delta",)),
+    "fig09": dict(owner="study", reads=("events",)),
+    "fig10": dict(owner="study", reads=("trace",)),
+    "fig11": dict(owner="study", reads=("spectra",), per="inv_beta"),
+    "fig12": dict(owner="study", reads=("spectra",), per="inv_beta"),
+    "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta"),
+    "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta"),
+    "fig16": dict(owner="orbits", reads=("orbits",)),
+}
+
+_VARIANT = re.compile(r"^(?P<name>[a-z][a-z0-9_]*?)(-(?P<index>[0-9]+))?$")
+
+
+def figure_variant(target):
+    """``"fig13-1"`` -> ``("fig13", 1)``; ``"fig07"`` -> ``("fig07", None)``."""
+    match = _VARIANT.match(target)
+    if match is None:
+        raise ValueError(f"figure target must look like fig07 or fig13-1, got {target!r}")
+    index = match["index"]
+    return match["name"], None if index is None else int(index)
+
+
+def _item_name(item):
+    return item if isinstance(item, str) else item["name"]
+
+
+def figure_item(entry, name):
+    """The item of ``entry["figures"]`` that asks for figure ``name`` (a mapping)."""
+    for item in entry.get("figures", []):
+        if _item_name(item) == name:
+            return {"name": item} if isinstance(item, str) else dict(item)
+    raise ValueError(f"figures: {name!r} is not listed; listed: "
+                     f"{[_item_name(i) for i in entry.get('figures', [])]}")
+
+
+def figure_targets(entry):
+    """Target names (``fig07``, ``fig13-0`` ...) of every figure an entry lists."""
+    targets = []
+    for item in entry.get("figures", []):
+        name = _item_name(item)
+        per = FIGURES[name].get("per")
+        if per is None or isinstance(item, str) or per not in item:
+            targets.append(name)
+        else:
+            targets += [f"{name}-{k}" for k in range(len(item[per]))]
+    return targets
+
+
+def figure_options(entry, target):
+    """Keyword options of the plotting function for ``target`` of a config entry.
+
+    The figure's ``options`` keys of the entry, then the item's own keys (except ``name``);
+    for a ``per`` figure, the parameter's value of this variant.
+    """
+    name, index = figure_variant(target)
+    spec = FIGURES[name]
+    options = {key: entry[key] for key in spec.get("options", ()) if entry.get(key)}
+    item = figure_item(entry, name)
+    options.update({k: v for k, v in item.items() if k != "name"})
+    per = spec.get("per")
+    if per is not None and per in item:
+        values = item[per]
+        if index is None or not 0 <= index < len(values):
+            raise ValueError(f"figure {target!r}: {name} is drawn per {per}; "
+                             f"give {name}-k with k in [0, {len(values) - 1}]")
+        options[per] = values[index]
+    elif index is not None:
+        raise ValueError(f"figure {target!r}: {name} lists no {per or 'parameter'} values")
+    return options

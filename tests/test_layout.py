@@ -1,0 +1,46 @@
+"""The package's shape: light imports for jobs that do not simulate, lazy public API."""
+import subprocess
+import sys
+
+import pytest
+
+
+def _modules_after(code):
+    out = subprocess.run([sys.executable, "-c", code + "\nimport sys; print(' '.join(sys.modules))"],
+                         capture_output=True, text=True, check=True)
+    return set(out.stdout.split())
+
+
+@pytest.mark.parametrize("imports", [
+    "import vibroimpact",
+    # what a figure job and an aggregation job import
+    "from vibroimpact.pipeline import tasks; from vibroimpact import plotting",
+])
+def test_jobs_that_do_not_simulate_do_not_load_numba(imports):
+    loaded = _modules_after(imports)
+    assert "numba" not in loaded
+    assert not {m for m in loaded if m.startswith(("vibroimpact.impact", "vibroimpact.orbit"))}
+
+
+def test_public_api_is_re_exported_lazily():
+    loaded = _modules_after("from vibroimpact import simulate, periodic_orbits\n"
+                            "assert simulate.__module__ == 'vibroimpact.impact.simulate'")
+    assert "numba" in loaded
+    import vibroimpact
+    assert {"simulate", "periodic_orbits", "PeriodicOrbit", "orbit_map"} <= set(dir(vibroimpact))
+    with pytest.raises(AttributeError, match="no_such_name"):
+        vibroimpact.no_such_name
+
+
+def test_validators_name_the_argument_and_its_range():
+    from vibroimpact import _checks
+
+    with pytest.raises(ValueError, match=r"^zeta must be a finite real number in \(0, 1\), got 1.5$"):
+        _checks.zeta(1.5)
+    with pytest.raises(ValueError, match=r"^n must be an integer >= 1, got 0$"):
+        _checks.integer("n", 0, low=1)
+    assert _checks.integer("n_samples", 1.0e8, low=0) == 100_000_000
+    with pytest.raises(ValueError, match="dt must be a finite real number > 0, got nan"):
+        _checks.real("dt", float("nan"), low=0.0, low_open=True)
+    with pytest.raises(ValueError, match="got True"):
+        _checks.real("delta", True)

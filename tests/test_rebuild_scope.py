@@ -1,0 +1,177 @@
+"""Rebuild scope: after a build, an edit reruns exactly the jobs it touches (README, "What reruns").
+
+The test config is built once in a temporary git repository holding the working tree; each case
+edits one thing there and reads the job list of ``snakemake -n``. The package is imported from
+that copy (PYTHONPATH), so an edit of its sources is an edit of the code the workflow runs.
+"""
+import os
+from pathlib import Path
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+import yaml
+
+pytestmark = pytest.mark.workflow
+
+ROOT = Path(__file__).resolve().parents[1]
+SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+FIGURE_RULES = {"draw_figure", "copy_paper_figure", "all"}
+STUDY_RULES = {"simulate_events", "simulate_spectra", "simulate_trace", "aggregate_events",
+               "aggregate_spectra"}
+ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits"}
+
+
+def _git(repo, *args):
+    subprocess.run(["git", *args], cwd=repo, check=True, capture_output=True,
+                   env={**os.environ, "GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@t",
+                        "GIT_COMMITTER_NAME": "t", "GIT_COMMITTER_EMAIL": "t@t"})
+
+
+def _snakemake(repo, *args):
+    env = {**os.environ, "PYTHONPATH": str(repo / "src")}
+    out = subprocess.run([SNAKEMAKE, *args, "--cores", "2", "--configfile", "config/test.yaml"],
+                         cwd=repo, capture_output=True, text=True, timeout=900, env=env)
+    if out.returncode != 0:
+        raise AssertionError(f"snakemake {' '.join(args)} failed:\n{out.stdout[-3000:]}\n"
+                             f"{out.stderr[-3000:]}")
+    return out.stdout + out.stderr
+
+
+def scheduled(repo):
+    """``{rule: {outputs}}`` of the jobs a dry run would execute."""
+    jobs = {}
+    rule = None
+    for line in _snakemake(repo, "-n").splitlines():
+        match = re.match(r"^(?:local)?rule (\w+):$", line.strip())
+        if match:
+            rule = match[1]
+            jobs.setdefault(rule, set())
+        elif rule and line.strip().startswith("output:"):
+            jobs[rule].update(p.strip() for p in line.split(":", 1)[1].split(","))
+    return jobs
+
+
+@pytest.fixture(scope="module")
+def repo(tmp_path_factory):
+    """A git repository holding the working tree, with the test config built."""
+    repo = tmp_path_factory.mktemp("rebuild")
+    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT,
+                           capture_output=True, text=True, check=True).stdout.split()
+    for name in files:
+        if (ROOT / name).is_file():
+            (repo / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(ROOT / name, repo / name)
+    _git(repo, "init", "-q")
+    _git(repo, "add", "-A")
+    _git(repo, "commit", "-qm", "base")
+    _snakemake(repo)
+    assert scheduled(repo) == {}
+    return repo
+
+
+@pytest.fixture()
+def edit(repo):
+    """Edit files of ``repo`` for one case; restore them (and the git history) afterwards."""
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=repo, capture_output=True,
+                          text=True, check=True).stdout.strip()
+    saved = {}
+
+    def change(path, func):
+        path = repo / path
+        saved.setdefault(path, path.read_text())
+        path.write_text(func(path.read_text()))
+
+    yield change
+    for path, text in saved.items():
+        path.write_text(text)
+    _git(repo, "reset", "-q", "--hard", head)
+
+
+def _set(key_path, value):
+    def func(text):
+        cfg = yaml.safe_load(text)
+        node = cfg
+        for key in key_path[:-1]:
+            node = node[key]
+        node[key_path[-1]] = value
+        return yaml.safe_dump(cfg, sort_keys=False)
+    return func
+
+
+def _append_comment(text):
+    return text + "\n# an edit\n"
+
+
+def test_commits_of_nothing_docs_readme_tests_rerun_nothing(repo, edit):
+    _git(repo, "commit", "-q", "--allow-empty", "-m", "empty")
+    assert scheduled(repo) == {}
+    for path in ("README.md", "docs/model.md", "tests/test_stats.py"):
+        edit(path, _append_comment)
+    _git(repo, "commit", "-qam", "docs, readme, tests")
+    assert scheduled(repo) == {}
+
+
+def test_plotting_edit_reruns_only_figures(repo, edit):
+    edit("src/vibroimpact/plotting/_common.py", _append_comment)
+    jobs = scheduled(repo)
+    assert set(jobs) == FIGURE_RULES
+    _git(repo, "commit", "-qam", "plotting")          # committed or not: the same jobs
+    assert set(scheduled(repo)) == FIGURE_RULES
+
+
+def test_figure_only_key_reruns_only_that_figure(repo, edit):
+    edit("config/test.yaml", _set(("studies", "random", "density_delta"), [0.5, 0.0]))
+    jobs = scheduled(repo)
+    assert set(jobs) == FIGURE_RULES
+    drawn = {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")}
+    assert drawn == {"fig07.png", "fig08.png"}
+    edit("config/test.yaml", _set(("studies", "random", "figures"),
+                                  ["fig03", "fig04", "fig05", "fig06", "fig07", "fig08",
+                                   "fig09"][::-1]))
+    assert set(scheduled(repo)) == FIGURE_RULES
+
+
+def test_simulator_edit_reruns_the_studies_and_downstream(repo, edit):
+    edit("src/vibroimpact/impact/kernels.py", _append_comment)    # uncommitted
+    jobs = scheduled(repo)
+    assert set(jobs) == STUDY_RULES | FIGURE_RULES
+    assert not any("fig16" in p for p in jobs["draw_figure"])
+
+
+def test_statistics_edit_reruns_the_studies(repo, edit):
+    edit("src/vibroimpact/stats/events.py", _append_comment)
+    assert STUDY_RULES <= set(scheduled(repo))
+
+
+def test_physical_value_reruns_that_study(repo, edit):
+    edit("config/test.yaml", _set(("studies", "random", "eps"), 0.6))
+    jobs = scheduled(repo)
+    assert set(jobs) == STUDY_RULES | FIGURE_RULES
+    assert "generate_noise" not in jobs
+
+
+def test_noise_edit_reruns_everything_it_feeds(repo, edit):
+    edit("config/test.yaml", _set(("noises", "random_input", "rms"), 0.4))
+    assert set(scheduled(repo)) == {"generate_noise"} | STUDY_RULES | FIGURE_RULES
+
+
+def test_orbit_entry_or_solver_edit_reruns_only_fig16(repo, edit):
+    edit("config/test.yaml", _set(("orbits", "harmonic", "zeta"), 0.06))
+    jobs = scheduled(repo)
+    assert set(jobs) == ORBIT_RULES | FIGURE_RULES
+    assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {"fig16.png"}
+    (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
+    edit("src/vibroimpact/orbit_kernels.py", _append_comment)
+    assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES
+
+
+def test_outputs_record_the_dirty_flag(repo, edit):
+    import xarray as xr
+
+    attrs = xr.open_dataset(repo / "results/datasets/random_events.nc").attrs
+    commit = subprocess.run(["git", "rev-parse", "HEAD"], cwd=repo, capture_output=True,
+                            text=True, check=True).stdout.strip()
+    assert attrs["git_commit"] == commit and attrs["git_dirty"] == 0
