@@ -1,6 +1,6 @@
 """Peers for the simulator benchmark: general-purpose integrators given the same problem.
 
-Every peer integrates the oscillator of MODEL.md (x'' + 2 zeta x' + x = r(tau), wall at
+Every peer integrates the oscillator of docs/model.md (x'' + 2 zeta x' + x = r(tau), wall at
 x = delta, restitution eps) under a piecewise-linear random force r(tau) sampled every `dt`
 (no harmonic part), and returns the impacts it found as ``(impact_time, impact_velocity)``
 float64 arrays, impact_velocity being the approach velocity u_{j-0} > 0.
@@ -88,7 +88,7 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
     Parameters
     ----------
     zeta, eps, delta : float
-        Damping ratio, restitution coefficient, wall position (MODEL.md).
+        Damping ratio, restitution coefficient, wall position (docs/model.md).
     noise : ndarray of float64, shape (n,)
         r[k] = r(k dt); r is linear in between.
     dt : float

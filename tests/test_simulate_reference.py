@@ -385,7 +385,7 @@ def test_invariants(run):
 def test_elastic_bounces_pressed_on_wall_terminate():
     """eps = 1 with the force pressing the mass on the wall (f - delta = 0.6 > 0): damping
     shrinks the bounces only like 1/k, so they do not accumulate in finite time but their
-    number grows like exp(2 zeta tau / 3); the simulator must still return (MODEL.md: never
+    number grows like exp(2 zeta tau / 3); the simulator must still return (docs/model.md: never
     hang) with the mass at the wall."""
     res = simulate(0.6, 1.0, -0.6, np.zeros(401), 0.1, x0=-1.5, record_every=1)
     assert np.all(res.a >= -1e-12)

@@ -130,7 +130,7 @@ def test_same_config_same_datasets(built, tmp_path):
         xr.testing.assert_identical(a.drop_attrs(), b.drop_attrs())
 
 
-# --- the paper's findings 1-4 (FIGURES.md) on the datasets of the test config -------------
+# --- the paper's findings 1-4 (docs/figures.md) on the datasets of the test config -------------
 
 @pytest.fixture(scope="module")
 def events(built):

@@ -1,6 +1,6 @@
 """Stationary Gaussian random force: target spectra, seeded generation and estimators.
 
-The random part of the force is a sample sequence ``r_k = r(k dt)`` (MODEL.md, "Forcing");
+The random part of the force is a sample sequence ``r_k = r(k dt)`` (docs/model.md, section 4);
 the simulator draws the straight line between samples. This module is the only place where
 randomness enters the package: every realization is a function of a :class:`NoiseSpec`, a
 recorded seed and the package version.

@@ -273,7 +273,7 @@ def linear_psd_response(beta, S_f, zeta: float):
 
     Notes
     -----
-    ``H(beta) = 1 / (1 - beta^2 + 2 j zeta beta)`` (MODEL.md, linear reference), so
+    ``H(beta) = 1 / (1 - beta^2 + 2 j zeta beta)`` (docs/model.md, section 7), so
     ``|H|^2 = 1 / ((1 - beta^2)^2 + (2 zeta beta)^2)``.
     """
     _checks.zeta(zeta)

@@ -1,6 +1,6 @@
 """Independent high-precision reference simulator of the vibro-impact oscillator (mpmath).
 
-Written from the closed form of MODEL.md, without importing ``vibroimpact``, so that the
+Written from the closed form of docs/model.md (section 5), without importing ``vibroimpact``, so that the
 package's float64 simulator can be tested against it.
 
 Between impacts, on a stretch where the random force is linear, ``r(s) = r0 + b s``::
