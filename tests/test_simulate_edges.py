@@ -87,7 +87,7 @@ def test_gave_up_message_says_what_it_saw():
     from vibroimpact.impact.simulate import _raise_status
     diag = np.array([0.05, -1e-17, -2e-9, kernels.FREE, 40000, 25534])
     P = np.zeros(21)
-    P[3] = -0.45
+    P[kernels.P_DELTA] = -0.45
     r = np.array([0.0, 0.1, 0.2, 0.3, -0.45, -0.5, 0.0, -0.45, -0.52])
     with pytest.raises(RuntimeError) as info:
         _raise_status(kernels.TOO_MANY_EVENTS, 7, 0.1, r, 0, diag, P)

@@ -4,7 +4,7 @@ Pure functions of numpy arrays and scalars: no I/O, no random numbers, no alloca
 step. The Python driver (:mod:`vibroimpact.simulate`) validates input, allocates the
 output buffers and wraps the results.
 
-Model (MODEL.md, paper eqs. 2-7)::
+Model (docs/model.md, sections 2-6; paper eqs. 2-7)::
 
     x'' + 2 zeta x' + x = f(tau) = A sin(beta tau) + r(tau),   x <= delta,
     impact at x = delta with u = x'(tau-) > 0:  x'(tau+) = -eps u,
@@ -56,6 +56,23 @@ MICRO_HEIGHT = 1e-12
 #: Impacts and sticking events one step may write; the driver flushes buffers before a step
 #: when less room than this is left.
 STEP_HEADROOM = 1 << 16
+
+# --- named indices ----------------------------------------------------------------------
+# The parameter vector P (built by vibroimpact.impact.simulate.kernel_parameters); numba
+# reads module-level ints as compile-time constants, so P[P_DELTA] costs what P[3] did.
+P_ZETA, P_OMEGA, P_EPS, P_DELTA, P_DT = 0, 1, 2, 3, 4       # zeta, sqrt(1 - zeta^2), eps, delta, h
+P_A, P_BETA, P_AQ, P_PHI = 5, 6, 7, 8                       # harmonic A, beta, A q, phase lag phi
+P_COS_PHI, P_SIN_PHI = 9, 10
+P_BH_HI, P_BH_LO = 11, 12                                   # beta h in double-double
+P_M11, P_M12, P_M21, P_M22 = 13, 14, 15, 16                 # free-response propagator over h
+P_INV_DT, P_INV_OMEGA, P_COS_BH, P_SIN_BH = 17, 18, 19, 20
+N_PARAMS = 21
+# The segment tuple c returned by `segment`: the state, the force and the free response at
+# the segment's start.
+C_XD, C_V0, C_B, C_SP, C_CP = 0, 1, 2, 3, 4        # x0 - delta, x0 velocity, slope b, sin/cos psi0
+C_Y0, C_YV0, C_C2, C_D2, C_R = 5, 6, 7, 8, 9       # free response, its velocity, coefficients, amplitude
+C_G2, C_G3, C_F0, C_DF0 = 10, 11, 12, 13           # 2nd, 3rd derivative of x; f - delta and its slope
+C_SIN_T, C_COS_T, C_F_LIN = 14, 15, 16             # sin/cos of the forcing phase; r0 + b s
 
 TWO_PI_HI = 6.283185307179586
 TWO_PI_LO = 2.4492935982947064e-16
@@ -144,8 +161,8 @@ def segment(x0, v0, s, r0, b, theta_k, P):
     ``P`` is the parameter vector built by :func:`vibroimpact.simulate.kernel_parameters`.
     Returns a tuple used by :func:`seg_eval` and the bounds of the search.
     """
-    zeta, omega, delta = P[0], P[1], P[3]
-    A, beta, Aq, phi = P[5], P[6], P[7], P[8]
+    zeta, omega, delta = P[P_ZETA], P[P_OMEGA], P[P_DELTA]
+    A, beta, Aq, phi = P[P_A], P[P_BETA], P[P_AQ], P[P_PHI]
     P0 = r0 + b * s - 2.0 * zeta * b
     if Aq != 0.0:
         psi0 = theta_k + beta * s - phi
@@ -160,8 +177,8 @@ def segment(x0, v0, s, r0, b, theta_k, P):
     d2 = (y0 + zeta * yv0) / omega
     R = math.sqrt(y0 * y0 + c2 * c2) * BOUND_SAFETY
     # force at the segment start: sin(theta) = sin(psi0 + phi)
-    sin_t = sp * P[9] + cp * P[10]
-    cos_t = cp * P[9] - sp * P[10]
+    sin_t = sp * P[P_COS_PHI] + cp * P[P_SIN_PHI]
+    cos_t = cp * P[P_COS_PHI] - sp * P[P_SIN_PHI]
     F0 = r0 + b * s + A * sin_t - delta       # f - delta: the push into the wall at x = delta
     dF0 = b + A * beta * cos_t
     g2 = F0 + delta - 2.0 * zeta * v0 - x0      # x'' at the start
@@ -177,9 +194,9 @@ def seg_eval(sig, c, P):
     Written as ``x(sig) - x0`` plus ``x0 - delta`` with ``expm1`` and half-angle sines so that
     short flights (chatter) keep full relative accuracy; ``x''`` follows from eq. (2).
     """
-    zeta, omega, delta = P[0], P[1], P[3]
-    A, beta, Aq = P[5], P[6], P[7]
-    g0, b, sp, cp, y0, yv0, c2, d2 = c[0], c[2], c[3], c[4], c[5], c[6], c[7], c[8]
+    zeta, omega, delta = P[P_ZETA], P[P_OMEGA], P[P_DELTA]
+    A, beta, Aq = P[P_A], P[P_BETA], P[P_AQ]
+    g0, b, sp, cp, y0, yv0, c2, d2 = c[C_XD], c[C_B], c[C_SP], c[C_CP], c[C_Y0], c[C_YV0], c[C_C2], c[C_D2]
     em1 = expm1(-zeta * sig)
     E = em1 + 1.0
     sh, ch = sincos(0.5 * omega * sig)
@@ -187,14 +204,14 @@ def seg_eval(sig, c, P):
     C = 1.0 - 2.0 * sh * sh
     dx = b * sig + y0 * (em1 * C - 2.0 * sh * sh) + c2 * E * S
     v = b + E * (yv0 * C - d2 * S)
-    f = c[16] + b * sig
+    f = c[C_F_LIN] + b * sig
     if Aq != 0.0:
         sb, cb = sincos(0.5 * beta * sig)
         cos_b = 1.0 - 2.0 * sb * sb
         sin_b = 2.0 * sb * cb
         dx += 2.0 * Aq * (cp * cb - sp * sb) * sb
         v += Aq * beta * (cp * cos_b - sp * sin_b)
-        f += A * (c[14] * cos_b + c[15] * sin_b)
+        f += A * (c[C_SIN_T] * cos_b + c[C_COS_T] * sin_b)
     g = g0 + dx
     return g, v, f - 2.0 * zeta * v - (g + delta)
 
@@ -202,12 +219,12 @@ def seg_eval(sig, c, P):
 @njit(cache=True, error_model="numpy")
 def _bounds(c, P):
     """Bounds on ``|x''|, |x'''|, |x''''|`` over a segment, and scales for tolerances."""
-    Aq, beta = abs(P[7]), P[6]
-    R = c[9]
+    Aq, beta = abs(P[P_AQ]), P[P_BETA]
+    R = c[C_R]
     M2 = Aq * beta * beta * BOUND_SAFETY + R
     M3 = Aq * beta * beta * beta * BOUND_SAFETY + R
     M4 = Aq * beta * beta * beta * beta * BOUND_SAFETY + R
-    vscale = abs(c[2]) + Aq * beta + R + abs(c[1]) + 1e-300
+    vscale = abs(c[C_B]) + Aq * beta + R + abs(c[C_V0]) + 1e-300
     return M2, M3, M4, vscale
 
 
@@ -342,7 +359,7 @@ def _newton_from(a, ga, va, acc, M3, H):
 @njit(cache=True, error_model="numpy")
 def tolg_wall(c, P):
     """Round-off of ``x - delta`` near the wall: separations below it are not resolvable."""
-    return 16.0 * EPS64 * (abs(P[3]) + abs(c[16]) + abs(P[7]) + c[9])
+    return 16.0 * EPS64 * (abs(P[P_DELTA]) + abs(c[C_F_LIN]) + abs(P[P_AQ]) + c[C_R])
 
 
 @njit(cache=True, error_model="numpy")
@@ -357,7 +374,7 @@ def leave_wall(c, P, H, tolF, M3, M4):
     turns back in the step, returns ``-sF`` (``sF`` the instant it is back to zero): the mass
     stays on the wall.
     """
-    F0, g2, g3 = c[12], c[10], c[11]
+    F0, g2, g3 = c[C_F0], c[C_G2], c[C_G3]
     best = 0.0
     if F0 < -tolF:
         best = safe_step(0.0, 0.0, min(g2, F0), M3, H)
@@ -413,9 +430,9 @@ def first_contact(c, P, H, at_wall):
     """
     M2, M3, M4, vscale = _bounds(c, P)
     a = 0.0
-    ga = c[0]
-    va = c[1]
-    acc = c[10]
+    ga = c[C_XD]
+    va = c[C_V0]
+    acc = c[C_G2]
     if at_wall:
         tolv = 64.0 * EPS64 * vscale
         if va > tolv:
@@ -423,7 +440,7 @@ def first_contact(c, P, H, at_wall):
         if va >= -tolv:
             # at rest on the wall: held or leaving by the same rule as release_time
             tolF = force_tol(c, P)
-            if stays_on_wall(c[12], c[13], tolF):
+            if stays_on_wall(c[C_F0], c[C_DF0], tolF):
                 return PRESSED, 0.0, 0.0, 0.0
             sa = leave_wall(c, P, H, tolF, M3, M4)
             if sa < 0.0:
@@ -440,7 +457,7 @@ def first_contact(c, P, H, at_wall):
                 return NO_ROOT, H, va, ga
             return (ROOT if va > 0.0 else TOUCH), H, va, 0.0
         if ga >= 0.0:       # only by round-off: the bound says ga < 0
-            ga = -EPS64 * abs(P[3])
+            ga = -EPS64 * abs(P[P_DELTA])
     have_end = False
     gH = 0.0
     vH = 0.0
@@ -449,7 +466,7 @@ def first_contact(c, P, H, at_wall):
         w = H - a
         d = _newton_from(a, ga, va, acc, M3, H)
         if d > 0.0:
-            tolg = EPS64 * (abs(c[0]) + (a + d) * vscale)
+            tolg = EPS64 * (abs(c[C_XD]) + (a + d) * vscale)
             s, u = _polish(a, a + d, a, ga, va, acc, tolg, M3, c, P)
             return ROOT, s, u, 0.0
         if not have_end:
@@ -460,7 +477,7 @@ def first_contact(c, P, H, at_wall):
         if max(ga, gH) + 0.125 * Mloc * w * w < 0.0:
             return NO_ROOT, H, vH, gH
         if gH >= 0.0 and 0.5 * (va + vH) - 0.5 * Mloc * w > 0.0:
-            tolg = EPS64 * (abs(c[0]) + H * vscale)
+            tolg = EPS64 * (abs(c[C_XD]) + H * vscale)
             s, u = _newton_bracket(a, H, ga, va, gH, vH, tolg, M3, c, P)
             return ROOT, s, u, 0.0
         step = safe_step(ga, va, acc, M3, w)
@@ -473,7 +490,7 @@ def first_contact(c, P, H, at_wall):
             return (ROOT if va > 0.0 else TOUCH), a, va, 0.0
         a = a + step
         ga, va, acc = seg_eval(a, c, P)
-        if ga >= -8.0 * EPS64 * (abs(c[0]) + a * vscale):
+        if ga >= -8.0 * EPS64 * (abs(c[C_XD]) + a * vscale):
             if va <= 64.0 * EPS64 * vscale:
                 return TOUCH, a, va, 0.0
             if ga >= 0.0:
@@ -490,7 +507,7 @@ def force_tol(c, P):
     agree: a mass they disagreed on would be released and stuck again forever. It depends
     on the force's size and the step length ``h``, never on the time left in the step.
     """
-    return 8.0 * EPS64 * (abs(c[16]) + abs(P[3]) + abs(P[5]) + abs(c[2]) * P[4] + 1e-300)
+    return 8.0 * EPS64 * (abs(c[C_F_LIN]) + abs(P[P_DELTA]) + abs(P[P_A]) + abs(c[C_B]) * P[P_DT] + 1e-300)
 
 
 @njit(cache=True, error_model="numpy")
@@ -503,14 +520,14 @@ def stays_on_wall(F, dF, tolF):
 @njit(cache=True, error_model="numpy")
 def push_eval(sig, c, P):
     """``F = f - delta`` and ``dF/dtau`` at ``sig`` after the segment start, in difference form."""
-    A, beta = P[5], P[6]
-    F = c[12] + c[2] * sig
-    dF = c[2]
+    A, beta = P[P_A], P[P_BETA]
+    F = c[C_F0] + c[C_B] * sig
+    dF = c[C_B]
     if A != 0.0:
         sb = math.sin(beta * sig)
         cb = math.cos(beta * sig)
-        F += A * (c[15] * sb - c[14] * (1.0 - cb))
-        dF += A * beta * (c[15] * cb - c[14] * sb)
+        F += A * (c[C_COS_T] * sb - c[C_SIN_T] * (1.0 - cb))
+        dF += A * beta * (c[C_COS_T] * cb - c[C_SIN_T] * sb)
     return F, dF
 
 
@@ -519,10 +536,10 @@ def push_recovery(c, P, H):
     """First ``sig`` in ``(0, H]`` where ``F = f - delta`` (negative at the start) is back to
     ``>= 0``, approached from the left by steps proved safe by ``|F''| <= A beta^2``; ``-1``
     if it stays negative through ``H``."""
-    MF = abs(P[5]) * P[6] * P[6] * BOUND_SAFETY
+    MF = abs(P[P_A]) * P[P_BETA] * P[P_BETA] * BOUND_SAFETY
     tolF = force_tol(c, P)
     a = 0.0
-    Fa, dFa = c[12], c[13]
+    Fa, dFa = c[C_F0], c[C_DF0]
     for _ in range(MAX_SEARCH):
         if Fa >= -tolF:
             return a
@@ -542,10 +559,10 @@ def release_time(c, P, H):
     Returns ``-1.0`` when the mass stays on the wall through ``H``. ``f`` is linear plus a
     sinusoid, so ``|F''| <= A beta^2`` bounds the safe steps as in :func:`first_contact`.
     """
-    A, beta = P[5], P[6]
+    A, beta = P[P_A], P[P_BETA]
     MF = abs(A) * beta * beta * BOUND_SAFETY
     a = 0.0
-    Fa, dFa = c[12], c[13]
+    Fa, dFa = c[C_F0], c[C_DF0]
     tolF = force_tol(c, P)
     if not stays_on_wall(Fa, dFa, tolF):
         return 0.0
@@ -617,14 +634,14 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
     (kept in ``ftot`` rather than an argument of its own: every argument and branch added to
     :func:`run_steps` slows its hot loop, measured by benchmarks/ab_no_impact.py).
     """
-    zeta, eps, delta = P[0], P[2], P[3]
-    theta_k = phase(k, 0.0, P[11], P[12], P[6]) if P[5] != 0.0 else 0.0
+    zeta, eps, delta = P[P_ZETA], P[P_EPS], P[P_DELTA]
+    theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
     s = 0.0
     n_events = 0
     if mode == WALL:
         # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
-        if P[5] != 0.0:
-            v += P[7] * P[6] * math.cos(theta_k - P[8])
+        if P[P_A] != 0.0:
+            v += P[P_AQ] * P[P_BETA] * math.cos(theta_k - P[P_PHI])
         mode = FREE
     at_wall = x >= delta
     if at_wall:
@@ -646,17 +663,17 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             return x, v, mode, TOO_MANY_EVENTS
         c = segment(x, v, s, r0, b, theta_k, P)
         Hs = H - s
-        if just_hit and v < 0.0 and c[12] > 0.0:
+        if just_hit and v < 0.0 and c[C_F0] > 0.0:
             # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
             # sum the tail in closed form once its neglected terms are below CHATTER_TIME_TOL
-            wv, F, dF = -v, c[12], c[13]
+            wv, F, dF = -v, c[C_F0], c[C_DF0]
             if eps < 1.0:
                 tail = 2.0 * wv / (F * (1.0 - eps))
                 ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_TIME_TOL
             else:
                 tail = 2.0 * wv / F
                 ok = tail <= ELASTIC_MICRO_FLIGHT
-            F_end = F + dF * tail - 0.5 * abs(P[5]) * P[6] * P[6] * tail * tail
+            F_end = F + dF * tail - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail
             micro = n_events >= MANY_EVENTS and (
                 wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
                 or 2.0 * wv / F <= 16.0 * H / STEP_HEADROOM)
@@ -699,7 +716,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         s = min(s + sig, H)
         x = delta
         at_wall = True
-        if code == ROOT and u <= 64.0 * EPS64 * (abs(b) + abs(P[7]) * P[6] + c[9] + abs(v)):
+        if code == ROOT and u <= 64.0 * EPS64 * (abs(b) + abs(P[P_AQ]) * P[P_BETA] + c[C_R] + abs(v)):
             code = TOUCH          # arrives with zero velocity within round-off: grazing touch
         if code == TOUCH:
             v = min(u, 0.0)
@@ -725,11 +742,11 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
 
     Returns ``(status, k)``: the sample reached.
     """
-    zeta, delta, h = P[0], P[3], P[4]
-    Aq, beta = P[7], P[6]
-    a11, a12, a21, a22 = P[13], P[14], P[15], P[16]
-    inv_h, inv_omega = P[17], P[18]
-    cbh, sbh = P[19], P[20]
+    zeta, delta, h = P[P_ZETA], P[P_DELTA], P[P_DT]
+    Aq, beta = P[P_AQ], P[P_BETA]
+    a11, a12, a21, a22 = P[P_M11], P[P_M12], P[P_M21], P[P_M22]
+    inv_h, inv_omega = P[P_INV_DT], P[P_INV_OMEGA]
+    cbh, sbh = P[P_COS_BH], P[P_SIN_BH]
     h2_8 = 0.125 * h * h
     M0 = abs(Aq) * beta * beta * BOUND_SAFETY
     margin = 1e-11 * abs(Aq) + 1e-300
@@ -744,7 +761,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
     status, k_stop = OK, k_end
     for k in range(k_begin, k_end):
         if has_h and k % RESYNC_EVERY == 0:
-            psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+            psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
             sp = math.sin(psi)
             cp = math.cos(psi)
         if stride > 0 and k % stride == 0:
@@ -753,7 +770,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 grid[grid_n[0]] = 0.0
                 grid_v[grid_n[0]] = wv + Aq * beta * cp
             elif has_h:
-                psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+                psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
                 grid[grid_n[0]] = delta - (w + Aq * math.sin(psi))
                 grid_v[grid_n[0]] = wv + Aq * beta * math.cos(psi)
             else:
@@ -792,7 +809,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             x = w
             v = wv
             if has_h:
-                psi = phase(k, 0.0, P[11], P[12], beta) - P[8]
+                psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
                 x = w + Aq * math.sin(psi)
                 v = wv + Aq * beta * math.cos(psi)
         else:
@@ -812,7 +829,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
         if status != OK:
             return status, k
         if has_h:
-            psi = phase(k + 1, 0.0, P[11], P[12], beta) - P[8]
+            psi = phase(k + 1, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
             sp1 = math.sin(psi)
             cp1 = math.cos(psi)
         w = x - Aq * sp1

@@ -101,12 +101,17 @@ def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
     E = math.exp(-zeta * dt)
     C, S = math.cos(omega * dt), math.sin(omega * dt)
     bh_hi, bh_lo = kernels.two_prod(beta, dt)
-    return np.array([
-        zeta, omega, eps, delta, dt, amplitude, beta, amplitude * q, phi,
-        math.cos(phi), math.sin(phi), bh_hi, bh_lo,
-        E * (C + zeta * S / omega), E * S / omega, -E * S / omega, E * (C - zeta * S / omega),
-        1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt),
-    ])
+    P = np.empty(kernels.N_PARAMS)
+    P[[kernels.P_ZETA, kernels.P_OMEGA, kernels.P_EPS, kernels.P_DELTA, kernels.P_DT]] = (
+        zeta, omega, eps, delta, dt)
+    P[[kernels.P_A, kernels.P_BETA, kernels.P_AQ, kernels.P_PHI]] = amplitude, beta, amplitude * q, phi
+    P[[kernels.P_COS_PHI, kernels.P_SIN_PHI]] = math.cos(phi), math.sin(phi)
+    P[[kernels.P_BH_HI, kernels.P_BH_LO]] = bh_hi, bh_lo
+    P[[kernels.P_M11, kernels.P_M12, kernels.P_M21, kernels.P_M22]] = (
+        E * (C + zeta * S / omega), E * S / omega, -E * S / omega, E * (C - zeta * S / omega))
+    P[[kernels.P_INV_DT, kernels.P_INV_OMEGA, kernels.P_COS_BH, kernels.P_SIN_BH]] = (
+        1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt))
+    return P
 
 
 def _split_steps(t_end, dt):
@@ -153,7 +158,7 @@ def _raise_status(status, k, dt, r, k0, diag, P):
         raise ValueError(f"noise must be finite: noise[{bad}] = {float(r[bad - k0])!r}")
     if status == kernels.TOO_MANY_EVENTS:
         s, gap, v, mode, n_imp, n_stk = (float(d) for d in diag)
-        delta, A, beta = (float(p) for p in (P[3], P[5], P[6]))
+        delta, A, beta = (float(p) for p in (P[kernels.P_DELTA], P[kernels.P_A], P[kernels.P_BETA]))
         r0, r1 = float(r[k - k0]), float(r[k - k0 + 1])
         f0 = r0 + A * math.sin(beta * k * dt)
         f1 = r1 + A * math.sin(beta * (k + 1) * dt)
@@ -179,7 +184,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     P = kernel_parameters(zeta, eps, delta, dt, amplitude, beta)
     params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
                   x0=x0, v0=v0)
-    Aq, phi = P[7], P[8]
+    Aq, phi = P[kernels.P_AQ], P[kernels.P_PHI]
     state = np.array([x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE,
                       -math.sin(phi), math.cos(phi)])
     n_full, rem = _split_steps(t_end, dt)
@@ -238,14 +243,14 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
 
 def _state_at(state, P, k):
     """Displacement, velocity and mode at sample ``k`` from the kernel's state vector."""
-    delta, beta, Aq = P[3], P[6], P[7]
+    delta, beta, Aq = P[kernels.P_DELTA], P[kernels.P_BETA], P[kernels.P_AQ]
     mode = int(state[2])
     if mode == kernels.STUCK:
         return delta, 0.0, kernels.STUCK
     if Aq == 0.0:
         x, v = state[0], state[1]
     else:
-        psi = kernels.phase(k, 0.0, P[11], P[12], beta) - P[8]
+        psi = kernels.phase(k, 0.0, P[kernels.P_BH_HI], P[kernels.P_BH_LO], beta) - P[kernels.P_PHI]
         x, v = state[0] + Aq * math.sin(psi), state[1] + Aq * beta * math.cos(psi)
     if mode == kernels.WALL:
         x = delta       # exactly on the wall, not through the round-off of w + p_h
@@ -337,7 +342,7 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
 
     Notes
     -----
-    Between samples and impacts the motion is the closed-form solution (MODEL.md; the
+    Between samples and impacts the motion is the closed-form solution (docs/model.md, section 5; the
     paper's eqs. 3-6); each impact is the smallest root of ``x - delta`` in its step, found
     by a rigorous exclusion bound and refined to round-off, so grazing double crossings
     inside a step are caught. A chatter sequence is followed impact by impact until its
