@@ -1,9 +1,13 @@
 """Cell statistics against linear theory: with the wall out of reach the simulated PSD of
-a(tau) is the linear |H|^2 S_f of the piecewise-linear input (MODEL.md)."""
+a(tau) is the linear |H|^2 S_f of the piecewise-linear input (docs/model.md, section 7)."""
+import logging
+
 import numpy as np
+import pytest
 
 from vibroimpact import noise, stats
-from vibroimpact.pipeline import cells
+from vibroimpact.pipeline import cells, datasets
+from vibroimpact.pipeline.study import Study
 
 
 def test_psd_without_impacts_is_linear_response():
@@ -26,3 +30,75 @@ def test_psd_without_impacts_is_linear_response():
     # the input's estimated PSD is its target, in the same convention
     band = (beta > 0.2) & (beta < 6.0)
     assert abs(np.mean(out["S_f"][band] / spec.psd(beta[band])) - 1.0) < 0.02
+
+
+# ------------------------------------------------------------------ events of one cell
+
+BINS = datasets.bin_edges(dict(v_after=dict(max=2.5, n=50), interval=dict(max=20.0, n=80),
+                               ratio=dict(max=4.0, n=80)))
+NOISE = noise.NoiseSpec(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0)
+
+
+@pytest.fixture(scope="module")
+def record():
+    return noise.generate_array(NOISE, 40_001, seed=3)      # tau up to 4000
+
+
+def test_t_end_beyond_the_record_is_refused(record):
+    # 40 001 samples at dt = 0.1 end at tau = 4000: asking for more must not be cut silently
+    kw = dict(zeta=0.05, eps=0.5, delta=0.0)
+    with pytest.raises(ValueError, match=r"t_end = 5000\.0.*40001 samples.*4000"):
+        cells.event_statistics(record, NOISE.dt, **kw, t_end=5000.0, bins=BINS)
+    with pytest.raises(ValueError, match="t_end"):
+        cells.spectra_statistics(record, NOISE.dt, **kw, t_end=4000.5, nperseg=256)
+    with pytest.raises(ValueError, match="t_end"):
+        cells.trace(record, NOISE.dt, **kw, t_end=1e6)
+    # the record's own end, written in decimal, is accepted
+    out = cells.event_statistics(record, NOISE.dt, **kw, t_end=4000.0, bins=BINS, transient=50.0)
+    assert out["simulated_time"] == pytest.approx(3950.0, rel=1e-12)
+
+
+def test_ratio_statistics_only_with_a_harmonic_force(record):
+    # Without a harmonic force there is no forcing period: z_j / z and the (m/n) motions
+    # would be computed with a dummy beta, so they are absent from the results and datasets.
+    kw = dict(zeta=0.05, eps=0.5, delta=0.0, transient=50.0, bins=BINS)
+    plain = cells.event_statistics(record, NOISE.dt, **kw)
+    forced = cells.event_statistics(record, NOISE.dt, **kw, amplitude=1.0, beta_f=1 / 1.1)
+    harmonic_only = {"ratio_density", "ratio_density_stderr", "ratio_beyond",
+                     "motion_probability"}
+    assert not harmonic_only & set(plain) and harmonic_only <= set(forced)
+    for name, study in (("plain", dict(amplitude=0.0)),
+                        ("forced", dict(amplitude=1.0, inv_beta=[1.1]))):
+        cell_list = Study.from_config(name, dict(zeta=0.05, eps=0.5, delta=[0.0],
+                                                 **study)).cells()
+        tile = datasets.events_tile(cell_list, [plain if name == "plain" else forced], BINS,
+                                    dict(zeta=0.05))
+        present = {"ratio_density", "motion_probability", "ratio", "motion"} & set(tile.variables)
+        assert present == (set() if name == "plain" else {"ratio_density", "motion_probability",
+                                                          "ratio", "motion"})
+        for var in tile.data_vars.values():
+            assert var.attrs["long_name"] and "units" in var.attrs
+    with pytest.raises(ValueError, match="mix"):
+        datasets.events_tile(cell_list * 2, [plain, forced], BINS, {})
+
+
+def test_batch_statistics_and_their_lag1_warning(record, caplog):
+    # A forcing period of 2000 time units over a record of 4000 makes the impact statistics
+    # drift: the 20 batch means then follow the slow cycle (lag-1 correlation ~0.7, far above
+    # 2/sqrt(20) = 0.45) and the cell warns. The stationary cell (delta = 0, noise only) has
+    # a lag-1 correlation near 0 and stays silent.
+    kw = dict(zeta=0.05, eps=0.5, transient=50.0, bins=BINS, n_batches=20)
+    with caplog.at_level(logging.WARNING, logger="vibroimpact"):
+        calm = cells.event_statistics(record, NOISE.dt, delta=0.0, **kw)
+    assert not caplog.records
+    assert calm["n_batches"] == 20 and abs(calm["v_after_lag1"]) < 2 / np.sqrt(20)
+    # density errors are the batch-means ones of stats.density
+    v_after = calm["v_after_density"]
+    assert np.nansum(v_after * np.diff(BINS["v_after"])) + calm["v_after_beyond"] == \
+        pytest.approx(1.0, abs=1e-12)
+    with caplog.at_level(logging.WARNING, logger="vibroimpact"):
+        drift = cells.event_statistics(record, NOISE.dt, delta=0.5, amplitude=0.5,
+                                       beta_f=2 * np.pi / 2000, **kw)
+    assert drift["v_after_lag1"] > 2 / np.sqrt(20) and drift["interval_lag1"] > 2 / np.sqrt(20)
+    messages = [r.getMessage() for r in caplog.records]
+    assert len(messages) == 2 and all("lag-1" in m and "delta=0.5" in m for m in messages)

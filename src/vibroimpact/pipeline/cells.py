@@ -5,6 +5,7 @@ the figures need on the fly: impact events for densities and means (no a(tau) re
 Welch spectra of a(tau) accumulated segment by segment (no long series kept), or a short
 sampled trace. Inputs are arrays or sliceable records; outputs are dicts of numpy values.
 """
+import logging
 import math
 
 import numpy as np
@@ -14,10 +15,40 @@ from vibroimpact.impact import simulate_chunks
 
 MOTIONS = stats.DEFAULT_MOTIONS
 
+log = logging.getLogger("vibroimpact")
+
+#: Relative slack when comparing ``t_end`` with the record's length, so that a ``t_end``
+#: written as ``(n - 1) * dt`` in decimal is not refused for its last bit.
+RECORD_END_RTOL = 1e-12
+
 
 def _record_end(noise, dt, t_end):
+    """End of the simulated stretch: ``t_end``, or the whole record when it is None.
+
+    Raises
+    ------
+    ValueError
+        If ``t_end`` lies beyond the last sample of the record (no silent truncation).
+    """
     full = (len(noise) - 1) * dt
-    return full if t_end is None else min(float(t_end), full)
+    if t_end is None:
+        return full
+    t_end = float(t_end)
+    if t_end > full * (1.0 + RECORD_END_RTOL):
+        raise ValueError(f"t_end = {t_end!r} is longer than the noise record: {len(noise)} "
+                         f"samples at dt = {dt!r} end at tau = {full!r}")
+    return min(t_end, full)
+
+
+def _lag1_check(name, result, cell):
+    """Warn when the batch means of `name` are correlated (batches too short for the error)."""
+    if result is None or result.n_batches < 2 or not np.isfinite(result.lag1):
+        return
+    limit = 2.0 / math.sqrt(result.n_batches)
+    if result.lag1 > limit:
+        log.warning("%s: lag-1 correlation of the batch means of %s is %.3g > 2/sqrt(B) = %.3g "
+                    "(B = %d): the batches are too short and its standard errors too small",
+                    cell, name, result.lag1, limit, result.n_batches)
 
 
 def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
@@ -30,29 +61,44 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     noise : array_like, shape (N,)
         Random force samples at spacing ``dt``.
     zeta, eps, delta, amplitude, beta_f : float
-        Physical parameters (``beta_f``: frequency ratio of ``amplitude * sin(beta_f tau)``).
+        Physical parameters (``beta_f``: frequency ratio of ``amplitude * sin(beta_f tau)``;
+        unused when ``amplitude == 0``).
     transient : float
         Time discarded before statistics (impacts before it are dropped).
     t_end : float, optional
-        End of the record used (default: the whole noise record).
+        End of the record used (default: the whole noise record); longer than the record
+        raises ValueError.
     bins : dict
-        ``{"v_after": edges, "interval": edges, "ratio": edges}`` histogram bin edges.
+        ``{"v_after": edges, "interval": edges, "ratio": edges}`` histogram bin edges
+        (``"ratio"`` only read for a harmonic force).
     n_batches : int
-        Batches for the batch-means standard errors.
+        Batches B of the batch-means standard errors of the means and the densities.
     motion_window : float
-        Half-width w of the impact-motion classification (FIGURES.md, fig15).
+        Half-width w of the impact-motion classification (docs/figures.md, fig15).
 
     Returns
     -------
     dict
-        Scalars ``n_impacts, impact_rate, simulated_time, v_after_mean, v_after_stderr,
-        interval_mean, interval_stderr, contact_fraction, n_chatter`` and arrays
-        ``v_after_density(_stderr), interval_density(_stderr), ratio_density`` (on the bins)
-        and ``motion_probability`` (one value per motion of ``MOTIONS``).
+        Scalars ``n_impacts, impact_rate, simulated_time, n_batches, v_after_mean,
+        v_after_stderr, v_after_lag1, interval_mean, interval_stderr, interval_lag1,
+        contact_fraction, n_chatter, v_after_beyond, interval_beyond`` and arrays
+        ``v_after_density(_stderr), interval_density(_stderr)`` (on the bins). With a
+        harmonic force (``amplitude != 0``) also ``ratio_density(_stderr)``, ``ratio_beyond`` and
+        ``motion_probability`` (one value per motion of ``MOTIONS``); without one there is
+        no forcing period, so these are absent.
+
+    Notes
+    -----
+    Density errors are batch-means standard errors per bin (`stats.density` with
+    ``n_batches``). A lag-1 correlation of the batch means above ``2/sqrt(B)`` is logged as
+    a warning on the ``vibroimpact`` logger: the batches are then too short for an honest
+    error.
     """
     t_end = _record_end(noise, dt, t_end)
     if not 0.0 <= transient < t_end:
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
+    n_batches = int(n_batches)
+    harmonic = amplitude != 0.0
     steps, offsets, u_minus = [], [], []
     n_chatter = 0
     contact = 0.0
@@ -68,29 +114,41 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     duration = t_end - transient
     v_after = stats.velocity_after_impact(u_minus, eps)
     z = stats.impact_intervals(steps, offsets, dt)
+    cell = (f"cell delta={delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
     v_stats = stats.batch_means(v_after, n_batches) if v_after.size else None
     z_stats = stats.batch_means(z, n_batches) if z.size else None
-    v_dens = stats.density(v_after, bins["v_after"], total=v_after.size)
-    z_dens = stats.density(z, bins["interval"], total=z.size)
-    ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size)
-    motion = stats.impact_motion_probabilities(z, beta_f, motion_window, total_time=duration,
-                                               motions=MOTIONS)
+    _lag1_check("the velocity after impact", v_stats, cell)
+    _lag1_check("the interval", z_stats, cell)
+    v_dens = stats.density(v_after, bins["v_after"], total=v_after.size, n_batches=n_batches)
+    z_dens = stats.density(z, bins["interval"], total=z.size, n_batches=n_batches)
     nan = math.nan
-    return dict(
+    out = dict(
         n_impacts=int(u_minus.size),
         impact_rate=u_minus.size / duration,
         simulated_time=duration,
+        n_batches=n_batches,
         v_after_mean=v_stats.mean if v_stats else nan,
         v_after_stderr=v_stats.stderr if v_stats else nan,
+        v_after_lag1=v_stats.lag1 if v_stats else nan,
         interval_mean=z_stats.mean if z_stats else nan,
         interval_stderr=z_stats.stderr if z_stats else nan,
+        interval_lag1=z_stats.lag1 if z_stats else nan,
         contact_fraction=contact / duration,
         n_chatter=int(n_chatter),
         v_after_density=v_dens.density, v_after_density_stderr=v_dens.stderr,
+        v_after_beyond=v_dens.beyond,
         interval_density=z_dens.density, interval_density_stderr=z_dens.stderr,
-        ratio_density=ratio_dens.density,
-        motion_probability=np.array(list(motion.values())),   # in the order of MOTIONS
+        interval_beyond=z_dens.beyond,
     )
+    if harmonic:
+        ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
+                                   n_batches=n_batches)
+        motion = stats.impact_motion_probabilities(z, beta_f, motion_window,
+                                                   total_time=duration, motions=MOTIONS)
+        out.update(ratio_density=ratio_dens.density, ratio_density_stderr=ratio_dens.stderr,
+                   ratio_beyond=ratio_dens.beyond,
+                   motion_probability=np.array(list(motion.values())))   # order of MOTIONS
+    return out
 
 
 def _clipped_contact(start, end, transient):
@@ -133,7 +191,11 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
 
 
 def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
-    """A short sampled record from rest (Figs. 3 and 10): force, a(tau) and impacts."""
+    """A short sampled record from rest (Figs. 3 and 10): force, a(tau) and impacts.
+
+    ``t_end`` longer than the noise record raises ValueError.
+    """
+    t_end = _record_end(noise, dt, t_end)
     res = next(iter(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                     beta=beta_f, t_end=t_end, record_every=1,
                                     chunk_size=int(math.ceil(t_end / dt)) + 1)))

@@ -24,15 +24,22 @@ META = {
     "simulated_time": ("record length after the transient", "1"),
     "v_after_mean": ("mean velocity after impact", "1"),
     "v_after_stderr": ("standard error of the mean velocity after impact (batch means)", "1"),
+    "v_after_lag1": ("lag-1 autocorrelation of the batch means of the velocity after impact", "1"),
     "interval_mean": ("mean interval between adjacent impacts", "1"),
     "interval_stderr": ("standard error of the mean interval (batch means)", "1"),
+    "interval_lag1": ("lag-1 autocorrelation of the batch means of the interval", "1"),
+    "n_batches": ("batches B of the batch-means standard errors (t quantile: B - 1 dof)", "1"),
     "contact_fraction": ("fraction of time resting on the wall", "1"),
     "n_chatter": ("chatter sequences ended by sticking", "1"),
     "v_after_density": ("probability density of the velocity after impact", "1"),
-    "v_after_density_stderr": ("standard error of the velocity density", "1"),
+    "v_after_density_stderr": ("batch-means standard error of the velocity density", "1"),
+    "v_after_beyond": ("fraction of velocities after impact beyond the last bin", "1"),
     "interval_density": ("probability density of the interval between impacts", "1"),
-    "interval_density_stderr": ("standard error of the interval density", "1"),
+    "interval_density_stderr": ("batch-means standard error of the interval density", "1"),
+    "interval_beyond": ("fraction of intervals beyond the last bin", "1"),
     "ratio_density": ("probability density of z_j / z", "1"),
+    "ratio_density_stderr": ("batch-means standard error of the density of z_j / z", "1"),
+    "ratio_beyond": ("fraction of ratios z_j / z beyond the last bin", "1"),
     "motion_probability": ("probability of the impact motion (fraction of time)", "1"),
     "S_a": ("power spectral density of a(tau) (two-sided, eq. 9)", "1"),
     "S_f": ("power spectral density of the input f(tau) (estimate, two-sided)", "1"),
@@ -50,11 +57,15 @@ META = {
     "impact_velocity": ("approach velocity at impact", "1"),
 }
 
-_EVENT_SCALARS = ("n_impacts", "impact_rate", "simulated_time", "v_after_mean", "v_after_stderr",
-                  "interval_mean", "interval_stderr", "contact_fraction", "n_chatter")
+_EVENT_SCALARS = ("n_impacts", "impact_rate", "simulated_time", "n_batches", "v_after_mean",
+                  "v_after_stderr", "v_after_lag1", "interval_mean", "interval_stderr",
+                  "interval_lag1", "contact_fraction", "n_chatter", "v_after_beyond",
+                  "interval_beyond")
 _EVENT_DENSITIES = (("v_after_density", "v_after"), ("v_after_density_stderr", "v_after"),
-                    ("interval_density", "interval"), ("interval_density_stderr", "interval"),
-                    ("ratio_density", "ratio"))
+                    ("interval_density", "interval"), ("interval_density_stderr", "interval"))
+#: Statistics that need a forcing period: present only for a harmonic study (amplitude != 0).
+_HARMONIC_SCALARS = ("ratio_beyond",)
+_HARMONIC_DENSITIES = (("ratio_density", "ratio"), ("ratio_density_stderr", "ratio"))
 
 
 def _annotate(ds):
@@ -70,16 +81,36 @@ def bin_edges(bins_config):
             for name, b in bins_config.items()}
 
 
+def _cell_coords(cells):
+    """Coordinates of a tile: the cell indices and each cell's parameter values."""
+    return dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
+                delta_cell=("cell", [c.delta for c in cells]))
+
+
 def events_tile(cells, results, edges, attrs):
-    """Dataset of one tile of event statistics, along dimension ``cell``."""
-    centres = {k: 0.5 * (e[1:] + e[:-1]) for k, e in edges.items()}
-    data = {name: ("cell", np.array([r[name] for r in results])) for name in _EVENT_SCALARS}
-    for name, dim in _EVENT_DENSITIES:
+    """Dataset of one tile of event statistics, along dimension ``cell``.
+
+    ``results`` are :func:`vibroimpact.pipeline.cells.event_statistics` dicts. The (m/n)
+    statistics (``ratio_density(_stderr)``, ``ratio_beyond``, ``motion_probability`` and the
+    coordinates ``ratio``, ``motion``) are stored only when the results carry them, that is
+    for a harmonic force; all results of a tile must agree.
+    """
+    harmonic = {"ratio_density" in r for r in results}
+    if len(harmonic) != 1:
+        raise ValueError("results of one tile mix harmonic and non-harmonic cells")
+    harmonic = harmonic.pop()
+    scalars = _EVENT_SCALARS + (_HARMONIC_SCALARS if harmonic else ())
+    densities = _EVENT_DENSITIES + (_HARMONIC_DENSITIES if harmonic else ())
+    data = {name: ("cell", np.array([r[name] for r in results])) for name in scalars}
+    for name, dim in densities:
         data[name] = (("cell", dim), np.stack([r[name] for r in results]))
-    data["motion_probability"] = (("cell", "motion"), np.stack([r["motion_probability"] for r in results]))
-    coords = dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
-                  delta_cell=("cell", [c.delta for c in cells]),
-                  motion=[f"{m}/{n}" for m, n in stats.DEFAULT_MOTIONS], **centres)
+    used = {dim for _, dim in densities}
+    centres = {k: 0.5 * (e[1:] + e[:-1]) for k, e in edges.items() if k in used}
+    coords = dict(_cell_coords(cells), **centres)
+    if harmonic:
+        data["motion_probability"] = (("cell", "motion"),
+                                      np.stack([r["motion_probability"] for r in results]))
+        coords["motion"] = [f"{m}/{n}" for m, n in stats.DEFAULT_MOTIONS]
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -88,8 +119,7 @@ def spectra_tile(cells, results, attrs):
     data = dict(S_a=(("cell", "beta"), np.stack([r["S_a"] for r in results])),
                 S_f=(("cell", "beta"), np.stack([r["S_f"] for r in results])),
                 n_segments=("cell", np.array([r["n_segments"] for r in results])))
-    coords = dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
-                  delta_cell=("cell", [c.delta for c in cells]), beta=results[0]["beta"])
+    coords = dict(_cell_coords(cells), beta=results[0]["beta"])
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -120,6 +150,12 @@ def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
     ``input_correlation`` is ``(lag, estimate, target)`` of the random input (eq. 8).
     """
     ds = _to_grid(tiles, study.inv_beta, study.spectra_delta)
+    # every cell of a row estimates S_f from the same stretch of the same input: keep one
+    S_f = ds["S_f"]
+    if not (S_f == S_f.isel(delta=0)).all():
+        raise ValueError("S_f differs between the deltas of one inv_beta: the cells did not "
+                         "see the same input record")
+    ds["S_f"] = S_f.isel(delta=0, drop=True)
     beta = ds["beta"].values
     S_lin = stats.linear_psd_response(beta, spec.psd_piecewise_linear(beta), study.zeta)
     ds["S_lin"] = ("beta", S_lin)

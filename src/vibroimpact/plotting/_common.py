@@ -16,6 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from vibroimpact._files import atomic_path
+from vibroimpact.stats.events import t_quantile
 
 #: The house style sheet (the only place rcParams are set).
 STYLE_FILE = Path(__file__).with_name("vibroimpact.mplstyle")
@@ -24,8 +25,13 @@ STYLE_FILE = Path(__file__).with_name("vibroimpact.mplstyle")
 SPECTRUM_BETA_MAX = 4.0
 #: Lower end of the log density axis of figs 7, 8, 13, 14, relative to the highest density.
 DENSITY_DECADES = 1e-5
-#: Confidence bars are +-Z_95 standard errors (normal 95 % quantile).
-Z_95 = 1.96
+#: Confidence level of the bars (fig09) and bands (figs 7, 8, 13, 14): +-t standard errors, t
+#: the Student quantile of B - 1 dof for B batches, as `vibroimpact.stats.BatchMeans.interval`.
+CONFIDENCE = 0.95
+#: A density curve's legend states the share of values beyond the last bin above this fraction.
+BEYOND_SHOWN = 1e-3
+#: A mean resting on fewer impacts than this is drawn as such (open marker, no bar) in fig09.
+FEW_IMPACTS = 20
 #: Part of the colour map used for a family of curves (the top end of viridis is too pale).
 COLOR_SPAN = (0.0, 0.88)
 #: Units that mean "dimensionless" (CF writes "1") and are left out of axis labels.
@@ -89,9 +95,18 @@ def axis_label(da, extra=""):
 
 
 def _psd_label(da):
-    """PSD axis label stating the convention of paper eq. (9) unless long_name already does."""
+    """PSD axis label stating the convention of paper eq. (9): two-sided, angular frequency.
+
+    A long_name that says "two-sided" but not "angular" (the writers' names) gets "angular"
+    added there; one that says neither gets the whole note appended.
+    """
     name = str(da.attrs.get("long_name", da.name))
-    return axis_label(da, "" if "two-sided" in name else " (two-sided, angular)")
+    if "angular" in name:
+        return axis_label(da)
+    if "two-sided" in name:
+        return axis_label(da.assign_attrs(long_name=name.replace("two-sided",
+                                                                 "two-sided, angular", 1)))
+    return axis_label(da, " (two-sided, angular)")
 
 
 def _num(value):
@@ -149,12 +164,23 @@ def _system_text(ds):
     return rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
 
 
+def _spectrum_parts(attrs):
+    """``["band_limited", "beta_c = 4"]``: the input's spectrum from ``noise_*`` attributes."""
+    parts = [str(attrs["noise_kind"])] if "noise_kind" in attrs else []
+    return parts + _filter_parts(attrs)
+
+
+def _filter_parts(attrs):
+    """Cut-off beta_c and filter damping zeta_f, for the noise kinds that have them."""
+    symbols = (("noise_beta_c", r"$\beta_c$"), ("noise_zeta_f", r"$\zeta_f$"))
+    return [f"{sym} = {_num(attrs[key])}" for key, sym in symbols if key in attrs]
+
+
 def _noise_text(ds):
-    """``rms r = ...`` and the noise's name, from whichever attributes the dataset carries."""
+    """``rms_r = ...``, the spectrum and the noise's name, from the dataset's global attributes."""
     rms = ds.attrs.get("noise_rms")
-    if rms is None and "r" in ds.variables:
-        rms = ds["r"].attrs.get("rms")
     parts = [] if rms is None else [f"rms$_r$ = {_num(rms)}"]
+    parts += _spectrum_parts(ds.attrs)
     name = ds.attrs.get("noise")
     if isinstance(name, str) and name:
         parts.append(f"noise '{name}'")
@@ -174,17 +200,19 @@ def _forcing_text(ds, beta_f=None, inv_beta=None):
     return rf"f($\tau$) = {harmonic}r($\tau$)" + (f" ({noise})" if noise else "")
 
 
-def _spectrum_text(r):
-    """Description of a random force from the attributes of the noise variable ``r``."""
-    attrs = r.attrs
-    parts = [f"{attrs['kind']} noise"] if "kind" in attrs else []
-    symbols = (("rms", "rms"), ("dt", r"$\Delta\tau$"), ("beta_c", r"$\beta_c$"),
-               ("zeta_f", r"$\zeta_f$"))
-    parts += [f"{sym} = {_num(attrs[key])}" for key, sym in symbols if key in attrs]
-    if "seed" in attrs:
-        parts.append(f"seed {attrs['seed']}")
-    parts.append(f"{r.size} samples")
-    return ", ".join(parts)
+def _spectrum_text(noise):
+    """Description of a noise record from its global attributes (``pipeline.io.write_noise``).
+
+    Kind, rms, sample step, cut-off beta_c and filter damping zeta_f (when the kind has them),
+    seed and number of samples; a missing required attribute raises KeyError naming it.
+    """
+    attrs = noise.attrs
+    dt = attrs["noise_dt"] if "noise_dt" in attrs else _attr(noise, "dt")
+    spectrum = [f"rms = {_num(_attr(noise, 'noise_rms'))}", rf"$\Delta\tau$ = {_num(dt)}",
+                *_filter_parts(attrs)]
+    n = int(attrs["n_samples"]) if "n_samples" in attrs else int(noise["r"].size)
+    return (f"{_attr(noise, 'noise_kind')} noise: {', '.join(spectrum)};  "
+            f"seed {_attr(noise, 'seed')}, {n:,} samples")
 
 
 # --------------------------------------------------------------------------------------------
@@ -271,21 +299,48 @@ def _density_deltas(events, density_delta):
     return sorted(index, key=lambda k: -deltas[k])
 
 
+def _require(ds, name, why):
+    """Variable `name` of a dataset, with an error naming it and what needs it."""
+    if name not in ds.variables:
+        raise KeyError(f"dataset lacks the variable {name!r} that {why} needs; "
+                       f"variables present: {sorted(ds.data_vars)}")
+    return ds[name]
+
+
+def _beyond_text(fraction):
+    """``", 18.5 % beyond axis"`` when more than `BEYOND_SHOWN` of the values lie past the bins."""
+    fraction = float(fraction)
+    if not np.isfinite(fraction) or fraction <= BEYOND_SHOWN:
+        return ""
+    return f", {100.0 * fraction:.3g} % beyond axis"
+
+
 def _density_figure(events, i_beta, var, title, params, density_delta=None):
-    """One density curve (with a 95 % band) per density delta, at inv_beta index `i_beta`."""
+    """One density curve per density delta at inv_beta index `i_beta`, with a confidence band.
+
+    The band is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile
+    of B - 1 dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number
+    of impacts and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
+    (``{quantity}_beyond``).
+    """
     fig, (ax,) = _figure()
     ds = events.isel(inv_beta=i_beta)
     index = _density_deltas(events, density_delta)
-    x = ds[var].dims[-1]
+    x = _require(ds, var, "this figure").dims[-1]
+    beyond = _require(ds, f"{var.removesuffix('_density')}_beyond", "this figure")
     band = f"{var}_stderr"
+    has_band = band in ds
+    if has_band:
+        t = t_quantile(np.asarray(_require(ds, "n_batches", "the confidence band")), CONFIDENCE)
     for color, k in zip(_colors(len(index)), index):
         cell = ds.isel(delta=k)
         n = int(cell["n_impacts"])
         y = np.asarray(cell[var], dtype=float)
         impacts = f"{n:,} impacts" if n else "no impacts"
-        ax.plot(cell[x], y, color=color, label=rf"$\delta$ = {_num(cell['delta'])}  ({impacts})")
-        if band in cell:
-            half = Z_95 * np.asarray(cell[band], dtype=float)
+        label = rf"$\delta$ = {_num(cell['delta'])}  ({impacts}{_beyond_text(beyond[k])})"
+        ax.plot(cell[x], y, color=color, label=label)
+        if has_band:
+            half = t[k] * np.asarray(cell[band], dtype=float)
             ax.fill_between(cell[x], np.clip(y - half, 1e-300, None), y + half, color=color,
                             alpha=0.2, lw=0)
     # log scale: chatter puts a tall spike at small velocities and intervals, and the
@@ -300,9 +355,23 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None):
     _bin_limits(ax, ds[x])
     ax.set_xlabel(axis_label(ds[x]))
     ax.set_ylabel(axis_label(ds[var]))
-    ax.legend(loc="upper right", title="bands: 95 % confidence" if band in ds else None)
+    title_text = None
+    if has_band:
+        b = np.unique(np.asarray(ds["n_batches"])[index])
+        t_text = (f"t = {_num(t[index[0]])}, B = {int(b[0])} batches" if b.size == 1
+                  else "t of B - 1 dof")
+        title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
+                      f"({100 * CONFIDENCE:g} %, {t_text})")
+    ax.legend(loc="upper right", title=title_text, title_fontsize=8)
     _header(fig, title, params)
     return fig, ax
+
+
+def _require_harmonic(events, figure):
+    """Raise unless `events` is the dataset of a harmonic study (z_j / z needs a period)."""
+    if float(_attr(events, "amplitude")) == 0.0 or "ratio_density" not in events:
+        raise ValueError(f"{figure} needs the events of a harmonic study (amplitude != 0, "
+                         f"with ratio_density); got amplitude = {events.attrs.get('amplitude')!r}")
 
 
 def _events_params(events, i_beta):

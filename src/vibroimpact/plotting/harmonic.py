@@ -5,7 +5,8 @@ import numpy as np
 
 from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _density_figure, _events_params, _figure, _header, _mark_forcing,
-    _nearest, _psd_label, _response_spectra, _styled, _trace_figure, axis_label)
+    _nearest, _psd_label, _require_harmonic, _response_spectra, _styled, _trace_figure,
+    axis_label)
 
 
 def fig10(trace):
@@ -99,7 +100,13 @@ def fig13(events, inv_beta, density_delta=None):
     matplotlib.figure.Figure
         One axes: one line per density delta, a dash-dot line at z_j/z = 1/2 (the symmetry
         axis of the (2/1) motion) and dotted marks at 1 ((1/1) motion) and 2 ((1/2) motion).
+
+    Raises
+    ------
+    ValueError
+        If `events` is not from a harmonic study (no forcing period, no ``ratio_density``).
     """
+    _require_harmonic(events, "fig13")
     i = _nearest(events["inv_beta"], inv_beta)
     fig, ax = _density_figure(
         events, i, "ratio_density",
@@ -117,7 +124,12 @@ def fig13(events, inv_beta, density_delta=None):
 
 @_styled
 def fig14(events, inv_beta, density_delta=None):
-    """Fig. 14: density of the velocity after impact under sin(tau/inv_beta) + r(tau)."""
+    """Fig. 14: density of the velocity after impact under sin(tau/inv_beta) + r(tau).
+
+    As :func:`fig07`, at the ``inv_beta`` of the dataset nearest to the one given; a
+    non-harmonic study raises ValueError (its velocity density is fig07).
+    """
+    _require_harmonic(events, "fig14")
     i = _nearest(events["inv_beta"], inv_beta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",

@@ -21,7 +21,7 @@ _WHERE = {
     "linear_psd_response": "spectra",
     "DEFAULT_N_BATCHES": "events", "impact_intervals": "events",
     "velocity_after_impact": "events", "interval_ratio": "events", "Density": "events",
-    "density": "events", "BatchMeans": "events", "batch_means": "events",
+    "density": "events", "BatchMeans": "events", "batch_means": "events", "t_quantile": "events",
     "DEFAULT_MOTION_WINDOW": "motions", "DEFAULT_MOTIONS": "motions",
     "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
     "linear_response_std": "theory", "elastic_impact_rate": "theory", "rayleigh_pdf": "theory",

@@ -1,4 +1,4 @@
-"""Impact events: intervals, velocities after impact, densities and batch means (Figs. 7-9)."""
+"""Impact events: intervals, velocities after impact, densities, batch means (Figs. 7-9, 13, 14)."""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -9,7 +9,7 @@ from scipy import stats as _sps
 from vibroimpact import _checks
 
 __all__ = ["DEFAULT_N_BATCHES", "impact_intervals", "velocity_after_impact", "interval_ratio",
-           "Density", "density", "BatchMeans", "batch_means"]
+           "Density", "density", "t_quantile", "BatchMeans", "batch_means"]
 
 #: Batches in a batch-means standard error; >= 20 keeps the t-quantile close to the normal one.
 DEFAULT_N_BATCHES = 20
@@ -62,17 +62,19 @@ class Density(NamedTuple):
 
     centres: np.ndarray  #: bin centres, shape (nbins,)
     density: np.ndarray  #: probability density, integrates to 1 over the bins
-    stderr: np.ndarray   #: standard error of `density` per bin (binomial)
+    stderr: np.ndarray   #: standard error of `density` per bin (binomial, or batch means)
     n: int               #: number of values the density is normalised by (inside the bins unless `total`)
+    beyond: float = np.nan  #: fraction of the `n` values above the last bin edge (NaN if n = 0)
 
 
-def density(values, bins, range=None, total=None) -> Density:
-    """Probability density of `values` by histogram, with binomial standard errors.
+def density(values, bins, range=None, total=None, n_batches=None) -> Density:
+    """Probability density of `values` by histogram, with per-bin standard errors.
 
     Parameters
     ----------
-    values : array_like of float
-        Samples (e.g. velocities after impact, intervals, z_j / z).
+    values : array_like of float, shape (N,)
+        Samples (e.g. velocities after impact, intervals, z_j / z), in time order when
+        `n_batches` is given.
     bins : int or array_like
         Passed to ``numpy.histogram``.
     range : (float, float), optional
@@ -81,19 +83,28 @@ def density(values, bins, range=None, total=None) -> Density:
         Normalise by this many values instead of the count inside the bins, so that values
         beyond the bins keep their share of probability (the density then integrates to the
         fraction inside). Must be >= the count inside.
+    n_batches : int, optional
+        If given (B >= 2), the standard error is the batch-means one, valid for a correlated
+        sequence; otherwise it is binomial, valid for independent values only.
 
     Returns
     -------
     Density
         ``density_i = c_i / (n w_i)`` with c_i the count in bin i of width w_i and n the
-        count inside all bins (values outside are ignored, as ``numpy.histogram`` does);
-        ``stderr_i = sqrt(p_i (1 - p_i) / n) / w_i`` with ``p_i = c_i / n``. With no value in
-        the bins the density and its error are NaN.
+        count inside all bins (values outside are ignored, as ``numpy.histogram`` does) or
+        `total`. Binomial: ``stderr_i = sqrt(p_i (1 - p_i) / n) / w_i`` with ``p_i = c_i / n``.
+        Batch means: see Notes. ``beyond`` is the fraction of the n values above the last
+        edge. With no value in the bins the density and its error are NaN.
 
     Notes
     -----
-    The binomial error assumes independent samples. Successive impacts are correlated, so it
-    is a lower bound; for a mean use `batch_means`.
+    The binomial error assumes independent samples. Successive impacts are correlated, so for
+    them it is a lower bound. With `n_batches` = B the sequence is cut into B contiguous
+    batches of ``N // B`` values (the first ``N mod B`` dropped, as in `batch_means`); each
+    batch gives a density normalised by its own length (values beyond the bins keep their
+    share), and ``stderr_i = std_b(density_bi, ddof=1) / sqrt(B)``, the batch-means error of
+    the per-bin mean (NaN when N < B). The Student-t factor of a confidence band on it is
+    ``t_quantile(B)``, as for `BatchMeans.interval`.
     """
     values = np.asarray(values, dtype=float)
     counts, edges = np.histogram(values, bins=bins, range=range)
@@ -104,11 +115,50 @@ def density(values, bins, range=None, total=None) -> Density:
         if total < n:
             raise ValueError(f"total must be >= the count inside the bins ({n}), got {total!r}")
         n = int(total)
+    if n_batches is not None:
+        n_batches = _checks.integer("n_batches", n_batches, low=2)
     if n == 0:
         nan = np.full(counts.shape, np.nan)
-        return Density(centres, nan, nan.copy(), 0)
+        return Density(centres, nan, nan.copy(), 0, np.nan)
     p = counts / n
-    return Density(centres, p / widths, np.sqrt(p * (1.0 - p) / n) / widths, n)
+    beyond = float(np.count_nonzero(values > edges[-1]) / n)
+    if n_batches is None:
+        stderr = np.sqrt(p * (1.0 - p) / n) / widths
+    else:
+        stderr = _batch_density_stderr(values, edges, int(n_batches))
+    return Density(centres, p / widths, stderr, n, beyond)
+
+
+def _batch_density_stderr(values, edges, n_batches):
+    """Batch-means standard error of a histogram density (see `density`, Notes)."""
+    size = values.size // n_batches
+    if size == 0:
+        return np.full(edges.size - 1, np.nan)
+    batches = values[values.size - size * n_batches:].reshape(n_batches, size)
+    counts = np.stack([np.histogram(batch, bins=edges)[0] for batch in batches])
+    per_batch = counts / (size * np.diff(edges))
+    return per_batch.std(axis=0, ddof=1) / np.sqrt(n_batches)
+
+
+def t_quantile(n_batches, level: float = 0.95):
+    """Student-t factor of a two-sided batch-means interval: ``t_{(1 + level)/2, B - 1}``.
+
+    Parameters
+    ----------
+    n_batches : int or array_like of int
+        Number of batches B; the quantile has B - 1 degrees of freedom.
+    level : float, optional
+        Confidence level, 0 < level < 1 (default 0.95).
+
+    Returns
+    -------
+    float or ndarray
+        The factor (2.093 for B = 20 at 95 %); NaN where B < 2.
+    """
+    _checks.real("level", level, low=0.0, high=1.0, low_open=True, high_open=True)
+    b = np.asarray(n_batches, dtype=float)
+    q = np.where(b >= 2, _sps.t.ppf(0.5 + 0.5 * level, np.maximum(b - 1.0, 1.0)), np.nan)
+    return float(q) if q.ndim == 0 else q
 
 
 class BatchMeans(NamedTuple):
@@ -123,7 +173,7 @@ class BatchMeans(NamedTuple):
         """Two-sided Student-t confidence interval for the mean (n_batches - 1 dof)."""
         if self.n_batches < 2:
             return (np.nan, np.nan)
-        half = _sps.t.ppf(0.5 + 0.5 * level, self.n_batches - 1) * self.stderr
+        half = t_quantile(self.n_batches, level) * self.stderr
         return (self.mean - half, self.mean + half)
 
 

@@ -62,13 +62,13 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
 
     Notes
     -----
-    An (m/n) motion has m impacts per n forcing periods (MODEL.md, section 4). A group of m
+    An (m/n) motion has m impacts per n forcing periods (docs/model.md, section 8). A group of m
     consecutive intervals starting at j is of that type when
 
     - m = 1: ``|r_j - n| < w``;
     - m >= 2: every ``r_{j+i} < n - w`` and ``|r_j + ... + r_{j+m-1} - n| < w``
 
-    which for (1/1), (1/2), (2/1) is the definition of FIGURES.md. Groups may overlap (three
+    which for (1/1), (1/2), (2/1) is the definition of docs/figures.md. Groups may overlap (three
     intervals of 0.5 hold two candidate (2/1) pairs), and an interval is counted at most once,
     so groups are taken greedily left to right: at the first unassigned interval j that starts
     some matching group, the first motion in `motions` that matches there claims its m
@@ -124,7 +124,7 @@ def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_
     The probability of a type is the summed duration of the intervals assigned to it by
     `classify_impact_intervals` (a (2/1) pair contributes both of its intervals) divided by
     `total_time`. The paper (section 5, Fig. 15) does not define it precisely; this is the
-    pipeline's definition (FIGURES.md, "The probability of an impact motion").
+    pipeline's definition (docs/figures.md, "The probability of an impact motion").
     """
     intervals = np.asarray(intervals, dtype=float)
     motions = _check_motions(motions)
