@@ -482,6 +482,83 @@ def test_repeated_shorter_orbit_is_not_a_22_motion():
     assert len(orbits22) >= 1      # the genuine (2/2) motion there (see the dense scan)
 
 
+def test_symmetric_22_system_has_the_same_null_space():
+    """For even n the m = 2 scan takes the interval system in a symmetric form (sums and
+    differences over 2 o of the two flights' rows, z_1 = z/2 + o): the same null vector as the
+    plain system where that is well conditioned, and a regular one at o = 0, where the plain
+    system has rank 3 (the doubled (1/(n/2)) motion)."""
+    beta, delta = 1 / 1.3, 0.7
+    wd, q, _ = orbit_kernels.harmonic_constants(beta, ZETA)
+    kmat, sub, zs = np.empty((4, 5)), np.empty((4, 5)), np.empty(2)
+    for n in (2, 4):
+        z = 2 * math.pi * n / beta
+        for o in (-1.1, -0.3, 0.05, 0.9):
+            plain, sym = np.empty(5), np.empty(5)
+            orbit_kernels._m2_null(z / 2 + o, z, False, beta, delta, ZETA, EPS, wd, zs, kmat,
+                                   sub, plain)
+            orbit_kernels._m2_null(z / 2 + o, z, True, beta, delta, ZETA, EPS, wd, zs, kmat,
+                                   sub, sym)
+            a, b = plain / np.linalg.norm(plain), sym / np.linalg.norm(sym)
+            assert min(np.abs(a - b).max(), np.abs(a + b).max()) < 1e-12, (n, o)
+        at_half = np.empty(5)
+        orbit_kernels._m2_null(z / 2, z, True, beta, delta, ZETA, EPS, wd, zs, kmat, sub,
+                               at_half)
+        assert np.all(np.isfinite(at_half)) and np.linalg.norm(at_half) > 1e-6
+
+
+def test_21_fold_pair_found_at_every_distance():
+    """Next to a (2/1) fold both orbits of the pair are returned (multipliers straddling +1),
+    from 1e-5 down to 1e-12 in delta (further away the unstable one has lost its slow impact),
+    and none just past the fold: the scan resolves the near-double root of its circle
+    condition instead of needing a sign change in a cell."""
+    from vibroimpact.validation.orbit_families import fold_points
+    beta, zeta, eps = 0.4632189831209864, 0.140252977051332, 0.6902755657606898
+    folds = fold_points(2, 1, beta, zeta, eps)
+    assert folds
+    tf = 2 * math.pi / beta
+    for delta_f, side, merged in folds:
+        def near(orbits):
+            return [o for o in orbits if circ_dist(o.tau0, merged.taus[0], tf) < 0.05 * tf
+                    or circ_dist(o.tau0, merged.taus[1], tf) < 0.05 * tf]
+        for d in (1e-5, 1e-7, 1e-9, 1e-10, 1e-12):
+            pair = near(periodic_orbits(2, 1, beta, delta_f + side * d, zeta, eps,
+                                        include_inadmissible=True))
+            assert len(pair) == 2, (delta_f, d)
+            mu = sorted(o.multipliers[np.argmin(np.abs(o.multipliers - 1))].real for o in pair)
+            assert mu[0] < 1.0 < mu[1], (delta_f, d, mu)
+        past = near(periodic_orbits(2, 1, beta, delta_f - side * 1e-7, zeta, eps,
+                                    include_inadmissible=True))
+        assert past == [], delta_f
+
+
+def test_22_motion_next_to_a_period_doubling():
+    """On one side of a period doubling of the (1/1) motion one (2/2) motion is born (intervals
+    z/2 +- ~sqrt(distance)), on the other side none: from 1e-4 down to 1e-10 in delta the
+    (2/2) call returns it exactly once there and never the doubled (1/1) motion, which is
+    within ~1e-16/distance of solving the (2/2) equations with a nearly singular Jacobian."""
+    from vibroimpact.validation.orbit_families import period_doubling_points
+    beta, zeta, eps = 1.1961933965658853, 0.019884047202237826, 0.542731103892917
+    points = period_doubling_points(beta, zeta, eps)
+    assert points
+    delta_pd = points[0][0]
+    z = 4 * math.pi / beta
+    counts = {}
+    for side in (1, -1):
+        for d in (1e-4, 1e-6, 1e-8, 1e-9, 1e-10):
+            delta = delta_pd + side * d
+            (o11,) = [o for o in periodic_orbits(1, 1, beta, delta, zeta, eps)
+                      if abs(o.multipliers[0] + 1) < 0.1]
+            near = [o for o in periodic_orbits(2, 2, beta, delta, zeta, eps,
+                                               include_inadmissible=True)
+                    if abs(o.intervals[0] - z / 2) < 0.1 and
+                    circ_dist(o.tau0, o11.tau0, 2 * math.pi / beta) < 0.1]
+            counts.setdefault(side, set()).add(len(near))
+            for o in near:
+                # a genuine (2/2) motion: intervals apart by ~ sqrt(d), not the doubled one
+                assert abs(o.intervals[0] - o.intervals[1]) > 1e-2 * math.sqrt(d), (side, d)
+    assert sorted(map(tuple, counts.values())) == [(0,), (1,)], counts
+
+
 # ------------------------------------------------------------------------------------------
 # eps = 0: plastic impacts, a rank-one map
 

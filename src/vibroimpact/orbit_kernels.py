@@ -13,7 +13,7 @@ A free flight starting on the wall at ``tau_a`` with approach velocity ``u_a`` (
 where ``P(s)`` is the damped free propagator of ``y'' + 2 zeta y' + y = 0``.
 """
 import numpy as np
-from math import acos, atan2, ceil, cos, exp, floor, hypot, pi, sin, sqrt
+from math import acos, atan2, ceil, cos, cosh, exp, floor, hypot, pi, sin, sinh, sqrt
 from numba import njit, prange
 
 # Numerical thresholds (one place).
@@ -21,7 +21,28 @@ NEWTON_MAXIT = 30
 NEWTON_GIVE_UP_IT = 10       # a start still this far off after this many steps is abandoned
 NEWTON_GIVE_UP_RTOL = 1e-4
 NEWTON_RTOL = 1e-12          # residual tolerance, relative to the problem's displacement scale
+# Float64 evaluation noise of the residual at an exact solution, relative to the scale: measured
+# <= 2.5e-15 (median 2.4e-16) at 150 mpmath-polished orbits of (1/1), (2/1), (2/2), (1/2); 4x
+# that. Below it a Newton step is driven by round-off alone (near a fold or a period doubling,
+# where |mu - 1| is tiny, such a step moves the orbit by noise/|mu - 1|), so Newton stops there.
+RESIDUAL_NOISE_RTOL = 1e-14
+# Once the residual is below NEWTON_RTOL, Newton goes on while a full step at least halves the
+# residual (quadratic convergence does far better) and stops when it does not: the step is then
+# dominated by round-off and would only move the solution along a near-null direction.
+NEWTON_POLISH_DECREASE = 0.5
+NEWTON_STEP_RTOL = 1e-14     # converged on the step: |dy_i| <= this * (1 + |y_i|) (a few ulps)
 SAME_ORBIT_RTOL = 1e-7       # two solutions closer than this (phase/T_f, velocity/scale) are one
+# Uncertainty of a solution (added to SAME_ORBIT_RTOL in the dedupe and repeated-orbit tests):
+# UNCERTAINTY_SAFETY * |J^-1| (residual + noise), per component, in the units of
+# SAME_ORBIT_RTOL. The factor covers the first-order bound's neglect of curvature (a Newton
+# point stopped in the flat, noise-level region between close roots: then the bound is >= its
+# distance to either root for any factor >= 1). At the doubled (1/1) motion 1e-10 in delta from
+# a period doubling the bound is 6e-5 .. 3e-3 (it takes the noise at its ceiling), while Newton
+# copies of that motion landed ~5e-7 off it (relative): the cap decides there. It is 100 x
+# SAME_ORBIT_RTOL, above those copies' errors and 10 x below the 1e-4 at which the independent
+# check pairs orbits, so a (near) singular J never merges orbits that are clearly apart.
+UNCERTAINTY_SAFETY = 4.0
+UNCERTAINTY_CAP = 1e-5
 ADMISSIBLE_TOL = 1e-12       # margin >= -tol counts as admissible (grazing is the edge, included)
 MAX_SOLUTIONS = 64           # capacity per (m/n) type and parameter point
 # Interval-scan steps, in radians of the fastest of beta and wd (m = 2: 1-D scan, m = 3: per
@@ -32,6 +53,16 @@ EDGE_LEVELS = 6              # m = 2 scan: extra nodes at 10^-6 .. 10^-1 steps f
 MAP_SCAN_STEP_M2 = SCAN_STEP_M2   # m = 2 scans are cheap: the map scans every point
 MAP_SCAN_STEP_M3 = 0.25
 MAP_SCAN_EVERY = 4           # map: global scan at every 4th delta; branches followed in between
+# m = 2 scan, near-tangencies: a local extremum of a circle factor (no sign change around it)
+# is refined when the parabola through its three nodes comes within TANGENCY_MARGIN * a2 H^2
+# of zero (a2: the parabola's curvature, H: the wider cell). The parabola predicts the
+# extremum to ~H g'''/g'' (~2% at 0.02 rad nodes) of a2 H^2, so a pair of roots hidden in
+# the cells (the two orbits next to a fold, ~sqrt(distance) apart) is never skipped.
+TANGENCY_MARGIN = 1.0
+# The refinement (Brent's minimization) stops at this fraction of the two cells: a hidden pair
+# ~1e-7 apart (a fold ~1e-14 away in delta) still shows a negative value at that resolution.
+TANGENCY_XTOL = 1e-9
+ROOT_MAXIT = 100             # Brent root/minimum iterations (bisection bound ~60 for float64)
 FLIGHT_PHASE_STEP = 0.5      # admissibility: initial bracketing step (radians), refined by bounds
 FLIGHT_MIN_STEP = 1e-9       # admissibility: smallest bracket before giving up refinement
 
@@ -288,48 +319,103 @@ def _residual_jacobian(y, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac):
 
 
 @njit(cache=True)
+def _norm(v, n):
+    acc = 0.0
+    for i in range(n):
+        acc += v[i] * v[i]
+    return sqrt(acc)
+
+
+@njit(cache=True)
 def newton(y, m, z, beta, delta, zeta, eps, scale, res, jac, dy, ytry):
-    """Damped Newton with the analytic Jacobian, in place on ``y``; True when converged."""
+    """Damped Newton with the analytic Jacobian, in place on ``y``.
+
+    Returns ``(converged, residual norm at y)``. Converged means a residual <= NEWTON_RTOL
+    times ``scale`` *and* a settled position: Newton goes on below that tolerance while full
+    steps keep cutting the residual (by NEWTON_POLISH_DECREASE at least) and stops on a step
+    of a few ulps, at the round-off floor (RESIDUAL_NOISE_RTOL) or when a step no longer
+    helps; a step that does not help is not taken (near a singular Jacobian it would only
+    carry the solution along the near-null direction, by noise / |mu - 1|).
+    """
     wd, q, phi = harmonic_constants(beta, zeta)
     nn = 2 * m
     tol = NEWTON_RTOL * scale
+    floor_ = RESIDUAL_NOISE_RTOL * scale
     _residual_jacobian(y, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac)
-    nr = 0.0
-    for i in range(nn):
-        nr += res[i] * res[i]
-    nr = sqrt(nr)
-    polished = 0
+    nr = _norm(res, nn)
     for it in range(NEWTON_MAXIT):
         if not np.isfinite(nr) or (it >= NEWTON_GIVE_UP_IT and nr > NEWTON_GIVE_UP_RTOL * scale):
-            return False
-        if nr <= tol:
-            polished += 1
-            if polished > 1:
-                return True
+            return False, nr
+        if nr <= floor_:
+            return True, nr
         for i in range(nn):
             dy[i] = -res[i]
         if not _solve_inplace(jac, dy, nn):
-            return nr <= tol
+            return nr <= tol, nr
+        polishing = nr <= tol
         step = 1.0
         accepted = False
-        for _ in range(8):
+        nt = nr
+        for _ in range(1 if polishing else 8):
             for i in range(nn):
                 ytry[i] = y[i] + step * dy[i]
             _residual_jacobian(ytry, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac)
-            nt = 0.0
-            for i in range(nn):
-                nt += res[i] * res[i]
-            nt = sqrt(nt)
-            if nt < nr or nt <= tol:
+            nt = _norm(res, nn)
+            if polishing:
+                accepted = nt <= NEWTON_POLISH_DECREASE * nr
+                break
+            if nt < nr:
                 accepted = True
                 break
             step *= 0.5
-        for i in range(nn):
-            y[i] = ytry[i]
         if not accepted:
-            return nt <= tol
+            return nr <= tol, nr               # y unchanged (res, jac: the rejected trial)
+        small = True
+        for i in range(nn):
+            if abs(ytry[i] - y[i]) > NEWTON_STEP_RTOL * (1.0 + abs(y[i])):
+                small = False
+            y[i] = ytry[i]
         nr = nt
-    return nr <= tol
+        if small and nr <= tol:
+            return True, nr
+    return nr <= tol, nr
+
+
+@njit(cache=True)
+def uncertainty(y, m, z, beta, delta, zeta, eps, scale, tf, uscale):
+    """Error bound of the solution ``y`` in the units of SAME_ORBIT_RTOL (phase / T_f,
+    velocity / uscale), from the conditioning of eqs. (10)-(11) there.
+
+    ``UNCERTAINTY_SAFETY * max_i sum_j |J^-1_ij| (|res| + noise)`` over the phases (over
+    ``tf``) and the velocities (over ``uscale``), capped at UNCERTAINTY_CAP. Next to a fold or
+    a period doubling (|mu - 1| small) round-off alone leaves a Newton solution this far off.
+    """
+    wd, q, phi = harmonic_constants(beta, zeta)
+    nn = 2 * m
+    res = np.empty(nn)
+    jac = np.empty((nn, nn))
+    a = np.empty((nn, nn))
+    col = np.empty(nn)
+    rows = np.zeros(nn)
+    _residual_jacobian(y, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac)
+    err = _norm(res, nn) + RESIDUAL_NOISE_RTOL * scale
+    for c in range(nn):
+        for i in range(nn):
+            for k in range(nn):
+                a[i, k] = jac[i, k]
+            col[i] = 0.0
+        col[c] = 1.0
+        if not _solve_inplace(a, col, nn):
+            return UNCERTAINTY_CAP
+        for i in range(nn):
+            rows[i] += abs(col[i])
+    worst = 0.0
+    for i in range(m):
+        worst = max(worst, rows[i] / tf, rows[m + i] / uscale)
+    bound = UNCERTAINTY_SAFETY * worst * err
+    if not bound < UNCERTAINTY_CAP:             # also NaN
+        return UNCERTAINTY_CAP
+    return bound
 
 
 # --------------------------------------------------------------------------------------------
@@ -506,49 +592,76 @@ def _circ_dist(a, b, period):
 
 
 @njit(cache=True)
-def _same_orbit(ya, yb, m, shift, tf, uscale):
-    """True when ``yb`` rotated by ``shift`` impacts is ``ya`` (phases mod T_f, velocities)."""
+def _same_orbit(ya, yb, m, shift, tf, uscale, tol):
+    """True when ``yb`` rotated by ``shift`` impacts is ``ya`` within ``tol`` (phases mod T_f
+    over T_f, velocities over ``uscale``)."""
     for j in range(m):
         k = (j + shift) % m
-        if _circ_dist(ya[j], yb[k], tf) > SAME_ORBIT_RTOL * tf:
+        if _circ_dist(ya[j], yb[k], tf) > tol * tf:
             return False
-        if abs(ya[m + j] - yb[m + k]) > SAME_ORBIT_RTOL * uscale:
+        if abs(ya[m + j] - yb[m + k]) > tol * uscale:
             return False
     return True
 
 
 @njit(cache=True)
-def _accept(y, m, z, tf, uscale, sols, count):
-    """Append ``y`` to ``sols`` unless invalid, a duplicate, or a repeated shorter orbit."""
+def _valid(y, m, z):
+    """Positive approach velocities and increasing impact instants within one period."""
     for j in range(m):
         if not (y[m + j] > 0.0):
-            return count
+            return False
     for j in range(1, m):
         if not (y[j] - y[j - 1] > 0.0):
-            return count
-    if not (y[0] + z - y[m - 1] > 0.0):
+            return False
+    return y[0] + z - y[m - 1] > 0.0
+
+
+@njit(cache=True)
+def _accept(y, rho, rep_rho, m, z, tf, uscale, sols, count):
+    """Append ``y`` (uncertainty ``rho``) to ``sols`` unless invalid, a duplicate, or a
+    repeated shorter orbit; returns the new count.
+
+    Rows of ``sols`` are ``(tau.., u.., rho)``. Two solutions are one orbit when they agree
+    within ``SAME_ORBIT_RTOL + rho_a + rho_b`` (the uncertainty of a Newton solution grows like
+    noise / |mu - 1| next to a fold or a period doubling); the better-conditioned copy is kept.
+    ``y`` is a shorter orbit traversed repeatedly (e.g. the doubled (1/1) motion among the
+    (2/2) solutions) when it is its own rotation within ``SAME_ORBIT_RTOL + 2 rep_rho``: pass
+    ``rep_rho = rho`` for a Newton solution, 0 for one whose intervals are exact (the m = 2
+    scan's, whose circle condition stays regular at the doubled motion).
+    """
+    if not _valid(y, m, z):
         return count
+    nn = 2 * m
     for r in range(1, m):
-        if _same_orbit(y, y, m, r, tf, uscale):
+        if _same_orbit(y, y, m, r, tf, uscale, SAME_ORBIT_RTOL + 2.0 * rep_rho):
             return count                       # a shorter orbit traversed m/r times
     for i in range(count):
+        tol = SAME_ORBIT_RTOL + rho + sols[i, nn]
         for r in range(m):
-            if _same_orbit(sols[i], y, m, r, tf, uscale):
+            if _same_orbit(sols[i], y, m, r, tf, uscale, tol):
+                if rho < sols[i, nn]:
+                    for c in range(nn):
+                        sols[i, c] = y[c]
+                    sols[i, nn] = rho
                 return count
     if count >= sols.shape[0]:
         return count
-    for i in range(2 * m):
-        sols[count, i] = y[i]
+    for c in range(nn):
+        sols[count, c] = y[c]
+    sols[count, nn] = rho
     return count + 1
 
 
 @njit(cache=True)
 def _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, uscale, sols, count, work, jac):
+    """Newton from ``y``; a converged, valid solution goes to ``_accept``."""
     res = work[0]
     dy = work[1]
     ytry = work[2]
-    if newton(y, m, z, beta, delta, zeta, eps, scale, res, jac, dy, ytry):
-        count = _accept(y, m, z, tf, uscale, sols, count)
+    conv, _ = newton(y, m, z, beta, delta, zeta, eps, scale, res, jac, dy, ytry)
+    if conv and _valid(y, m, z):
+        rho = uncertainty(y, m, z, beta, delta, zeta, eps, scale, tf, uscale)
+        count = _accept(y, rho, rho, m, z, tf, uscale, sols, count)
     return count
 
 
@@ -585,6 +698,354 @@ def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub, nve
     if _guess_from_null(nvec, m, zs, q, phi, beta, sign, y):
         count = _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, scale, sols, count,
                            work, jac)
+    return count
+
+
+# --- m = 2: the circle condition along z_1, exact roots ------------------------------------
+
+@njit(cache=True)
+def _even_parts(alpha, gamma, e_h, c_h, s_h, e_p, e_m, c_o, s_o, ch_z, sh_z_o, s_o_o):
+    """``f(h +- o)``, their mean and ``(f(h+o) - f(h-o)) / (2 o)`` for
+    ``f(s) = exp(-zeta s) (alpha cos wd s + gamma sin wd s)``, the difference in product form
+    (no cancellation as o -> 0): ``f(h +- o) = e_h exp(-+zeta o) (X cos wd o +- Y sin wd o)``."""
+    x_ = alpha * c_h + gamma * s_h
+    y_ = gamma * c_h - alpha * s_h
+    plus = e_h * e_p * (x_ * c_o + y_ * s_o)
+    minus = e_h * e_m * (x_ * c_o - y_ * s_o)
+    mean = 0.5 * (plus + minus)
+    diff = e_h * (-x_ * c_o * sh_z_o + y_ * ch_z * s_o_o)
+    return plus, minus, mean, diff
+
+
+@njit(cache=True)
+def _fill_symmetric_system(o, h, beta, delta, zeta, eps, wd, kmat):
+    """(2/n) system for even n at ``z_1 = h + o``, ``z_2 = h - o`` (``h = z/2``), regular at o = 0.
+
+    For even n the flights' forcing phases differ by ``beta o`` only, and at o = 0 the four
+    rows of ``_fill_interval_system`` have rank 3: the doubled (1/(n/2)) motion solves them for
+    every delta, and their null vector, a 0/0 there, is computed with an error ~ 1e-16 / o.
+    This is that matrix with its rows recombined into the sums ``(r_1 + r_3)/2``,
+    ``(r_2 + r_4)/2`` and the differences ``(r_1 - r_3)/(2 o)``, ``(r_2 - r_4)/(2 o)`` of the two
+    flights' rows, and its velocity columns into ``u+ = (u_0 + u_1)/2``, ``ub = (u_0 - u_1)/(2 o)``
+    (columns ``S0, C0, u+, ub, t``), every difference in closed product form. Same null space
+    (``u_0, u_1 = u+ +- o ub``), a regular matrix at o = 0: the (2/n) motions born there from the
+    doubled motion (a period doubling, intervals ``h +- O(sqrt(distance))``) are simple roots of
+    its circle condition, found to round-off instead of to ~1e-16 / distance.
+    """
+    c = cos(beta * o)
+    s = sin(beta * o)
+    if o != 0.0:
+        sb2 = sin(0.5 * beta * o)
+        s2o = s / (2.0 * o)                   # sin(beta o) / (2 o)
+        omc2o = sb2 * sb2 / o                 # (1 - cos beta o) / (2 o)
+        sh_z_o = sinh(zeta * o) / o
+        s_o_o = sin(wd * o) / o
+    else:
+        s2o = 0.5 * beta
+        omc2o = 0.0
+        sh_z_o = zeta
+        s_o_o = wd
+    e_h = exp(-zeta * h)
+    c_h = cos(wd * h)
+    s_h = sin(wd * h)
+    e_p = exp(-zeta * o)
+    e_m = exp(zeta * o)
+    c_o = cos(wd * o)
+    s_o = sin(wd * o)
+    ch_z = cosh(zeta * o)
+    p11p, p11m, m11, d11 = _even_parts(1.0, zeta / wd, e_h, c_h, s_h, e_p, e_m, c_o, s_o, ch_z,
+                                       sh_z_o, s_o_o)
+    p12p, p12m, m12, d12 = _even_parts(0.0, 1.0 / wd, e_h, c_h, s_h, e_p, e_m, c_o, s_o, ch_z,
+                                       sh_z_o, s_o_o)
+    p21p, p21m, m21, d21 = _even_parts(0.0, -1.0 / wd, e_h, c_h, s_h, e_p, e_m, c_o, s_o, ch_z,
+                                       sh_z_o, s_o_o)
+    p22p, p22m, m22, d22 = _even_parts(1.0, -zeta / wd, e_h, c_h, s_h, e_p, e_m, c_o, s_o, ch_z,
+                                       sh_z_o, s_o_o)
+    # sums of the position and velocity rows of the two flights
+    kmat[0, 0] = 0.5 * (c - p11p - p11m * c + beta * p12m * s + 1.0)
+    kmat[0, 1] = 0.5 * (s - beta * p12p - p11m * s - beta * p12m * c)
+    kmat[0, 2] = -eps * m12
+    kmat[0, 3] = -eps * o * o * d12
+    kmat[0, 4] = m11 - 1.0
+    kmat[1, 0] = 0.5 * (-p21p - beta * s - p21m * c + beta * p22m * s)
+    kmat[1, 1] = 0.5 * (-beta * p22p + beta * c - p21m * s - beta * p22m * c + beta)
+    kmat[1, 2] = -1.0 - eps * m22
+    kmat[1, 3] = -eps * o * o * d22
+    kmat[1, 4] = m21
+    # differences over 2 o
+    kmat[2, 0] = -omc2o * (1.0 + p11m) - d11 - beta * p12m * s2o
+    kmat[2, 1] = s2o * (1.0 + p11m) - beta * d12 - beta * p12m * omc2o
+    kmat[2, 2] = -eps * d12
+    kmat[2, 3] = -eps * m12
+    kmat[2, 4] = d11
+    kmat[3, 0] = -d21 - p21m * omc2o - beta * s2o * (1.0 + p22m)
+    kmat[3, 1] = -beta * d22 - beta * (1.0 + p22m) * omc2o + p21m * s2o
+    kmat[3, 2] = -eps * d22
+    kmat[3, 3] = 1.0 - eps * m22
+    kmat[3, 4] = d21
+
+
+@njit(cache=True)
+def _m2_null(x, z, even, beta, delta, zeta, eps, wd, zs, kmat, sub, nvec):
+    """Null vector ``(S0, C0, u_0, u_1, t)`` of the (2/n) equations at ``z_1 = x``, in ``nvec``."""
+    if even:
+        h = 0.5 * z
+        o = x - h
+        _fill_symmetric_system(o, h, beta, delta, zeta, eps, wd, kmat)
+        _cofactors(kmat, 0, 5, sub, nvec)
+        up = nvec[2]
+        ub = nvec[3]
+        nvec[2] = up + o * ub
+        nvec[3] = up - o * ub
+    else:
+        zs[0] = x
+        zs[1] = z - x
+        _fill_interval_system(zs, 2, beta, delta, zeta, eps, wd, kmat)
+        _cofactors(kmat, 0, 5, sub, nvec)
+
+
+@njit(cache=True)
+def _m2_factor(x, f, z, even, beta, delta, zeta, eps, wd, q, zs, kmat, sub, nvec):
+    """Circle factor ``f`` (0 or 1, ``_circle_factors``) of the (2/n) equations at ``z_1 = x``."""
+    _m2_null(x, z, even, beta, delta, zeta, eps, wd, zs, kmat, sub, nvec)
+    g0, g1 = _circle_factors(nvec, 5, delta, q)
+    return g0 if f == 0 else g1
+
+
+@njit(cache=True)
+def _m2_zero(a, b, fa, fb, f, z, even, beta, delta, zeta, eps, wd, q, zs, kmat, sub, nvec):
+    """Root of circle factor ``f`` in ``[a, b]`` (``fa fb <= 0``): Brent's method, a few ulps."""
+    if fa == 0.0:
+        return a
+    if fb == 0.0:
+        return b
+    c = a
+    fc = fa
+    d = b - a
+    e = d
+    for _ in range(ROOT_MAXIT):
+        if (fb > 0.0) == (fc > 0.0):
+            c = a
+            fc = fa
+            d = b - a
+            e = d
+        if abs(fc) < abs(fb):
+            a = b
+            b = c
+            c = a
+            fa = fb
+            fb = fc
+            fc = fa
+        tol = 4.4e-16 * abs(b) + 1e-300
+        xm = 0.5 * (c - b)
+        if abs(xm) <= tol or fb == 0.0:
+            return b
+        if abs(e) >= tol and abs(fa) > abs(fb):
+            s = fb / fa
+            if a == c:
+                p = 2.0 * xm * s
+                qq = 1.0 - s
+            else:
+                qq = fa / fc
+                r = fb / fc
+                p = s * (2.0 * xm * qq * (qq - r) - (b - a) * (r - 1.0))
+                qq = (qq - 1.0) * (r - 1.0) * (s - 1.0)
+            if p > 0.0:
+                qq = -qq
+            else:
+                p = -p
+            if 2.0 * p < min(3.0 * xm * qq - abs(tol * qq), abs(e * qq)):
+                e = d
+                d = p / qq
+            else:
+                d = xm
+                e = d
+        else:
+            d = xm
+            e = d
+        a = b
+        fa = fb
+        if abs(d) > tol:
+            b += d
+        else:
+            b += tol if xm > 0.0 else -tol
+        fb = _m2_factor(b, f, z, even, beta, delta, zeta, eps, wd, q, zs, kmat, sub, nvec)
+    return b
+
+
+@njit(cache=True)
+def _m2_dip(a, b, x, fx, sgn, f, z, even, beta, delta, zeta, eps, wd, q, zs, kmat, sub, nvec):
+    """Minimum of ``sgn g`` (g: circle factor ``f``) on ``[a, b]`` from the node ``x`` (Brent).
+
+    Returns ``(x, sgn g(x))``, at once when ``sgn g`` drops to <= 0 (then ``[a, x]`` and
+    ``[x, b]`` each bracket a root: the pair of a near-double root, next to a fold).
+    """
+    golden = 0.3819660112501051
+    tol1 = TANGENCY_XTOL * (b - a)
+    v = x
+    w = x
+    fv = fx
+    fw = fx
+    d = 0.0
+    e = 0.0
+    for _ in range(ROOT_MAXIT):
+        xm = 0.5 * (a + b)
+        tol2 = 2.0 * tol1
+        if abs(x - xm) <= tol2 - 0.5 * (b - a):
+            break
+        parabolic = False
+        if abs(e) > tol1:
+            r = (x - w) * (fx - fv)
+            qq = (x - v) * (fx - fw)
+            p = (x - v) * qq - (x - w) * r
+            qq = 2.0 * (qq - r)
+            if qq > 0.0:
+                p = -p
+            else:
+                qq = -qq
+            if abs(p) < abs(0.5 * qq * e) and p > qq * (a - x) and p < qq * (b - x):
+                e = d
+                d = p / qq
+                u = x + d
+                if u - a < tol2 or b - u < tol2:
+                    d = tol1 if xm >= x else -tol1
+                parabolic = True
+        if not parabolic:
+            e = (a - x) if x >= xm else (b - x)
+            d = golden * e
+        u = x + d if abs(d) >= tol1 else x + (tol1 if d > 0.0 else -tol1)
+        fu = sgn * _m2_factor(u, f, z, even, beta, delta, zeta, eps, wd, q, zs, kmat, sub, nvec)
+        if fu <= 0.0:
+            return u, fu
+        if fu <= fx:
+            if u >= x:
+                a = x
+            else:
+                b = x
+            v = w
+            fv = fw
+            w = x
+            fw = fx
+            x = u
+            fx = fu
+        else:
+            if u < x:
+                a = u
+            else:
+                b = u
+            if fu <= fw or w == x:
+                v = w
+                fv = fw
+                w = u
+                fw = fu
+            elif fu <= fv or v == x or v == w:
+                v = u
+                fv = fu
+    return x, fx
+
+
+@njit(cache=True)
+def _m2_solution(x, f, n, beta, delta, zeta, eps, scale, zs, kmat, sub, nvec, y, sols, count,
+                 work, jac):
+    """The (2/n) solution at the root ``z_1 = x`` of circle factor ``f``, into ``sols``.
+
+    At fixed intervals eqs. (10)-(11) are linear, so the root gives the solution directly; it
+    is kept as it is when its residual is below NEWTON_RTOL (no Newton: its intervals are exact
+    even where the full system is near singular), and polished by Newton otherwise.
+    """
+    wd, q, phi = harmonic_constants(beta, zeta)
+    z = 2.0 * pi * n / beta
+    tf = 2.0 * pi / beta
+    even = n % 2 == 0
+    _m2_null(x, z, even, beta, delta, zeta, eps, wd, zs, kmat, sub, nvec)
+    zs[0] = x
+    zs[1] = z - x
+    if not _guess_from_null(nvec, 2, zs, q, phi, beta, 1.0 if f == 0 else -1.0, y):
+        return count
+    res = work[0]
+    _residual_jacobian(y, 2, z, beta, delta, zeta, eps, wd, q, phi, res, jac)
+    if _norm(res, 4) <= NEWTON_RTOL * scale:
+        if _valid(y, 2, z):
+            rho = uncertainty(y, 2, z, beta, delta, zeta, eps, scale, tf, scale)
+            count = _accept(y, rho, 0.0, 2, z, tf, scale, sols, count)
+        return count
+    return _try_start(y, 2, z, beta, delta, zeta, eps, scale, tf, scale, sols, count, work, jac)
+
+
+@njit(cache=True)
+def _scan_m2(n, beta, delta, zeta, eps, scan_step, sols, count, work, jac):
+    """Every (2/n) solution from the circle condition along ``0 < z_1 < z`` (see solve_general)."""
+    wd, q, phi = harmonic_constants(beta, zeta)
+    z = 2.0 * pi * n / beta
+    scale = 1.0 + abs(delta) + q * (1.0 + beta)
+    even = n % 2 == 0
+    fast = max(beta, wd)
+    kmat = np.empty((4, 5))
+    sub = np.empty((4, 5))
+    nvec = np.empty(5)
+    zs = np.empty(2)
+    y = np.empty(4)
+    # nodes: uniform inside, geometric towards both ends (z_1 -> 0 and z_2 -> 0), where a
+    # solution with a very short flight lives and a zero-length flight makes K singular; for
+    # even n an odd count puts a node at z/2, which the (2/n) pair born from the doubled
+    # (1/(n/2)) motion straddles
+    npt = max(16, int(ceil(z * fast / scan_step)))
+    if even and npt % 2 == 0:
+        npt += 1
+    nodes = np.empty(npt + 2 * EDGE_LEVELS)
+    for k in range(EDGE_LEVELS):
+        nodes[k] = z / npt * 10.0 ** (k - EDGE_LEVELS)
+        nodes[npt + 2 * EDGE_LEVELS - 1 - k] = z - nodes[k]
+    for k in range(npt):
+        nodes[EDGE_LEVELS + k] = z * (k + 0.5) / npt
+    nnode = nodes.shape[0]
+    gval = np.empty((2, nnode))
+    for k in range(nnode):
+        _m2_null(nodes[k], z, even, beta, delta, zeta, eps, wd, zs, kmat, sub, nvec)
+        gval[0, k], gval[1, k] = _circle_factors(nvec, 5, delta, q)
+    for f in range(2):
+        for k in range(nnode - 1):
+            h0 = gval[f, k]
+            h1 = gval[f, k + 1]
+            if not (h0 * h1 <= 0.0 and h0 != h1):
+                continue
+            x = _m2_zero(nodes[k], nodes[k + 1], h0, h1, f, z, even, beta, delta, zeta, eps, wd,
+                         q, zs, kmat, sub, nvec)
+            count = _m2_solution(x, f, n, beta, delta, zeta, eps, scale, zs, kmat, sub, nvec, y,
+                                 sols, count, work, jac)
+        # near-tangencies: both roots of a near-double root in the cells next to a node
+        for k in range(1, nnode - 1):
+            gk = gval[f, k]
+            if gk == 0.0:
+                continue
+            sgn = 1.0 if gk > 0.0 else -1.0
+            pl = sgn * gval[f, k - 1]
+            pk = sgn * gk
+            pr = sgn * gval[f, k + 1]
+            if not (pl > 0.0 and pr > 0.0 and pk < pl and pk <= pr):
+                continue                     # no dip toward zero here (or already bracketed)
+            xl = nodes[k - 1]
+            xk = nodes[k]
+            xr = nodes[k + 1]
+            d1 = (pk - pl) / (xk - xl)
+            a2 = ((pr - pk) / (xr - xk) - d1) / (xr - xl)
+            slope = d1 + a2 * (xk - xl)
+            wide = max(xk - xl, xr - xk)
+            if pk - slope * slope / (4.0 * a2) > TANGENCY_MARGIN * a2 * wide * wide:
+                continue
+            xm, pm = _m2_dip(xl, xr, xk, pk, sgn, f, z, even, beta, delta, zeta, eps, wd, q, zs,
+                             kmat, sub, nvec)
+            if pm > 0.0:
+                continue
+            for side in range(2):
+                a = xl if side == 0 else xm
+                b = xm if side == 0 else xr
+                fa = sgn * (pl if side == 0 else pm)
+                fb = sgn * (pm if side == 0 else pr)
+                x = _m2_zero(a, b, fa, fb, f, z, even, beta, delta, zeta, eps, wd, q, zs, kmat,
+                             sub, nvec)
+                count = _m2_solution(x, f, n, beta, delta, zeta, eps, scale, zs, kmat, sub,
+                                     nvec, y, sols, count, work, jac)
     return count
 
 
@@ -631,14 +1092,21 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     -----
     For fixed intervals the 2m equations are linear in ``(S0, C0, u_0..u_{m-1}, t=delta)``
     (``_fill_interval_system``). For m = 2 the 4x5 matrix has a cofactor null vector ``w(z_1)``
-    and the solutions are the roots of ``h(z_1) = delta^2 (w_S^2 + w_C^2) - q^2 w_t^2`` (the
-    circle condition), a smooth scalar function scanned over ``0 < z_1 < z``. For m = 3 the
-    matrix is 6x6: the roots are the common zeros of ``det K`` and the same circle function
-    (null vector of rows 1-5) on the triangle ``z_1 + z_2 < z``. Every bracket (a sign change
-    of ``h``; a cell where both change sign) and every shallow local minimum of ``|h|`` (of the
-    circle function in a cell where ``det K`` changes sign) seeds Newton on the full system.
-    Each orbit appears m times in the scan (one per choice of first impact), so a bracket lost
-    to a near-tangency is usually recovered from a rotation.
+    and the solutions are the roots of the two factors of the circle condition
+    ``delta^2 (w_S^2 + w_C^2) = q^2 w_t^2`` (``_circle_factors``), smooth functions of ``z_1``
+    scanned over ``0 < z_1 < z`` (``_scan_m2``): every sign change is solved to a few ulps
+    (Brent), and every dip of a factor toward zero between nodes is minimized first, so that
+    both roots of a near-double root (the two orbits next to a fold) are bracketed. A root
+    gives the solution directly (the equations are linear at fixed intervals); Newton only
+    polishes one whose residual is above NEWTON_RTOL. For even n the matrix is taken in the
+    symmetric form of ``_fill_symmetric_system``, regular at ``z_1 = z/2`` where the doubled
+    (1/(n/2)) motion makes the plain one singular. For m = 3 the matrix is 6x6: the roots are
+    the common zeros of ``det K`` and the same circle function (null vector of rows 1-5) on the
+    triangle ``z_1 + z_2 < z``; every cell where both change sign (or the circle function comes
+    near zero while ``det K`` changes sign) seeds Newton on the full system. Each orbit appears
+    m times in the scan (one per choice of first impact). Solutions are kept once each
+    (``_accept``: within SAME_ORBIT_RTOL plus their uncertainty from the conditioning,
+    ``uncertainty``), and a repeated shorter orbit is dropped.
     """
     wd, q, phi = harmonic_constants(beta, zeta)
     z = 2.0 * pi * n / beta
@@ -663,41 +1131,7 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     nvec = np.empty(ncol)
     zs = np.empty(m)
     if m == 2:
-        # nodes: uniform inside, geometric towards both ends (z_1 -> 0 and z_2 -> 0), where a
-        # solution with a very short flight lives and a zero-length flight makes K singular
-        npt = max(16, int(ceil(z * fast / scan_step)))
-        nodes = np.empty(npt + 2 * EDGE_LEVELS)
-        for k in range(EDGE_LEVELS):
-            nodes[k] = z / npt * 10.0 ** (k - EDGE_LEVELS)
-            nodes[npt + 2 * EDGE_LEVELS - 1 - k] = z - nodes[k]
-        for k in range(npt):
-            nodes[EDGE_LEVELS + k] = z * (k + 0.5) / npt
-        nnode = nodes.shape[0]
-        gval = np.empty((2, nnode))
-        for k in range(nnode):
-            zs[0] = nodes[k]
-            zs[1] = z - zs[0]
-            _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
-            _cofactors(kmat, 0, ncol, sub, nvec)
-            gval[0, k], gval[1, k] = _circle_factors(nvec, ncol, delta, q)
-        for f in range(2):
-            sign = 1.0 if f == 0 else -1.0
-            for k in range(nnode - 1):
-                h0 = gval[f, k]
-                h1 = gval[f, k + 1]
-                cand = -1.0
-                if h0 * h1 <= 0.0 and h0 != h1:
-                    cand = nodes[k] + (nodes[k + 1] - nodes[k]) * h0 / (h0 - h1)
-                elif (0 < k and abs(h0) < 0.3 and abs(h0) <= abs(gval[f, k - 1])
-                      and abs(h0) <= abs(h1)):
-                    cand = nodes[k]
-                if cand <= 0.0 or cand >= z:
-                    continue
-                zs[0] = cand
-                zs[1] = z - zs[0]
-                count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub,
-                                              nvec, y, sols, count, work, jac)
-        return count
+        return _scan_m2(n, beta, delta, zeta, eps, scan_step, sols, count, work, jac)
     # m == 3: 2-D scan over (z_1, z_2), z_3 = z - z_1 - z_2. The nodes are offset by a third
     # of a step from the edges of the triangle, where a zero-length flight makes K singular.
     npt = max(12, int(ceil(z * fast / scan_step)))
@@ -786,10 +1220,13 @@ def _follow_back(y0, m, n, beta, deltas, d_from, d_stop, zeta, eps, sols, counts
     for dd in range(d_from - 1, d_stop - 1, -1):
         delta = deltas[dd]
         scale = 1.0 + abs(delta) + q * (1.0 + beta)
-        if not newton(y, m, z, beta, delta, zeta, eps, scale, work[0], jac, work[1], work[2]):
+        conv, _ = newton(y, m, z, beta, delta, zeta, eps, scale, work[0], jac, work[1],
+                         work[2])
+        if not conv or not _valid(y, m, z):
             return
+        rho = uncertainty(y, m, z, beta, delta, zeta, eps, scale, tf, scale)
         before = counts[dd]
-        counts[dd] = _accept(y, m, z, tf, scale, sols[dd], before)
+        counts[dd] = _accept(y, rho, rho, m, z, tf, scale, sols[dd], before)
         if counts[dd] == before:
             return
 
@@ -812,7 +1249,7 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
         n = types[t, 1]
         nn = 2 * m
         z = 2.0 * pi * n / beta
-        sols = np.empty((nd, MAX_SOLUTIONS, nn))
+        sols = np.empty((nd, MAX_SOLUTIONS, nn + 1))   # rows (tau.., u.., uncertainty)
         counts = np.zeros(nd, dtype=np.int64)
         work = np.empty((3, nn))
         jac = np.empty((nn, nn))

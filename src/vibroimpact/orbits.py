@@ -11,9 +11,22 @@ Method
   closed form (``orbit_kernels.solve_m1``).
 - (2/n), (3/n): for fixed intervals the equations are linear in the impact phase's
   ``(sin, cos)`` and the velocities; the solutions are the zeros of a smooth scalar circle
-  condition over the intervals (a 1-D scan for m = 2, a 2-D one for m = 3). Every bracket seeds
-  Newton on the full 2m-equation system with its analytic Jacobian
-  (``orbit_kernels.solve_general``). m >= 4 is not supported.
+  condition over the intervals (a 1-D scan for m = 2, a 2-D one for m = 3;
+  ``orbit_kernels.solve_general``). m >= 4 is not supported.
+- m = 2: every sign change of the circle condition is solved to round-off in ``z_1`` and gives
+  the solution directly; every dip toward zero between scan nodes is minimized first, so that
+  the two orbits next to a fold (a near-double root, ~sqrt(distance) apart) are both bracketed.
+  For even n the condition is taken in a symmetric form that stays regular at ``z_1 = z/2``,
+  where the doubled (1/(n/2)) motion makes the plain linear system singular: the (2/n) motion
+  born there at a period doubling is then a simple root, found to round-off.
+- m = 3 (and any m = 2 root with a residual above tolerance): Newton on the full 2m-equation
+  system with its analytic Jacobian, converged on the residual and the step; it stops at the
+  round-off floor or when a step no longer cuts the residual, instead of drifting along the
+  near-null direction where ``|mu - 1|`` is tiny.
+- One orbit once: solutions closer than ``1e-7`` plus their uncertainty (round-off over the
+  conditioning of the equations, ``orbit_kernels.uncertainty``) are one; a solution that is
+  its own rotation within that tolerance is a shorter orbit traversed repeatedly (e.g. the
+  doubled (1/1) motion among the (2/2) solutions; it is reported by the (1/1) call).
 - Admissibility: the exact largest interior maximum of x on every flight, from the zeros of
   the velocity (``orbit_kernels.flight_max``).
 - Stability: the analytic one-period Jacobian ``T = T_m ... T_1`` of the impact map, whose
@@ -26,7 +39,10 @@ Method
 Limits: for m = 3 the scan nodes keep a third of a step (~0.04 / max(beta, 1) in time) off the
 edges of the interval triangle, so a (3/n) solution with a flight shorter than that (an orbit
 at the edge of its existence, next to chatter) can be missed by a single call; the map may
-still reach it by following its branch.
+still reach it by following its branch. In float64 the two orbits of a fold pair (m = 2) are
+told apart down to ~1e-14 in delta from the fold (~1e-7 apart), and a (2/2k) motion whose
+intervals differ by less than ~1e-7 of a forcing period (~1e-14 in delta from the period
+doubling) counts as the doubled (1/k) motion.
 
 eps = 0: every impact leaves the mass on the wall at rest; the motion is still a free flight
 when the force pulls it off at once, and only then is it an orbit here (a flight whose
@@ -175,11 +191,11 @@ def _validate(m, n, beta, delta, zeta, eps):
 
 def _raw_solutions(m, n, beta, delta, zeta, eps):
     """Rows ``(tau_0..tau_{m-1}, u_0..u_{m-1})`` of every solution of eqs. (10)-(11)."""
-    sols = np.empty((ok.MAX_SOLUTIONS, 2 * m))
-    seeds = np.empty((1, 2 * m))
+    sols = np.empty((ok.MAX_SOLUTIONS, 2 * m + 1))     # the last column: uncertainty
+    seeds = np.empty((1, 2 * m + 1))
     step = ok.SCAN_STEP_M2 if m == 2 else ok.SCAN_STEP_M3
     count = ok.solve_type(m, n, beta, delta, zeta, eps, seeds, 0, step, sols)
-    return sols[:count]
+    return sols[:count, :2 * m]
 
 
 def _make_orbit(y, m, n, beta, delta, zeta, eps):

@@ -3,8 +3,8 @@
 The slow tests run the three stress families of ``vibroimpact.validation.orbit_families`` at
 full size (``pytest -m slow tests/stress``); the fast ones show that the API works and that
 the independent solver agrees with a third method (mpmath Newton, DOP853) at ordinary points.
-The known failing cases (``KNOWN_CASES``) re-run, point by point, disagreements that the
-families found and that mpmath and DOP853 confirm; each fails until the package is fixed.
+``KNOWN_CASES`` re-run, point by point, disagreements that the families once found (confirmed
+by mpmath and DOP853 then) and that the solver now gets right: regression tests.
 """
 import math
 
@@ -111,17 +111,8 @@ def test_tolerance_grows_like_inverse_sqrt_distance():
 # ------------------------------------------------------------------------------------------
 # slow: the families at full size
 
-# Open defects of vibroimpact.orbits that these families found (see KNOWN_CASES below): strict,
-# so that the fix shows as an unexpected pass and these marks must then go.
-ORBIT_SOLVER_DEFECT = pytest.mark.xfail(strict=True, reason=(
-    "vibroimpact.orbits misses one (2/1) orbit of a fold pair within ~5e-5 of the fold, and "
-    "misses, duplicates or returns the doubled (1/1) motion as (2/2) next to a period doubling"))
-FAMILY_PARAMS = [pytest.param(name, marks=ORBIT_SOLVER_DEFECT) if name != "orbit_grazing"
-                 else name for name in FAMILIES]
-
-
 @pytest.mark.slow
-@pytest.mark.parametrize("name", FAMILY_PARAMS)
+@pytest.mark.parametrize("name", FAMILIES)
 def test_orbit_family(name):
     report = run_orbit_family(name, SLOW_CASES[name], SEED)
     print(report.summary())
@@ -130,33 +121,33 @@ def test_orbit_family(name):
     assert report.ok, report.details()
 
 
-# Disagreements found by the families (seed 11 and others), each confirmed by mpmath Newton
-# and DOP853 (see the failure messages), kept as exact points so that they can be re-run one
-# by one: `pytest -m slow tests/stress/test_orbit_families.py -k known`.
+# Regression points: disagreements the families found in earlier versions of the solver (seed
+# 11 and others), each confirmed by mpmath Newton and DOP853 at the time, kept as exact points
+# that re-run one by one: `pytest -m slow tests/stress/test_orbit_families.py -k known`.
 KNOWN_CASES = {
-    # (2/1) fold at delta = 0.91900401692..., pair exists below it: the package returns only
-    # the unstable orbit (mu = 1.012); the stable one (mu = 0.988, taus = [2.29005, 5.21955],
-    # us = [0.32698, 0.03509]) is missed. Misses like it occur up to d ~ 3e-5 from (2/1) folds,
-    # of either orbit of the pair (here, far: the unstable one, mu = 1.041).
+    # (2/1) fold at delta = 0.91900401692..., pair exists below it (mu = 0.988 and 1.012,
+    # taus [2.29005, 5.21955] and [2.29079, 5.22204]): both roots of the scan's circle
+    # condition fell into one cell (no sign change) and the stable orbit was missed
     "fold21_missed": dict(kind="fold", m=2, n=1, beta=0.4632189831209864,
                           delta=0.9190038876942133, zeta=0.140252977051332,
                           eps=0.6902755657606898, distance=1.2923239466329618e-07),
+    # the same 3e-5 from a (2/1) fold (mu = 0.961 and 1.041): the unstable orbit was missed
     "fold21_missed_far": dict(kind="fold", m=2, n=1, beta=0.8517027775096446,
                               delta=0.4942993299947039, zeta=0.03673492301695671,
                               eps=0.3439009975609669, distance=3.128751429230677e-05),
     # period doubling of the (1/1) motion at delta = -0.0245038778075...: on the (2/2) side
-    # the package returns the (2/2) motion twice (two copies 4e-7 apart, both ~3e-7 from it)
+    # one (2/2) motion (intervals z/2 +- 6e-5, mu = 1 - 1e-9), once returned twice (two Newton
+    # copies 4e-7 apart, each ~3e-7 off along the near-null direction)
     "pd22_duplicate": dict(kind="period_doubling", m=1, n=1, beta=1.1961933965658853,
                            delta=-0.024503878339668096, zeta=0.019884047202237826,
                            eps=0.542731103892917, distance=5.321381126426478e-10),
-    # on the side without a (2/2) motion the package returns two (2/2) "orbits" that are the
-    # doubled (1/1) motion, ~6e-6 off it (mpmath Newton from them lands on the doubled orbit)
+    # on the side without a (2/2) motion: the doubled (1/1) motion, once returned as two (2/2)
+    # "orbits" ~6e-6 off it; none must be returned
     "pd22_doubled_returned": dict(kind="period_doubling", m=1, n=1, beta=0.49804546289989854,
                                   delta=0.9652952254202881, zeta=0.01628618781285054,
                                   eps=0.6777280430375708, distance=1.0222807972779106e-10),
-    # 1.4e-5 from a period doubling there are two (2/2) motions with mu = 1.00003 and 0.99998
-    # (a fold pair); the package returns the first and misses the second (taus = [2.24786,
-    # 9.49944], us = [0.76437, 0.96469])
+    # 1.4e-5 from a period doubling: a (2/2) fold pair with mu = 1.00003 and 0.99998 (taus
+    # [2.25842, 9.49078] and [2.24786, 9.49944]); the second was once missed
     "pd22_missed": dict(kind="period_doubling", m=1, n=1, beta=0.8496452856909297,
                         delta=2.0614207639521664, zeta=0.115499898297842,
                         eps=0.6821883665749093, distance=1.4048159726616551e-05),
@@ -164,7 +155,6 @@ KNOWN_CASES = {
 
 
 @pytest.mark.slow
-@ORBIT_SOLVER_DEFECT
 @pytest.mark.parametrize("key", sorted(KNOWN_CASES))
 def test_known_case(key):
     messages = check_case(KNOWN_CASES[key])
