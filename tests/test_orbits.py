@@ -11,7 +11,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from vibroimpact import orbit_kernels
+from vibroimpact.orbits import kernels as orbit_kernels
 from vibroimpact.orbits import PeriodicOrbit, orbit_map, periodic_orbits
 
 ZETA, EPS = 0.05, 0.5

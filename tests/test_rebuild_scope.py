@@ -164,7 +164,7 @@ def test_orbit_entry_or_solver_edit_reruns_only_fig16(repo, edit):
     assert set(jobs) == ORBIT_RULES | FIGURE_RULES
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {"fig16.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
-    edit("src/vibroimpact/orbit_kernels.py", _append_comment)
+    edit("src/vibroimpact/orbits/kernels.py", _append_comment)
     assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES
 
 

@@ -26,9 +26,9 @@ _LAZY = {
     "simulate": "vibroimpact.impact.simulate",
     "simulate_chunks": "vibroimpact.impact.simulate",
     "SimulationResult": "vibroimpact.impact.simulate",
-    "periodic_orbits": "vibroimpact.orbits",
-    "PeriodicOrbit": "vibroimpact.orbits",
-    "orbit_map": "vibroimpact.orbits",
+    "periodic_orbits": "vibroimpact.orbits.api",
+    "PeriodicOrbit": "vibroimpact.orbits.api",
+    "orbit_map": "vibroimpact.orbits.api",
 }
 
 __all__ = [*_LAZY, "PAPER_REFERENCE", "__version__"]

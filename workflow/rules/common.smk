@@ -61,7 +61,7 @@ CODE = {
                               "_checks", "_files"),
     "aggregate": source_digest("pipeline/datasets", "pipeline/study", "pipeline/io",
                                "pipeline/tasks", "stats/spectra", "noise", "_files"),
-    "orbits": source_digest("orbits", "orbit_kernels", "pipeline/datasets", "pipeline/study",
+    "orbits": source_digest("orbits", "pipeline/datasets", "pipeline/study",
                             "pipeline/io", "pipeline/tasks", "_checks", "_files"),
     "figure": source_digest("plotting", "pipeline/figures", "pipeline/tasks", "stats",
                             "_files"),

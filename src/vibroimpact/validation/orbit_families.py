@@ -18,7 +18,7 @@ compared orbit by orbit with an independent solver written here:
     other side it must not be.
 
 The independent solver shares no code with ``vibroimpact.orbits`` or
-``vibroimpact.orbit_kernels`` (nothing of the package is imported but the function under test):
+``vibroimpact.orbits.kernels`` (nothing of the package is imported but the function under test):
 
 - flight: the textbook closed form ``x = q sin(beta tau - phi) + exp(-zeta s)(c1 cos wd s +
   c2 sin wd s)``;

@@ -1,7 +1,7 @@
 """Numba kernels for the periodic impact motions of section 4 (used by ``vibroimpact.orbits``).
 
 Pure functions of numbers and preallocated arrays: no I/O, no Python objects. Notation follows
-the paper and ``shared/spec/MODEL.md``: forcing ``sin(beta*tau)``, wall at ``x = delta``,
+the paper and docs/model.md (section 8): forcing ``sin(beta*tau)``, wall at ``x = delta``,
 ``wd = sqrt(1 - zeta**2)``, steady harmonic response ``x_p = q sin(beta*tau - phi)``.
 
 A free flight starting on the wall at ``tau_a`` with approach velocity ``u_a`` (so leaving with
@@ -15,6 +15,9 @@ where ``P(s)`` is the damped free propagator of ``y'' + 2 zeta y' + y = 0``.
 import numpy as np
 from math import acos, atan2, ceil, cos, cosh, exp, floor, hypot, pi, sin, sinh, sqrt
 from numba import njit, prange
+
+#: Reason codes of the map (``orbits.api.Reason``): why a point has no stable motion of a type.
+REASON_STABLE, REASON_NO_SOLUTION, REASON_INADMISSIBLE, REASON_UNSTABLE = 0, 1, 2, 3
 
 # Numerical thresholds (one place).
 NEWTON_MAXIT = 30
@@ -1292,13 +1295,13 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
             n_stab[t, ib, d] = n_st
             lam_best[t, ib, d] = best if n_adm > 0 else np.nan
             if n_st > 0:
-                reason[t, ib, d] = 0
+                reason[t, ib, d] = REASON_STABLE
             elif counts[d] == 0:
-                reason[t, ib, d] = 1
+                reason[t, ib, d] = REASON_NO_SOLUTION
             elif n_adm == 0:
-                reason[t, ib, d] = 2
+                reason[t, ib, d] = REASON_INADMISSIBLE
             else:
-                reason[t, ib, d] = 3
+                reason[t, ib, d] = REASON_UNSTABLE
 
 
 @njit(cache=True, parallel=True)

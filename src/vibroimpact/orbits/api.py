@@ -3,16 +3,16 @@
 An (m/n) motion has period ``z = 2 pi n / beta`` and exactly m impacts per period. This module
 finds every one of them at a parameter point (``periodic_orbits``) and classifies a whole
 ``(1/beta, delta)`` grid (``orbit_map``). Flights are closed form; the kernels live in
-``vibroimpact.orbit_kernels``.
+``vibroimpact.orbits.kernels``.
 
 Method
 ------
 - (1/n): the equations reduce to ``cos(psi_0 - chi) = kappa`` in the impact phase: both roots in
-  closed form (``orbit_kernels.solve_m1``).
+  closed form (``kernels.solve_m1``).
 - (2/n), (3/n): for fixed intervals the equations are linear in the impact phase's
   ``(sin, cos)`` and the velocities; the solutions are the zeros of a smooth scalar circle
   condition over the intervals (a 1-D scan for m = 2, a 2-D one for m = 3;
-  ``orbit_kernels.solve_general``). m >= 4 is not supported.
+  ``kernels.solve_general``). m >= 4 is not supported.
 - m = 2: every sign change of the circle condition is solved to round-off in ``z_1`` and gives
   the solution directly; every dip toward zero between scan nodes is minimized first, so that
   the two orbits next to a fold (a near-double root, ~sqrt(distance) apart) are both bracketed.
@@ -24,16 +24,16 @@ Method
   round-off floor or when a step no longer cuts the residual, instead of drifting along the
   near-null direction where ``|mu - 1|`` is tiny.
 - One orbit once: solutions closer than ``1e-7`` plus their uncertainty (round-off over the
-  conditioning of the equations, ``orbit_kernels.uncertainty``) are one; a solution that is
+  conditioning of the equations, ``kernels.uncertainty``) are one; a solution that is
   its own rotation within that tolerance is a shorter orbit traversed repeatedly (e.g. the
   doubled (1/1) motion among the (2/2) solutions; it is reported by the (1/1) call).
 - Admissibility: the exact largest interior maximum of x on every flight, from the zeros of
-  the velocity (``orbit_kernels.flight_max``).
+  the velocity (``kernels.flight_max``).
 - Stability: the analytic one-period Jacobian ``T = T_m ... T_1`` of the impact map, whose
   determinant is ``eps^(2m) exp(-2 zeta z)``.
 - Map (``orbit_map``): rows of constant 1/beta run in parallel; along a row the solutions of
   the previous delta seed Newton (branch following). m = 2 also runs the global scan at every
-  point; m = 3 runs it every ``orbit_kernels.MAP_SCAN_EVERY`` points, wherever a branch ends,
+  point; m = 3 runs it every ``kernels.MAP_SCAN_EVERY`` points, wherever a branch ends,
   and follows every branch a scan finds back to the previous scan.
 
 Limits: for m = 3 the scan nodes keep a third of a step (~0.04 / max(beta, 1) in time) off the
@@ -55,20 +55,40 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
+import enum
 
 import numba
 import numpy as np
 
-from vibroimpact import orbit_kernels as ok
+from vibroimpact.orbits import kernels as ok
 
-__all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "REASON_CODES"]
+__all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
 
-REASON_CODES = {
-    0: "a stable admissible solution exists",
-    1: "no solution of eqs. (10)-(11) with positive intervals and velocities",
-    2: "solutions exist but none is admissible (a flight crosses the wall, eq. 13)",
-    3: "admissible solutions exist but none is stable (eq. 22)",
+
+class Reason(enum.IntEnum):
+    """Why a map point has no stable motion of a type (``orbit_map``'s ``reason``; Fig. 16).
+
+    The values are those the kernels write (``kernels.REASON_*``) and the datasets store.
+    """
+
+    STABLE = ok.REASON_STABLE              #: a stable admissible solution exists
+    NO_SOLUTION = ok.REASON_NO_SOLUTION    #: no solution of eqs. (10)-(11) (paper: D, V, X)
+    INADMISSIBLE = ok.REASON_INADMISSIBLE  #: every solution has a flight crossing the wall (eq. 13)
+    UNSTABLE = ok.REASON_UNSTABLE          #: admissible solutions, none stable (eq. 22; paper: U)
+
+    @property
+    def description(self):
+        return _REASON_TEXT[self]
+
+
+_REASON_TEXT = {
+    Reason.STABLE: "a stable admissible solution exists",
+    Reason.NO_SOLUTION: "no solution of eqs. (10)-(11) with positive intervals and velocities",
+    Reason.INADMISSIBLE: "solutions exist but none is admissible (a flight crosses the wall, eq. 13)",
+    Reason.UNSTABLE: "admissible solutions exist but none is stable (eq. 22)",
 }
+#: ``{code: description}`` of `Reason` (kept for the datasets' attributes and old callers).
+REASON_CODES = {int(r): r.description for r in Reason}
 MAX_M = 3
 
 
