@@ -8,8 +8,8 @@ import os
 import netCDF4
 import numpy as np
 
-from vibroimpact import noise as noise_mod
 from vibroimpact._files import atomic_path
+
 
 def write_dataset(ds, path):
     """Write an ``xarray.Dataset`` to netCDF4 atomically."""
@@ -41,6 +41,8 @@ def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estim
     max_lag : float
         Largest lag tau* of the autocorrelation (time units).
     """
+    from vibroimpact import noise as noise_mod   # scipy.signal: only the noise job needs it
+
     with atomic_path(path) as tmp:
         nc = netCDF4.Dataset(tmp, "w", format="NETCDF4")
         try:
@@ -78,6 +80,8 @@ def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estim
 
 def noise_spec(nc_attrs):
     """The :class:`~vibroimpact.noise.NoiseSpec` stored in a noise file's attributes."""
+    from vibroimpact import noise as noise_mod
+
     keys = ("kind", "rms", "dt", "beta_c", "zeta_f")
     kwargs = {k: nc_attrs[f"noise_{k}"] for k in keys if f"noise_{k}" in nc_attrs}
     for k in ("rms", "dt", "beta_c", "zeta_f"):

@@ -11,7 +11,6 @@ import logging
 
 import xarray as xr
 
-from vibroimpact.noise import NoiseSpec
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.figures import figure_variant
 from vibroimpact.pipeline.provenance import provenance
@@ -38,7 +37,9 @@ def logged(path):
 
 
 def noise_spec(entry):
-    """The :class:`NoiseSpec` of a ``noises`` config entry."""
+    """The :class:`~vibroimpact.noise.NoiseSpec` of a ``noises`` config entry."""
+    from vibroimpact.noise import NoiseSpec   # scipy.signal and scipy.fft: not for every job
+
     return NoiseSpec(**{k: entry[k] for k in _NOISE_FIELDS if entry.get(k) is not None})
 
 
