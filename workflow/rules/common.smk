@@ -37,6 +37,10 @@ def _check_references():
                     raise ValueError(f"{section}.{name}.figures: {name_!r} is not drawn from "
                                      f"{'a study' if kind == 'study' else 'an orbits map'}; "
                                      f"allowed: {allowed}")
+                if figures.FIGURES[name_].get("harmonic") and not entry.get("amplitude"):
+                    raise ValueError(f"{section}.{name}.figures: {name_} shows the harmonic "
+                                     f"force; it needs amplitude != 0, got "
+                                     f"{entry.get('amplitude', 0.0)!r}")
     for fig, name in config.get("paper_figures", {}).items():
         section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
         if name not in config[section]:
@@ -167,9 +171,8 @@ def _noise_samples(name):
     return int(config["noises"][name]["n_samples"])
 
 
-def noise_mem_mb(wildcards):
-    # chunked generation: one chunk (8 MB) plus the 2**22-sample head kept for the estimates
-    return BASE_MEM_MB + 200
+# chunked generation: one chunk (8 MB) plus the 2**22-sample head kept for the estimates
+NOISE_MEM_MB = BASE_MEM_MB + 200
 
 
 def simulate_mem_mb(wildcards):

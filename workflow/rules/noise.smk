@@ -9,7 +9,7 @@ rule generate_noise:
         "results/benchmarks/generate_noise/{noise}.tsv"
     threads: 1
     resources:
-        mem_mb=noise_mem_mb,
+        mem_mb=NOISE_MEM_MB,
         runtime=20,
     params:
         entry=noise_entry,

@@ -53,13 +53,13 @@ impact-stick motions are not returned). The map is then rank one: ``T`` has a ze
 from __future__ import annotations
 
 import math
-import numbers
 from dataclasses import dataclass
 import enum
 
 import numba
 import numpy as np
 
+from vibroimpact import _checks
 from vibroimpact.orbits import kernels as ok
 
 __all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
@@ -179,34 +179,14 @@ class PeriodicOrbit:
         return x, v
 
 
-def _check_int(name, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 1:
-        raise ValueError(f"{name} must be a positive integer, got {value!r}")
-    return int(value)
-
-
-def _check_real(name, value):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
-    return float(value)
-
-
 def _validate(m, n, beta, delta, zeta, eps):
-    m = _check_int("m", m)
-    n = _check_int("n", n)
+    m = _checks.integer("m", m, low=1)
+    n = _checks.integer("n", n, low=1)
     if m > MAX_M:
         raise NotImplementedError(f"m must be at most {MAX_M} (m = {m} is not supported)")
-    beta = _check_real("beta", beta)
-    if beta <= 0.0:
-        raise ValueError(f"beta must be > 0, got {beta!r}")
-    delta = _check_real("delta", delta)
-    zeta = _check_real("zeta", zeta)
-    if not 0.0 < zeta < 1.0:
-        raise ValueError(f"zeta must be in (0, 1), got {zeta!r}")
-    eps = _check_real("eps", eps)
-    if not 0.0 <= eps <= 1.0:
-        raise ValueError(f"eps must be in [0, 1], got {eps!r}")
-    return m, n, beta, delta, zeta, eps
+    beta = _checks.real("beta", beta, low=0.0, low_open=True)
+    delta = _checks.real("delta", delta)
+    return m, n, beta, delta, _checks.zeta(zeta), _checks.eps(eps)
 
 
 def _raw_solutions(m, n, beta, delta, zeta, eps):

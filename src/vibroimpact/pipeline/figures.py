@@ -5,7 +5,8 @@ under ``reads``, its drawing options come from its owner's config entry (keys li
 ``options``, figure-only keys that never reach a simulation) and from the figure's own item
 in the entry's ``figures`` list. A figure that names a ``per`` parameter is drawn once per
 listed value: the item ``{name: fig13, inv_beta: [0.8, 1.25]}`` gives the targets
-``fig13-0`` and ``fig13-1`` (an index, never a float in a file name).
+``fig13-0`` and ``fig13-1`` (an index, never a float in a file name). ``harmonic`` figures
+(Figs. 10-14) need a study with a harmonic force (``amplitude != 0``).
 """
 import re
 
@@ -19,11 +20,11 @@ FIGURES = {
     "fig07": dict(owner="study", reads=("events",), options=("density_delta",)),
     "fig08": dict(owner="study", reads=("events",), options=("density_delta",)),
     "fig09": dict(owner="study", reads=("events",)),
-    "fig10": dict(owner="study", reads=("trace",)),
-    "fig11": dict(owner="study", reads=("spectra",), per="inv_beta"),
-    "fig12": dict(owner="study", reads=("spectra",), per="inv_beta"),
-    "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta"),
-    "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta"),
+    "fig10": dict(owner="study", reads=("trace",), harmonic=True),
+    "fig11": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True),
+    "fig12": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True),
+    "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta", harmonic=True),
+    "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta", harmonic=True),
     "fig16": dict(owner="orbits", reads=("orbits",)),
 }
 
