@@ -255,9 +255,24 @@ def test_fig11_fig12_select_the_nearest_forcing_frequency(data):
     fig12 = plotting.fig12(spectra, inv_beta=1.08)
     for fig in (fig11, fig12):
         assert r"\sin(\tau/1.1)" in _title(fig)
-        assert _vlines_at(fig.axes[0]) == [pytest.approx(1 / 1.1)]
-    assert len(_data_lines(fig11.axes[0])) == 1
+    assert _vlines_at(fig12.axes[0]) == [pytest.approx(1 / 1.1)]
     assert len(_data_lines(fig12.axes[0])) == spectra.sizes["delta"] + 1
+
+
+def test_fig11_draws_the_harmonic_part_as_a_line_of_power_half(data):
+    """The input's PSD: the random part as a curve, sin(beta_f tau) as an arrow at beta_f
+    labelled with its power A^2/2, never a Welch-smeared peak."""
+    spectra = data["spectra_h"]
+    ax = plotting.fig11(spectra, inv_beta=1.08).axes[0]
+    arrows = [t for t in ax.texts if hasattr(t, "xy")]
+    assert [a.xy[0] for a in arrows] == [pytest.approx(1 / 1.1)]
+    assert any("power $A^2/2$ = 0.5" in t for t in _legend_texts(ax))
+    curve = _data_lines(ax)[0]
+    beta = np.asarray(curve.get_xdata(), float)
+    S = np.asarray(curve.get_ydata(), float)
+    near = np.abs(beta - 1 / 1.1) < 0.1
+    # no peak at the forcing frequency: the curve is the random part alone
+    assert S[near].max() < 2.0 * np.median(S[beta < 3.0])
 
 
 def test_fig13_ratio_density_with_motion_marks(data):

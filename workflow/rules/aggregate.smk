@@ -3,6 +3,7 @@ localrules:
     aggregate_events,
     aggregate_spectra,
     aggregate_orbits,
+    aggregate_map,
 
 
 rule aggregate_events:
@@ -48,3 +49,25 @@ rule aggregate_spectra:
         code=CODE["aggregate"],
     script:
         "../scripts/aggregate_spectra.py"
+
+
+rule aggregate_map:
+    input:
+        tiles("map"),
+    output:
+        "results/datasets/{study}_map.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/aggregate_map/{study}.log",
+    benchmark:
+        "results/benchmarks/aggregate_map/{study}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
+    params:
+        block=study_block("map"),
+        code=CODE["aggregate"],
+    script:
+        "../scripts/aggregate_map.py"

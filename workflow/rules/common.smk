@@ -19,7 +19,21 @@ wildcard_constraints:
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
     # figNN, our own names (fig15_vs_fig16, work_precision), -k: k-th value of a listed parameter
     fig="[a-z][a-z0-9_]*(-[0-9]+)?",
-    paper_fig="fig[0-9][0-9]",
+    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?",
+
+
+def _check_orbits_item(where, fig, entry, item):
+    """A study figure drawn over an orbit map names an `orbits` entry of the same system."""
+    orbits = item.get("orbits")
+    if orbits not in config["orbits"]:
+        raise ValueError(f"{where}: {fig} is drawn over an orbit map; give its `orbits` entry "
+                         f"as {{name: {fig}, orbits: <name>}}; allowed: {sorted(config['orbits'])}"
+                         f", got {orbits!r}")
+    for key in ("zeta", "eps"):
+        if float(config["orbits"][orbits][key]) != float(entry[key]):
+            raise ValueError(f"{where}: {fig} compares the map with orbits.{orbits}, which has "
+                             f"{key} = {config['orbits'][orbits][key]!r}; the study has "
+                             f"{key} = {entry[key]!r}: they must be the same system")
 
 
 def _check_references():
@@ -41,6 +55,9 @@ def _check_references():
                     raise ValueError(f"{section}.{name}.figures: {name_} shows the harmonic "
                                      f"force; it needs amplitude != 0, got "
                                      f"{entry.get('amplitude', 0.0)!r}")
+                if "orbits" in figures.FIGURES[name_]["reads"] and kind == "study":
+                    _check_orbits_item(f"{section}.{name}.figures", name_, entry,
+                                       figures.figure_item(entry, name_))
     for fig, name in config.get("paper_figures", {}).items():
         section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
         if name not in config[section]:
@@ -74,7 +91,8 @@ CODE = {
 # Config keys each job reads from a study entry (nothing else of the entry reaches its params).
 _PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size")
 _READS = {
-    "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "bins"),
+    "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins"),
+    "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map"),
     "spectra": _PHYSICS + ("spectra",),
     "trace": _PHYSICS + ("trace",),
 }
@@ -126,6 +144,7 @@ _DATASETS = {
     "trace": "results/traces/{name}.nc",
     "spectra": "results/datasets/{name}_spectra.nc",
     "events": "results/datasets/{name}_events.nc",
+    "map": "results/datasets/{name}_map.nc",
     "orbits": "results/orbits/{name}.nc",
 }
 
@@ -136,7 +155,8 @@ def figure_inputs(wildcards):
     fig, _ = figures.figure_variant(wildcards.fig)
     if figures.FIGURES.get(fig, {}).get("owner") != kind:
         raise ValueError(f"{wildcards.owner}: no figure {fig!r} for a {kind} entry")
-    return [_DATASETS[d].format(name=name, noise=entry.get("noise"))
+    names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
+    return [_DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
             for d in figures.FIGURES[fig]["reads"]]
 
 
@@ -147,9 +167,14 @@ def figure_options(wildcards):
 
 
 def paper_figure_source(wildcards):
+    if wildcards.paper_fig not in config.get("paper_figures", {}):
+        raise ValueError(f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
+                         f"{sorted(config.get('paper_figures', {}))}")
     name = config["paper_figures"][wildcards.paper_fig]
-    owner = f"orbits/{name}" if figures.FIGURES[wildcards.paper_fig]["owner"] == "orbits" else name
-    return {ext: f"results/figures/{owner}/{wildcards.paper_fig}.{ext}" for ext in ("png", "pdf")}
+    section = "orbits" if figures.FIGURES[wildcards.paper_fig]["owner"] == "orbits" else "studies"
+    owner = f"orbits/{name}" if section == "orbits" else name
+    target = figures.paper_target(config[section][name], wildcards.paper_fig)
+    return {ext: f"results/figures/{owner}/{target}.{ext}" for ext in ("png", "pdf")}
 
 
 def all_targets():
@@ -190,6 +215,10 @@ def simulate_runtime(kind):
         steps = _noise_samples(entry["noise"])
         if kind == "spectra" and entry["spectra"].get("t_end"):
             steps = min(steps, entry["spectra"]["t_end"] / noise["dt"])
-        cells = len(study.tile(int(wildcards.tile), kind)) if kind != "trace" else 0
+        if kind == "map":   # a cell runs at most to its cap, the longest forcing period's
+            steps = min(steps, (entry["transient"] + entry["map"]["max_periods"] * 2 * 3.141592653589793
+                                * float(study.inv_beta.max())) / noise["dt"])
+        grid = "events" if kind == "map" else kind
+        cells = len(study.tile(int(wildcards.tile), grid)) if kind != "trace" else 0
         return 5 + int(cells * steps * 60e-9 / 60)
     return runtime

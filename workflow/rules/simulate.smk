@@ -62,3 +62,25 @@ rule simulate_trace:
         code=CODE["simulate"],
     script:
         "../scripts/simulate_trace.py"
+
+
+rule simulate_map:
+    input:
+        noise=study_noise,
+    output:
+        "results/cells/{study}/map/{tile}.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/simulate_map/{study}/{tile}.log",
+    benchmark:
+        "results/benchmarks/simulate_map/{study}/{tile}.tsv"
+    threads: 1
+    resources:
+        mem_mb=simulate_mem_mb,
+        runtime=simulate_runtime("map"),
+    params:
+        block=study_block("map"),
+        code=CODE["simulate"],
+    script:
+        "../scripts/simulate_map.py"

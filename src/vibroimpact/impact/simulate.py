@@ -178,6 +178,12 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     Same arguments as :func:`simulate`. Each chunk carries the events of its stretch of
     time; counters are per chunk; ``t_end, x_end, v_end, stuck_end`` are the chunk's last
     state. Memory is bounded by the chunk size whatever the record's length.
+
+    The generator also accepts ``send(n)``: the next chunk then holds ``n`` samples instead
+    of ``chunk_size`` (at most ``chunk_size`` when recording ``a(tau)``), so a caller that
+    stops when a statistic is precise enough can step to its next check in one chunk and
+    close the generator there. Chunk boundaries never change the motion: the samples are
+    taken one by one by the same kernel whatever the chunking.
     """
     zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size = _check_inputs(
         zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size)
@@ -193,8 +199,9 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     stick_open = [None]  # start time of an unfinished sticking interval
     buf = _Buffers(chunk_size // stride + 2 if stride else 0)   # reused by every chunk
     k0 = 0
+    size = chunk_size
     while True:
-        k1 = min(k0 + chunk_size, n_full)
+        k1 = min(k0 + size, n_full)
         if noise is None:
             r = zeros[: k1 - k0 + 1]
         else:
@@ -235,10 +242,14 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[1:], P)
             t_chunk = t_end
         buf.drain(parts)
-        yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final)
+        requested = yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode,
+                                stick_open, final)
         k0 = k1
         if final:
             return
+        if requested is not None:
+            size = _checks.integer("chunk size sent", requested, low=1,
+                                   high=chunk_size if stride else None)
 
 
 def _state_at(state, P, k):

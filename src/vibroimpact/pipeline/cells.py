@@ -13,8 +13,6 @@ import numpy as np
 from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 
-MOTIONS = stats.DEFAULT_MOTIONS
-
 log = logging.getLogger("vibroimpact")
 
 #: Relative slack when comparing ``t_end`` with the record's length, so that a ``t_end``
@@ -53,8 +51,9 @@ def _lag1_check(name, result, cell):
 
 def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                      transient=0.0, t_end=None, bins, n_batches=stats.DEFAULT_N_BATCHES,
-                     motion_window=stats.DEFAULT_MOTION_WINDOW, chunk_size=2**20):
-    """Impact statistics of one cell (Figs. 7-9, 13-15).
+                     motion_window=stats.DEFAULT_MOTION_WINDOW, motions=stats.DEFAULT_MOTIONS,
+                     chunk_size=2**20):
+    """Impact statistics of one cell (Figs. 7-9, 13, 14).
 
     Parameters
     ----------
@@ -75,6 +74,8 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         Batches B of the batch-means standard errors of the means and the densities.
     motion_window : float
         Half-width w of the impact-motion classification (docs/figures.md, fig15).
+    motions : sequence of (m, n)
+        Motions whose probabilities are reported (harmonic force only).
 
     Returns
     -------
@@ -84,7 +85,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         contact_fraction, n_chatter, v_after_beyond, interval_beyond`` and arrays
         ``v_after_density(_stderr), interval_density(_stderr)`` (on the bins). With a
         harmonic force (``amplitude != 0``) also ``ratio_density(_stderr)``, ``ratio_beyond`` and
-        ``motion_probability`` (one value per motion of ``MOTIONS``); without one there is
+        ``motion_probability`` (one value per motion of ``motions``); without one there is
         no forcing period, so these are absent.
 
     Notes
@@ -144,10 +145,10 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
                                    n_batches=n_batches)
         motion = stats.impact_motion_probabilities(z, beta_f, motion_window,
-                                                   total_time=duration, motions=MOTIONS)
+                                                   total_time=duration, motions=motions)
         out.update(ratio_density=ratio_dens.density, ratio_density_stderr=ratio_dens.stderr,
                    ratio_beyond=ratio_dens.beyond,
-                   motion_probability=np.array(list(motion.values())))   # order of MOTIONS
+                   motion_probability=np.array(list(motion.values())))   # order of motions
     return out
 
 
@@ -158,7 +159,7 @@ def _clipped_contact(start, end, transient):
 
 def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                        transient=0.0, t_end=None, nperseg=4096, chunk_size=2**20):
-    """Welch PSDs of a(tau) and of the total input force for one cell (Figs. 6, 11, 12).
+    """Welch PSDs of a(tau) and of the random input r(tau) for one cell (Figs. 6, 11, 12).
 
     a(tau) is recorded at every sample and fed segment by segment to a
     :class:`vibroimpact.stats.WelchAccumulator`; nothing longer than a chunk is kept.
@@ -167,7 +168,10 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     -------
     dict
         ``beta`` (>= 0), ``S_a`` and ``S_f`` (paper's two-sided angular convention, eq. 9),
-        ``n_segments``.
+        ``n_segments``. ``S_f`` is the random part r(tau) of the input only: the harmonic
+        part ``amplitude sin(beta_f tau)`` is a spectral line of power ``amplitude**2 / 2``,
+        which a Welch estimate would smear over its window's main lobe (Fig. 11 draws it as
+        the line it is).
     """
     t_end = _record_end(noise, dt, t_end)
     skip = int(math.ceil(transient / dt - 1e-9))
@@ -181,10 +185,7 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
             continue
         k = k[keep]
         acc_a.feed(chunk.a[keep])
-        force = np.asarray(noise[k[0] : k[-1] + 1], dtype=float)
-        if amplitude != 0.0:
-            force = force + amplitude * np.sin(beta_f * dt * k)
-        acc_f.feed(force)
+        acc_f.feed(np.asarray(noise[k[0] : k[-1] + 1], dtype=float))
     beta, S_a = acc_a.result()
     _, S_f = acc_f.result()
     return dict(beta=beta, S_a=S_a, S_f=S_f, n_segments=acc_a.n_segments)
@@ -204,3 +205,99 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
     f = r + amplitude * np.sin(beta_f * res.grid_time)
     return dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
                 impact_time=res.impact_time, impact_velocity=res.impact_velocity)
+
+
+def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
+                    motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
+                    n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
+                    max_periods=5000, min_switches=10, growth=1.2):
+    """Probabilities of the (m/n) motions of one cell of the Fig. 15 map, to a target precision.
+
+    The cell is simulated from rest over the common record ``noise`` (every cell of a map
+    reads the same one). After ``transient``, the record is extended until every
+    probability's batch-means standard error is at most ``target_stderr`` and the record
+    either stayed in one motion or switched at least ``min_switches`` times between motions,
+    or until ``max_periods`` forcing periods (the cap).
+
+    Parameters
+    ----------
+    noise : array_like, shape (N,)
+        Random force samples at spacing ``dt``; long enough for ``transient`` plus the cap.
+    zeta, eps, delta, beta_f, amplitude : float
+        Physical parameters; the force is ``amplitude sin(beta_f tau) + r(tau)``.
+    transient : float
+        Time discarded before statistics.
+    motions, window, n_batches
+        Motions classified, half-width w and batches B (`stats.motion_statistics`).
+    target_stderr : float
+        Standard error every probability must reach (a fraction: 0.01 is 1 percentage point).
+    min_time : float
+        Shortest record after the transient, so that a few quiet forcing periods cannot
+        pass for a precise zero.
+    max_periods : int
+        Cap on the record after the transient, in forcing periods ``2 pi / beta_f``.
+    min_switches : int
+        Switches between motions that make a mixed record trustworthy.
+    growth : float
+        Safety factor on the predicted record length (the error falls as 1/sqrt(time)).
+
+    Returns
+    -------
+    dict
+        ``probability, stderr`` (per motion), ``n_switches, n_impacts, impact_rate,
+        v_after_mean, simulated_time, record_end`` (the last simulated instant: simulating
+        the cell alone to ``t_end = record_end`` reproduces it bit for bit), ``reached``
+        (every stderr at target), ``few_switches`` (1 to ``min_switches - 1`` switches: the
+        probabilities say where the record started), ``n_checks``.
+
+    Raises
+    ------
+    ValueError
+        If the record is shorter than ``transient`` plus the cap.
+    """
+    period = 2.0 * math.pi / beta_f
+    n_cap = int(math.ceil((transient + max_periods * period) / dt - 1e-9))
+    if n_cap > len(noise) - 1:
+        raise ValueError(
+            f"the noise record ends at tau = {(len(noise) - 1) * dt!r}; this cell needs "
+            f"transient + max_periods * 2 pi / beta_f = {transient!r} + {max_periods} * "
+            f"{period:.6g} = {n_cap * dt:.6g}: lengthen the record (n_samples) or lower "
+            f"max_periods")
+    n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
+    gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
+                          beta=beta_f, t_end=n_cap * dt, chunk_size=n_next)
+    steps, offsets, u_minus = [], [], []
+    k, n_checks, request = 0, 0, None
+    try:
+        while True:
+            chunk = gen.send(request) if request is not None else next(gen)
+            keep = chunk.impact_time >= transient
+            steps.append(chunk.impact_step[keep])
+            offsets.append(chunk.impact_offset[keep])
+            u_minus.append(chunk.impact_velocity[keep])
+            k += chunk.n_steps
+            n_checks += 1
+            s, o = np.concatenate(steps), np.concatenate(offsets)
+            steps, offsets = [s], [o]
+            res = stats.motion_statistics(s * dt + o, stats.impact_intervals(s, o, dt), beta_f,
+                                          transient, k * dt, window=window, motions=motions,
+                                          n_batches=n_batches)
+            worst = float(res.stderr.max())
+            reached = worst <= target_stderr
+            mixed_ok = res.n_switches == 0 or res.n_switches >= min_switches
+            if (reached and mixed_ok) or k >= n_cap:
+                break
+            length = k * dt - transient
+            predicted = length * (worst / target_stderr) ** 2 * growth if not reached else 0.0
+            wanted = max(predicted, 2.0 * length if not mixed_ok else 0.0, growth * length)
+            n_next = min(n_cap, int(math.ceil((transient + wanted) / dt)))
+            request = n_next - k
+    finally:
+        gen.close()
+    u = np.concatenate(u_minus)
+    duration = k * dt - transient
+    return dict(probability=res.probability, stderr=res.stderr, n_switches=res.n_switches,
+                n_impacts=int(u.size), impact_rate=u.size / duration,
+                v_after_mean=float(eps * u.mean()) if u.size else math.nan,
+                simulated_time=duration, record_end=k * dt, reached=bool(reached),
+                few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks)

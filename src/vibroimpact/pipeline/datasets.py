@@ -41,8 +41,17 @@ META = {
     "ratio_density_stderr": ("batch-means standard error of the density of z_j / z", "1"),
     "ratio_beyond": ("fraction of ratios z_j / z beyond the last bin", "1"),
     "motion_probability": ("probability of the impact motion (fraction of time)", "1"),
+    "probability": ("probability of the impact motion (fraction of time)", "1"),
+    "probability_stderr": ("batch-means standard error of the probability", "1"),
+    "n_switches": ("changes between classified motions in the record", "1"),
+    "few_switches": ("1: between 1 and min_switches - 1 switches (probabilities not stationary)", "1"),
+    "reached": ("1: every probability reached the target standard error", "1"),
+    "record_end": ("last simulated instant (from rest at tau = 0)", "1"),
+    "n_checks": ("precision checks made while extending the record", "1"),
+    "cpu_time": ("CPU time of the cell (s)", "s"),
     "S_a": ("power spectral density of a(tau) (two-sided, eq. 9)", "1"),
-    "S_f": ("power spectral density of the input f(tau) (estimate, two-sided)", "1"),
+    "S_f": ("power spectral density of the random input r(tau) (estimate, two-sided)", "1"),
+    "S_r_target": ("power spectral density of the random input r(tau) (target, two-sided)", "1"),
     "S_lin": ("linear response |H|^2 S_f (no wall)", "1"),
     "n_segments": ("Welch segments averaged", "1"),
     "lag": ("time lag tau*", "1"),
@@ -87,7 +96,11 @@ def _cell_coords(cells):
                 delta_cell=("cell", [c.delta for c in cells]))
 
 
-def events_tile(cells, results, edges, attrs):
+def _motion_names(motions):
+    return [f"{m}/{n}" for m, n in motions]
+
+
+def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
     """Dataset of one tile of event statistics, along dimension ``cell``.
 
     ``results`` are :func:`vibroimpact.pipeline.cells.event_statistics` dicts. The (m/n)
@@ -110,8 +123,34 @@ def events_tile(cells, results, edges, attrs):
     if harmonic:
         data["motion_probability"] = (("cell", "motion"),
                                       np.stack([r["motion_probability"] for r in results]))
-        coords["motion"] = [f"{m}/{n}" for m, n in stats.DEFAULT_MOTIONS]
+        coords["motion"] = _motion_names(motions)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+
+
+_MAP_SCALARS = ("n_switches", "few_switches", "reached", "n_impacts", "impact_rate",
+                "v_after_mean", "simulated_time", "record_end", "n_checks", "cpu_time")
+
+
+def map_tile(cells, results, motions, attrs):
+    """Dataset of one tile of the probability map (Fig. 15), along dimension ``cell``.
+
+    ``results`` are :func:`vibroimpact.pipeline.cells.motion_map_cell` dicts with a
+    ``cpu_time`` entry added by the job.
+    """
+    data = {name: ("cell", np.array([r[name] for r in results])) for name in _MAP_SCALARS}
+    for flag in ("few_switches", "reached"):
+        data[flag] = ("cell", data[flag][1].astype("int8"))     # netCDF has no bool
+    data["probability"] = (("cell", "motion"), np.stack([r["probability"] for r in results]))
+    data["probability_stderr"] = (("cell", "motion"), np.stack([r["stderr"] for r in results]))
+    coords = dict(_cell_coords(cells), motion=_motion_names(motions))
+    return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+
+
+def aggregate_map(tiles, study, attrs):
+    """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
+    ds = _to_grid(tiles, study.inv_beta, study.delta).transpose("motion", "inv_beta", "delta")
+    ds.attrs = dict(attrs)
+    return _annotate(ds)
 
 
 def spectra_tile(cells, results, attrs):
@@ -157,8 +196,9 @@ def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
                          "see the same input record")
     ds["S_f"] = S_f.isel(delta=0, drop=True)
     beta = ds["beta"].values
-    S_lin = stats.linear_psd_response(beta, spec.psd_piecewise_linear(beta), study.zeta)
-    ds["S_lin"] = ("beta", S_lin)
+    S_r = spec.psd_piecewise_linear(beta)
+    ds["S_lin"] = ("beta", stats.linear_psd_response(beta, S_r, study.zeta))
+    ds["S_r_target"] = ("beta", S_r)
     lag, phi, phi_target = input_correlation
     ds = ds.assign_coords(lag=lag)
     ds["phi_r"] = ("lag", phi)

@@ -5,12 +5,16 @@ under ``reads``, its drawing options come from its owner's config entry (keys li
 ``options``, figure-only keys that never reach a simulation) and from the figure's own item
 in the entry's ``figures`` list. A figure that names a ``per`` parameter is drawn once per
 listed value: the item ``{name: fig13, inv_beta: [0.8, 1.25]}`` gives the targets
-``fig13-0`` and ``fig13-1`` (an index, never a float in a file name). ``harmonic`` figures
-(Figs. 10-14) need a study with a harmonic force (``amplitude != 0``).
+``fig13-0`` and ``fig13-1`` (an index, never a float in a file name); a list of one value
+keeps the plain name ``fig13``. ``harmonic`` figures
+(Figs. 10-15) need a study with a harmonic force (``amplitude != 0``). A figure that lists
+``sources`` reads those datasets from the config entry its item names (``fig15_vs_fig16``
+draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits: harmonic}``).
 """
 import re
 
-__all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item"]
+__all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item",
+           "figure_sources", "paper_target"]
 
 FIGURES = {
     "fig03": dict(owner="study", reads=("trace",)),
@@ -25,6 +29,9 @@ FIGURES = {
     "fig12": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True),
     "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta", harmonic=True),
     "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta", harmonic=True),
+    "fig15": dict(owner="study", reads=("map",), harmonic=True),
+    "fig15_vs_fig16": dict(owner="study", reads=("map", "orbits"), sources=("orbits",),
+                           harmonic=True),
     "fig16": dict(owner="orbits", reads=("orbits",)),
 }
 
@@ -59,7 +66,7 @@ def figure_targets(entry):
     for item in entry.get("figures", []):
         name = _item_name(item)
         per = FIGURES[name].get("per")
-        if per is None or isinstance(item, str) or per not in item:
+        if per is None or isinstance(item, str) or per not in item or len(item[per]) == 1:
             targets.append(name)
         else:
             targets += [f"{name}-{k}" for k in range(len(item[per]))]
@@ -76,10 +83,13 @@ def figure_options(entry, target):
     spec = FIGURES[name]
     options = {key: entry[key] for key in spec.get("options", ()) if entry.get(key)}
     item = figure_item(entry, name)
-    options.update({k: v for k, v in item.items() if k != "name"})
+    options.update({k: v for k, v in item.items()
+                    if k != "name" and k not in spec.get("sources", ())})
     per = spec.get("per")
     if per is not None and per in item:
         values = item[per]
+        if index is None and len(values) == 1:
+            index = 0       # one value: the plain name (fig11), no variant suffix
         if index is None or not 0 <= index < len(values):
             raise ValueError(f"figure {target!r}: {name} is drawn per {per}; "
                              f"give {name}-k with k in [0, {len(values) - 1}]")
@@ -87,3 +97,24 @@ def figure_options(entry, target):
     elif index is not None:
         raise ValueError(f"figure {target!r}: {name} lists no {per or 'parameter'} values")
     return options
+
+
+def figure_sources(entry, name):
+    """``{dataset kind: config entry name}`` for the ``sources`` of figure ``name``."""
+    sources = FIGURES[name].get("sources", ())
+    if not sources:
+        return {}
+    item = figure_item(entry, name)
+    missing = [k for k in sources if k not in item]
+    if missing:
+        raise ValueError(f"figures: {name} needs {missing} in its item, e.g. "
+                         f"{{name: {name}, {missing[0]}: <entry>}}")
+    return {k: item[k] for k in sources}
+
+
+def paper_target(entry, name):
+    """The target of ``entry`` that the paper figure ``name`` copies (its first variant)."""
+    targets = [t for t in figure_targets(entry) if figure_variant(t)[0] == name]
+    if not targets:
+        raise ValueError(f"figures: {name!r} is not listed")
+    return targets[0]

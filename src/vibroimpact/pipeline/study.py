@@ -62,6 +62,7 @@ class Study:
     delta: np.ndarray
     spectra_delta: np.ndarray
     tile_size: int
+    motions: tuple = ((1, 1), (2, 1), (1, 2))
 
     @classmethod
     def from_config(cls, name, entry):
@@ -76,11 +77,13 @@ class Study:
                    amplitude=amplitude, inv_beta=inv_beta,
                    delta=grid_values(entry["delta"]) if "delta" in entry else np.empty(0),
                    spectra_delta=grid_values(spectra["delta"]) if spectra.get("delta") else np.empty(0),
-                   tile_size=int(entry.get("tile_size", 16)))
+                   tile_size=int(entry.get("tile_size", 16)),
+                   motions=tuple((int(m), int(n)) for m, n in entry.get("motions", cls.motions)))
 
     def cells(self, kind="events"):
-        """All cells of the events grid (``inv_beta x delta``) or of the spectra grid."""
-        deltas = self.delta if kind == "events" else self.spectra_delta
+        """All cells of the events grid (``inv_beta x delta``; also the map's) or of the
+        spectra grid (``kind="spectra"``)."""
+        deltas = self.spectra_delta if kind == "spectra" else self.delta
         return [Cell(i * len(deltas) + j, i, j, float(ib), float(d))
                 for i, ib in enumerate(self.inv_beta) for j, d in enumerate(deltas)]
 

@@ -78,11 +78,47 @@ def events_tile(name, block, tile, noise_path, out):
         results.append(cells.event_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
             t_end=block.get("t_end"), bins=edges, n_batches=int(block["n_batches"]),
-            motion_window=float(block["motion_window"])))
+            motion_window=float(block["motion_window"]), motions=study.motions))
     ds = datasets.events_tile(study.tile(tile, "events"), results, edges,
                               dict(_study_attrs(study, block, noise_attrs),
-                                   motion_window=float(block["motion_window"])))
+                                   motion_window=float(block["motion_window"])),
+                              motions=study.motions)
     io.write_dataset(ds, out)
+
+
+def map_tile(name, block, tile, noise_path, out):
+    """Rule ``simulate_map``: probabilities of the (m/n) motions on the cells of one tile.
+
+    Every cell runs from rest over the same noise record (common random numbers), so the
+    differences between neighbouring cells are not sampling noise of different records.
+    """
+    import time
+
+    from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
+
+    study = Study.from_config(name, block)
+    samples, dt, noise_attrs = io.read_noise(noise_path)
+    spec = block["map"]
+    results = []
+    for cell in study.tile(tile, "events"):
+        start = time.process_time()
+        result = cells.motion_map_cell(
+            samples, dt, **_physics(study, cell), transient=float(block["transient"]),
+            motions=study.motions, window=float(block["motion_window"]),
+            n_batches=int(block["n_batches"]), target_stderr=float(spec["target_stderr"]),
+            min_time=float(spec["min_time"]), max_periods=int(spec["max_periods"]),
+            min_switches=int(spec["min_switches"]))
+        result["cpu_time"] = time.process_time() - start
+        log.info("cell %d: inv_beta=%g delta=%g: %.0f time units, %d impacts, %.3f s%s",
+                 cell.index, cell.inv_beta, cell.delta, result["simulated_time"],
+                 result["n_impacts"], result["cpu_time"],
+                 "" if result["reached"] else ", target precision not reached")
+        results.append(result)
+    attrs = dict(_study_attrs(study, block, noise_attrs), motion_window=float(block["motion_window"]),
+                 **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods", "min_switches")},
+                 transient=float(block["transient"]))
+    io.write_dataset(datasets.map_tile(study.tile(tile, "events"), results, study.motions, attrs),
+                     out)
 
 
 def spectra_tile(name, block, tile, noise_path, out):
@@ -119,13 +155,15 @@ def trace(name, block, noise_path, out):
 
 
 def aggregate(name, block, kind, tiles, out, noise_path=None):
-    """Rules ``aggregate_events`` / ``aggregate_spectra``: one dataset per study."""
+    """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: one dataset per study."""
     study = Study.from_config(name, block)
     parts = [xr.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)
     attrs.update(provenance(block, attrs.get("seed")))
     if kind == "events":
         ds = datasets.aggregate_events(parts, study, attrs)
+    elif kind == "map":
+        ds = datasets.aggregate_map(parts, study, attrs)
     else:
         spec = io.noise_spec(io.read_noise_attrs(noise_path))
         ds = datasets.aggregate_spectra(parts, study, spec, attrs,

@@ -13,13 +13,15 @@ Datasets and the figures that read them (docs/figures.md)::
     results/traces/{study}.nc           fig03, fig10           (random, harmonic)
     results/datasets/{study}_spectra.nc fig06, fig11, fig12    (random, harmonic)
     results/datasets/{study}_events.nc  fig07, fig08, fig09, fig13, fig14
-    results/orbits/{name}.nc            fig16                  (orbits)
+    results/datasets/{study}_map.nc     fig15, fig15_vs_fig16  (harmonic)
+    results/orbits/{name}.nc            fig16, fig15_vs_fig16  (orbits)
 
 Plotting never imports the simulator or the orbit solver; it may use small helpers of
 `vibroimpact.stats`.
 """
 from vibroimpact.plotting._common import STYLE_FILE, axis_label, save, style
 from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
+from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement
 from vibroimpact.plotting.orbits import fig16
 from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fig06, fig07,
                                          fig08, fig09)
@@ -27,5 +29,6 @@ from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fi
 __all__ = [
     "STYLE_FILE", "style", "axis_label", "critical_delta", "save",
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
-    "fig10", "fig11", "fig12", "fig13", "fig14", "fig16",
+    "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
+    "map_agreement",
 ]

@@ -147,8 +147,19 @@ def _bin_limits(ax, centres):
     ax.set_xlim(c[0] - half, c[-1] + half)
 
 
+#: Characters of a parameter line above which it is broken at its "; " separators.
+HEADER_WIDTH = 90
+
+
 def _header(fig, title, params):
-    fig.suptitle(f"{title}\n{params}")
+    lines = []
+    for line in params.split("\n"):
+        while len(line) > HEADER_WIDTH and ";  " in line[:HEADER_WIDTH + 10]:
+            cut = line.rfind(";  ", 0, HEADER_WIDTH + 10)
+            lines.append(line[:cut + 1])
+            line = line[cut + 3:]
+        lines.append(line)
+    fig.suptitle("\n".join([title, *lines]))
 
 
 def _panel_tag(ax, tag):

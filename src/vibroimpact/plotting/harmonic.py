@@ -4,9 +4,8 @@ from __future__ import annotations
 import numpy as np
 
 from vibroimpact.plotting._common import (
-    SPECTRUM_BETA_MAX, _density_figure, _events_params, _figure, _header, _mark_forcing,
-    _nearest, _psd_label, _require_harmonic, _response_spectra, _styled, _trace_figure,
-    axis_label)
+    SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
+    _num, _psd_label, _require_harmonic, _response_spectra, _styled, _trace_figure, axis_label)
 
 
 def fig10(trace):
@@ -28,12 +27,13 @@ def fig10(trace):
 
 @_styled
 def fig11(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
-    """Fig. 11: PSD of the total input sin(beta_f tau) + r(tau) at one forcing frequency.
+    """Fig. 11: PSD of the input A sin(beta_f tau) + r(tau) at one forcing frequency.
 
     Parameters
     ----------
     spectra : xarray.Dataset
-        Spectra dataset of the harmonic study: ``S_f(inv_beta, beta)``.
+        Spectra dataset of the harmonic study: ``S_f(inv_beta, beta)`` (random part,
+        estimated from the record), ``S_r_target(beta)``; attribute ``amplitude``.
     inv_beta : float
         1/beta_f; the nearest value of the dataset is shown (and printed).
     beta_max : float, optional
@@ -42,19 +42,35 @@ def fig11(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
     Returns
     -------
     matplotlib.figure.Figure
-        One log-y axes with S_f and a dotted line at the forcing frequency.
+        One log-y axes: the continuous part (the random input, estimate and target) and the
+        harmonic part drawn as what it is, a spectral line at beta_f carrying the power
+        A**2 / 2 (in the paper's two-sided angular convention the pair of delta functions
+        ``pi A**2 / 2 [delta(beta - beta_f) + delta(beta + beta_f)]``), not a smeared peak.
     """
     fig, (ax,) = _figure()
     i = _nearest(spectra["inv_beta"], inv_beta)
     ds = spectra.isel(inv_beta=i)
     ds = ds.isel(beta=np.flatnonzero(np.asarray(ds["beta"]) <= beta_max))
-    ax.plot(ds["beta"], ds["S_f"], color="C0", label="estimate from the simulated record")
-    _mark_forcing(ax, float(ds["inv_beta"]))
+    ax.plot(ds["beta"], ds["S_f"], color="C0",
+            label=r"random part $r(\tau)$: estimate from the simulated record")
+    if "S_r_target" in ds:
+        ax.plot(ds["beta"], ds["S_r_target"], color="k", ls="--", lw=1.0,
+                label=r"random part: target $S_r$")
+    amplitude = float(_attr(spectra, "amplitude"))
+    beta_f = 1.0 / float(ds["inv_beta"])
     ax.set_yscale("log")
+    low, high = ax.get_ylim()
+    ax.set_ylim(low, high * 30.0)
+    ax.annotate("", xy=(beta_f, 1.0), xycoords=("data", "axes fraction"), xytext=(beta_f, 0.0),
+                textcoords=("data", "axes fraction"),
+                arrowprops=dict(arrowstyle="-|>", color="C3", lw=1.6))
+    ax.plot([], [], color="C3", lw=1.6,
+            label=rf"line of $A\sin(\beta_f\tau)$, A = {_num(amplitude)}, at $\beta_f$ = "
+                  rf"{_num(beta_f)}: power $A^2/2$ = {_num(amplitude ** 2 / 2)}")
     ax.set_xlim(0.0, float(ds["beta"].max()))
     ax.set_xlabel(axis_label(ds["beta"]))
-    ax.set_ylabel(_psd_label(ds["S_f"]))
-    ax.legend(loc="upper right")
+    ax.set_ylabel(r"PSD of the input (two-sided, angular)")
+    ax.legend(loc="upper right", fontsize=7)
     _header(fig, "Fig. 11  Power spectral density of the harmonic plus random input",
             _events_params(spectra, i))
     return fig

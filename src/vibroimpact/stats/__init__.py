@@ -24,6 +24,8 @@ _WHERE = {
     "density": "events", "BatchMeans": "events", "batch_means": "events", "t_quantile": "events",
     "DEFAULT_MOTION_WINDOW": "motions", "DEFAULT_MOTIONS": "motions",
     "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
+    "count_motion_switches": "motions", "MotionStatistics": "motions",
+    "motion_statistics": "motions", "motion_map_agreement": "motions",
     "linear_response_std": "theory", "elastic_impact_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory",
 }

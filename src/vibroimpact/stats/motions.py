@@ -1,6 +1,8 @@
 """The (m/n) classification of impact intervals and the probabilities of motions (Fig. 15)."""
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
@@ -8,7 +10,8 @@ from vibroimpact import _checks
 from vibroimpact.stats.events import interval_ratio
 
 __all__ = ["DEFAULT_MOTION_WINDOW", "DEFAULT_MOTIONS", "classify_impact_intervals",
-           "impact_motion_probabilities"]
+           "impact_motion_probabilities", "count_motion_switches", "MotionStatistics",
+           "motion_statistics", "motion_map_agreement"]
 
 #: Half-width w of the window on r_j = z_j / z that assigns an interval to a motion type (fig15).
 DEFAULT_MOTION_WINDOW = 0.1
@@ -135,7 +138,156 @@ def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_
         raise ValueError(f"total_time must be >= the sum of the intervals ({covered!r}), "
                          f"got {total_time!r}")
     labels = classify_impact_intervals(interval_ratio(intervals, beta), window, motions)
+    return dict(zip(map(_motion_key, motions), _fractions(intervals, labels, len(motions),
+                                                             total_time)))
+
+
+def _fractions(intervals, labels, n_motions, total_time):
+    """Covered time of each motion over `total_time` (the one formula of the probability)."""
     if total_time <= 0.0:
-        return {_motion_key(mn): 0.0 for mn in motions}
-    return {_motion_key(mn): float(intervals[labels == i].sum() / total_time)
-            for i, mn in enumerate(motions)}
+        return [0.0] * n_motions
+    return [float(intervals[labels == i].sum() / total_time) for i in range(n_motions)]
+
+
+def count_motion_switches(labels) -> int:
+    """Changes from one classified motion to another along a labelled record.
+
+    Parameters
+    ----------
+    labels : array_like of int, shape (N,)
+        Output of `classify_impact_intervals` (-1: unclassified).
+
+    Returns
+    -------
+    int
+        The number of adjacent pairs of classified intervals, unclassified ones skipped,
+        whose motions differ: ``(1/1) (1/1) - - (2/1) (2/1) (1/1)`` holds two switches.
+
+    Notes
+    -----
+    Under weak noise a cell with two stable motions may stay in one of them for most of
+    the record; its probabilities then say where the record started, not how the time is
+    shared in the long run. Few switches are the sign of it (fig15 marks such cells).
+    """
+    labels = np.asarray(labels)
+    typed = labels[labels >= 0]
+    return int(np.count_nonzero(typed[1:] != typed[:-1]))
+
+
+class MotionStatistics(NamedTuple):
+    """Probabilities of motions on one record, with their batch-means standard errors."""
+
+    probability: np.ndarray   #: (n_motions,) fraction of the recorded time covered
+    stderr: np.ndarray        #: (n_motions,) batch-means standard error of `probability`
+    n_switches: int           #: changes between classified motions (`count_motion_switches`)
+    labels: np.ndarray        #: (N,) motion index of each interval, -1 if none
+
+
+def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_stop: float, *,
+                      window: float = DEFAULT_MOTION_WINDOW, motions=DEFAULT_MOTIONS,
+                      n_batches: int = 20) -> MotionStatistics:
+    """Probabilities of the (m/n) motions over ``[t_start, t_stop]`` with standard errors.
+
+    Parameters
+    ----------
+    impact_time : array_like of float, shape (N + 1,)
+        Impact instants in ``[t_start, t_stop]``, increasing.
+    intervals : array_like of float, shape (N,)
+        The intervals between them in full precision (`impact_intervals`).
+    beta : float
+        Forcing frequency ratio (period ``z = 2 pi / beta``).
+    t_start, t_stop : float
+        The recorded stretch the probabilities refer to (after the transient).
+    window, motions
+        As for `classify_impact_intervals`.
+    n_batches : int
+        B equal stretches of time for the standard errors (>= 2).
+
+    Returns
+    -------
+    MotionStatistics
+        ``probability`` is exactly `impact_motion_probabilities` with ``total_time =
+        t_stop - t_start``. ``stderr`` is ``std(p_b, ddof=1) / sqrt(B)`` of the fractions
+        ``p_b`` of the B consecutive stretches of length ``(t_stop - t_start) / B`` covered by
+        each motion (an interval across a stretch boundary counts in both, by its overlap),
+        whose mean is ``probability``: the batch-means error of a time average.
+
+    Notes
+    -----
+    The error is honest when the stretches are much longer than the time the motion takes
+    to forget its type; a record with few switches between motions (`n_switches`) violates
+    that, and its error is then too small (the workflow marks such cells).
+    """
+    t = np.asarray(impact_time, dtype=float)
+    z = np.asarray(intervals, dtype=float)
+    motions = _check_motions(motions)
+    n_batches = _checks.integer("n_batches", n_batches, low=2)
+    duration = float(t_stop) - float(t_start)
+    if not duration > 0.0:
+        raise ValueError(f"t_stop must be > t_start, got [{t_start!r}, {t_stop!r}]")
+    if t.size != z.size + 1 and not (t.size == 0 and z.size == 0):
+        raise ValueError(f"impact_time must hold one more value than intervals, got "
+                         f"{t.size} and {z.size}")
+    labels = classify_impact_intervals(interval_ratio(z, beta), window, motions)
+    probability = np.array(_fractions(z, labels, len(motions), duration))
+    if z.size == 0:
+        zero = np.zeros(len(motions))
+        return MotionStatistics(probability, zero, 0, labels)
+    # covered time of each motion up to each impact, then at the stretch edges (linear within
+    # an interval of that motion, flat elsewhere)
+    onehot = labels[None, :] == np.arange(len(motions))[:, None]          # (n_motions, N)
+    cover = np.concatenate([np.zeros((len(motions), 1)), np.cumsum(z * onehot, axis=1)], axis=1)
+    edges = float(t_start) + duration * np.arange(n_batches + 1) / n_batches
+    j = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 1)   # impact before
+    inside = (edges > t[0]) & (j < z.size)                                   # within interval j
+    jj = np.minimum(j, z.size - 1)
+    extra = np.where(inside[None, :] & onehot[:, jj], np.minimum(edges - t[j], z[jj])[None, :],
+                     0.0)
+    at_edges = np.where(edges[None, :] > t[0], cover[:, j] + extra, 0.0)
+    batches = np.diff(at_edges, axis=1) * (n_batches / duration)           # (n_motions, B)
+    stderr = batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
+    return MotionStatistics(probability, stderr, count_motion_switches(labels), labels)
+
+
+def motion_map_agreement(probability, stable, S, threshold: float = 0.5) -> dict[str, float]:
+    """How well a probability map of one motion matches its stable domain (fig15 vs fig16).
+
+    Parameters
+    ----------
+    probability : array_like, shape (n_inv_beta, n_delta)
+        Probability of the motion under harmonic plus random force (NaN: not computed).
+    stable : array_like of bool, same shape
+        Where a stable periodic motion of that type exists under the harmonic force alone.
+    S : array_like, same shape
+        Its degree of stability (%), NaN outside the stable domain.
+    threshold : float
+        Probability above which the motion counts as dominant (default 0.5).
+
+    Returns
+    -------
+    dict
+        ``n_dominant``: cells with probability >= threshold; ``dominant_inside``: the share of
+        them inside the stable domain (NaN if none); ``domain_covered``: the share of the
+        stable domain where the motion is dominant; ``rank_correlation``: Spearman's rank
+        correlation of probability and S over the stable domain (NaN with fewer than 3
+        cells or no spread), and ``n_domain`` its cells.
+    """
+    from scipy.stats import spearmanr
+
+    p = np.asarray(probability, dtype=float)
+    stable = np.asarray(stable, dtype=bool)
+    S = np.asarray(S, dtype=float)
+    if not p.shape == stable.shape == S.shape:
+        raise ValueError(f"probability, stable and S must have one shape, got {p.shape}, "
+                         f"{stable.shape}, {S.shape}")
+    known = np.isfinite(p)
+    dominant = known & (p >= threshold)
+    domain = known & stable & np.isfinite(S)
+    n_dom = int(dominant.sum())
+    rho = np.nan
+    if domain.sum() >= 3 and np.ptp(p[domain]) > 0 and np.ptp(S[domain]) > 0:
+        rho = float(spearmanr(p[domain], S[domain]).statistic)
+    return dict(n_dominant=n_dom,
+                dominant_inside=float((dominant & stable).sum() / n_dom) if n_dom else np.nan,
+                domain_covered=float((dominant & domain).sum() / domain.sum()) if domain.any() else np.nan,
+                rank_correlation=rho, n_domain=int(domain.sum()))
