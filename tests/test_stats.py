@@ -10,10 +10,10 @@ from scipy import integrate, linalg, signal
 from scipy import stats as sps
 
 from vibroimpact.stats import (
-    WelchAccumulator, batch_means, classify_impact_intervals, density, elastic_impact_rate,
-    impact_intervals, impact_motion_probabilities, interval_ratio, linear_psd_response,
-    linear_response_std, rayleigh_pdf, truncated_gaussian_pdf, variance_from_psd,
-    velocity_after_impact, welch_psd,
+    WelchAccumulator, batch_means, classify_impact_intervals, count_motion_switches, density,
+    elastic_impact_rate, impact_intervals, impact_motion_probabilities, interval_ratio,
+    linear_psd_response, linear_response_std, motion_map_agreement, motion_statistics,
+    rayleigh_pdf, truncated_gaussian_pdf, variance_from_psd, velocity_after_impact, welch_psd,
 )
 from vibroimpact.stats.events import t_quantile
 
@@ -306,6 +306,74 @@ def test_probabilities_are_fractions_summing_to_at_most_one(r):
     assert all(0.0 <= v <= 1.0 for v in p.values())
     assert sum(p.values()) <= 1.0 + 1e-12
     np.testing.assert_allclose(interval_ratio(np.asarray(r) * Z, BETA), r, rtol=1e-14)
+
+
+def test_sticking_and_a_record_ending_mid_motion():
+    # A chatter sequence (tiny intervals) ending in sticking: the interval that holds the rest
+    # on the wall counts by its whole length, here one period: (1/1).
+    r = np.r_[np.ones(4), [0.02, 0.01, 0.005], 0.965, np.ones(3)]
+    labels = classify_impact_intervals(r)
+    assert list(labels) == [0] * 4 + [-1] * 3 + [0] * 4
+    # A (2/1) record cut after the first impact of a pair: the lone short interval is no type.
+    assert list(classify_impact_intervals([0.3, 0.7, 0.3, 0.7, 0.3])) == [1, 1, 1, 1, -1]
+    # No impact, or a single one: no interval, no motion.
+    assert list(classify_impact_intervals([])) == []
+    assert count_motion_switches([]) == 0
+
+
+def test_switches_count_changes_between_classified_motions_only():
+    assert count_motion_switches([0, 0, -1, -1, 1, 1, 0]) == 2
+    assert count_motion_switches([0, -1, 0, -1, 0]) == 0       # unclassified is no type
+    assert count_motion_switches([1, 1, 1, 1]) == 0
+    assert count_motion_switches([-1, 2, -1, 0, 0, 2]) == 2
+
+
+def _brute_force_batches(t, labels, n_motions, t0, t1, n_batches, n_points=400_000):
+    """Fractions of each batch covered by each motion, by sampling time on a fine grid."""
+    grid = t0 + (np.arange(n_points) + 0.5) * (t1 - t0) / n_points
+    j = np.searchsorted(t, grid, side="right") - 1
+    lab = np.where((j >= 0) & (j < len(labels)), labels[np.clip(j, 0, len(labels) - 1)], -1)
+    per = grid.size // n_batches
+    return np.array([[np.mean(lab[b * per:(b + 1) * per] == i) for b in range(n_batches)]
+                     for i in range(n_motions)])
+
+
+def test_motion_statistics_time_batches_against_sampling():
+    """Probability = impact_motion_probabilities (exactly); the batch fractions behind the
+    error match a brute-force time sampling of the labelled record to its resolution."""
+    rng = np.random.default_rng(8)
+    r = np.concatenate([np.ones(30) + rng.uniform(-0.05, 0.05, 30), np.tile([0.3, 0.7], 20),
+                        2 + rng.uniform(-0.05, 0.05, 12), rng.uniform(0.1, 3.0, 15),
+                        np.ones(25)])
+    z = r * Z
+    t = 7.0 + np.r_[0.0, np.cumsum(z)]
+    t0, t1 = 3.0, t[-1] + 5.0
+    res = motion_statistics(t, z, BETA, t0, t1, n_batches=10)
+    expected = impact_motion_probabilities(z, BETA, total_time=t1 - t0)
+    assert list(res.probability) == list(expected.values())
+    brute = _brute_force_batches(t, res.labels, 3, t0, t1, 10)
+    np.testing.assert_allclose(brute.mean(axis=1), res.probability, atol=1e-4)
+    stderr = brute.std(axis=1, ddof=1) / np.sqrt(10)
+    np.testing.assert_allclose(res.stderr, stderr, atol=2e-4)
+    assert res.n_switches == count_motion_switches(res.labels) >= 4
+    # a pure record has no spread between batches; no impacts: zero probability, zero error
+    pure = motion_statistics(np.arange(41) * Z, np.full(40, Z), BETA, 0.0, 40 * Z)
+    assert list(pure.probability) == [1.0, 0.0, 0.0] and pure.stderr.max() < 1e-12
+    empty = motion_statistics([], [], BETA, 0.0, 100.0)
+    assert not empty.probability.any() and empty.n_switches == 0
+    with pytest.raises(ValueError, match="t_stop"):
+        motion_statistics(t, z, BETA, 5.0, 5.0)
+
+
+def test_map_agreement_shares_and_rank_correlation():
+    p = np.array([[0.9, 0.6, 0.1], [0.7, 0.2, np.nan]])
+    stable = np.array([[True, True, False], [True, False, False]])
+    S = np.where(stable, np.array([[30.0, 10.0, 0.0], [20.0, 0.0, 0.0]]), np.nan)
+    a = motion_map_agreement(p, stable, S)
+    assert a["n_dominant"] == 3 and a["dominant_inside"] == 1.0 and a["domain_covered"] == 1.0
+    assert a["rank_correlation"] == pytest.approx(1.0) and a["n_domain"] == 3
+    none = motion_map_agreement(np.zeros((2, 3)), stable, S)
+    assert none["n_dominant"] == 0 and np.isnan(none["dominant_inside"])
 
 
 # ------------------------------------------------------------- exact elastic-impact oracles

@@ -12,7 +12,7 @@ import yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
-FIGURES = [f"fig{n:02d}" for n in range(3, 10)] + ["fig16"]
+FIGURES = [f"fig{n:02d}" for n in range(3, 17)] + ["fig15_vs_fig16"]
 
 
 def _workdir(tmp_path):
@@ -67,6 +67,17 @@ def test_fig16_runs_no_simulation(workdir):
         "solve_orbit_tile", "aggregate_orbits", "draw_figure", "copy_paper_figure"}
 
 
+def test_fig15_runs_no_orbit_computation(workdir):
+    assert scheduled_rules(workdir, "results/figures/fig15.png") == {
+        "generate_noise", "simulate_map", "aggregate_map", "draw_figure", "copy_paper_figure"}
+
+
+def test_fig15_vs_fig16_runs_the_map_and_the_orbits(workdir):
+    assert scheduled_rules(workdir, "results/figures/fig15_vs_fig16.png") == {
+        "generate_noise", "simulate_map", "aggregate_map", "solve_orbit_tile",
+        "aggregate_orbits", "draw_figure", "copy_paper_figure"}
+
+
 def test_fig07_records_no_spectra(workdir):
     rules = scheduled_rules(workdir, "results/figures/fig07.png")
     assert "simulate_events" in rules
@@ -79,6 +90,8 @@ def test_fig07_records_no_spectra(workdir):
     (("studies", "random", "delta"), "abc", "delta"),
     (("studies", "random", "colour"), "red", "colour"),
     (("studies", "random", "noise"), "missing_noise", "noise"),
+    (("studies", "motion_map", "map", "target_stderr"), 0.0, "target_stderr"),
+    (("studies", "motion_map", "figures"), ["fig15", "fig15_vs_fig16"], "orbits"),
 ])
 def test_bad_config_fails_before_any_job(workdir, tmp_path, path, value, key):
     cfg = yaml.safe_load((ROOT / "config" / "test.yaml").read_text())
@@ -185,3 +198,90 @@ def test_finding4_means_grow_until_impacts_cease(events):
     rate = events.impact_rate.values
     assert np.all(np.diff(rate[events.delta.values > 0]) < 0)
     assert rate[-1] < 0.01 * rate.max()
+
+
+# --- harmonic plus random force: findings 5-7 and the map (docs/figures.md) -------------------
+
+@pytest.fixture(scope="module")
+def harmonic(built):
+    load = lambda name: xr.load_dataset(built / "results" / "datasets" / name)
+    return load("harmonic_events.nc"), load("harmonic_spectra.nc")
+
+
+@pytest.mark.workflow
+def test_finding5_input_is_a_line_and_the_response_spreads_as_delta_decreases(harmonic):
+    """The input's power is concentrated at beta_f (the line A^2/2 = 0.5 against the random
+    part's rms^2 = 0.084: 86 %); the response's share within +-0.1 of beta_f falls as delta
+    decreases (measured on the test config: 0.91 -> 0.60 at beta_f = 1.1, 0.83 -> 0.71 at
+    1/1.1)."""
+    _, spectra = harmonic
+    beta = spectra.beta.values
+    step = beta[1] - beta[0]
+    for inv_beta in spectra.inv_beta.values:
+        s = spectra.sel(inv_beta=inv_beta)
+        random_power = 2 * s.S_f.values.sum() * step / (2 * np.pi)
+        assert random_power == pytest.approx(0.29 ** 2, rel=0.05)
+        assert 0.5 / (0.5 + random_power) > 0.8
+        near = np.abs(beta - 1 / inv_beta) < 0.1
+        share = [float(s.S_a.sel(delta=d).values[near].sum() / s.S_a.sel(delta=d).values.sum())
+                 for d in sorted(s.delta.values)]
+        assert share[0] < share[-1] - 0.1
+
+
+def _ratio_density(events, delta):
+    e = events.sel(inv_beta=1.1, delta=delta)
+    return e.ratio.values, e.ratio_density.values
+
+
+@pytest.mark.workflow
+def test_finding6_one_peak_at_one_for_large_play_two_about_one_half_for_small(harmonic):
+    events, _ = harmonic
+    r, dens = _ratio_density(events, 1.0)
+    assert abs(r[np.argmax(dens)] - 1.0) < 0.05                 # the (1/1) motion
+    assert float(events.motion_probability.sel(inv_beta=1.1, delta=1.0, motion="1/1")) > 0.8
+    for delta in (0.0, 0.25):                                    # the (2/1) motion
+        r, dens = _ratio_density(events, delta)
+        low = r < 1.0
+        lo_peak = r[low & (r < 0.5)][np.argmax(dens[low & (r < 0.5)])]
+        hi_peak = r[low & (r > 0.5)][np.argmax(dens[low & (r > 0.5)])]
+        assert abs(lo_peak + hi_peak - 1.0) < 0.1                # symmetric about 1/2
+        assert float(events.motion_probability.sel(inv_beta=1.1, delta=delta, motion="2/1")) > 0.6
+
+
+@pytest.mark.workflow
+def test_finding7_velocity_after_impact_narrow_where_11_dominates(harmonic):
+    events, _ = harmonic
+    e = events.sel(inv_beta=1.1)
+    v = e.v_after.values
+
+    def spread(delta):
+        d = e.v_after_density.sel(delta=delta).values
+        mean = (v * d).sum() / d.sum()
+        return np.sqrt(((v - mean) ** 2 * d).sum() / d.sum()) / mean
+
+    assert spread(1.0) < 0.5 * min(spread(0.25), spread(0.0), spread(-0.5))
+
+
+@pytest.mark.workflow
+def test_map_cells_are_bit_identical_to_the_cell_alone(built):
+    """Two cells of the built map against `simulate` over the same noise file, classified."""
+    from vibroimpact import simulate, stats
+    from vibroimpact.pipeline import io
+
+    ds = xr.load_dataset(built / "results" / "datasets" / "motion_map_map.nc")
+    noise, dt, _ = io.read_noise(built / "results" / "noise" / "harmonic_input.nc")
+    busiest = np.unravel_index(np.argmax(ds.n_impacts.values), ds.n_impacts.shape)
+    for i, j in (busiest, (1, 4)):
+        cell = ds.isel(inv_beta=i, delta=j)
+        beta = 1.0 / float(cell.inv_beta)
+        res = simulate(ds.attrs["zeta"], ds.attrs["eps"], float(cell.delta), noise=noise, dt=dt,
+                       amplitude=1.0, beta=beta, t_end=float(cell.record_end))
+        keep = res.impact_time >= ds.attrs["transient"]
+        z = stats.impact_intervals(res.impact_step[keep], res.impact_offset[keep], dt)
+        p = stats.impact_motion_probabilities(z, beta, ds.attrs["motion_window"],
+                                              total_time=float(cell.simulated_time))
+        assert list(cell.probability.values) == list(p.values())
+    assert ds.reached.values.mean() > 0.9
+    for name in ("probability", "probability_stderr", "n_switches", "few_switches",
+                 "impact_rate", "v_after_mean", "simulated_time"):
+        assert ds[name].attrs.get("long_name"), name

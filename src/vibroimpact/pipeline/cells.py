@@ -210,7 +210,7 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
 def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
                     motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
                     n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
-                    max_periods=5000, min_switches=10, growth=1.2):
+                    max_periods=8000, min_switches=10, growth=1.1):
     """Probabilities of the (m/n) motions of one cell of the Fig. 15 map, to a target precision.
 
     The cell is simulated from rest over the common record ``noise`` (every cell of a map

@@ -8,6 +8,7 @@ entry the task reads (the workflow passes nothing else, so nothing else can reru
 """
 import contextlib
 import logging
+import math
 
 import xarray as xr
 
@@ -99,6 +100,14 @@ def map_tile(name, block, tile, noise_path, out):
     study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = block["map"]
+    need = float(block["transient"]) + int(spec["max_periods"]) * 2 * math.pi * study.inv_beta.max()
+    if need > (len(samples) - 1) * dt:
+        raise ValueError(
+            f"studies.{name}.map.max_periods: {spec['max_periods']} forcing periods at 1/beta_f "
+            f"= {study.inv_beta.max():g} after the transient reach tau = {need:.6g}, beyond the "
+            f"noise record {block['noise']!r} ({len(samples)} samples, tau <= "
+            f"{(len(samples) - 1) * dt:.6g}): lower max_periods or raise n_samples to at least "
+            f"{int(math.ceil(need / dt)) + 1}")
     results = []
     for cell in study.tile(tile, "events"):
         start = time.process_time()

@@ -1,0 +1,108 @@
+"""The Fig. 15 map cell: deterministic limits against `periodic_orbits`, and bit-identity with
+simulating the cell alone (`simulate`) and classifying its impacts."""
+import numpy as np
+import pytest
+
+from vibroimpact import periodic_orbits, simulate, stats
+from vibroimpact.noise import NoiseSpec, generate_array
+from vibroimpact.pipeline.cells import motion_map_cell
+
+ZETA, EPS, DT = 0.05, 0.5, 0.1
+MOTIONS = ((1, 1), (2, 1), (1, 2))
+TRANSIENT = 3000.0   # e^(-zeta * 3000) = 1e-65: the transient from rest has died out
+
+
+def _map_cell(noise, inv_beta, delta, **kw):
+    kw = dict(dict(transient=TRANSIENT, min_time=2000.0, max_periods=600), **kw)
+    return motion_map_cell(noise, DT, zeta=ZETA, eps=EPS, delta=delta, beta_f=1.0 / inv_beta,
+                           motions=MOTIONS, **kw)
+
+
+def _alone(noise, inv_beta, delta, transient, t_end):
+    """The cell simulated by itself over ``[0, t_end]``: impacts after the transient."""
+    res = simulate(ZETA, EPS, delta, noise=noise, dt=DT, amplitude=1.0, beta=1.0 / inv_beta,
+                   t_end=t_end)
+    keep = res.impact_time >= transient
+    return res, res.impact_step[keep], res.impact_offset[keep], res.impact_velocity[keep]
+
+
+# (inv_beta, delta) inside the stable domain of each type (Fig. 16), where the motion from
+# rest under sin(beta tau) alone settles on that orbit
+DETERMINISTIC = [((1, 1), 1.1, 1.0), ((2, 1), 1.1, 0.0), ((1, 2), 1.1, 2.5),
+                 ((1, 1), 0.6, 0.5)]
+
+
+@pytest.mark.parametrize("motion, inv_beta, delta", DETERMINISTIC)
+def test_without_noise_a_stable_orbit_is_the_whole_record(motion, inv_beta, delta):
+    """r = 0: the probability of the orbit's type is 1 up to the uncovered ends of the record
+    (before the first and after the last impact, and for m = 2 a lone interval at either end
+    when the record starts or stops inside a pair); the others are 0; the impact velocities
+    equal the orbit's to 1e-8."""
+    noise = np.zeros(int((TRANSIENT + 600 * 2 * np.pi * inv_beta) / DT) + 10)
+    m, n = motion
+    (orbit,) = [o for o in periodic_orbits(m, n, 1.0 / inv_beta, delta, ZETA, EPS) if o.stable]
+    cell = _map_cell(noise, inv_beta, delta)
+    _, step, offset, u = _alone(noise, inv_beta, delta, TRANSIENT, cell["record_end"])
+    t = step * DT + offset
+    z = stats.impact_intervals(step, offset, DT)
+    labels = stats.classify_impact_intervals(stats.interval_ratio(z, 1.0 / inv_beta),
+                                             motions=MOTIONS)
+    k = MOTIONS.index(motion)
+    ends = (t[0] - TRANSIENT) + (cell["record_end"] - t[-1])
+    if m == 1:
+        assert (labels == k).all()
+    else:
+        assert (labels[1:-1] == k).all()
+        ends += z[0] * (labels[0] != k) + z[-1] * (labels[-1] != k)
+    assert cell["probability"][k] == pytest.approx(1.0 - ends / cell["simulated_time"],
+                                                   abs=1e-12)
+    assert np.delete(cell["probability"], k).max() == 0.0
+    assert cell["n_switches"] == 0 and cell["reached"] and not cell["few_switches"]
+    # every impact velocity of the record is one of the orbit's m velocities
+    dist = np.abs(u[:, None] - orbit.velocities[None, :]).min(axis=1)
+    assert dist.max() < 1e-8
+    assert cell["v_after_mean"] == pytest.approx(EPS * orbit.velocities.mean(), abs=1e-8)
+
+
+def test_without_noise_below_the_wall_there_is_no_impact():
+    """1/beta = 0.3: the wall-free response has amplitude 1/|1 - beta^2| ~ 0.1 < delta = 1."""
+    noise = np.zeros(100_000)
+    cell = _map_cell(noise, 0.3, 1.0, transient=200.0, max_periods=5000)
+    assert cell["n_impacts"] == 0 and not cell["probability"].any()
+    assert cell["reached"] and cell["simulated_time"] == pytest.approx(2000.0, abs=DT)
+
+
+@pytest.fixture(scope="module")
+def record():
+    spec = NoiseSpec(kind="band_limited", rms=0.29, dt=DT, beta_c=4.0)
+    return generate_array(spec, 300_001, 1974)
+
+
+@pytest.mark.parametrize("inv_beta, delta", [(2.6, -0.75), (1.4, 0.7), (0.9, 1.3), (2.0, 0.95)])
+def test_a_map_cell_is_bit_identical_to_the_cell_alone(record, inv_beta, delta):
+    """Stopping at precision checks (chunks of any length) changes nothing: `simulate` to the
+    cell's record end gives the same impacts, and classifying them the same probabilities, to
+    the last bit."""
+    cell = _map_cell(record, inv_beta, delta, transient=200.0, max_periods=1500,
+                     target_stderr=0.02)
+    assert cell["n_checks"] >= 2 or cell["reached"]
+    _, step, offset, u = _alone(record, inv_beta, delta, 200.0, cell["record_end"])
+    z = stats.impact_intervals(step, offset, DT)
+    p = stats.impact_motion_probabilities(z, 1.0 / inv_beta, total_time=cell["simulated_time"],
+                                          motions=MOTIONS)
+    assert list(cell["probability"]) == list(p.values())
+    assert cell["n_impacts"] == u.size and cell["v_after_mean"] == EPS * u.mean()
+
+
+def test_a_cell_stops_at_its_precision_or_at_the_cap(record):
+    """Precise cells stop early with every error at target; the cap stops the others, which
+    say so; a record too short for the cap is refused before any simulation."""
+    quick = _map_cell(record, 0.9, 1.3, transient=200.0, max_periods=2000, target_stderr=0.05)
+    assert quick["reached"] and quick["stderr"].max() <= 0.05
+    assert quick["simulated_time"] < 2000 * 2 * np.pi * 0.9
+    capped = _map_cell(record, 2.0, 0.95, transient=200.0, max_periods=50, min_time=100.0,
+                       target_stderr=1e-4)
+    assert not capped["reached"]
+    assert capped["record_end"] == pytest.approx(200.0 + 50 * 2 * np.pi * 2.0, abs=DT)
+    with pytest.raises(ValueError, match="max_periods"):
+        _map_cell(record[:1000], 2.0, 0.95, transient=200.0, max_periods=50)
