@@ -22,6 +22,7 @@ FIGURE_RULES = {"draw_figure", "copy_paper_figure", "all"}
 STUDY_RULES = {"simulate_events", "simulate_spectra", "simulate_trace", "aggregate_events",
                "aggregate_spectra"}
 ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits"}
+MAP_RULES = {"simulate_map", "aggregate_map"}
 
 
 def _git(repo, *args):
@@ -137,8 +138,8 @@ def test_figure_only_key_reruns_only_that_figure(repo, edit):
 def test_simulator_edit_reruns_the_studies_and_downstream(repo, edit):
     edit("src/vibroimpact/impact/kernels.py", _append_comment)    # uncommitted
     jobs = scheduled(repo)
-    assert set(jobs) == STUDY_RULES | FIGURE_RULES
-    assert not any("fig16" in p for p in jobs["draw_figure"])
+    assert set(jobs) == STUDY_RULES | MAP_RULES | FIGURE_RULES
+    assert "fig16.png" not in {Path(p).name for p in jobs["draw_figure"]}
 
 
 def test_statistics_edit_reruns_the_studies(repo, edit):
@@ -158,11 +159,13 @@ def test_noise_edit_reruns_everything_it_feeds(repo, edit):
     assert set(scheduled(repo)) == {"generate_noise"} | STUDY_RULES | FIGURE_RULES
 
 
-def test_orbit_entry_or_solver_edit_reruns_only_fig16(repo, edit):
-    edit("config/test.yaml", _set(("orbits", "harmonic", "zeta"), 0.06))
+def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
+    edit("config/test.yaml", _set(("orbits", "harmonic", "delta"),
+                                  {"start": -1.5, "stop": 3.0, "step": 0.5}))
     jobs = scheduled(repo)
     assert set(jobs) == ORBIT_RULES | FIGURE_RULES
-    assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {"fig16.png"}
+    assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
+        "fig16.png", "fig15_vs_fig16.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
     edit("src/vibroimpact/orbits/kernels.py", _append_comment)
     assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES
