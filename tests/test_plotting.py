@@ -368,3 +368,57 @@ def test_save_writes_png_and_pdf_atomically(data, tmp_path):
     assert png.stat().st_size > 0 and pdf.stat().st_size > 0
     with pytest.raises(ValueError, match="path_png"):
         plotting.save(fig, tmp_path / "fig04.svg")
+
+
+# ------------------------------------------------------------------ Fig. 15 and its comparison
+
+def _synthetic_map():
+    """A map whose (1/1) probability is 1 inside a disc and (2/1) 1 outside, one cell few."""
+    inv_beta = np.round(np.arange(0.5, 2.51, 0.1), 10)
+    delta = np.round(np.arange(-1.0, 2.01, 0.1), 10)
+    ib, d = np.meshgrid(inv_beta, delta, indexing="ij")
+    inside = (ib - 1.5) ** 2 + d ** 2 < 0.5
+    p = np.stack([inside * 0.9, ~inside * 0.6, np.zeros_like(ib)])
+    few = np.zeros(ib.shape, "int8")
+    few[3, 4] = 1
+    reached = np.ones(ib.shape, "int8")
+    reached[0, 0] = 0
+    scalars = dict(few_switches=few, reached=reached, simulated_time=np.full(ib.shape, 5000.0))
+    ds = xr.Dataset({"probability": (("motion", "inv_beta", "delta"), p),
+                     **{k: (("inv_beta", "delta"), v) for k, v in scalars.items()}},
+                    coords=dict(motion=["1/1", "2/1", "1/2"], inv_beta=inv_beta, delta=delta),
+                    attrs=dict(zeta=0.05, eps=0.5, amplitude=1.0, noise_rms=0.29,
+                               noise_kind="band_limited", noise_beta_c=4.0, motion_window=0.1,
+                               target_stderr=0.01, max_periods=8000, min_switches=10))
+    stable = np.stack([inside, np.zeros_like(inside), np.zeros_like(inside)])
+    orbits = xr.Dataset({"n_stable": (("type", "inv_beta", "delta"), stable.astype(int)),
+                         "S": (("type", "inv_beta", "delta"),
+                               np.where(stable, 40.0 - 10 * np.hypot(ib - 1.5, d), np.nan))},
+                        coords=dict(type=["1/1", "2/1", "1/2"], inv_beta=inv_beta, delta=delta),
+                        attrs=dict(zeta=0.05, eps=0.5))
+    return ds, orbits
+
+
+def test_fig15_three_maps_in_percent_with_untrusted_cells_marked():
+    ds, _ = _synthetic_map()
+    fig = plotting.fig15(ds)
+    panels = [ax for ax in fig.axes if ax.get_title()]
+    assert [ax.get_title() for ax in panels] == ["(1/1)", "(2/1)", "(1/2)"]
+    hatched = [c for ax in panels for c in ax.collections
+               if any(getattr(c, "hatches", None) or [None])]
+    assert hatched, "cells with few switches must be hatched"
+    title = _title(fig)
+    assert "99.8 % of cells" in title and r"\sin(\beta_f\tau)" in title
+    assert any("percent" in ax.get_ylabel() or "%" in ax.get_ylabel() for ax in fig.axes)
+
+
+def test_fig15_vs_fig16_prints_the_agreement_and_refuses_another_system():
+    ds, orbits = _synthetic_map()
+    fig = plotting.fig15_vs_fig16(ds, orbits)
+    agreement = plotting.map_agreement(ds, orbits)
+    assert agreement["1/1"]["dominant_inside"] == 1.0 and agreement["1/1"]["domain_covered"] == 1.0
+    assert agreement["2/1"]["n_domain"] == 0
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert any("100 % inside" in t for t in texts)
+    with pytest.raises(ValueError, match="zeta"):
+        plotting.fig15_vs_fig16(ds, orbits.assign_attrs(zeta=0.06))
