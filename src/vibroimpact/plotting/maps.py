@@ -48,6 +48,14 @@ def _few_switches(ax, x, y, few):
                     hatches=[FEW_SWITCHES_HATCH])
 
 
+def _finish_figure(fig, motion_map, handles, title):
+    """Legend below the panels and the header: system, forcing, the map's statistics."""
+    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
+    _header(fig, title, f"{_system_text(motion_map)};  {_map_forcing_text(motion_map)}\n"
+                        f"{_map_text(motion_map)}")
+    return fig
+
+
 def _finish_axes(axes, ds):
     for ax in axes:
         ax.set_xlabel(axis_label(ds["inv_beta"]))
@@ -102,12 +110,8 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
     if short.any():
         handles.append(Line2D([], [], ls="none", marker=".", color="C3",
                               label="target precision not reached (cap)"))
-    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
-    _header(fig, "Fig. 15  Probability of the impact motions under harmonic plus random force",
-            f"{_system_text(motion_map)};  "
-            f"{_map_forcing_text(motion_map)}\n"
-            f"{_map_text(motion_map)}")
-    return fig
+    return _finish_figure(fig, motion_map, handles,
+                          "Fig. 15  Probability of the impact motions under harmonic plus random force")
 
 
 def _orbits_on(motion_map, orbits, name):
@@ -205,9 +209,5 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
                       label=f"probability {', '.join(map(str, levels))} % with noise (Fig. 15)"),
                Patch(facecolor="white", edgecolor="k", hatch=FEW_SWITCHES_HATCH,
                      label="few switches: not stationary")]
-    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
-    _header(fig, "Fig. 15 over Fig. 16  Likely motions under noise and stable periodic motions",
-            f"{_system_text(motion_map)};  "
-            f"{_map_forcing_text(motion_map)}\n"
-            f"{_map_text(motion_map)}")
-    return fig
+    return _finish_figure(fig, motion_map, handles,
+                          "Fig. 15 over Fig. 16  Likely motions under noise and stable periodic motions")
