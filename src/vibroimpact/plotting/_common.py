@@ -295,6 +295,8 @@ def _mark_forcing(ax, inv_beta):
 
 #: Curves drawn by a density figure when no deltas are given (the largest deltas of the grid).
 DENSITY_CURVES = 7
+#: Legend entries a density figure keeps inside its axes; more go beside them.
+LEGEND_INSIDE = 4
 
 
 def _density_deltas(events, density_delta):
@@ -373,7 +375,13 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None):
                   else "t of B - 1 dof")
         title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
                       f"({100 * CONFIDENCE:g} %, {t_text})")
-    ax.legend(loc="upper right", title=title_text, title_fontsize=8)
+    if len(index) > LEGEND_INSIDE:
+        # a legend this tall would hide the curves' peaks: below the axes instead
+        fig.set_figheight(fig.get_figheight() * 1.3)
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, title=title_text,
+                  title_fontsize=8, fontsize=8)
+    else:
+        ax.legend(loc="upper right", title=title_text, title_fontsize=8)
     _header(fig, title, params)
     return fig, ax
 
