@@ -207,6 +207,26 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
                 impact_time=res.impact_time, impact_velocity=res.impact_velocity)
 
 
+def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_periods"):
+    """Sample steps to a map cell's cap: ``transient + max_periods`` forcing periods.
+
+    Raises
+    ------
+    ValueError
+        If a record of ``n_samples`` samples is shorter; the message names ``where`` (the
+        config key) and the ``n_samples`` that would do.
+    """
+    need = transient + max_periods * 2.0 * math.pi / beta_f
+    n_cap = int(math.ceil(need / dt - 1e-9))
+    if n_cap > n_samples - 1:
+        raise ValueError(
+            f"{where}: {max_periods} forcing periods at 1/beta_f = {1.0 / beta_f:g} after the "
+            f"transient {transient:g} reach tau = {need:.6g}, beyond the noise record "
+            f"({n_samples} samples, tau <= {(n_samples - 1) * dt:.6g}): lower max_periods or "
+            f"raise n_samples to at least {n_cap + 1}")
+    return n_cap
+
+
 def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
                     motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
                     n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
@@ -255,14 +275,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     ValueError
         If the record is shorter than ``transient`` plus the cap.
     """
-    period = 2.0 * math.pi / beta_f
-    n_cap = int(math.ceil((transient + max_periods * period) / dt - 1e-9))
-    if n_cap > len(noise) - 1:
-        raise ValueError(
-            f"the noise record ends at tau = {(len(noise) - 1) * dt!r}; this cell needs "
-            f"transient + max_periods * 2 pi / beta_f = {transient!r} + {max_periods} * "
-            f"{period:.6g} = {n_cap * dt:.6g}: lengthen the record (n_samples) or lower "
-            f"max_periods")
+    n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next)

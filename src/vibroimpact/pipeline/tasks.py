@@ -8,7 +8,6 @@ entry the task reads (the workflow passes nothing else, so nothing else can reru
 """
 import contextlib
 import logging
-import math
 
 import xarray as xr
 
@@ -100,14 +99,10 @@ def map_tile(name, block, tile, noise_path, out):
     study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = block["map"]
-    need = float(block["transient"]) + int(spec["max_periods"]) * 2 * math.pi * study.inv_beta.max()
-    if need > (len(samples) - 1) * dt:
-        raise ValueError(
-            f"studies.{name}.map.max_periods: {spec['max_periods']} forcing periods at 1/beta_f "
-            f"= {study.inv_beta.max():g} after the transient reach tau = {need:.6g}, beyond the "
-            f"noise record {block['noise']!r} ({len(samples)} samples, tau <= "
-            f"{(len(samples) - 1) * dt:.6g}): lower max_periods or raise n_samples to at least "
-            f"{int(math.ceil(need / dt)) + 1}")
+    # the longest forcing period of the whole study: every tile fails alike, before simulating
+    cells.map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
+                        1.0 / study.inv_beta.max(),
+                        where=f"studies.{name}.map.max_periods (noise {block['noise']!r})")
     results = []
     for cell in study.tile(tile, "events"):
         start = time.process_time()
@@ -124,6 +119,7 @@ def map_tile(name, block, tile, noise_path, out):
                  "" if result["reached"] else ", target precision not reached")
         results.append(result)
     attrs = dict(_study_attrs(study, block, noise_attrs), motion_window=float(block["motion_window"]),
+                 n_batches=int(block["n_batches"]),
                  **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods", "min_switches")},
                  transient=float(block["transient"]))
     io.write_dataset(datasets.map_tile(study.tile(tile, "events"), results, study.motions, attrs),
