@@ -1,14 +1,22 @@
 # vibroimpact: regenerate Irie, Yamada & Matsuzaki (1974) figure by figure.
 # `snakemake results/figures/fig07.png` builds one figure and only what it needs.
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version
+
+from vibroimpact.pipeline import configuration
 
 min_version("9.0")
 
 
-configfile: "config/config.yaml"
-
-
-validate(config, "config/schema.yaml")
+# The paper's config/config.yaml, with the files given by --configfile layered on it (README,
+# "Your own studies"). No `configfile:` directive: Snakemake would deep-merge a user's entry
+# into a paper entry of the same name; `configuration.load` adds, refuses collisions, and
+# checks and costs the whole config here, before any job (a problem: one or two lines each).
+try:
+    _config, PLAN = configuration.load(dict(config), root=workflow.basedir)
+except configuration.ConfigError as err:
+    raise configuration.ConfigError(err.problems) from None
+config.clear()
+config.update(_config)
 
 
 include: "workflow/rules/common.smk"

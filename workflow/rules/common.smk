@@ -22,55 +22,6 @@ wildcard_constraints:
     paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?",
 
 
-def _check_orbits_item(where, fig, entry, item):
-    """A study figure drawn over an orbit map names an `orbits` entry of the same system."""
-    orbits = item.get("orbits")
-    if orbits not in config["orbits"]:
-        raise ValueError(f"{where}: {fig} is drawn over an orbit map; give its `orbits` entry "
-                         f"as {{name: {fig}, orbits: <name>}}; allowed: {sorted(config['orbits'])}"
-                         f", got {orbits!r}")
-    for key in ("zeta", "eps"):
-        if float(config["orbits"][orbits][key]) != float(entry[key]):
-            raise ValueError(f"{where}: {fig} compares the map with orbits.{orbits}, which has "
-                             f"{key} = {config['orbits'][orbits][key]!r}; the study has "
-                             f"{key} = {entry[key]!r}: they must be the same system")
-
-
-def _check_references():
-    """Cross-references the JSON Schema cannot express, checked before any job."""
-    for name, entry in config["studies"].items():
-        if entry["noise"] not in config["noises"]:
-            raise ValueError(f"studies.{name}.noise: unknown noise {entry['noise']!r}; "
-                             f"allowed: {sorted(config['noises'])}")
-    for kind, section in (("study", "studies"), ("orbits", "orbits")):
-        for name, entry in config[section].items():
-            for fig in entry["figures"]:
-                name_ = fig if isinstance(fig, str) else fig["name"]
-                if figures.FIGURES.get(name_, {}).get("owner") != kind:
-                    allowed = sorted(f for f, spec in figures.FIGURES.items() if spec["owner"] == kind)
-                    raise ValueError(f"{section}.{name}.figures: {name_!r} is not drawn from "
-                                     f"{'a study' if kind == 'study' else 'an orbits map'}; "
-                                     f"allowed: {allowed}")
-                if figures.FIGURES[name_].get("harmonic") and not entry.get("amplitude"):
-                    raise ValueError(f"{section}.{name}.figures: {name_} shows the harmonic "
-                                     f"force; it needs amplitude != 0, got "
-                                     f"{entry.get('amplitude', 0.0)!r}")
-                if "orbits" in figures.FIGURES[name_]["reads"] and kind == "study":
-                    _check_orbits_item(f"{section}.{name}.figures", name_, entry,
-                                       figures.figure_item(entry, name_))
-    for fig, name in config.get("paper_figures", {}).items():
-        section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
-        if name not in config[section]:
-            raise ValueError(f"paper_figures.{fig}: {fig} is drawn from {section} entries; "
-                             f"unknown {section} entry {name!r}; allowed: "
-                             f"{sorted(config[section])}")
-        names = [f if isinstance(f, str) else f["name"] for f in config[section][name]["figures"]]
-        if fig not in names:
-            raise ValueError(f"paper_figures.{fig}: {section}.{name} does not list {fig} "
-                             f"in its figures")
-
-
-_check_references()
 STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}
 
 # Package sources each kind of output depends on (modules or subpackages of vibroimpact).
@@ -178,10 +129,15 @@ def paper_figure_source(wildcards):
 
 
 def all_targets():
-    targets = [f"results/figures/{fig}.png" for fig in config.get("paper_figures", {})]
-    for name, entry in config["studies"].items():
+    """The figures of the entries the config builds (``PLAN.drawn``: with ``paper: false``,
+    only the user's file's own entries)."""
+    drawn = PLAN.drawn
+    targets = [f"results/figures/{fig}.png" for fig in sorted(drawn["paper_figures"])]
+    for name in sorted(drawn["studies"]):
+        entry = config["studies"][name]
         targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
-    for name, entry in config["orbits"].items():
+    for name in sorted(drawn["orbits"]):
+        entry = config["orbits"][name]
         targets += [f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)]
     return targets
 

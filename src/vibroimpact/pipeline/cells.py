@@ -12,6 +12,7 @@ import numpy as np
 
 from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
+from vibroimpact.pipeline.study import map_cap_steps
 
 log = logging.getLogger("vibroimpact")
 
@@ -205,26 +206,6 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
     f = r + amplitude * np.sin(beta_f * res.grid_time)
     return dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
                 impact_time=res.impact_time, impact_velocity=res.impact_velocity)
-
-
-def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_periods"):
-    """Sample steps to a map cell's cap: ``transient + max_periods`` forcing periods.
-
-    Raises
-    ------
-    ValueError
-        If a record of ``n_samples`` samples is shorter; the message names ``where`` (the
-        config key) and the ``n_samples`` that would do.
-    """
-    need = transient + max_periods * 2.0 * math.pi / beta_f
-    n_cap = int(math.ceil(need / dt - 1e-9))
-    if n_cap > n_samples - 1:
-        raise ValueError(
-            f"{where}: {max_periods} forcing periods at 1/beta_f = {1.0 / beta_f:g} after the "
-            f"transient {transient:g} reach tau = {need:.6g}, beyond the noise record "
-            f"({n_samples} samples, tau <= {(n_samples - 1) * dt:.6g}): lower max_periods or "
-            f"raise n_samples to at least {n_cap + 1}")
-    return n_cap
 
 
 def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,

@@ -13,6 +13,24 @@ import numpy as np
 GRID_DECIMALS = 10
 
 
+def grid_size(spec):
+    """Number of values of a grid, without building it (a huge grid is refused on this count).
+
+    Raises
+    ------
+    ValueError
+        As :func:`grid_values`, for a step that is not > 0 or a stop below the start.
+    """
+    if isinstance(spec, dict):
+        start, stop, step = float(spec["start"]), float(spec["stop"]), float(spec["step"])
+        if not step > 0.0:
+            raise ValueError(f"grid step must be > 0, got {step!r}")
+        if stop < start:
+            raise ValueError(f"grid stop must be >= start, got start={start!r}, stop={stop!r}")
+        return int(math.floor((stop - start) / step + 1e-9)) + 1
+    return len(spec)
+
+
 def grid_values(spec):
     """Values of a grid given as a list or as ``{start, stop, step}`` (``stop`` included).
 
@@ -26,13 +44,8 @@ def grid_values(spec):
     ndarray of float64
     """
     if isinstance(spec, dict):
-        start, stop, step = float(spec["start"]), float(spec["stop"]), float(spec["step"])
-        if not step > 0.0:
-            raise ValueError(f"grid step must be > 0, got {step!r}")
-        if stop < start:
-            raise ValueError(f"grid stop must be >= start, got start={start!r}, stop={stop!r}")
-        n = int(math.floor((stop - start) / step + 1e-9)) + 1
-        return np.round(start + step * np.arange(n), GRID_DECIMALS)
+        start, step = float(spec["start"]), float(spec["step"])
+        return np.round(start + step * np.arange(grid_size(spec)), GRID_DECIMALS)
     values = np.asarray([float(v) for v in spec], dtype=float)
     if values.size == 0 or not np.all(np.isfinite(values)):
         raise ValueError(f"grid must hold at least one finite value, got {spec!r}")
@@ -107,3 +120,23 @@ def orbit_rows(entry):
     """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
     rows = grid_values(entry["inv_beta"])
     return rows, -(-rows.size // int(entry["tile_rows"]))
+
+
+def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_periods"):
+    """Sample steps to a map cell's cap: ``transient + max_periods`` forcing periods.
+
+    Raises
+    ------
+    ValueError
+        If a record of ``n_samples`` samples is shorter; the message names ``where`` (the
+        config key) and the ``n_samples`` that would do.
+    """
+    need = transient + max_periods * 2.0 * math.pi / beta_f
+    n_cap = int(math.ceil(need / dt - 1e-9))
+    if n_cap > n_samples - 1:
+        raise ValueError(
+            f"{where}: {max_periods} forcing periods at 1/beta_f = {1.0 / beta_f:g} after the "
+            f"transient {transient:g} reach tau = {need:.6g}, beyond the noise record "
+            f"({n_samples} samples, tau <= {(n_samples - 1) * dt:.6g}): lower max_periods or "
+            f"raise n_samples to at least {n_cap + 1}")
+    return n_cap

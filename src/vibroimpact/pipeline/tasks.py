@@ -14,7 +14,7 @@ import xarray as xr
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.figures import figure_variant
 from vibroimpact.pipeline.provenance import provenance
-from vibroimpact.pipeline.study import Study, grid_values, orbit_rows
+from vibroimpact.pipeline.study import Study, grid_values, map_cap_steps, orbit_rows
 
 log = logging.getLogger("vibroimpact")
 
@@ -100,7 +100,7 @@ def map_tile(name, block, tile, noise_path, out):
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = block["map"]
     # the longest forcing period of the whole study: every tile fails alike, before simulating
-    cells.map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
+    map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
                         1.0 / study.inv_beta.max(),
                         where=f"studies.{name}.map.max_periods (noise {block['noise']!r})")
     results = []

@@ -1,0 +1,902 @@
+"""The workflow's config: read, layered, checked and costed before any job runs.
+
+One place for everything that can be known about a config before a simulation starts, so
+that a bad value stops the build at once with a message of one or two lines naming the key
+path, the value and the allowed range, instead of failing minutes into a build:
+
+- :func:`read_yaml` reads a config file; a syntax error names the file, line and column.
+- :func:`compose` layers a user's file on the paper's config (``config/config.yaml``): its
+  entries are added; an entry named like a paper entry but different is refused unless the
+  file lists it under ``replace`` (it would overwrite the paper's results); with
+  ``paper: false`` only the file's own entries are built (the paper's stay available by
+  name, e.g. a noise record or an orbits map).
+- :func:`check` validates against ``config/schema.yaml`` (filling defaults), rejects
+  non-finite numbers (JSON Schema lets ``.nan`` through), checks every cross-field
+  relation (records, grids, figures and the blocks they need), and returns the
+  :class:`Plan`: cells, jobs, disk and a rough CPU time, refused beyond ``limits``.
+
+The Snakefile and the ``python -m vibroimpact`` entry point both call :func:`load`, so a
+dry run, a build and the plan see the same config and the same errors.
+"""
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from vibroimpact.pipeline import figures
+from vibroimpact.pipeline.study import grid_size, grid_values
+
+__all__ = ["ConfigError", "Plan", "read_yaml", "compose", "check", "load", "SECTIONS"]
+
+#: Sections whose entries are named; a user's entry replaces a paper entry whole.
+SECTIONS = ("noises", "studies", "orbits", "paper_figures")
+
+#: Relative tolerance for "on the grid" (a value written as 1/1.1 matches 0.9090909091).
+GRID_RTOL = 1e-6
+
+#: Environment variable asking for the full schema validator output after the short one.
+VERBOSE_ENV = "VIBROIMPACT_VERBOSE"
+
+
+class ConfigError(ValueError):
+    """A config that cannot be built; ``str()`` is one or two lines per problem."""
+
+    def __init__(self, problems, details=None):
+        self.problems = list(problems) if not isinstance(problems, str) else [problems]
+        self.details = details
+        text = "\n".join(self.problems)
+        if details and os.environ.get(VERBOSE_ENV):
+            text += "\n\n" + details
+        super().__init__(text)
+
+
+# --- reading and layering ---------------------------------------------------------------------
+
+def read_yaml(path):
+    """The mapping in a YAML config file; a syntax error names the file, line and column."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot read the config file ({err.strerror})") from None
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        context = getattr(err, "context", None)
+        raise ConfigError(f"{where}: YAML syntax error: {problem}"
+                          + (f" ({context})" if context else "")) from None
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: a config file holds a mapping of keys (noises, studies, "
+                          f"...), got a {type(data).__name__}")
+    return data
+
+
+def _replaced(user, section, name):
+    replace = user.get("replace", False)
+    if replace is True:
+        return True
+    return isinstance(replace, list) and f"{section}.{name}" in replace
+
+
+def compose(paper, user):
+    """``(config, own)``: the paper's config with a user's layered on, and what is built.
+
+    ``own`` is ``None`` when everything is built (no user file, or ``paper: true``), else
+    ``{section: names}`` of the user's own entries (``paper: false``).
+
+    Raises
+    ------
+    ConfigError
+        If a user entry would overwrite a different paper entry without being listed under
+        ``replace``, or ``replace`` names no user entry.
+    """
+    if not user:
+        return copy.deepcopy(paper), None
+    config = copy.deepcopy(paper)
+    problems = []
+    for key, value in user.items():
+        if key not in SECTIONS:
+            config[key] = copy.deepcopy(value)      # paper, replace, limits: the user's
+    config.setdefault("paper", True)
+    for section in SECTIONS:
+        mine = user.get(section)
+        if mine is None:
+            continue
+        if not isinstance(mine, dict) or not isinstance(config.get(section, {}), dict):
+            config[section] = copy.deepcopy(mine)     # the schema check names the problem
+            continue
+        merged = config.setdefault(section, {})
+        for name, entry in mine.items():
+            if name in merged and merged[name] != entry and not _replaced(user, section, name):
+                problems.append(
+                    f"{section}.{name}: the paper's config (config/config.yaml) has an entry "
+                    f"of this name; yours differs and would overwrite its results.\n"
+                    f"  Rename yours, or list it to replace the paper's: "
+                    f"replace: [{section}.{name}] (or replace: true)")
+            merged[name] = copy.deepcopy(entry)
+    replace = user.get("replace")
+    if isinstance(replace, list):
+        for item in replace:
+            section, _, name = str(item).partition(".")
+            if section not in SECTIONS or name not in (user.get(section) or {}):
+                problems.append(f"replace: {item!r} names no entry of your file; allowed: "
+                                f"<section>.<name> with section in {list(SECTIONS)}")
+    if problems:
+        raise ConfigError(problems)
+    own = None
+    if user.get("paper", True) is False:
+        own = {s: set(user.get(s) or {}) if isinstance(user.get(s), dict) else set()
+               for s in SECTIONS}
+    return config, own
+
+
+# --- schema validation with short messages ----------------------------------------------------
+
+def _path(parts):
+    text = ""
+    for p in parts:
+        text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
+    return text or "<top level>"
+
+
+def _num(x):
+    return f"{x:g}" if isinstance(x, float) else str(x)
+
+
+def allowed(schema):
+    """The allowed values of a schema node, in words (``a number > 0 and < 1``)."""
+    if "$ref" in schema:
+        schema = {**_resolve(schema["$ref"]), **{k: v for k, v in schema.items() if k != "$ref"}}
+    if "enum" in schema:
+        return "one of " + ", ".join(map(str, schema["enum"]))
+    if "oneOf" in schema:
+        return schema.get("description") or " or ".join(allowed(s) for s in schema["oneOf"])
+    types = schema.get("type")
+    types = [types] if isinstance(types, str) else list(types or [])
+    null = "null" in types
+    types = [t for t in types if t != "null"]
+    kind = types[0] if types else None
+    bounds = []
+    for key, op in (("minimum", ">="), ("exclusiveMinimum", ">"), ("maximum", "<="),
+                    ("exclusiveMaximum", "<")):
+        if key in schema:
+            bounds.append(f"{op} {_num(schema[key])}")
+    if kind in ("number", "integer"):
+        text = ("an integer" if kind == "integer" else "a finite number")
+        text += (" " + " and ".join(bounds)) if bounds else ""
+    elif kind == "string":
+        text = "a string" + (f" matching {schema['pattern']}" if "pattern" in schema else "")
+    elif kind == "boolean":
+        text = "true or false"
+    elif kind == "array":
+        text = "a list"
+        if "minItems" in schema:
+            text += f" of at least {schema['minItems']} item(s)"
+    elif kind == "object":
+        props = list(schema.get("properties", {}))
+        text = "a mapping" + (f" with keys {', '.join(props)}" if props else " of named entries")
+    else:
+        text = "a value"
+    if null:
+        text += ", or null"
+    return text
+
+
+_SCHEMA = {}
+
+
+def _resolve(ref):
+    node = _SCHEMA["root"]
+    for part in ref.lstrip("#/").split("/"):
+        node = node[part]
+    return node
+
+
+def _schema_at(parts):
+    """The schema node describing the config value at ``parts`` (best effort)."""
+    node = _SCHEMA["root"]
+    for p in parts:
+        while "$ref" in node:
+            node = _resolve(node["$ref"])
+        if "oneOf" in node:
+            branch = [b for b in node["oneOf"]
+                      if (b.get("type") == "array") == isinstance(p, int)]
+            node = branch[0] if branch else node["oneOf"][0]
+            while "$ref" in node:
+                node = _resolve(node["$ref"])
+        if isinstance(p, int):
+            node = node.get("items", {})
+        elif p in node.get("properties", {}):
+            node = node["properties"][p]
+        elif isinstance(node.get("additionalProperties"), dict):
+            node = node["additionalProperties"]
+        else:
+            return {}
+    while "$ref" in node:
+        node = _resolve(node["$ref"])
+    return node
+
+
+def _describe(parts):
+    node = _schema_at(parts)
+    text = allowed(node) if node else "see config/schema.yaml"
+    desc = node.get("description", "").strip() if node else ""
+    if desc and desc != text and "oneOf" not in node:
+        text += f" ({desc})"
+    return text
+
+
+def _short(value):
+    text = yaml.safe_dump(value, default_flow_style=True, width=10**6).strip()
+    text = text.removesuffix("...").strip()
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _schema_messages(error):
+    """One or two lines for one jsonschema error (descending into oneOf branches)."""
+    parts = list(error.absolute_path)
+    where = _path(parts)
+    kind = error.validator
+    if kind in ("oneOf", "anyOf") and error.context:
+        by_branch = {}
+        for sub in error.context:
+            by_branch.setdefault(sub.relative_schema_path[0], []).append(sub)
+        for branch, subs in sorted(by_branch.items()):
+            schema = error.validator_value[branch]
+            while "$ref" in schema:
+                schema = _resolve(schema["$ref"])
+            want = schema.get("type")
+            same = ((want == "object" and isinstance(error.instance, dict))
+                    or (want == "array" and isinstance(error.instance, list))
+                    or (want == "string" and isinstance(error.instance, str)))
+            if same and not any(s.validator == "type" and not s.relative_path for s in subs):
+                return [m for s in subs for m in _schema_messages(s)]
+        return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts)}"]
+    if kind == "required":
+        missing = [k for k in error.validator_value if k not in error.instance]
+        key = missing[0] if missing else error.message.split("'")[1]
+        return [f"{_path(parts + [key])}: missing; allowed: {_describe(parts + [key])}"]
+    if kind == "additionalProperties":
+        known = list(error.schema.get("properties", {}))
+        extra = [k for k in error.instance if k not in known]
+        return [f"{_path(parts + [k])}: unknown key; allowed keys here: {', '.join(known)}"
+                for k in extra]
+    if kind == "propertyNames":
+        name = error.instance
+        return [f"{where}: the name {name!r} is not allowed; allowed: letters, digits and _, "
+                f"starting with a letter"]
+    if kind in ("minProperties", "minItems") and not error.instance:
+        return [f"{where}: empty; allowed: {_describe(parts)}"]
+    return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts)}"]
+
+
+def _validator(schema):
+    import jsonschema
+
+    base = jsonschema.Draft202012Validator
+    properties = base.VALIDATORS["properties"]
+
+    def set_defaults(validator, props, instance, schema_):
+        if isinstance(instance, dict):
+            for name, sub in props.items():
+                if "default" in sub and name not in instance:
+                    instance[name] = copy.deepcopy(sub["default"])
+        yield from properties(validator, props, instance, schema_)
+
+    return jsonschema.validators.extend(base, {"properties": set_defaults})(schema)
+
+
+def _nonfinite(value, parts=()):
+    if isinstance(value, float) and not math.isfinite(value):
+        yield list(parts), value
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield from _nonfinite(v, (*parts, k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            yield from _nonfinite(v, (*parts, i))
+
+
+def validate(config, schema):
+    """Check ``config`` against the JSON Schema, filling defaults in place.
+
+    Raises
+    ------
+    ConfigError
+        One or two lines per problem (the full validator output with
+        ``VIBROIMPACT_VERBOSE=1``).
+    """
+    _SCHEMA["root"] = schema
+    problems = [f"{_path(p)} = {v}: not a finite number; allowed: {_describe(p)}"
+                for p, v in _nonfinite(config)]
+    if problems:
+        raise ConfigError(problems)
+    errors = sorted(_validator(schema).iter_errors(config), key=lambda e: list(map(str, e.path)))
+    if errors:
+        lines = []
+        for error in errors:
+            for line in _schema_messages(error):
+                if line not in lines:
+                    lines.append(line)
+        raise ConfigError(lines, details="\n\n".join(str(e) for e in errors))
+
+
+# --- cross-field checks -----------------------------------------------------------------------
+
+def _record(config, noise):
+    """``(n_samples, dt, tau_end)`` of a noise entry."""
+    entry = config["noises"][noise]
+    n, dt = int(entry["n_samples"]), float(entry["dt"])
+    return n, dt, (n - 1) * dt
+
+
+def _on_grid(value, grid):
+    return bool(np.any(np.abs(grid - value) <= GRID_RTOL * max(1.0, abs(value))))
+
+
+def _grid_text(grid):
+    if grid.size <= 8:
+        return ", ".join(_num(float(v)) for v in grid)
+    return f"{_num(float(grid[0]))}, {_num(float(grid[1]))}, ..., {_num(float(grid[-1]))}"
+
+
+class _Problems(list):
+    def add(self, where, value, problem, allowed_):
+        shown = f" = {_short(value)}" if value is not None else ""
+        self.append(f"{where}{shown}: {problem}; allowed: {allowed_}")
+
+
+def _grid(problems, where, spec, limit, positive=False):
+    """Values of a grid, or None after recording why it is unusable."""
+    try:
+        n = grid_size(spec)
+    except ValueError as err:
+        key = "stop" if "stop" in str(err) else "step"
+        problems.add(f"{where}.{key}", spec.get(key), str(err).split(",")[0].removeprefix("grid "),
+                     f"stop >= start = {_num(spec['start'])}" if key == "stop" else "> 0")
+        return None
+    if n > limit:
+        problems.add(where, spec, f"{n:,} values (more than the limit of cells)",
+                     f"at most {limit:,} values (limits.max_cells), e.g. a larger step")
+        return None
+    values = grid_values(spec)
+    if positive and np.any(values <= 0.0):
+        bad = float(values[values <= 0.0][0])
+        key = f"{where}.start" if isinstance(spec, dict) else where
+        problems.add(key, spec["start"] if isinstance(spec, dict) else spec,
+                     f"1/beta_f = {_num(bad)} is not a forcing period ratio",
+                     "values > 0")
+        return None
+    return values
+
+
+def _check_noises(config, problems):
+    from vibroimpact.noise import NoiseSpec   # its own checks (FIR length) after ours
+
+    for name, entry in config["noises"].items():
+        where = f"noises.{name}"
+        kind, dt = entry["kind"], float(entry["dt"])
+        needs = {"white": (), "band_limited": ("beta_c",), "lowpass2": ("beta_c", "zeta_f")}[kind]
+        ok = True
+        for key in ("beta_c", "zeta_f"):
+            given = entry.get(key) is not None
+            if given != (key in needs):
+                ok = False
+                problems.add(f"{where}.{key}", entry.get(key),
+                             f"{'required' if not given else 'not used'} for kind {kind}",
+                             "a number > 0" if not given else "null (or leave it out)")
+        nyquist = math.pi / dt
+        beta_c = entry.get("beta_c")
+        if beta_c is not None and beta_c > nyquist * (1 + 1e-9):
+            ok = False
+            problems.add(f"{where}.beta_c", beta_c,
+                         f"above the Nyquist frequency pi/dt of dt = {_num(dt)}",
+                         f"0 < beta_c <= {nyquist:.6g}")
+        if int(entry["nperseg"]) > int(entry["n_samples"]):
+            problems.add(f"{where}.nperseg", entry["nperseg"], "longer than the record",
+                         f"16 <= nperseg <= n_samples = {entry['n_samples']}")
+        if ok:
+            try:
+                NoiseSpec(**{k: entry[k] for k in ("kind", "rms", "dt", "beta_c", "zeta_f")
+                             if entry.get(k) is not None})
+            except ValueError as err:
+                problems.add(where, None, str(err), "see config/schema.yaml, noises")
+
+
+def _check_figures(config, section, name, entry, problems, grids):
+    where = f"{section}.{name}.figures"
+    kind = "study" if section == "studies" else "orbits"
+    if not entry["figures"]:
+        allowed_ = sorted(f for f, s in figures.FIGURES.items() if s["owner"] == kind)
+        problems.add(where, [], "no figure listed: this entry would build nothing",
+                     f"a list of figures from {', '.join(allowed_)}")
+        return
+    seen = set()
+    for i, item in enumerate(entry["figures"]):
+        fig = item if isinstance(item, str) else item["name"]
+        spec = figures.FIGURES[fig]
+        at = f"{where}[{i}]"
+        if spec["owner"] != kind:
+            allowed_ = sorted(f for f, s in figures.FIGURES.items() if s["owner"] == kind)
+            problems.add(at, fig, f"not drawn from {'a study' if kind == 'study' else 'an orbits map'}",
+                         ", ".join(allowed_))
+            continue
+        if fig in seen:
+            problems.add(at, fig, "listed twice", "each figure once (a list of values under "
+                         "its `inv_beta` draws it several times)")
+        seen.add(fig)
+        if kind != "study":
+            continue
+        if spec.get("harmonic") and not entry.get("amplitude"):
+            problems.add(f"studies.{name}.amplitude", entry.get("amplitude", 0.0),
+                         f"{fig} shows the harmonic force", "amplitude != 0 for this figure")
+        for block in ("trace", "spectra"):
+            if block in spec["reads"] and not entry.get(block):
+                problems.add(f"studies.{name}.{block}", None,
+                             f"missing, and {fig} draws it",
+                             f"a `{block}:` block (config/schema.yaml), or drop {fig}")
+        item = {} if isinstance(item, str) else item
+        for key in item:
+            if key == "name":
+                continue
+            usable = (key == spec.get("per") or key in spec.get("options", ())
+                      or key in spec.get("sources", ())
+                      or (key == "beta_max" and "spectra" in spec["reads"]))
+            if not usable:
+                problems.add(f"{at}.{key}", item[key], f"not an option of {fig}",
+                             _figure_keys(fig))
+        if spec.get("per") == "inv_beta" and "inv_beta" in item:
+            for j, v in enumerate(item["inv_beta"]):
+                if not _on_grid(v, grids["inv_beta"]):
+                    problems.add(f"{at}.inv_beta[{j}]", v, "not on the study's inv_beta grid",
+                                 _grid_text(grids["inv_beta"]))
+        for j, v in enumerate(item.get("density_delta", [])):
+            if not _on_grid(v, grids["delta"]):
+                problems.add(f"{at}.density_delta[{j}]", v, "not on the study's delta grid",
+                             _grid_text(grids["delta"]))
+        if "orbits" in spec.get("sources", ()):
+            _check_orbits_item(config, name, entry, at, fig, item, problems)
+
+
+def _figure_keys(fig):
+    spec = figures.FIGURES[fig]
+    keys = ["name", *([spec["per"]] if spec.get("per") else []), *spec.get("options", ()),
+            *spec.get("sources", ()), *(["beta_max"] if "spectra" in spec["reads"] else [])]
+    return ", ".join(keys)
+
+
+def _check_orbits_item(config, name, entry, at, fig, item, problems):
+    orbits = item.get("orbits")
+    names = sorted(config.get("orbits", {}))
+    if orbits not in config.get("orbits", {}):
+        problems.add(f"{at}.orbits", orbits, f"{fig} is drawn over an orbit map; give its "
+                     f"entry as {{name: {fig}, orbits: <name>}}", ", ".join(names) or
+                     "an `orbits` entry (none defined)")
+        return
+    other = config["orbits"][orbits]
+    for key in ("zeta", "eps"):
+        if float(other[key]) != float(entry[key]):
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = "
+                         f"{_num(other[key])}, the study {key} = {_num(entry[key])}",
+                         "an `orbits` entry of the same zeta and eps")
+    types = {tuple(t) for t in other["types"]}
+    missing = [m for m in entry["motions"] if tuple(m) not in types]
+    if missing:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
+                     f"which studies.{name}.motions lists", "an `orbits` entry whose types "
+                     "include every motion of the study")
+
+
+def _check_study(config, name, entry, problems, limits):
+    where = f"studies.{name}"
+    if entry["noise"] not in config["noises"]:
+        problems.add(f"{where}.noise", entry["noise"], "no such noise record",
+                     ", ".join(sorted(config["noises"])))
+        return None
+    n, dt, tau = _record(config, entry["noise"])
+    record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
+    grids = {"delta": _grid(problems, f"{where}.delta", entry["delta"], limits["max_cells"])}
+    harmonic = float(entry["amplitude"]) != 0.0
+    grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
+                               limits["max_cells"], positive=True)
+                         if harmonic else np.array([1.0]))
+    transient = float(entry["transient"])
+    t_end = entry.get("t_end")
+    end = tau if t_end is None else float(t_end)
+    if t_end is not None and t_end > tau * (1 + 1e-9):
+        problems.add(f"{where}.t_end", t_end, f"longer than the noise record ({record})",
+                     f"transient < t_end <= {tau:.6g}, or null for the whole record")
+    elif transient >= end:
+        problems.add(f"{where}.transient", transient, "leaves no record for the statistics "
+                     f"(t_end = {end:.6g})", f"0 <= transient < {end:.6g}")
+    uses = {r for f in entry["figures"] for r in figures.FIGURES[
+        f if isinstance(f, str) else f["name"]]["reads"]}
+    spectra = entry.get("spectra")
+    if spectra:
+        s_end = tau if spectra.get("t_end") is None else float(spectra["t_end"])
+        if s_end > tau * (1 + 1e-9):
+            problems.add(f"{where}.spectra.t_end", spectra["t_end"],
+                         f"longer than the noise record ({record})",
+                         f"transient < t_end <= {tau:.6g}, or null")
+        else:
+            samples = int((s_end - transient) / dt)
+            if samples < int(spectra["nperseg"]):
+                problems.add(f"{where}.spectra.nperseg", spectra["nperseg"],
+                             f"longer than the spectra record ((t_end - transient)/dt = "
+                             f"{max(samples, 0)} samples)",
+                             f"16 <= nperseg <= {max(samples, 0)}, or a longer spectra.t_end")
+        sgrid = _grid(problems, f"{where}.spectra.delta", spectra["delta"], limits["max_cells"])
+        if sgrid is not None and grids["delta"] is not None:
+            for j, v in enumerate(sgrid):
+                if not _on_grid(v, grids["delta"]):
+                    problems.add(f"{where}.spectra.delta" + (f"[{j}]" if isinstance(
+                        spectra["delta"], list) else ""), float(v),
+                        "not on the study's delta grid (a spectrum's cell has its impact "
+                        "statistics too)", _grid_text(grids["delta"]))
+    trace = entry.get("trace")
+    if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"],
+                     f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
+    if grids["delta"] is not None:
+        for j, v in enumerate(entry["density_delta"]):
+            if not _on_grid(v, grids["delta"]):
+                problems.add(f"{where}.density_delta[{j}]", v, "not on the delta grid",
+                             _grid_text(grids["delta"]))
+    motions = [tuple(m) for m in entry["motions"]]
+    if len(set(motions)) != len(motions):
+        problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
+                     "distinct [m, n] pairs")
+    if "map" in uses and harmonic and grids["inv_beta"] is not None:
+        spec = entry["map"]
+        longest = float(grids["inv_beta"].max()) * 2 * math.pi
+        need = transient + int(spec["max_periods"]) * longest
+        if need > tau * (1 + 1e-9):
+            problems.add(f"{where}.map.max_periods", spec["max_periods"],
+                         f"{spec['max_periods']} periods at 1/beta_f = "
+                         f"{_num(float(grids['inv_beta'].max()))} after the transient reach "
+                         f"tau = {need:.6g}, beyond the record ({record})",
+                         f"max_periods <= {int((tau - transient) / longest)}, or n_samples >= "
+                         f"{math.ceil(need / dt) + 1} in noises.{entry['noise']}")
+        if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
+            problems.add(f"{where}.map.min_time", spec["min_time"],
+                         f"transient + min_time is beyond the record ({record})",
+                         f"0 < min_time <= {tau - transient:.6g}")
+    if all(g is not None for g in grids.values()):
+        _check_figures(config, "studies", name, entry, problems, grids)
+    return grids
+
+
+def _check_orbits(config, name, entry, problems, limits):
+    from vibroimpact.orbits.api import MAX_M
+
+    where = f"orbits.{name}"
+    _grid(problems, f"{where}.inv_beta", entry["inv_beta"], limits["max_orbit_cells"],
+          positive=True)
+    _grid(problems, f"{where}.delta", entry["delta"], limits["max_orbit_cells"])
+    for j, (m, n) in enumerate(entry["types"]):
+        if m > MAX_M:
+            problems.add(f"{where}.types[{j}]", [m, n], f"the orbit solver finds (m/n) motions "
+                         f"with m <= {MAX_M} impacts a period only", f"[m, n] with 1 <= m <= "
+                         f"{MAX_M} and 1 <= n <= 12")
+    types = [tuple(t) for t in entry["types"]]
+    if len(set(types)) != len(types):
+        problems.add(f"{where}.types", entry["types"], "a type is listed twice",
+                     "distinct [m, n] pairs")
+    _check_figures(config, "orbits", name, entry, problems, None)
+
+
+def _check_paper_figures(config, problems):
+    for fig, name in config["paper_figures"].items():
+        section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
+        where = f"paper_figures.{fig}"
+        if name not in config[section]:
+            problems.add(where, name, f"{fig} is drawn from {section} entries; no such entry",
+                         ", ".join(sorted(config[section])))
+            continue
+        names = [f if isinstance(f, str) else f["name"] for f in config[section][name]["figures"]]
+        if fig not in names:
+            problems.add(where, name, f"{section}.{name} does not list {fig} in its figures",
+                         f"an entry listing {fig}, or add {fig} to {section}.{name}.figures")
+
+
+def check(config, own=None, *, results="results"):
+    """Every cross-field relation, the limits; returns the :class:`Plan` of the build.
+
+    ``config`` has passed :func:`validate`; ``own`` is from :func:`compose`.
+
+    Raises
+    ------
+    ConfigError
+        Listing every problem found, one or two lines each.
+    """
+    limits = config["limits"]
+    problems = _Problems()
+    _check_noises(config, problems)
+    for name, entry in config["studies"].items():
+        _check_study(config, name, entry, problems, limits)
+    for name, entry in config["orbits"].items():
+        _check_orbits(config, name, entry, problems, limits)
+    _check_paper_figures(config, problems)
+    if own is not None and not any(own[s] for s in ("studies", "orbits", "paper_figures")):
+        problems.add("paper", False, "your file builds nothing of its own",
+                     "paper: false with at least one study or orbits entry that lists figures")
+    if problems:
+        raise ConfigError(problems)
+    plan = make_plan(config, own, results=results)
+    plan.refuse_beyond_limits()
+    return plan
+
+
+def load(user=None, *, root=".", user_files=()):
+    """Read the paper's config, layer ``user`` on it, validate and check: ``(config, plan)``.
+
+    Parameters
+    ----------
+    user : dict, optional
+        The user's config (what ``--configfile`` files gave Snakemake), or None.
+    root : path
+        The project directory (holding ``config/config.yaml`` and ``config/schema.yaml``).
+    user_files : sequence of paths
+        Files to read as the user's config (deep-merged in order) when ``user`` is None.
+    """
+    root = Path(root)
+    if user is None and user_files:
+        user = {}
+        for path in user_files:
+            user = _deep_merge(user, read_yaml(path))
+    schema = read_yaml(root / "config" / "schema.yaml")
+    paper = read_yaml(root / "config" / "config.yaml")
+    config, own = compose(paper, user or {})
+    validate(config, schema)
+    plan = check(config, own, results=root / "results")
+    return config, plan
+
+
+def _deep_merge(base, extra):
+    out = dict(base)
+    for key, value in extra.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = _deep_merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+# --- the plan: cells, jobs, disk and time -----------------------------------------------------
+
+# Costs measured on the default build (results/benchmarks/*, 2 cores; README, "Job costs"):
+JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
+NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
+NS_PER_SAMPLE = 50.0       # noise generation
+US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
+FIGURE_S = 1.5             # one figure, start-up included
+# Bytes of the outputs (measured file sizes of the default build):
+FILE_OVERHEAD = 20_000
+FIGURE_BYTES = 400_000     # png + pdf
+
+
+@dataclass
+class Row:
+    """One line of the plan: a config entry and what building it costs."""
+
+    key: str
+    detail: str
+    cells: int = 0
+    orbit_cells: int = 0
+    jobs: int = 0
+    bytes: float = 0.0
+    cpu_s: float = 0.0
+
+
+@dataclass
+class Plan:
+    """What a build will make, before anything runs (``str()`` is the printed plan)."""
+
+    rows: list = field(default_factory=list)
+    limits: dict = field(default_factory=dict)
+    free_bytes: float | None = None
+    results: str = "results"
+    drawn: dict = field(default_factory=dict)    # built_entries(...)[0]: what `rule all` draws
+
+    @property
+    def cells(self):
+        return sum(r.cells for r in self.rows)
+
+    @property
+    def orbit_cells(self):
+        return sum(r.orbit_cells for r in self.rows)
+
+    @property
+    def jobs(self):
+        return sum(r.jobs for r in self.rows)
+
+    @property
+    def bytes(self):
+        return sum(r.bytes for r in self.rows)
+
+    @property
+    def cpu_s(self):
+        return sum(r.cpu_s for r in self.rows)
+
+    def summary(self, cores=2):
+        return (f"{self.cells:,} simulation cells, {self.orbit_cells:,} orbit cells, "
+                f"{self.jobs} jobs, ~{_bytes(self.bytes)} of outputs, ~{_time(self.cpu_s)} of "
+                f"CPU (~{_time(self.cpu_s / max(cores, 1))} on {cores} cores)")
+
+    def format(self, cores=2):
+        lines = ["vibroimpact plan (every output of `rule all`, whether or not already built):"]
+        width = max([len(r.key) for r in self.rows] + [10])
+        for r in self.rows:
+            lines.append(f"  {r.key:<{width}}  {r.jobs:>4} jobs  {_bytes(r.bytes):>8}  "
+                         f"~{_time(r.cpu_s):>7}  {r.detail}")
+        lines.append(f"  total: {self.summary(cores)}")
+        lim = self.limits
+        lines.append(f"  limits: {self.cells:,}/{lim['max_cells']:,} cells (limits.max_cells), "
+                     f"{self.orbit_cells:,}/{lim['max_orbit_cells']:,} orbit cells "
+                     f"(limits.max_orbit_cells), {self.jobs}/{lim['max_jobs']} jobs "
+                     f"(limits.max_jobs), {_bytes(self.bytes)}/{_num(lim['max_disk_gb'])} GB "
+                     f"(limits.max_disk_gb)"
+                     + (f"; {_bytes(self.free_bytes)} free under {self.results}"
+                        if self.free_bytes is not None else ""))
+        return "\n".join(lines)
+
+    __str__ = format
+
+    def refuse_beyond_limits(self):
+        lim, problems = self.limits, []
+        for value, key, what in ((self.cells, "max_cells", "simulation cells"),
+                                 (self.orbit_cells, "max_orbit_cells", "orbit cells"),
+                                 (self.jobs, "max_jobs", "jobs")):
+            if value > lim[key]:
+                problems.append(f"limits.{key} = {lim[key]:,}: this build has {value:,} "
+                                f"{what}; raise limits.{key} to build it, or shrink the grids"
+                                f"\n  ({self.summary()})")
+        gb = self.bytes / 1e9
+        if gb > lim["max_disk_gb"]:
+            problems.append(f"limits.max_disk_gb = {_num(lim['max_disk_gb'])}: this build "
+                            f"writes ~{_bytes(self.bytes)}; raise limits.max_disk_gb to build "
+                            f"it, or shorten the records\n  ({self.summary()})")
+        elif self.free_bytes is not None and self.bytes > self.free_bytes:
+            problems.append(f"disk: this build writes ~{_bytes(self.bytes)}, only "
+                            f"{_bytes(self.free_bytes)} free under {self.results}; free "
+                            f"some space or shorten the records")
+        if problems:
+            raise ConfigError(problems)
+
+
+def _bytes(n):
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{int(n)} B"
+
+
+def _time(s):
+    if s >= 3600:
+        return f"{s / 3600:.2g} h"
+    if s >= 60:
+        return f"{s / 60:.2g} min"
+    return f"{s:.2g} s"
+
+
+def _study_needs(entry):
+    return {r for f in entry["figures"] for r in figures.FIGURES[
+        f if isinstance(f, str) else f["name"]]["reads"]}
+
+
+def built_entries(config, own=None):
+    """``(drawn, reads)`` of ``rule all``: ``drawn`` the entries whose figures it draws
+    (``{section: names}``, paper figures included), ``reads`` every entry whose datasets
+    those figures read (``{"studies", "orbits", "noises": names}``)."""
+    sections = ("studies", "orbits", "paper_figures")
+    drawn = {s: set(config.get(s, {})) if own is None else set(own[s]) for s in sections}
+    for fig in drawn["paper_figures"]:
+        section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
+        drawn[section].add(config["paper_figures"][fig])
+    reads = {"studies": set(drawn["studies"]), "orbits": set(drawn["orbits"]), "noises": set()}
+    for name in drawn["studies"]:
+        entry = config["studies"][name]
+        for item in entry["figures"]:
+            fig = item if isinstance(item, str) else item["name"]
+            for kind, other in figures.figure_sources(entry, fig).items():
+                reads[kind].add(other)
+        if _study_needs(entry) - {"orbits"}:
+            reads["noises"].add(entry["noise"])
+    return drawn, reads
+
+
+def make_plan(config, own=None, *, results="results"):
+    """The :class:`Plan` of ``rule all``: cells, jobs, bytes and CPU seconds per entry."""
+    from vibroimpact.pipeline.study import Study, orbit_rows
+
+    drawn, build = built_entries(config, own)
+    plan = Plan(limits=dict(config["limits"]), results=str(results), drawn=drawn)
+    for name in sorted(build["noises"]):
+        entry = config["noises"][name]
+        n = int(entry["n_samples"])
+        plan.rows.append(Row(f"noises.{name}", f"{n:,} samples", jobs=1,
+                             bytes=8 * n + FILE_OVERHEAD,
+                             cpu_s=JOB_START_S + n * NS_PER_SAMPLE * 1e-9))
+    for name in sorted(build["studies"]):
+        entry = config["studies"][name]
+        study = Study.from_config(name, entry)
+        n, dt, tau = _record(config, entry["noise"])
+        needs = _study_needs(entry)
+        row = Row(f"studies.{name}", "")
+        parts = []
+        if "events" in needs:
+            cells = len(study.cells("events"))
+            steps = (tau if entry.get("t_end") is None else float(entry["t_end"])) / dt
+            bins = sum(int(b["n"]) for b in entry["bins"].values())
+            per_cell = 12 * (bins + 100)
+            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * per_cell,
+                 cells * steps * NS_PER_STEP * 1e-9)
+            parts.append(f"events {cells} cells")
+        if "map" in needs:
+            cells = len(study.cells("events"))
+            cap = sum(len(study.delta) * min(n - 1, (float(entry["transient"]) + int(
+                entry["map"]["max_periods"]) * 2 * math.pi * ib) / dt) for ib in study.inv_beta)
+            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200, cap * NS_PER_STEP
+                 * 1e-9)
+            parts.append(f"map {cells} cells (CPU at the caps)")
+        if "spectra" in needs:
+            cells = len(study.cells("spectra"))
+            spec = entry["spectra"]
+            steps = (tau if spec.get("t_end") is None else float(spec["t_end"])) / dt
+            _add(row, cells, study.n_tiles("spectra") + 1,
+                 2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1),
+                 cells * steps * NS_PER_STEP * 1e-9)
+            parts.append(f"spectra {cells} cells")
+        if "trace" in needs:
+            steps = float(entry["trace"]["t_end"]) / dt
+            _add(row, 0, 1, 40 * steps, 0.0)
+            parts.append("trace")
+        targets = len(figures.figure_targets(entry))
+        row.jobs += targets
+        row.bytes += targets * FIGURE_BYTES
+        row.cpu_s += targets * FIGURE_S + row.jobs * JOB_START_S
+        row.detail = ", ".join(parts) + f", {targets} figures"
+        plan.rows.append(row)
+    for name in sorted(build["orbits"]):
+        entry = config["orbits"][name]
+        rows, n_tiles = orbit_rows(entry)
+        cells = len(rows) * grid_size(entry["delta"])
+        targets = len(figures.figure_targets(entry)) if name in drawn["orbits"] else 0
+        row = Row(f"orbits.{name}", f"{cells:,} cells x {len(entry['types'])} types, "
+                  f"{targets} figures", orbit_cells=cells, jobs=n_tiles + 1 + targets,
+                  bytes=2 * cells * len(entry["types"]) * 34 + targets * FIGURE_BYTES)
+        row.cpu_s = (cells * len(entry["types"]) * US_PER_ORBIT * 1e-6
+                     + row.jobs * JOB_START_S + targets * FIGURE_S)
+        plan.rows.append(row)
+    copies = drawn["paper_figures"]
+    if copies:
+        plan.rows.append(Row("paper_figures", f"{len(copies)} copies", jobs=len(copies),
+                             bytes=len(copies) * FIGURE_BYTES))
+    try:
+        probe = Path(results)
+        while not probe.exists():
+            probe = probe.parent
+        import shutil
+
+        plan.free_bytes = shutil.disk_usage(probe).free
+    except OSError:
+        plan.free_bytes = None
+    return plan
+
+
+def _add(row, cells, jobs, nbytes, cpu_s):
+    row.cells += cells
+    row.jobs += jobs
+    row.bytes += nbytes + jobs * FILE_OVERHEAD
+    row.cpu_s += cpu_s
