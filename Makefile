@@ -6,10 +6,17 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 CORES  ?= 2
+# your own config, layered on config/config.yaml: make CONFIG=my_study.yaml
+CONFIG ?=
+CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
 
-.PHONY: all test test-fast test-slow bench lint clean
+.PHONY: all plan test test-fast test-slow bench lint clean
+# checks the config, prints the plan, recovers from a killed run, then runs Snakemake
 all: $(STAMP)
-	$(BIN)/snakemake --cores $(CORES) --profile workflow/profiles/default
+	$(BIN)/python -m vibroimpact run --cores $(CORES) $(CONFIG_ARGS)
+
+plan: $(STAMP)
+	$(BIN)/python -m vibroimpact plan --cores $(CORES) $(CONFIG_ARGS)
 
 $(STAMP): environment.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)

@@ -18,6 +18,16 @@ except configuration.ConfigError as err:
 config.clear()
 config.update(_config)
 
+if workflow.is_main_process:    # not again in each job of a cluster run
+    from snakemake.logging import logger
+
+    from vibroimpact._files import sweep_stale_temporaries
+    from vibroimpact.pipeline.io import check_readable
+
+    logger.info(f"vibroimpact plan: {PLAN.summary(workflow.resource_settings.cores or 1)}")
+    sweep_stale_temporaries("results")      # of writers killed outright (SIGKILL)
+    check_readable("results")               # a damaged result: one line, before any job
+
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/noise.smk"

@@ -16,7 +16,7 @@ FIGURES = [f"fig{n:02d}" for n in range(3, 17)] + ["fig15_vs_fig16"]
 
 
 def _workdir(tmp_path):
-    for item in ("Snakefile", "config", "workflow"):
+    for item in ("Snakefile", "config", "workflow", "profiles"):
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
     return tmp_path

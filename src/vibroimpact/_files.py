@@ -1,10 +1,40 @@
 """The one atomic-write helper: a result appears under its final name complete, or not at all."""
 import contextlib
 import os
-import secrets
 from pathlib import Path
+import re
+import secrets
+import signal
+import socket
+import threading
+import time
 
-__all__ = ["atomic_path"]
+__all__ = ["atomic_path", "sweep_stale_temporaries", "TEMP_PATTERN"]
+
+#: Temporary names: ``.<name>.<pid>.<random>@<host>.tmp`` beside the final file, so a later
+#: run can tell whose they are (the writer's process, on which machine).
+TEMP_PATTERN = re.compile(r"^\.(?P<name>.+)\.(?P<pid>[0-9]+)\.[0-9a-f]{12}@(?P<host>.+)\.tmp$")
+
+#: A temporary file of another machine untouched this long is stale (its writer is gone).
+STALE_ELSEWHERE_S = 2 * 24 * 3600.0
+
+
+def _raise_exit(signum, frame):
+    raise SystemExit(128 + signum)
+
+
+@contextlib.contextmanager
+def _terminate_as_exit():
+    """While writing, SIGTERM unwinds like Ctrl-C (so ``finally`` removes the temporary)."""
+    if threading.current_thread() is not threading.main_thread() \
+            or signal.getsignal(signal.SIGTERM) is not signal.SIG_DFL:
+        yield
+        return
+    signal.signal(signal.SIGTERM, _raise_exit)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
 @contextlib.contextmanager
@@ -12,10 +42,12 @@ def atomic_path(path):
     """Yield a fresh temporary path beside ``path``; rename it to ``path`` if the block succeeds.
 
     The temporary name is in the target's directory (so :func:`os.replace` is a rename on one
-    file system) and starts with a dot; it is not created here, so the writer creates it with
-    the usual umask permissions. On any exception, including an interrupt, the temporary file
-    is removed and ``path`` is left as it was: a failed or interrupted run never leaves a
-    half-written file under a name a later run would trust.
+    file system), starts with a dot and names its writer (:data:`TEMP_PATTERN`); it is not
+    created here, so the writer creates it with the usual umask permissions. On any
+    exception, an interrupt (SIGINT) or a SIGTERM, the temporary file is removed and
+    ``path`` is left as it was: a failed or interrupted run never leaves a half-written file
+    under a name a later run would trust. A writer killed outright (SIGKILL) leaves its
+    temporary, which :func:`sweep_stale_temporaries` removes at the next start.
 
     Parameters
     ----------
@@ -24,10 +56,49 @@ def atomic_path(path):
     """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{secrets.token_hex(6)}.tmp")
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.{secrets.token_hex(6)}"
+                         f"@{socket.gethostname()}.tmp")
+    with _terminate_as_exit():
+        try:
+            yield str(tmp)
+            os.replace(tmp, path)
+        finally:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+
+
+def _alive(pid):
     try:
-        yield str(tmp)
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    return True
+
+
+def sweep_stale_temporaries(root):
+    """Remove the temporary files of writers that are gone, under directory ``root``.
+
+    A temporary of this machine is stale when its writer's process is no longer alive; one
+    written on another machine (a cluster node) when untouched for two days. A live
+    writer's temporary is never touched. Returns the removed paths.
+    """
+    root, host, now, removed = Path(root), socket.gethostname(), time.time(), []
+    if not root.is_dir():
+        return removed
+    for tmp in root.rglob(".*.tmp"):
+        match = TEMP_PATTERN.match(tmp.name)
+        if match is None:
+            continue
+        stale = False
+        if match["host"] == host:
+            stale = not _alive(int(match["pid"]))
+        else:
+            with contextlib.suppress(FileNotFoundError):
+                stale = now - tmp.stat().st_mtime > STALE_ELSEWHERE_S
+        if stale:
+            with contextlib.suppress(FileNotFoundError):
+                tmp.unlink()
+                removed.append(tmp)
+    return removed

@@ -737,16 +737,17 @@ class Plan:
     def format(self, cores=2):
         lines = ["vibroimpact plan (every output of `rule all`, whether or not already built):"]
         width = max([len(r.key) for r in self.rows] + [10])
+        lines.append(f"  {'entry':<{width}}  {'jobs':>4}  {'outputs':>8}  {'CPU':>8}  what")
         for r in self.rows:
-            lines.append(f"  {r.key:<{width}}  {r.jobs:>4} jobs  {_bytes(r.bytes):>8}  "
+            lines.append(f"  {r.key:<{width}}  {r.jobs:>4}  {_bytes(r.bytes):>8}  "
                          f"~{_time(r.cpu_s):>7}  {r.detail}")
         lines.append(f"  total: {self.summary(cores)}")
         lim = self.limits
-        lines.append(f"  limits: {self.cells:,}/{lim['max_cells']:,} cells (limits.max_cells), "
-                     f"{self.orbit_cells:,}/{lim['max_orbit_cells']:,} orbit cells "
-                     f"(limits.max_orbit_cells), {self.jobs}/{lim['max_jobs']} jobs "
-                     f"(limits.max_jobs), {_bytes(self.bytes)}/{_num(lim['max_disk_gb'])} GB "
-                     f"(limits.max_disk_gb)"
+        lines.append(f"  limits: {self.cells:,} of {lim['max_cells']:,} cells (limits.max_cells), "
+                     f"{self.orbit_cells:,} of {lim['max_orbit_cells']:,} orbit cells "
+                     f"(limits.max_orbit_cells),")
+        lines.append(f"          {self.jobs} of {lim['max_jobs']} jobs (limits.max_jobs), "
+                     f"{_bytes(self.bytes)} of {_num(lim['max_disk_gb'])} GB (limits.max_disk_gb)"
                      + (f"; {_bytes(self.free_bytes)} free under {self.results}"
                         if self.free_bytes is not None else ""))
         return "\n".join(lines)

@@ -1,14 +1,69 @@
-"""Files: atomic netCDF writes, provenance attributes, the noise record.
+"""Files: atomic netCDF writes, checked reads, the noise record.
 
 A failed or interrupted write never leaves a file under the final name: everything is
-written to a temporary name in the same directory and renamed into place on success.
+written to a temporary name in the same directory and renamed into place on success. A file
+that cannot be read (truncated or damaged by something else) gives :class:`CorruptFileError`:
+one line naming the file and telling to delete it, never a traceback from HDF5.
 """
+import contextlib
 import os
+from pathlib import Path
 
 import netCDF4
 import numpy as np
 
 from vibroimpact._files import atomic_path
+
+__all__ = ["CorruptFileError", "check_readable", "load_dataset", "write_dataset", "write_noise",
+           "noise_spec", "read_noise_attrs", "read_input_correlation", "read_noise"]
+
+
+class CorruptFileError(OSError):
+    """A result file that exists but cannot be read; ``str()`` is one line."""
+
+    def __init__(self, path, reason):
+        reason = str(reason).strip().splitlines()[-1] if str(reason).strip() else type(reason).__name__
+        super().__init__(f"{path}: cannot be read as netCDF ({reason}): the file is truncated "
+                         f"or corrupt; delete it and run again, it will be rebuilt")
+        self.path = Path(path)
+
+
+@contextlib.contextmanager
+def _reading(path):
+    """Turn a failure to read an existing ``path`` into :class:`CorruptFileError`."""
+    try:
+        yield
+    except FileNotFoundError:
+        raise
+    except (OSError, RuntimeError, ValueError, KeyError, IndexError) as err:
+        if not Path(path).is_file():
+            raise
+        raise CorruptFileError(path, err) from None
+
+
+def _open(path):
+    with _reading(path):
+        return netCDF4.Dataset(os.fspath(path), "r")
+
+
+def load_dataset(path):
+    """``xarray.load_dataset`` of a result file, or :class:`CorruptFileError`."""
+    import xarray as xr
+
+    with _reading(path):
+        return xr.load_dataset(path, engine="netcdf4")
+
+
+def check_readable(root):
+    """Open every netCDF file under ``root`` (not the temporaries); the unreadable ones
+    raise :class:`CorruptFileError` (the first one found) before any job would use them."""
+    root = Path(root)
+    if not root.is_dir():
+        return
+    for path in sorted(root.rglob("*.nc")):
+        if path.name.startswith("."):
+            continue
+        _open(path).close()
 
 
 def write_dataset(ds, path):
@@ -92,13 +147,13 @@ def noise_spec(nc_attrs):
 
 def read_noise_attrs(path):
     """Global attributes of a noise file (its spec, seed and provenance)."""
-    with netCDF4.Dataset(os.fspath(path), "r") as nc:
+    with _open(path) as nc:
         return {k: nc.getncattr(k) for k in nc.ncattrs()}
 
 
 def read_input_correlation(path):
     """``(lag, phi_estimate, phi_target)``: the random input's autocorrelation (eq. 8)."""
-    with netCDF4.Dataset(os.fspath(path), "r") as nc:
+    with _open(path) as nc, _reading(path):
         return tuple(np.asarray(nc.variables[k][:]) for k in ("lag", "phi_estimate", "phi_target"))
 
 
@@ -108,12 +163,13 @@ def read_noise(path, max_in_memory=2**26):
     Records up to ``max_in_memory`` samples are read into memory once; longer ones are
     returned as the netCDF variable, which the simulator reads chunk by chunk.
     """
-    nc = netCDF4.Dataset(os.fspath(path), "r")
-    var = nc.variables["r"]
-    var.set_auto_mask(False)
-    attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
-    if var.shape[0] <= max_in_memory:
-        samples = var[:]
-        nc.close()
-        return samples, float(attrs["dt"]), attrs
+    nc = _open(path)
+    with _reading(path):
+        var = nc.variables["r"]
+        var.set_auto_mask(False)
+        attrs = {k: nc.getncattr(k) for k in nc.ncattrs()}
+        if var.shape[0] <= max_in_memory:
+            samples = var[:]
+            nc.close()
+            return samples, float(attrs["dt"]), attrs
     return var, float(attrs["dt"]), attrs

@@ -8,8 +8,7 @@ entry the task reads (the workflow passes nothing else, so nothing else can reru
 """
 import contextlib
 import logging
-
-import xarray as xr
+import sys
 
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.figures import figure_variant
@@ -23,12 +22,20 @@ _NOISE_FIELDS = ("kind", "rms", "dt", "beta_c", "zeta_f")
 
 @contextlib.contextmanager
 def logged(path):
-    """Send this job's log messages, warnings and, on failure, its traceback to ``path``."""
+    """Send this job's log messages, warnings and, on failure, its traceback to ``path``.
+
+    An unreadable input file (:class:`~vibroimpact.pipeline.io.CorruptFileError`) ends the
+    job with its one-line message on stderr (the traceback goes to the log only).
+    """
     logging.basicConfig(filename=path, level=logging.INFO, force=True,
                         format="%(asctime)s %(levelname)s %(message)s")
     logging.captureWarnings(True)
     try:
         yield
+    except io.CorruptFileError as err:
+        log.exception("job failed")
+        print(f"error: {err}", file=sys.stderr)
+        raise SystemExit(1) from None
     except BaseException:
         log.exception("job failed")
         raise
@@ -162,7 +169,7 @@ def trace(name, block, noise_path, out):
 def aggregate(name, block, kind, tiles, out, noise_path=None):
     """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: one dataset per study."""
     study = Study.from_config(name, block)
-    parts = [xr.load_dataset(p) for p in tiles]
+    parts = [io.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)
     attrs.update(provenance(block, attrs.get("seed")))
     if kind == "events":
@@ -187,7 +194,7 @@ def figure(target, inputs, out_png, options):
     name, _ = figure_variant(target)
     log.info("drawing %s from %s with %s", target, inputs, options)
     with plotting.style():
-        fig = getattr(plotting, name)(*[xr.load_dataset(p) for p in inputs], **options)
+        fig = getattr(plotting, name)(*[io.load_dataset(p) for p in inputs], **options)
         plotting.save(fig, out_png)
 
 
@@ -213,6 +220,6 @@ def orbit_tile(entry, tile, out, threads=None):
 
 def aggregate_orbits(entry, tiles, out):
     """Rule ``aggregate_orbits``: the orbit map of one entry from its tiles."""
-    ds = datasets.concat_orbit_tiles([xr.load_dataset(p) for p in tiles])
+    ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles])
     ds.attrs.update(provenance(entry))
     io.write_dataset(ds, out)

@@ -1,0 +1,123 @@
+"""``python -m vibroimpact``: the project's entry point (``make`` calls ``run``).
+
+``plan``  reads and checks the config (the paper's, with ``--configfile`` files layered on
+          it) and prints what a build would make: cells, jobs, disk and a rough time.
+``run``   does the same checks, then prepares the directory and hands over to Snakemake:
+          removes the temporaries of writers that are gone, refuses an unreadable result
+          file (naming it), clears a lock left by a killed run when no run is alive in this
+          directory, and replaces itself with ``snakemake`` (the default profile,
+          ``profiles/default``, reruns the jobs a crash interrupted).
+
+A config file with a YAML syntax error is reported with its file, line and column here,
+before Snakemake's own loader (which drops the location) ever sees it.
+"""
+import argparse
+import os
+from pathlib import Path
+import shutil
+import subprocess
+import sys
+
+from vibroimpact import _files
+from vibroimpact.pipeline import configuration, io
+
+__all__ = ["main"]
+
+
+def _parser():
+    parser = argparse.ArgumentParser(
+        prog="python -m vibroimpact",
+        description="Check, plan and build the vibroimpact workflow (README).")
+    sub = parser.add_subparsers(dest="command", required=True)
+    for name, text in (("plan", "check the config and print what a build would make"),
+                       ("run", "check, prepare and build (extra arguments go to snakemake)")):
+        p = sub.add_parser(name, help=text, description=text)
+        p.add_argument("--configfile", action="append", default=[], metavar="FILE",
+                       help="your config file, layered on config/config.yaml (README); "
+                            "repeat for several")
+        p.add_argument("--cores", type=int, default=2, help="cores of the build (default 2)")
+        p.add_argument("--directory", default=".", help="the project directory (default .)")
+        p.add_argument("-v", "--verbose", action="store_true",
+                       help="also print the schema validator's full output on a config error")
+    return parser
+
+
+def _fail(message, code=2):
+    for line in str(message).splitlines():
+        print(f"error: {line}" if line and not line.startswith(" ") else line, file=sys.stderr)
+    return code
+
+
+def live_snakemake_runs(root):
+    """Processes running Snakemake in directory ``root`` (not their job processes)."""
+    import psutil
+
+    root, found = Path(root).resolve(), []
+    for proc in psutil.process_iter(["pid", "cmdline"]):
+        try:
+            cmd = proc.info["cmdline"] or []
+            main = any(Path(a).name == "snakemake" for a in cmd[:2]) or (
+                "-m" in cmd[:3] and "snakemake" in cmd[:4])
+            if main and proc.pid != os.getpid() and Path(proc.cwd()).resolve() == root:
+                found.append(proc)
+        except (psutil.Error, OSError):
+            continue
+    return found
+
+
+def _snakemake():
+    exe = Path(sys.executable).with_name("snakemake")
+    return str(exe) if exe.exists() else (shutil.which("snakemake") or "snakemake")
+
+
+def _clear_stale_lock(root, config_args):
+    """``snakemake --unlock`` when a killed run left its lock and no run is alive here."""
+    locks = root / ".snakemake" / "locks"
+    if not locks.is_dir() or not any(locks.iterdir()):
+        return 0
+    alive = live_snakemake_runs(root)
+    if alive:
+        pids = ", ".join(str(p.pid) for p in alive)
+        return _fail(f"another Snakemake run is alive in {root} (pid {pids}); wait for it to "
+                     f"finish, or stop it (kill {pids}) and run again", code=1)
+    print("vibroimpact: clearing the lock left by a run that did not finish (no run is alive "
+          "here)", file=sys.stderr)
+    out = subprocess.run([_snakemake(), "--unlock", *config_args], cwd=root,
+                         capture_output=True, text=True)
+    if out.returncode != 0:
+        return _fail(f"snakemake --unlock failed:\n{out.stderr[-2000:]}", code=1)
+    return 0
+
+
+def main(argv=None):
+    args, extra = _parser().parse_known_args(argv)
+    if args.command == "plan" and extra:
+        return _fail(f"unknown arguments {extra}; plan takes --configfile, --cores, -v")
+    if args.verbose:
+        os.environ[configuration.VERBOSE_ENV] = "1"
+    root = Path(args.directory).resolve()
+    try:
+        _, plan = configuration.load(root=root, user_files=args.configfile)
+    except configuration.ConfigError as err:
+        return _fail(err)
+    print(plan.format(args.cores), file=sys.stderr if args.command == "run" else sys.stdout)
+    if args.command == "plan":
+        return 0
+    removed = _files.sweep_stale_temporaries(root / "results")
+    if removed:
+        print(f"vibroimpact: removed {len(removed)} temporary file(s) of interrupted writes",
+              file=sys.stderr)
+    try:
+        io.check_readable(root / "results")
+    except io.CorruptFileError as err:
+        return _fail(err, code=1)
+    config_args = ["--configfile", *args.configfile] if args.configfile else []
+    code = _clear_stale_lock(root, config_args)
+    if code:
+        return code
+    # targets before --configfile, which would take them as more config files
+    cmd = [_snakemake(), "--cores", str(args.cores), *extra, *config_args]
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os.chdir(root)
+    os.execv(cmd[0], cmd)
