@@ -4,6 +4,7 @@ from pathlib import Path
 import shutil
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -122,9 +123,36 @@ def test_end_to_end(built):
     ds = xr.load_dataset(built / "results" / "datasets" / "random_events.nc")
     for name, var in ds.data_vars.items():
         assert var.attrs.get("long_name") and "units" in var.attrs, name
-    for key in ("package_version", "git_commit", "config_digest", "seed", "paper_reference"):
-        assert key in ds.attrs
+    for key in ("package_version", "git_commit", "git_dirty", "config_digest", "seed",
+                "paper_reference", "n_batches", "bins", "motion_window"):
+        assert key in ds.attrs, key
     assert not list(built.rglob("results/**/*.tmp")), "temporary files left behind"
+
+
+@pytest.mark.workflow
+def test_every_dataset_carries_its_config_block_and_creation_time(built):
+    """Provenance: the block the rule's params carry, as YAML, and the statistical settings."""
+    from datetime import datetime
+
+    test = yaml.safe_load((ROOT / "config" / "test.yaml").read_text())
+    random = test["studies"]["random"]
+    for path in sorted((built / "results").rglob("*.nc")):
+        attrs = xr.open_dataset(path).attrs
+        for key in ("config", "config_digest", "created", "package_version", "git_commit",
+                    "git_dirty"):
+            assert key in attrs, (path, key)
+        datetime.fromisoformat(attrs["created"])
+        assert isinstance(yaml.safe_load(attrs["config"]), dict), path
+    events = xr.open_dataset(built / "results" / "datasets" / "random_events.nc").attrs
+    block = yaml.safe_load(events["config"])
+    assert block["delta"] == random["delta"] and block["bins"] == random["bins"]
+    assert events["transient"] == random["transient"] and events["n_batches"] == random["n_batches"]
+    n, dt = test["noises"]["random_input"]["n_samples"], test["noises"]["random_input"]["dt"]
+    assert events["record_length"] == pytest.approx((n - 1) * dt - random["transient"])
+    assert yaml.safe_load(events["bins"]) == random["bins"]
+    spectra = xr.open_dataset(built / "results" / "datasets" / "random_spectra.nc").attrs
+    assert spectra["nperseg"] == random["spectra"]["nperseg"]
+    assert spectra["t_end"] == random["spectra"]["t_end"]
 
 
 @pytest.mark.workflow
@@ -133,14 +161,82 @@ def test_rerun_does_nothing(built):
     assert "Nothing to be done" in out.stdout + out.stderr
 
 
+def _data_files(root):
+    """Every dataset of a build except the per-job tiles: noise, traces, studies, orbits."""
+    return sorted(p.relative_to(root) for p in (root / "results").rglob("*.nc")
+                  if "cells" not in p.parts and "tiles" not in p.parts)
+
+
+def _data(path):
+    """A dataset without its attributes (``created`` ...) and run measurements (CPU times)."""
+    ds = xr.load_dataset(path)
+    timings = [v for v in ds.variables if ds[v].attrs.get("run_measurement") == 1]
+    return ds.drop_vars(timings).drop_attrs()
+
+
+def assert_same_data(a, b):
+    """The datasets of two builds hold identical data (attributes such as ``created`` aside)."""
+    files = _data_files(a)
+    assert files == _data_files(b)
+    assert len(files) >= 10
+    for name in files:
+        xr.testing.assert_identical(_data(a / name), _data(b / name))
+
+
 @pytest.mark.workflow
-def test_same_config_same_datasets(built, tmp_path):
+def test_same_data_between_runs_and_between_one_and_two_cores(built, tmp_path):
+    """Every dataset again, on one core (the orbit tiles run numba on one thread instead of
+    two): bit-identical data."""
     again = _workdir(tmp_path)
-    run(again, "results/datasets/random_events.nc", "results/datasets/random_spectra.nc")
-    for name in ("random_events.nc", "random_spectra.nc"):
-        a = xr.load_dataset(built / "results" / "datasets" / name)
-        b = xr.load_dataset(again / "results" / "datasets" / name)
-        xr.testing.assert_identical(a.drop_attrs(), b.drop_attrs())
+    targets = [str(p) for p in _data_files(built)]
+    out = subprocess.run([SNAKEMAKE, *targets, "--cores", "1", "--configfile", "config/test.yaml"],
+                         cwd=again, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert_same_data(built, again)
+
+
+@pytest.mark.workflow
+def test_kill_mid_simulation_then_the_readme_command_gives_the_same_datasets(built, tmp_path):
+    """SIGKILL of a build while simulation jobs run (the jobs are orphaned and may still
+    write; the lock and the incomplete markers stay), then the README's command again."""
+    again = _workdir(tmp_path)
+    cmd = [sys.executable, "-m", "vibroimpact", "run", "--configfile", "config/test.yaml"]
+    proc = subprocess.Popen(cmd, cwd=again, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    logs = again / "results" / "logs"
+    deadline = time.monotonic() + 300
+    while not list(logs.glob("simulate_*/**/*.log")):
+        assert proc.poll() is None, "the build ended before any simulation started"
+        assert time.monotonic() < deadline, "no simulation started within 300 s"
+        time.sleep(0.1)
+    time.sleep(1.0)
+    proc.kill()                      # `run` replaced itself with snakemake: this kills it
+    proc.wait()
+    assert any((again / ".snakemake" / "locks").iterdir()), "the killed run left no lock"
+    out = subprocess.run(cmd, cwd=again, capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert "clearing the lock" in out.stderr
+    assert not list((again / "results").rglob("*.tmp")), "temporary files left behind"
+    assert_same_data(built, again)
+
+
+@pytest.mark.workflow
+def test_truncated_dataset_stops_the_build_with_one_line_and_deletes_nothing(built, tmp_path):
+    copy = _workdir(tmp_path)
+    shutil.copytree(built / "results", copy / "results")
+    bad = copy / "results" / "datasets" / "random_events.nc"
+    with open(bad, "r+b") as f:
+        f.truncate(bad.stat().st_size // 2)
+    figures_before = sorted((copy / "results" / "figures").rglob("*.png"))
+    for cmd in ([sys.executable, "-m", "vibroimpact", "run", "--configfile", "config/test.yaml"],
+                [SNAKEMAKE, "--cores", "2", "--configfile", "config/test.yaml"]):
+        out = subprocess.run(cmd, cwd=copy, capture_output=True, text=True, timeout=300)
+        assert out.returncode != 0
+        lines = [l for l in (out.stdout + out.stderr).splitlines()
+                 if "results/datasets/random_events.nc" in l]
+        assert lines and "delete it" in lines[0], out.stdout + out.stderr
+        assert "Traceback" not in out.stderr
+        assert sorted((copy / "results" / "figures").rglob("*.png")) == figures_before
+    assert bad.exists()              # named, not deleted behind the user's back
 
 
 # --- the paper's findings 1-4 (docs/figures.md) on the datasets of the test config -------------

@@ -103,6 +103,10 @@ def compose(paper, user):
     """
     if not user:
         return copy.deepcopy(paper), None
+    replace = user.get("replace", False)
+    if not isinstance(replace, (bool, list)):
+        raise ConfigError(f"replace = {_short(replace)}: not allowed; allowed: true, or a list "
+                          f"of section.name, e.g. replace: [studies.random]")
     config = copy.deepcopy(paper)
     problems = []
     for key, value in user.items():
@@ -228,8 +232,8 @@ def _schema_at(parts):
     return node
 
 
-def _describe(parts):
-    node = _schema_at(parts)
+def _describe(parts, node=None):
+    node = node if node is not None else _schema_at(parts)
     text = allowed(node) if node else "see config/schema.yaml"
     desc = node.get("description", "").strip() if node else ""
     if desc and desc != text and "oneOf" not in node:
@@ -272,13 +276,14 @@ def _schema_messages(error):
         extra = [k for k in error.instance if k not in known]
         return [f"{_path(parts + [k])}: unknown key; allowed keys here: {', '.join(known)}"
                 for k in extra]
-    if kind == "propertyNames":
-        name = error.instance
-        return [f"{where}: the name {name!r} is not allowed; allowed: letters, digits and _, "
-                f"starting with a letter"]
+    if "propertyNames" in error.schema_path:
+        return [f"{where}: the name {error.instance!r} is not allowed; allowed: letters, "
+                f"digits and _, starting with a letter"]
     if kind in ("minProperties", "minItems") and not error.instance:
         return [f"{where}: empty; allowed: {_describe(parts)}"]
-    return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts)}"]
+    # the failing node itself (a figure name's pattern, not the figure item's oneOf)
+    node = error.schema if isinstance(error.schema, dict) and "oneOf" not in error.schema else None
+    return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts, node)}"]
 
 
 def _validator(schema):
@@ -471,9 +476,9 @@ def _check_figures(config, section, name, entry, problems, grids):
 
 def _figure_keys(fig):
     spec = figures.FIGURES[fig]
-    keys = ["name", *([spec["per"]] if spec.get("per") else []), *spec.get("options", ()),
+    keys = [*([spec["per"]] if spec.get("per") else []), *spec.get("options", ()),
             *spec.get("sources", ()), *(["beta_max"] if "spectra" in spec["reads"] else [])]
-    return ", ".join(keys)
+    return f"name, {', '.join(keys)}" if keys else f"only name ({fig} has no options)"
 
 
 def _check_orbits_item(config, name, entry, at, fig, item, problems):
@@ -529,6 +534,11 @@ def _check_study(config, name, entry, problems, limits):
             problems.add(f"{where}.spectra.t_end", spectra["t_end"],
                          f"longer than the noise record ({record})",
                          f"transient < t_end <= {tau:.6g}, or null")
+        elif s_end <= transient:
+            if transient < end:
+                problems.add(f"{where}.spectra.t_end", spectra["t_end"],
+                             f"leaves no record after the transient ({_num(transient)})",
+                             f"{_num(transient)} < t_end <= {tau:.6g}, or null")
         else:
             samples = int((s_end - transient) / dt)
             if samples < int(spectra["nperseg"]):
@@ -605,7 +615,7 @@ def _check_paper_figures(config, problems):
                          ", ".join(sorted(config[section])))
             continue
         names = [f if isinstance(f, str) else f["name"] for f in config[section][name]["figures"]]
-        if fig not in names:
+        if names and fig not in names:      # (an empty list is reported with its entry)
             problems.add(where, name, f"{section}.{name} does not list {fig} in its figures",
                          f"an entry listing {fig}, or add {fig} to {section}.{name}.figures")
 

@@ -77,10 +77,17 @@ _HARMONIC_SCALARS = ("ratio_beyond",)
 _HARMONIC_DENSITIES = (("ratio_density", "ratio"), ("ratio_density_stderr", "ratio"))
 
 
+#: Variables that measure the run that made the file (like the attribute ``created``), not
+#: results: flagged ``run_measurement = 1``; every other variable is bit-identical between runs.
+RUN_MEASUREMENTS = ("cpu_time",)
+
+
 def _annotate(ds):
     for name in list(ds.variables):
         if name in META:
             ds[name].attrs.update(long_name=META[name][0], units=META[name][1])
+        if name in RUN_MEASUREMENTS:
+            ds[name].attrs["run_measurement"] = 1
     return ds
 
 

@@ -2,8 +2,8 @@
 
 `provenance` is called by each job at run time (never passed through the workflow's params,
 so a commit alone reruns nothing) and records the package version, the git commit of the
-package's source tree with a dirty flag, the digest of the config block the job read, the
-seed and the paper's reference. `source_digest` is what the workflow puts in params instead:
+package's source tree with a dirty flag, the config block the job read (YAML text and
+digest), the creation time, the seed and the paper's reference. `source_digest` is what the workflow puts in params instead:
 a digest of the package sources an output depends on, so editing them (committed or not)
 reruns exactly the jobs they feed.
 """
@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 import subprocess
 
-__all__ = ["config_digest", "source_digest", "git_state", "provenance"]
+__all__ = ["config_digest", "config_text", "source_digest", "git_state", "provenance"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -71,21 +71,36 @@ def git_state():
     return commit, dirty
 
 
+def config_text(obj):
+    """The YAML text of a config fragment, keys sorted (what a dataset's ``config`` holds)."""
+    import yaml
+
+    return yaml.safe_dump(obj, sort_keys=True, default_flow_style=None, width=100)
+
+
 def provenance(config_block, seed=None):
     """Global attributes every output carries, collected now (at run time).
+
+    ``config`` (the block as YAML text: the same block the rule's params carry, so the
+    dataset says what it was computed from), ``config_digest``, ``created`` (UTC, ISO
+    8601), ``package_version``, ``git_commit`` and ``git_dirty``, ``paper_reference``.
 
     Parameters
     ----------
     config_block : mapping
-        The config the job read (its digest is recorded).
+        The config the job read.
     seed : int, optional
         The seed of the random input the output derives from.
     """
+    from datetime import datetime, timezone
+
     from vibroimpact import PAPER_REFERENCE, __version__
 
     commit, dirty = git_state()
     attrs = dict(package_version=__version__, git_commit=commit, git_dirty=dirty,
-                 config_digest=config_digest(config_block), paper_reference=PAPER_REFERENCE)
+                 config=config_text(config_block), config_digest=config_digest(config_block),
+                 created=datetime.now(timezone.utc).isoformat(timespec="seconds"),
+                 paper_reference=PAPER_REFERENCE)
     if seed is not None:
         attrs["seed"] = int(seed)
     return attrs

@@ -12,7 +12,7 @@ import sys
 
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.figures import figure_variant
-from vibroimpact.pipeline.provenance import provenance
+from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import Study, grid_values, map_cap_steps, orbit_rows
 
 log = logging.getLogger("vibroimpact")
@@ -60,11 +60,18 @@ def make_noise(entry, out):
 
 def _study_attrs(study, block, noise_attrs):
     noise = {k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}
-    attrs = dict(provenance([block, noise], int(noise_attrs["seed"])), study=study.name,
+    attrs = dict(provenance(block, int(noise_attrs["seed"])), study=study.name,
                  zeta=study.zeta, eps=study.eps, amplitude=study.amplitude,
                  noise=block["noise"], dt=float(noise_attrs["dt"]))
     attrs.update(noise)
     return attrs
+
+
+def _record_attrs(block, t_end, n_samples, dt):
+    """The statistical record: ``transient``, ``t_end`` (resolved) and ``record_length``."""
+    end = (n_samples - 1) * dt if t_end is None else float(t_end)
+    return dict(transient=float(block["transient"]), t_end=end,
+                record_length=end - float(block["transient"]))
 
 
 def _physics(study, cell):
@@ -88,6 +95,8 @@ def events_tile(name, block, tile, noise_path, out):
             motion_window=float(block["motion_window"]), motions=study.motions))
     ds = datasets.events_tile(study.tile(tile, "events"), results, edges,
                               dict(_study_attrs(study, block, noise_attrs),
+                                   **_record_attrs(block, block.get("t_end"), len(samples), dt),
+                                   n_batches=int(block["n_batches"]), bins=config_text(block["bins"]),
                                    motion_window=float(block["motion_window"])),
                               motions=study.motions)
     io.write_dataset(ds, out)
@@ -147,7 +156,9 @@ def spectra_tile(name, block, tile, noise_path, out):
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
             t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"])))
     ds = datasets.spectra_tile(study.tile(tile, "spectra"), results,
-                               _study_attrs(study, block, noise_attrs))
+                               dict(_study_attrs(study, block, noise_attrs),
+                                    **_record_attrs(block, spectra.get("t_end"), len(samples), dt),
+                                    nperseg=int(spectra["nperseg"])))
     io.write_dataset(ds, out)
 
 
@@ -162,7 +173,7 @@ def trace(name, block, noise_path, out):
     tr = cells.trace(samples, dt, zeta=study.zeta, eps=study.eps, delta=float(spec["delta"]),
                      amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
     attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
-                 beta_f=1.0 / inv_beta)
+                 beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
 
 

@@ -1,0 +1,384 @@
+"""Malformed configs, one realistic user mistake each, refused before any job runs.
+
+Each case is built from ``config/test.yaml`` (``paper: false``, ``replace: true``: it stands
+alone) with one value changed at a key path, or is a small file of its own layered on the
+paper's ``config/config.yaml``. A case names the key path its message must show and a
+fragment of the allowed range or of the remedy.
+
+- The fast suite calls :func:`configuration.load` on each case: it must raise
+  :class:`ConfigError` with that key path and fragment, one or two lines per problem.
+- The ``workflow`` suite runs the real ``snakemake --cores 1 --configfile bad.yaml`` (no dry
+  run) on each case in one copy of the project: it must fail at parse time with the same
+  message, and no job may have run (nothing under ``results``, no incomplete markers).
+"""
+import copy
+from dataclasses import dataclass
+import math
+from pathlib import Path
+import shutil
+import subprocess
+import sys
+import textwrap
+
+import pytest
+import yaml
+
+from vibroimpact.pipeline import configuration
+
+ROOT = Path(__file__).resolve().parents[1]
+SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+TEST_CONFIG = yaml.safe_load((ROOT / "config" / "test.yaml").read_text())
+
+DELETE = object()       # a value that removes the key instead
+APPEND = object()       # marker: the last path part appends to a list
+
+
+@dataclass(frozen=True)
+class Case:
+    """A malformed config: ``path``/``value`` changed in test.yaml, or ``text`` of its own."""
+
+    id: str
+    key: str                 # key path the message must name
+    fragment: str            # fragment of the allowed range / remedy
+    path: tuple = ()
+    value: object = None
+    text: str | None = None  # a user file of its own (layered on the paper's config)
+
+    def user(self):
+        """The user's config as ``--configfile`` would give it (a fresh dict)."""
+        if self.text is not None:
+            return yaml.safe_load(self.text)
+        cfg = copy.deepcopy(TEST_CONFIG)
+        node = cfg
+        for p in self.path[:-1]:
+            node = node[p]
+        last = self.path[-1]
+        if self.value is DELETE:
+            del node[last]
+        elif isinstance(last, tuple) and last[0] is APPEND:
+            node[last[1]].append(copy.deepcopy(last[2]))
+        elif isinstance(last, tuple) and last[0] == "rename":
+            node[last[2]] = node.pop(last[1])
+        else:
+            node[last] = copy.deepcopy(self.value)
+        return cfg
+
+    def yaml_text(self):
+        if self.text is not None:
+            return self.text
+        return yaml.safe_dump(self.user(), sort_keys=False)
+
+
+def _c(id, path, value, key, fragment):
+    return Case(id=id, key=key, fragment=fragment, path=tuple(path), value=value)
+
+
+def _own(id, text, key, fragment):
+    return Case(id=id, key=key, fragment=fragment, text=textwrap.dedent(text))
+
+
+R = ("studies", "random")
+H = ("studies", "harmonic")
+M = ("studies", "motion_map")
+O = ("orbits", "harmonic")
+N = ("noises", "random_input")
+
+CASES = [
+    # --- non-finite, out of range, wrong type, unknown keys -----------------------------------
+    _c("zeta_nan", R + ("zeta",), math.nan, "studies.random.zeta", "> 0"),
+    _c("eps_inf", R + ("eps",), math.inf, "studies.random.eps", "<= 1"),
+    _c("zeta_negative", R + ("zeta",), -0.05, "studies.random.zeta", "> 0 and < 1"),
+    _c("zeta_percent", H + ("zeta",), 5.0, "studies.harmonic.zeta", "< 1"),
+    _c("eps_above_one", R + ("eps",), 1.5, "studies.random.eps", ">= 0 and <= 1"),
+    _c("unknown_study_key", R + ("colour",), "red", "studies.random.colour",
+       "allowed keys here: noise, zeta, eps"),
+    _c("unknown_top_key", ("studys",), {}, "studys", "allowed keys here: paper, replace"),
+    _c("missing_delta", R + ("delta",), DELETE, "studies.random.delta",
+       "missing; allowed: A list of values, or {start, stop, step}"),
+    _c("grid_wrong_type", R + ("delta",), "-1 to 3", "studies.random.delta",
+       "{start, stop, step}"),
+    _c("grid_stop_below_start", R + ("delta",), {"start": 3.0, "stop": -1.0, "step": 0.5},
+       "studies.random.delta.stop", "stop >= start"),
+    _c("grid_step_zero", R + ("delta",), {"start": -1.0, "stop": 3.0, "step": 0.0},
+       "studies.random.delta.step", "> 0"),
+    _c("grid_step_tiny", R + ("delta",), {"start": -1.0, "stop": 3.0, "step": 1e-6},
+       "studies.random.delta", "limits.max_cells"),
+    _c("inv_beta_wrong_type", H + ("inv_beta",), "0.909, 1.1", "studies.harmonic.inv_beta",
+       "{start, stop, step}"),
+    # --- noise records ---------------------------------------------------------------------
+    _c("n_samples_huge", N + ("n_samples",), 10_000_000_000, "limits.max_disk_gb",
+       "raise limits.max_disk_gb"),
+    _c("n_samples_exponent_string", N + ("n_samples",), "4e5", "noises.random_input.n_samples",
+       "an integer >= 16"),
+    _c("noise_kind_typo", N + ("kind",), "bandlimited", "noises.random_input.kind",
+       "one of white, band_limited, lowpass2"),
+    _c("noise_nperseg_beyond_record", N + ("nperseg",), 500_000, "noises.random_input.nperseg",
+       "nperseg <= n_samples = 400001"),
+    _c("beta_c_above_nyquist", N + ("beta_c",), 40.0, "noises.random_input.beta_c",
+       "0 < beta_c <= 31.4159"),
+    _c("band_limited_without_beta_c", N + ("beta_c",), DELETE, "noises.random_input.beta_c",
+       "a number > 0"),
+    _c("white_with_beta_c", N + ("kind",), "white", "noises.random_input.beta_c",
+       "null (or leave it out)"),
+    _c("lowpass2_without_zeta_f", N + ("kind",), "lowpass2", "noises.random_input.zeta_f",
+       "a number > 0"),
+    _c("dt_zero", N + ("dt",), 0.0, "noises.random_input.dt", "> 0"),
+    _c("rms_negative", N + ("rms",), -0.5, "noises.random_input.rms", ">= 0"),
+    _c("seed_negative", N + ("seed",), -1, "noises.random_input.seed", ">= 0"),
+    # --- records: transient, t_end, spectra, trace ------------------------------------------
+    _c("transient_beyond_record", R + ("transient",), 50_000.0, "studies.random.transient",
+       "0 <= transient < 40000"),
+    _c("t_end_beyond_record", H + ("t_end",), 50_000.0, "studies.harmonic.t_end",
+       "<= 40000, or null for the whole record"),
+    _c("transient_not_below_t_end", H + ("transient",), 20_000.0, "studies.harmonic.transient",
+       "0 <= transient < 20000"),
+    _c("spectra_t_end_beyond_record", R + ("spectra", "t_end"), 50_000.0,
+       "studies.random.spectra.t_end", "<= 40000"),
+    _c("spectra_nperseg_beyond_spectra_record", R + ("spectra", "nperseg"), 500_000,
+       "studies.random.spectra.nperseg", "16 <= nperseg <= 199000"),
+    _c("spectra_delta_off_grid", R + ("spectra", "delta"), [3.0, 1.0, 0.3],
+       "studies.random.spectra.delta[2]", "-1, -0.5, ..., 3"),
+    _c("trace_t_end_beyond_record", R + ("trace", "t_end"), 50_000.0,
+       "studies.random.trace.t_end", "0 < t_end <= 40000"),
+    # --- study settings ------------------------------------------------------------------------
+    _c("tile_size_zero", R + ("tile_size",), 0, "studies.random.tile_size", ">= 1"),
+    _c("n_batches_one", R + ("n_batches",), 1, "studies.random.n_batches", ">= 2"),
+    _c("bins_n_zero", R + ("bins", "v_after", "n"), 0, "studies.random.bins.v_after.n", ">= 1"),
+    _c("motion_window_too_wide", H + ("motion_window",), 0.75, "studies.harmonic.motion_window",
+       "<= 0.5"),
+    _c("duplicated_motions", H + ("motions",), [[1, 1], [2, 1], [1, 1]],
+       "studies.harmonic.motions", "distinct [m, n] pairs"),
+    _c("motion_m_zero", H + ("motions",), [[0, 1], [1, 1]], "studies.harmonic.motions[0][0]",
+       ">= 1"),
+    _c("study_inv_beta_zero", H + ("inv_beta",), [0.0, 1.1], "studies.harmonic.inv_beta",
+       "values > 0"),
+    _c("unknown_noise", R + ("noise",), "random_inptu", "studies.random.noise",
+       "harmonic_input, random_input"),
+    _c("density_delta_off_grid", R + ("density_delta",), [1.0, 0.3],
+       "studies.random.density_delta[1]", "-1, -0.5, ..., 3"),
+    _c("entry_name_with_hyphen", ("studies", ("rename", "random", "random-fine")), None,
+       "random-fine", "letters, digits and _"),
+    # --- map ---------------------------------------------------------------------------------
+    _c("map_max_periods_beyond_record", M + ("map", "max_periods"), 5000,
+       "studies.motion_map.map.max_periods", "max_periods <= 2533"),
+    _c("map_target_stderr_zero", M + ("map", "target_stderr"), 0.0,
+       "studies.motion_map.map.target_stderr", "> 0"),
+    _c("map_min_time_beyond_record", M + ("map", "min_time"), 50_000.0,
+       "studies.motion_map.map.min_time", "0 < min_time <= 39800"),
+    # --- orbits --------------------------------------------------------------------------------
+    _c("orbits_inv_beta_from_zero", O + ("inv_beta",), {"start": 0.0, "stop": 3.0, "step": 0.3},
+       "orbits.harmonic.inv_beta.start", "values > 0"),
+    _c("orbits_type_m4", O + ("types",), [[1, 1], [2, 1], [1, 2], [4, 1]],
+       "orbits.harmonic.types[3]", "1 <= m <= 3"),
+    _c("orbits_duplicated_types", O + ("types",), [[1, 1], [2, 1], [1, 2], [1, 1]],
+       "orbits.harmonic.types", "distinct [m, n] pairs"),
+    _c("orbits_lists_study_figure", O + ("figures",), ["fig16", "fig07"],
+       "orbits.harmonic.figures[1]", "fig16"),
+    # --- figures -------------------------------------------------------------------------------
+    _c("fig03_without_trace", R + ("trace",), DELETE, "studies.random.trace",
+       "a `trace:` block"),
+    _c("fig06_without_spectra", R + ("spectra",), DELETE, "studies.random.spectra",
+       "a `spectra:` block"),
+    _c("figure_inv_beta_off_grid", H + ("figures",),
+       ["fig10", {"name": "fig11", "inv_beta": [0.9090909090909091]},
+        {"name": "fig12", "inv_beta": [1.2]}, {"name": "fig13", "inv_beta": [1.1]},
+        {"name": "fig14", "inv_beta": [1.1]}],
+       "studies.harmonic.figures[2].inv_beta[0]", "0.909091, 1.1"),
+    _c("figure_option_not_applicable", R + ("figures",),
+       ["fig03", "fig04", "fig05", "fig06", "fig07", "fig08",
+        {"name": "fig09", "density_delta": [0.0]}],
+       "studies.random.figures[6].density_delta", "not an option of fig09; allowed: name"),
+    _c("figure_listed_twice", R + ((APPEND, "figures", "fig07"),), None,
+       "studies.random.figures[7]", "each figure once"),
+    _c("figure_unknown_fig02", R + ("figures",),
+       ["fig02", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09"],
+       "studies.random.figures[0]", "fig03"),
+    _c("study_lists_orbits_figure", R + ("figures",),
+       ["fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09", "fig16"],
+       "studies.random.figures[7]", "fig15_vs_fig16"),
+    _c("harmonic_figure_without_amplitude", R + ((APPEND, "figures", "fig13"),), None,
+       "studies.random.amplitude", "amplitude != 0"),
+    _c("fig15_vs_fig16_without_orbits", M + ("figures",), ["fig15", "fig15_vs_fig16"],
+       "studies.motion_map.figures[1].orbits", "orbits: <name>"),
+    _c("fig15_vs_fig16_orbits_other_zeta", O + ("zeta",), 0.1,
+       "studies.motion_map.figures[1].orbits", "the same zeta and eps"),
+    _c("study_without_figures", R + ("figures",), [], "studies.random.figures",
+       "a list of figures from"),
+    _c("paper_figure_missing_entry", ("paper_figures", "fig07"), "randon", "paper_figures.fig07",
+       "harmonic, motion_map, random"),
+    _c("paper_figure_entry_without_it", ("paper_figures", "fig07"), "harmonic",
+       "paper_figures.fig07", "add fig07 to studies.harmonic.figures"),
+    # --- limits, layering ---------------------------------------------------------------------
+    _c("tiny_max_disk_gb", ("limits",), {"max_disk_gb": 0.001}, "limits.max_disk_gb",
+       "raise limits.max_disk_gb"),
+    _c("tiny_max_cells", ("limits",), {"max_cells": 10}, "limits.max_cells",
+       "raise limits.max_cells"),
+    _own("replace_as_a_string", """
+        paper: false
+        replace: studies.random
+        studies:
+          random:
+            noise: random_input
+            zeta: 0.1
+            eps: 0.5
+            delta: [0.0, 1.0]
+            figures: [fig09]
+        """, "studies.random", "replace: [studies.random]"),
+    _own("collision_without_replace", """
+        paper: false
+        studies:
+          random:
+            noise: random_input
+            zeta: 0.1
+            eps: 0.5
+            delta: [0.0, 1.0]
+            figures: [fig09]
+        """, "studies.random", "replace: [studies.random]"),
+    _own("replace_names_no_entry", """
+        paper: false
+        replace: [studies.random]
+        studies:
+          my_study:
+            noise: random_input
+            zeta: 0.05
+            eps: 0.5
+            delta: [0.0, 1.0]
+            figures: [fig09]
+        """, "replace", "<section>.<name>"),
+    _own("paper_false_builds_nothing", """
+        paper: false
+        noises:
+          my_noise:
+            kind: white
+            rms: 0.5
+            dt: 0.1
+            n_samples: 100001
+            seed: 1
+        """, "paper", "at least one study or orbits entry"),
+    _own("own_trace_beyond_own_noise", """
+        paper: false
+        noises:
+          short_input:
+            kind: white
+            rms: 0.5
+            dt: 0.1
+            n_samples: 10001
+            seed: 7
+        studies:
+          my_trace:
+            noise: short_input
+            zeta: 0.05
+            eps: 0.5
+            delta: [0.0]
+            trace: {delta: 0.0, t_end: 2000.0}
+            figures: [fig03]
+        """, "studies.my_trace.trace.t_end", "0 < t_end <= 1000"),
+]
+
+assert len({c.id for c in CASES}) == len(CASES), "case ids must be distinct"
+
+
+def _ids(cases):
+    return [c.id for c in cases]
+
+
+# --- fast suite: configuration.load ------------------------------------------------------------
+
+@pytest.mark.parametrize("case", CASES, ids=_ids(CASES))
+def test_load_refuses(case):
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.load(case.user(), root=ROOT)
+    err = info.value
+    text = "\n".join(err.problems)
+    assert case.key in text, f"key path {case.key!r} not named:\n{text}"
+    assert case.fragment in text, f"allowed range {case.fragment!r} not given:\n{text}"
+    for problem in err.problems:
+        assert len(problem.splitlines()) <= 2, f"a problem of more than 2 lines:\n{problem}"
+
+
+def test_huge_record_is_refused_without_writing(tmp_path):
+    """n_samples = 1e10 is costed, not generated: refused at once, nothing written."""
+    shutil.copytree(ROOT / "config", tmp_path / "config")
+    case = next(c for c in CASES if c.id == "n_samples_huge")
+    before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
+    with pytest.raises(configuration.ConfigError, match="limits.max_disk_gb"):
+        configuration.load(case.user(), root=tmp_path)
+    assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == before
+
+
+BROKEN = """\
+paper: false
+studies:
+  mine:
+    noise: random_input
+    zeta: 0.05
+     eps: 0.5
+    delta: [0.0, 1.0]
+    figures: [fig09]
+"""
+
+
+def _broken_mark():
+    """``line:col`` PyYAML gives for BROKEN (1-based), to compare with the message."""
+    try:
+        yaml.safe_load(BROKEN)
+    except yaml.YAMLError as err:
+        return f"{err.problem_mark.line + 1}:{err.problem_mark.column + 1}"
+    raise AssertionError("BROKEN must be invalid YAML")
+
+
+def test_yaml_syntax_error_names_file_line_column(tmp_path):
+    path = tmp_path / "broken.yaml"
+    path.write_text(BROKEN)
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.read_yaml(path)
+    text = str(info.value)
+    assert f"{path}:{_broken_mark()}" in text
+    assert _broken_mark().startswith("6:")      # the mis-indented `eps` line
+    assert "YAML syntax error" in text
+    assert len(text.splitlines()) <= 2
+
+
+# --- workflow suite: the real snakemake command in a copy of the project ----------------------
+
+@pytest.fixture(scope="module")
+def copy_dir(tmp_path_factory):
+    work = tmp_path_factory.mktemp("badconfig")
+    for item in ("Snakefile", "config", "workflow", "profiles"):
+        src = ROOT / item
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
+    return work
+
+
+def _no_job_ran(work):
+    results = work / "results"
+    written = [p for p in results.rglob("*")] if results.exists() else []
+    assert not written, f"files under results: {written[:5]}"
+    incomplete = work / ".snakemake" / "incomplete"
+    markers = list(incomplete.rglob("*")) if incomplete.exists() else []
+    assert not markers, f"incomplete markers: {markers[:5]}"
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("case", CASES, ids=_ids(CASES))
+def test_snakemake_refuses(copy_dir, case):
+    (copy_dir / "bad.yaml").write_text(case.yaml_text())
+    cmd = [SNAKEMAKE, "--cores", "1", "--configfile", "bad.yaml"]
+    out = subprocess.run(cmd, cwd=copy_dir, capture_output=True, text=True, timeout=120)
+    text = out.stdout + out.stderr
+    assert out.returncode != 0, text[-3000:]
+    assert case.key in text, f"key path {case.key!r} not named:\n{text[-3000:]}"
+    assert case.fragment in text, f"allowed range {case.fragment!r} not given:\n{text[-3000:]}"
+    _no_job_ran(copy_dir)
+
+
+@pytest.mark.workflow
+def test_plan_reports_yaml_syntax_error(copy_dir):
+    (copy_dir / "broken.yaml").write_text(BROKEN)
+    out = subprocess.run([sys.executable, "-m", "vibroimpact", "plan", "--configfile",
+                          "broken.yaml"], cwd=copy_dir, capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 2, out.stdout + out.stderr
+    assert f"broken.yaml:{_broken_mark()}" in out.stderr
+    assert out.stderr.startswith("error: ")
+    _no_job_ran(copy_dir)
