@@ -79,6 +79,30 @@ def test_fig15_vs_fig16_runs_the_map_and_the_orbits(workdir):
         "aggregate_orbits", "draw_figure", "copy_paper_figure"}
 
 
+def test_the_plan_counts_the_jobs_of_a_dry_run(workdir):
+    from vibroimpact.pipeline import configuration
+
+    _, plan = configuration.load(root=workdir, user_files=[workdir / "config" / "test.yaml"])
+    out = run(workdir, "-n", "--quiet", "rules")
+    total = next(int(l.split()[1]) for l in out.stdout.splitlines() if l.startswith("total"))
+    assert total == plan.jobs + 1           # + the target rule `all`
+    assert f"vibroimpact plan: {plan.summary(2)}" in out.stdout + out.stderr
+
+
+def test_a_users_study_is_built_alone_with_the_papers_noise(workdir, tmp_path):
+    """`paper: false`: only the user's study and the paper record it uses, no paper figure."""
+    mine = tmp_path / "mine.yaml"
+    mine.write_text("paper: false\nstudies:\n  mine:\n    noise: harmonic_input\n"
+                    "    zeta: 0.1\n    eps: 0.8\n    delta: [0.0, 1.0]\n    figures: [fig09]\n")
+    out = subprocess.run([SNAKEMAKE, "-n", "--quiet", "rules", "--cores", "2", "--configfile",
+                          str(mine)], cwd=workdir, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]
+    rules = {l.split()[0] for l in out.stdout.splitlines()
+             if len(l.split()) == 2 and l.split()[1].isdigit()} - {"total", "job"}
+    assert rules == {"generate_noise", "simulate_events", "aggregate_events", "draw_figure", "all"}
+    assert "results/figures/mine/fig09.png" in run(workdir, "-n", config=str(mine)).stdout
+
+
 def test_fig07_records_no_spectra(workdir):
     rules = scheduled_rules(workdir, "results/figures/fig07.png")
     assert "simulate_events" in rules

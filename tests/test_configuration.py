@@ -1,0 +1,153 @@
+"""Config layering, the plan and its limits, and the fault-recovery helpers (fast)."""
+import os
+from pathlib import Path
+import signal
+import socket
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+import yaml
+
+from vibroimpact import _files
+from vibroimpact.pipeline import configuration
+
+ROOT = Path(__file__).resolve().parents[1]
+PAPER = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+MINE = yaml.safe_load(textwrap.dedent("""\
+    paper: false
+    studies:
+      mine:
+        noise: harmonic_input      # the paper's record, used by name
+        zeta: 0.1
+        eps: 0.8
+        delta: [0.0, 0.5, 1.0]
+        figures: [fig09]
+"""))
+
+
+# --- layering ---------------------------------------------------------------------------------
+
+def test_no_user_file_is_the_paper_config():
+    config, plan = configuration.load(root=ROOT)
+    assert set(config["studies"]) == set(PAPER["studies"])
+    assert plan.drawn["paper_figures"] == set(PAPER["paper_figures"])
+
+
+def test_paper_false_builds_only_the_users_entries_with_the_papers_noise():
+    config, plan = configuration.load(MINE, root=ROOT)
+    assert set(config["studies"]) == set(PAPER["studies"]) | {"mine"}   # still defined
+    assert plan.drawn == {"studies": {"mine"}, "orbits": set(), "paper_figures": set()}
+    assert [r.key for r in plan.rows] == ["noises.harmonic_input", "studies.mine"]
+    assert plan.cells == 3
+
+
+def test_paper_true_builds_both():
+    config, plan = configuration.load(dict(MINE, paper=True), root=ROOT)
+    assert plan.drawn["studies"] == set(PAPER["studies"]) | {"mine"}
+    _, paper_plan = configuration.load(root=ROOT)
+    assert plan.cells == paper_plan.cells + 3
+
+
+def test_a_colliding_entry_is_refused_unless_replaced():
+    user = {"paper": False, "studies": {"random": dict(PAPER["studies"]["random"], zeta=0.1)}}
+    with pytest.raises(configuration.ConfigError, match=r"replace: \[studies\.random\]"):
+        configuration.load(user, root=ROOT)
+    config, plan = configuration.load(dict(user, replace=["studies.random"]), root=ROOT)
+    assert config["studies"]["random"]["zeta"] == 0.1
+    assert plan.drawn["studies"] == {"random"}
+
+
+def test_a_replaced_entry_is_replaced_whole_not_merged_key_by_key():
+    mine = {k: v for k, v in PAPER["studies"]["random"].items() if k != "spectra"}
+    mine["figures"] = ["fig07"]
+    config, _ = configuration.load({"paper": False, "replace": True,
+                                    "studies": {"random": mine}}, root=ROOT)
+    assert "spectra" not in config["studies"]["random"]
+
+
+def test_an_identical_entry_needs_no_replace():
+    user = {"paper": False, "studies": {"random": PAPER["studies"]["random"]}}
+    _, plan = configuration.load(user, root=ROOT)
+    assert plan.drawn["studies"] == {"random"}
+
+
+# --- the plan ---------------------------------------------------------------------------------
+
+def test_plan_of_the_paper_config():
+    """Cells from the grids of config.yaml; disk and time within a factor of the default
+    build measured at 61270b2 (120 MB on disk; 190 CPU-s in results/benchmarks)."""
+    _, plan = configuration.load(root=ROOT)
+    assert plan.cells == 71 + 4 + 16 + 10 + 57 * 91
+    assert plan.orbit_cells == 141 * 226
+    assert 60e6 < plan.bytes < 250e6
+    assert 90 < plan.cpu_s < 600
+    text = plan.format()
+    for key in ("limits.max_cells", "limits.max_disk_gb", "studies.motion_map", "total"):
+        assert key in text
+
+
+def test_a_build_beyond_a_limit_is_refused_with_the_estimate_and_the_key():
+    user = {"limits": {"max_cells": 1000}}
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.load(user, root=ROOT)
+    text = str(info.value)
+    assert "limits.max_cells = 1,000" in text and "5,288 simulation cells" in text
+    assert "raise limits.max_cells" in text
+
+
+def test_verbose_adds_the_validator_output(monkeypatch):
+    user = {"paper": False, "studies": {"mine": dict(MINE["studies"]["mine"], zeta=-1.0)}}
+    with pytest.raises(configuration.ConfigError) as short:
+        configuration.load(user, root=ROOT)
+    monkeypatch.setenv(configuration.VERBOSE_ENV, "1")
+    with pytest.raises(configuration.ConfigError) as full:
+        configuration.load(user, root=ROOT)
+    assert len(str(short.value).splitlines()) == 1
+    assert "Failed validating" in str(full.value)
+
+
+# --- temporaries of interrupted writes --------------------------------------------------------
+
+def _dead_pid():
+    proc = subprocess.Popen([sys.executable, "-c", "pass"])
+    proc.wait()
+    return proc.pid
+
+
+def test_sweep_removes_only_the_temporaries_of_dead_writers(tmp_path):
+    host = socket.gethostname()
+    dead = tmp_path / f".a.nc.{_dead_pid()}.0123456789ab@{host}.tmp"
+    live = tmp_path / f".b.nc.{os.getpid()}.0123456789ab@{host}.tmp"
+    elsewhere = tmp_path / ".c.nc.1.0123456789ab@another-node.tmp"
+    old_elsewhere = tmp_path / ".d.nc.1.0123456789ab@another-node.tmp"
+    unrelated = tmp_path / ".e.tmp"
+    for p in (dead, live, elsewhere, old_elsewhere, unrelated):
+        p.write_bytes(b"x")
+    two_days_ago = time.time() - 3 * 24 * 3600
+    os.utime(old_elsewhere, (two_days_ago, two_days_ago))
+    removed = _files.sweep_stale_temporaries(tmp_path)
+    assert sorted(removed) == sorted([dead, old_elsewhere])
+    assert live.exists() and elsewhere.exists() and unrelated.exists()
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
+def test_a_signal_while_writing_removes_the_temporary(tmp_path, sig):
+    target = tmp_path / "out.nc"
+    code = textwrap.dedent(f"""
+        import sys, time
+        from vibroimpact._files import atomic_path
+        with atomic_path({str(target)!r}) as tmp:
+            open(tmp, "w").write("half")
+            print(tmp, flush=True)
+            time.sleep(60)
+    """)
+    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    tmp = Path(proc.stdout.readline().strip())
+    assert tmp.exists() and _files.TEMP_PATTERN.match(tmp.name)
+    proc.send_signal(sig)
+    assert proc.wait(timeout=30) != 0
+    assert not tmp.exists() and not target.exists()
