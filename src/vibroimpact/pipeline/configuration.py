@@ -30,7 +30,7 @@ import numpy as np
 import yaml
 
 from vibroimpact.pipeline import figures
-from vibroimpact.pipeline.study import grid_size, grid_values
+from vibroimpact.pipeline.study import grid_size, grid_values, map_cap_steps
 
 __all__ = ["ConfigError", "Plan", "read_yaml", "compose", "check", "load", "SECTIONS"]
 
@@ -569,15 +569,11 @@ def _check_study(config, name, entry, problems, limits):
                      "distinct [m, n] pairs")
     if "map" in uses and harmonic and grids["inv_beta"] is not None:
         spec = entry["map"]
-        longest = float(grids["inv_beta"].max()) * 2 * math.pi
-        need = transient + int(spec["max_periods"]) * longest
-        if need > tau * (1 + 1e-9):
-            problems.add(f"{where}.map.max_periods", spec["max_periods"],
-                         f"{spec['max_periods']} periods at 1/beta_f = "
-                         f"{_num(float(grids['inv_beta'].max()))} after the transient reach "
-                         f"tau = {need:.6g}, beyond the record ({record})",
-                         f"max_periods <= {int((tau - transient) / longest)}, or n_samples >= "
-                         f"{math.ceil(need / dt) + 1} in noises.{entry['noise']}")
+        try:        # the cap of the longest forcing period (the job's own check, at parse time)
+            map_cap_steps(n, dt, transient, int(spec["max_periods"]),
+                          1.0 / float(grids["inv_beta"].max()), where=f"{where}.map.max_periods")
+        except ValueError as err:
+            problems.append(f"{err} in noises.{entry['noise']}")
         if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
             problems.add(f"{where}.map.min_time", spec["min_time"],
                          f"transient + min_time is beyond the record ({record})",

@@ -131,12 +131,14 @@ def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_peri
         If a record of ``n_samples`` samples is shorter; the message names ``where`` (the
         config key) and the ``n_samples`` that would do.
     """
-    need = transient + max_periods * 2.0 * math.pi / beta_f
+    period = 2.0 * math.pi / beta_f
+    need = transient + max_periods * period
     n_cap = int(math.ceil(need / dt - 1e-9))
     if n_cap > n_samples - 1:
+        tau = (n_samples - 1) * dt
         raise ValueError(
-            f"{where}: {max_periods} forcing periods at 1/beta_f = {1.0 / beta_f:g} after the "
-            f"transient {transient:g} reach tau = {need:.6g}, beyond the noise record "
-            f"({n_samples} samples, tau <= {(n_samples - 1) * dt:.6g}): lower max_periods or "
-            f"raise n_samples to at least {n_cap + 1}")
+            f"{where} = {max_periods}: {max_periods} forcing periods at 1/beta_f = "
+            f"{1.0 / beta_f:g} after the transient {transient:g} reach tau = {need:.6g}, beyond "
+            f"the noise record (tau <= {tau:.6g}); allowed: max_periods <= "
+            f"{max(int((tau - transient) / period), 0)}, or n_samples >= {n_cap + 1}")
     return n_cap

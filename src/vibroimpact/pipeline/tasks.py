@@ -117,8 +117,7 @@ def map_tile(name, block, tile, noise_path, out):
     spec = block["map"]
     # the longest forcing period of the whole study: every tile fails alike, before simulating
     map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
-                        1.0 / study.inv_beta.max(),
-                        where=f"studies.{name}.map.max_periods (noise {block['noise']!r})")
+                  1.0 / study.inv_beta.max(), where=f"studies.{name}.map.max_periods")
     results = []
     for cell in study.tile(tile, "events"):
         start = time.process_time()
