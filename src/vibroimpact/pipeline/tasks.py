@@ -43,6 +43,37 @@ def logged(path):
         logging.shutdown()
 
 
+class Progress:
+    """A job's progress over its cells, logged at most every ``every`` seconds and at the end.
+
+    Each line: cells done of total, impacts, simulated time, the rate and the time left
+    (README, "Progress of a build"): a long tile says where it stands without flooding its log.
+    """
+
+    def __init__(self, what, total, every=20.0, clock=None):
+        import time
+
+        self.what, self.total, self.every = what, int(total), float(every)
+        self.clock = clock or time.monotonic
+        self.start = self.last = self.clock()
+        self.done, self.impacts, self.simulated = 0, 0, 0.0
+
+    def cell_done(self, result):
+        """Count one cell (its ``n_impacts`` and ``simulated_time`` when it has them)."""
+        self.done += 1
+        self.impacts += int(result.get("n_impacts", 0))
+        self.simulated += float(result.get("simulated_time", 0.0))
+        now = self.clock()
+        if self.done < self.total and now - self.last < self.every:
+            return
+        self.last = now
+        elapsed = max(now - self.start, 1e-9)
+        rate = self.done / elapsed
+        log.info("progress %s: %d of %d cells, %d impacts, %.4g time units simulated, "
+                 "%.3g cells/s, ~%.0f s left", self.what, self.done, self.total, self.impacts,
+                 self.simulated, rate, (self.total - self.done) / rate)
+
+
 def noise_spec(entry):
     """The :class:`~vibroimpact.noise.NoiseSpec` of a ``noises`` config entry."""
     from vibroimpact.noise import NoiseSpec   # scipy.signal and scipy.fft: not for every job
@@ -87,12 +118,14 @@ def events_tile(name, block, tile, noise_path, out):
     samples, dt, noise_attrs = io.read_noise(noise_path)
     edges = datasets.bin_edges(block["bins"])
     results = []
+    progress = Progress(f"studies.{name} events tile {tile}", len(study.tile(tile, "events")))
     for cell in study.tile(tile, "events"):
-        log.info("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
+        log.debug("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
         results.append(cells.event_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
             t_end=block.get("t_end"), bins=edges, n_batches=int(block["n_batches"]),
             motion_window=float(block["motion_window"]), motions=study.motions))
+        progress.cell_done(results[-1])
     ds = datasets.events_tile(study.tile(tile, "events"), results, edges,
                               dict(_study_attrs(study, block, noise_attrs),
                                    **_record_attrs(block, block.get("t_end"), len(samples), dt),
@@ -119,6 +152,7 @@ def map_tile(name, block, tile, noise_path, out):
     map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
                   1.0 / study.inv_beta.max(), where=f"studies.{name}.map.max_periods")
     results = []
+    progress = Progress(f"studies.{name} map tile {tile}", len(study.tile(tile, "events")))
     for cell in study.tile(tile, "events"):
         start = time.process_time()
         result = cells.motion_map_cell(
@@ -128,11 +162,12 @@ def map_tile(name, block, tile, noise_path, out):
             min_time=float(spec["min_time"]), max_periods=int(spec["max_periods"]),
             min_switches=int(spec["min_switches"]))
         result["cpu_time"] = time.process_time() - start
-        log.info("cell %d: inv_beta=%g delta=%g: %.0f time units, %d impacts, %.3f s%s",
-                 cell.index, cell.inv_beta, cell.delta, result["simulated_time"],
-                 result["n_impacts"], result["cpu_time"],
-                 "" if result["reached"] else ", target precision not reached")
+        log.debug("cell %d: inv_beta=%g delta=%g: %.0f time units, %d impacts, %.3f s%s",
+                  cell.index, cell.inv_beta, cell.delta, result["simulated_time"],
+                  result["n_impacts"], result["cpu_time"],
+                  "" if result["reached"] else ", target precision not reached")
         results.append(result)
+        progress.cell_done(result)
     attrs = dict(_study_attrs(study, block, noise_attrs), motion_window=float(block["motion_window"]),
                  n_batches=int(block["n_batches"]),
                  **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods", "min_switches")},
@@ -149,11 +184,13 @@ def spectra_tile(name, block, tile, noise_path, out):
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spectra = block["spectra"]
     results = []
+    progress = Progress(f"studies.{name} spectra tile {tile}", len(study.tile(tile, "spectra")))
     for cell in study.tile(tile, "spectra"):
-        log.info("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
+        log.debug("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
         results.append(cells.spectra_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
             t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"])))
+        progress.cell_done(results[-1])
     ds = datasets.spectra_tile(study.tile(tile, "spectra"), results,
                                dict(_study_attrs(study, block, noise_attrs),
                                     **_record_attrs(block, spectra.get("t_end"), len(samples), dt),
