@@ -332,8 +332,8 @@ def harmonic(built):
 def test_finding5_input_is_a_line_and_the_response_spreads_as_delta_decreases(harmonic):
     """The input's power is concentrated at beta_f (the line A^2/2 = 0.5 against the random
     part's rms^2 = 0.084: 86 %); the response's share within +-0.1 of beta_f falls as delta
-    decreases (measured on the test config: 0.91 -> 0.60 at beta_f = 1.1, 0.83 -> 0.71 at
-    1/1.1)."""
+    decreases from delta = 2.5 to 0 (measured on the test config: 0.93 -> 0.60 at
+    beta_f = 1.1, 0.84 -> 0.71 at 1/1.1)."""
     _, spectra = harmonic
     beta = spectra.beta.values
     step = beta[1] - beta[0]
