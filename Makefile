@@ -27,7 +27,7 @@ $(STAMP): environment.txt pyproject.toml
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 	$(BIN)/python -m pytest -q -m slow
-	$(BIN)/python -m pytest -q -m workflow
+	$(BIN)/python -m pytest -q -m "workflow or slurm"
 	$(BIN)/lint-imports
 
 bench: $(STAMP)

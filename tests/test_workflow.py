@@ -11,24 +11,11 @@ import pytest
 import xarray as xr
 import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+from conftest import ROOT, SNAKEMAKE, _data_files, assert_same_data, make_workdir, snakemake
+
 FIGURES = [f"fig{n:02d}" for n in range(3, 17)] + ["fig15_vs_fig16"]
-
-
-def _workdir(tmp_path):
-    for item in ("Snakefile", "config", "workflow", "profiles"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
-    return tmp_path
-
-
-def run(workdir, *args, config="config/test.yaml", check=True):
-    cmd = [SNAKEMAKE, *args, "--cores", "2", "--configfile", config]
-    out = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=900)
-    if check and out.returncode != 0:
-        raise AssertionError(f"{' '.join(cmd)} failed:\n{out.stdout[-3000:]}\n{out.stderr[-3000:]}")
-    return out
+_workdir = make_workdir
+run = snakemake
 
 
 def scheduled_rules(workdir, target):
@@ -132,13 +119,6 @@ def test_bad_config_fails_before_any_job(workdir, tmp_path, path, value, key):
     assert not (workdir / "results").exists() or not any((workdir / "results").rglob("*.nc"))
 
 
-@pytest.fixture(scope="module")
-def built(workdir):
-    """The test config built end to end (only for tests marked ``workflow``)."""
-    run(workdir)            # rule all with the test config
-    return workdir
-
-
 @pytest.mark.workflow
 def test_end_to_end(built):
     for fig in FIGURES:
@@ -183,28 +163,6 @@ def test_every_dataset_carries_its_config_block_and_creation_time(built):
 def test_rerun_does_nothing(built):
     out = run(built, "-n")
     assert "Nothing to be done" in out.stdout + out.stderr
-
-
-def _data_files(root):
-    """Every dataset of a build except the per-job tiles: noise, traces, studies, orbits."""
-    return sorted(p.relative_to(root) for p in (root / "results").rglob("*.nc")
-                  if "cells" not in p.parts and "tiles" not in p.parts)
-
-
-def _data(path):
-    """A dataset without its attributes (``created`` ...) and run measurements (CPU times)."""
-    ds = xr.load_dataset(path)
-    timings = [v for v in ds.variables if ds[v].attrs.get("run_measurement") == 1]
-    return ds.drop_vars(timings).drop_attrs()
-
-
-def assert_same_data(a, b):
-    """The datasets of two builds hold identical data (attributes such as ``created`` aside)."""
-    files = _data_files(a)
-    assert files == _data_files(b)
-    assert len(files) >= 10
-    for name in files:
-        xr.testing.assert_identical(_data(a / name), _data(b / name))
 
 
 @pytest.mark.workflow
