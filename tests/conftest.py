@@ -50,9 +50,10 @@ def built(tmp_path_factory):
 
 
 def _data_files(root):
-    """Every dataset of a build except the per-job tiles: noise, traces, studies, orbits."""
+    """Every dataset of a build except the per-job tiles and the validation runs (timings):
+    noise, traces, studies, orbits."""
     return sorted(p.relative_to(root) for p in (root / "results").rglob("*.nc")
-                  if "cells" not in p.parts and "tiles" not in p.parts)
+                  if not {"cells", "tiles", "validation"} & set(p.parts))
 
 
 def _data(path):
