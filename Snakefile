@@ -7,6 +7,9 @@ from vibroimpact.pipeline import configuration
 min_version("9.0")
 
 
+report: "workflow/report/workflow.rst"
+
+
 # The paper's config/config.yaml, with the files given by --configfile layered on it (README,
 # "Your own studies"). No `configfile:` directive: Snakemake would deep-merge a user's entry
 # into a paper entry of the same name; `configuration.load` adds, refuses collisions, and
@@ -35,6 +38,9 @@ include: "workflow/rules/simulate.smk"
 include: "workflow/rules/aggregate.smk"
 include: "workflow/rules/orbits.smk"
 include: "workflow/rules/figures.smk"
+include: "workflow/rules/sweeps.smk"
+include: "workflow/rules/validation.smk"
+include: "workflow/rules/reports.smk"
 
 
 rule all:

@@ -6,13 +6,15 @@ between; zeta = 0.05, eps = 0.5, start at rest at min(0, delta)):
 1. throughput on the long record: ns per sample step with no impact reachable, ns per impact
    (delta = 0), cost per unit of simulated time for each delta, and the floor: the bare
    dependent 2x2 recurrence with forcing terms and no wall;
-2. a work-precision table on a short stretch of the same record, for delta in {1, 0, -0.5}:
-   the simulator, scipy's solve_ivp (RK45, DOP853, LSODA; restarted at every force sample and
-   after every impact, atol = rtol) at rtol 1e-3 ... 1e-12, and a numba fixed-step RK4 that
-   clamps x to the wall, at 1 ... 64 steps per sample. Error = max over the first N comparable
-   impacts (chatter tails excluded) of |impact time error| and |relative velocity error|,
-   against the mpmath reference of vibroimpact.validation.reference (34 digits); N is cut where a
-   float64-precision run of the reference stops agreeing with it to 1e-10;
+2. a work-precision table (`vibroimpact.validation.work_precision`, the same measurement as the
+   workflow's results/figures/work_precision.png) for delta in {1, 0, -0.5}: the simulator,
+   scipy's solve_ivp (RK45, DOP853, LSODA; restarted at every force sample and after every
+   impact, atol = rtol) at rtol 1e-3 ... 1e-12, numba RK4 with event location at 1 ... 64
+   steps per sample, and numba RK4 that clamps x to the wall (peers in
+   `vibroimpact.validation.peers`). Error = max over the first N comparable impacts (chatter
+   tails excluded) of |impact time error| and |relative velocity error|, against the mpmath
+   reference of vibroimpact.validation.reference (34 digits); N is cut where a float64-precision
+   run of the reference stops agreeing with it to 1e-10;
 3. the targets of the benchmark issue as ratios (printed, not asserted).
 
 Usage::
@@ -27,43 +29,28 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # before numba loads: one threa
 
 import argparse  # noqa: E402
 import math  # noqa: E402
-import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-import peers  # noqa: E402
-
 from vibroimpact import simulate  # noqa: E402
+from vibroimpact.validation import peers  # noqa: E402
+from vibroimpact.validation.work_precision import SIMULATOR, work_precision  # noqa: E402
 
 ZETA, EPS, DT = 0.05, 0.5, 0.1
 DELTAS = (1.0, 0.0, -0.5)
 DELTA_FREE = 1e6  # far beyond any excursion of the response (rms ~0.7): no impact reachable
 SEED = 19740072  # the paper's year and bulletin number
 METHODS = ("RK45", "DOP853", "LSODA")
-TRUST_TOL = 1e-10  # a float64 run of the reference must agree with 34 digits this closely
-U_TAIL = 1e-4  # chatter-tail impacts slower than this are not compared one by one
 T_MIN = 100.0  # shortest stretch for the work-precision runs (time units), for stable timings
+WP_SAMPLES = 10**6  # at most this long a record for the compiled methods of the work-precision
 
 TARGET_NS_PER_STEP = 4.5
 TARGET_NS_PER_IMPACT = 300.0
 TARGET_SPEEDUP = {1.0: 1e5, 0.0: 5e4}  # vs solve_ivp(DOP853, rtol = atol = 1e-10)
 TARGET_ERROR_GAIN = 100.0
 TARGET_RTOL = 1e-10
-
-
-def load_reference():
-    """The mpmath reference simulator (vibroimpact.validation.reference)."""
-    from vibroimpact.validation import reference
-    return reference
-
-
-def best_time(fn, repeats):
-    """Best wall time of `repeats` calls of fn() (time.perf_counter), and the last result."""
-    wall, _, out = best_times(fn, repeats)
-    return wall, out
 
 
 def best_times(fn, repeats):
@@ -81,51 +68,6 @@ def best_times(fn, repeats):
 
 def run_simulate(delta, noise):
     return simulate(ZETA, EPS, delta, noise, DT)
-
-
-def split_time(time_, dt):
-    """Impact times as (sample index, offset in the sample), float64."""
-    time_ = np.asarray(time_, dtype=np.float64)
-    step = np.floor(time_ / dt).astype(np.int64)
-    return step, time_ - step * dt
-
-
-def reference_impacts(reference, delta, noise, t_end, **kwargs):
-    """Comparable reference impacts: (step, offset, velocity) arrays; the offset is taken in
-    multiprecision so that the simulator's step + offset form is compared at full precision."""
-    from mpmath import mp, mpf
-
-    run = reference.reference_impacts(ZETA, EPS, delta, noise, DT, t_end=t_end, **kwargs)
-    tail = reference.chatter_tail_mask(run["time"], run["velocity"], run["stick_start"],
-                                       run["stick_end"], U_TAIL)
-    keep = [j for j, drop in enumerate(tail) if not drop]
-    with mp.workdps(40):
-        h = mpf(DT)
-        step = [int(mp.floor(run["time"][j] / h)) for j in keep]
-        offset = [float(run["time"][j] - s * h) for j, s in zip(keep, step)]
-    velocity = [float(run["velocity"][j]) for j in keep]
-    return run, (np.array(step, dtype=np.int64), np.array(offset), np.array(velocity))
-
-
-def impact_errors(ref, step, offset, velocity, n_impacts):
-    """(err_time, err_velocity) over the first n_impacts reference impacts.
-
-    Each reference impact is paired with the peer impact nearest in time (a missed or
-    spurious impact then shows as a large error, not as a shift of every later pair); the time
-    difference is taken as (step difference) * dt + (offset difference), exact for equal steps.
-    """
-    ref_step, ref_offset, ref_velocity = (a[:n_impacts] for a in ref)
-    if step.size == 0:
-        return math.inf, math.inf
-    ref_t = ref_step * DT + ref_offset
-    t = step * DT + offset
-    j = np.clip(np.searchsorted(t, ref_t), 1, max(t.size - 1, 1))
-    j = np.minimum(j, t.size - 1)
-    left = np.maximum(j - 1, 0)
-    j = np.where(np.abs(t[left] - ref_t) <= np.abs(t[j] - ref_t), left, j)
-    d_time = (step[j] - ref_step) * DT + (offset[j] - ref_offset)
-    d_velocity = (velocity[j] - ref_velocity) / ref_velocity
-    return float(np.max(np.abs(d_time))), float(np.max(np.abs(d_velocity)))
 
 
 def fmt(value, spec=".2e"):
@@ -168,72 +110,27 @@ def throughput(noise, repeats):
     return rows, floor_seconds, floor_cpu
 
 
-def stretch_end(delta, noise, n_impacts, res_long):
-    """End of the short stretch: just past the simulator's n_impacts-th impact faster than
-    U_TAIL (a proxy for the reference's comparable impacts), at least T_MIN, on the grid."""
-    fast = res_long.impact_time[res_long.impact_velocity >= U_TAIL]
-    t_n = fast[min(n_impacts, fast.size) - 1] if fast.size else T_MIN
-    steps = int(math.ceil(max(1.05 * t_n + 2.0, T_MIN) / DT))
-    return min(steps, noise.size - 1) * DT
+def print_work_precision(ds):
+    """The work-precision table of each delta, with the ratio to the simulator's cost."""
+    for delta in ds["delta"].values:
+        row = ds.sel(delta=delta)
+        print(f"\n== Work-precision, delta = {delta:g}: tau = 0 .. {float(row['t_stretch']):g}, "
+              f"{int(row['n_reference'])} reference impacts (reference run "
+              f"{float(row['reference_seconds']):.1f} s), errors over the first "
+              f"{int(row['n_compared'])} comparable ones; the round-off level of float64 on this "
+              f"stretch (a 53-bit run of the reference): {float(row['roundoff']):.2e} ==")
+        print(f"{'method':<22} {'setting':<10} {'impacts':>7} {'err time':>9} {'err vel':>9} "
+              f"{'error':>9} {'s/unit time':>11} {'timed on':>9} {'x simulate':>10}")
+        for j in ds["run"].values:
+            r = row.sel(run=j)
+            print(f"{str(r['method'].values):<22} {str(r['setting'].values):<10} "
+                  f"{int(r['n_found']):>7d} {fmt(float(r['err_time'])):>9} "
+                  f"{fmt(float(r['err_velocity'])):>9} {fmt(float(r['error'])):>9} "
+                  f"{float(r['cost']):>11.3e} {float(r['timed_span']):>9g} "
+                  f"{float(r['cost_ratio']):>10.3g}")
 
 
-def work_precision(delta, noise, reference, n_target, rtols, rk4_steps, repeats, long_run):
-    """Rows of the work-precision table for one delta; long_run: its throughput row."""
-    res_long = long_run["result"]
-    t_end = stretch_end(delta, noise, n_target, res_long)
-    n_short = int(round(t_end / DT))
-    short = noise[:n_short + 1]
-
-    t0 = time.perf_counter()
-    run34, ref = reference_impacts(reference, delta, short, t_end)
-    ref_seconds = time.perf_counter() - t0
-    run53, ref53 = reference_impacts(reference, delta, short, t_end, prec=53)
-    n_trust = reference.agreeing_prefix(run34, run53, tol=TRUST_TOL, u_tail=U_TAIL)
-    n_cmp = min(n_target, n_trust, ref[0].size)
-    roundoff = max(impact_errors(ref, *ref53, n_cmp))
-    print(f"\n== Work-precision, delta = {delta:g}: tau = 0 .. {t_end:g} ({n_short} samples), "
-          f"{len(run34['time'])} reference impacts ({ref[0].size} outside chatter tails, "
-          f"reference run {ref_seconds:.1f} s) ==")
-    print(f"A 53-bit run of the reference agrees with the 34-digit one to {TRUST_TOL:.0e} on "
-          f"{n_trust} impacts: errors are over the first {n_cmp}. Its error there, the round-off "
-          f"level of float64 arithmetic on this stretch: {roundoff:.2e}")
-
-    rows = []
-
-    def add(method, setting, step, offset, velocity, cost):
-        err_t, err_u = impact_errors(ref, step, offset, velocity, n_cmp)
-        rows.append(dict(delta=delta, method=method, setting=setting,
-                         n_found=int(np.sum(step * DT + offset <= t_end)),
-                         err_time=err_t, err_velocity=err_u, error=max(err_t, err_u), cost=cost))
-
-    add("simulate (long record)", "exact", res_long.impact_step, res_long.impact_offset,
-        res_long.impact_velocity, long_run["cost"])
-    seconds, res = best_time(lambda: run_simulate(delta, short), repeats)
-    add("simulate (short stretch)", "exact", res.impact_step, res.impact_offset, res.impact_velocity,
-        seconds / t_end)
-    for method in METHODS:
-        for rtol in rtols:
-            t0 = time.perf_counter()
-            t_imp, u_imp = peers.solve_ivp_impacts(ZETA, EPS, delta, short, DT, method, rtol)
-            seconds = time.perf_counter() - t0
-            add(f"solve_ivp {method}", f"rtol={rtol:.0e}", *split_time(t_imp, DT), u_imp,
-                seconds / t_end)
-    for m in rk4_steps:
-        seconds, (t_imp, u_imp) = best_time(
-            lambda: peers.rk4_clamp_impacts(ZETA, EPS, delta, short, DT, m), repeats)
-        add("RK4 clamp", f"dt/{m}", *split_time(t_imp, DT), u_imp, seconds / t_end)
-
-    sim = rows[0]["cost"]
-    print(f"{'method':<26} {'setting':<10} {'impacts':>7} {'err time':>9} {'err vel':>9} "
-          f"{'error':>9} {'s/unit time':>11} {'x simulate (long record)':>24}")
-    for row in rows:
-        print(f"{row['method']:<26} {row['setting']:<10} {row['n_found']:>7d} "
-              f"{fmt(row['err_time'])} {fmt(row['err_velocity']):>9} {fmt(row['error']):>9} "
-              f"{row['cost']:>11.3e} {row['cost'] / sim:>24.3g}")
-    return rows
-
-
-def print_targets(through, floor_seconds, floor_cpu, n_steps, table):
+def print_targets(through, floor_seconds, floor_cpu, n_steps, ds):
     print("\n== Targets (ratio = measured / target; <= 1 meets the target for costs, "
           ">= 1 for gains) ==")
     free, zero = through[DELTA_FREE], through[0.0]
@@ -247,19 +144,22 @@ def print_targets(through, floor_seconds, floor_cpu, n_steps, table):
               f"{ns_impact:.1f} ns vs target {TARGET_NS_PER_IMPACT:g} ns: "
               f"ratio {ns_impact / TARGET_NS_PER_IMPACT:.2f}")
     for delta, target in TARGET_SPEEDUP.items():
-        rows = [r for r in table if r["delta"] == delta]
-        sim = next(r for r in rows if r["method"] == "simulate (long record)")
-        peer = next((r for r in rows if r["method"] == "solve_ivp DOP853"
-                     and r["setting"] == f"rtol={TARGET_RTOL:.0e}"), None)
-        if peer is None:
+        if delta not in ds["delta"].values:
+            continue
+        row = ds.sel(delta=delta)
+        peer = np.flatnonzero((row["method"].values == "solve_ivp DOP853")
+                              & (row["setting"].values == f"rtol={TARGET_RTOL:.0e}"))
+        if peer.size == 0:
             print(f"delta = {delta:g}: no solve_ivp DOP853 run at rtol={TARGET_RTOL:.0e}")
             continue
-        speedup = peer["cost"] / sim["cost"]
-        gain = peer["error"] / sim["error"] if sim["error"] > 0 else math.inf
+        peer = row.isel(run=peer[0])
+        sim = row.isel(run=int(np.flatnonzero(row["method"].values == SIMULATOR)[0]))
+        speedup = float(peer["cost_ratio"])
+        gain = float(peer["error_ratio"])
         print(f"delta = {delta:g}: run time per unit time, solve_ivp DOP853 rtol=atol="
-              f"{TARGET_RTOL:.0e} / simulate (long record) = {speedup:.3g} vs target "
-              f"{target:.0e}: ratio {speedup / target:.2f}; error {fmt(peer['error'])} / "
-              f"{fmt(sim['error'])} = {fmt(gain, '.3g')} vs target {TARGET_ERROR_GAIN:g}: "
+              f"{TARGET_RTOL:.0e} / simulate = {speedup:.3g} vs target {target:.0e}: ratio "
+              f"{speedup / target:.2f}; error {fmt(float(peer['error']))} / "
+              f"{fmt(float(sim['error']))} = {fmt(gain, '.3g')} vs target {TARGET_ERROR_GAIN:g}: "
               f"ratio {gain / TARGET_ERROR_GAIN:.3g}")
 
 
@@ -292,20 +192,21 @@ def main(argv=None):
 
     for delta in (DELTA_FREE,) + DELTAS:  # compile and warm up before any timing
         run_simulate(delta, noise[:2001])
-        peers.rk4_clamp_impacts(ZETA, EPS, delta, noise[:101], DT, 2)
     peers.linear_recurrence(noise[:101], peers.linear_propagator(ZETA, DT))
 
     through, floor_seconds, floor_cpu = throughput(noise, args.repeats)
-    reference = load_reference()
-    table = []
-    for delta in DELTAS:
-        table += work_precision(delta, noise, reference, n_target, rtols, rk4_steps,
-                                args.repeats, through[delta])
-    print_targets(through, floor_seconds, floor_cpu, noise.size - 1, table)
+    ds = work_precision(DELTAS, impacts=n_target, stretch=T_MIN,
+                        long_samples=min(n_samples, WP_SAMPLES), seed=args.seed, rtol=rtols,
+                        rk4_steps=rk4_steps, clamp_steps=rk4_steps, repeats=args.repeats)
+    print_work_precision(ds)
+    print(f"(compiled methods timed on {min(n_samples, WP_SAMPLES)} samples, solve_ivp on the "
+          f"stretch; whole work-precision run {float(ds['build_seconds']):.1f} s)")
+    print_targets(through, floor_seconds, floor_cpu, noise.size - 1, ds)
     if args.plot is not None:
-        args.plot.parent.mkdir(parents=True, exist_ok=True)
-        peers.plot_work_precision(table).savefig(args.plot, dpi=150)
-        print(f"\nwork-precision figure: {args.plot}")
+        from vibroimpact import plotting
+
+        plotting.save(plotting.work_precision(ds), args.plot)
+        print(f"\nwork-precision figure: {args.plot} (and .pdf)")
 
 
 if __name__ == "__main__":

@@ -41,7 +41,8 @@ def test_paper_false_builds_only_the_users_entries_with_the_papers_noise():
     config, plan = configuration.load(MINE, root=ROOT)
     assert set(config["studies"]) == set(PAPER["studies"]) | {"mine"}   # still defined
     assert plan.drawn == {"studies": {"mine"}, "orbits": set(), "paper_figures": set()}
-    assert [r.key for r in plan.rows] == ["noises.harmonic_input", "studies.mine"]
+    assert [r.key for r in plan.rows] == ["noises.harmonic_input", "studies.mine", "reports"]
+    assert config["validation"]["build"] is False       # the paper's validation runs: not built
     assert plan.cells == 3
 
 

@@ -18,7 +18,11 @@ pytestmark = pytest.mark.workflow
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
-FIGURE_RULES = {"draw_figure", "copy_paper_figure", "all"}
+# a figure reruns the report that shows it
+FIGURE_RULES = {"draw_figure", "copy_paper_figure", "study_report", "all"}
+REPORT_RULES = {"orbits_report", "validation_report"}
+STRESS_RULES = {"sample_stress_families", "draw_validation_figure", "validation_report"}
+VALIDATION_RULES = STRESS_RULES | {"measure_work_precision"}
 STUDY_RULES = {"simulate_events", "simulate_spectra", "simulate_trace", "aggregate_events",
                "aggregate_spectra"}
 ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits"}
@@ -118,9 +122,10 @@ def test_commits_of_nothing_docs_readme_tests_rerun_nothing(repo, edit):
 def test_plotting_edit_reruns_only_figures(repo, edit):
     edit("src/vibroimpact/plotting/_common.py", _append_comment)
     jobs = scheduled(repo)
-    assert set(jobs) == FIGURE_RULES
+    drawn = FIGURE_RULES | REPORT_RULES | {"draw_validation_figure"}
+    assert set(jobs) == drawn
     _git(repo, "commit", "-qam", "plotting")          # committed or not: the same jobs
-    assert set(scheduled(repo)) == FIGURE_RULES
+    assert set(scheduled(repo)) == drawn
 
 
 def test_figure_only_key_reruns_only_that_figure(repo, edit):
@@ -138,7 +143,7 @@ def test_figure_only_key_reruns_only_that_figure(repo, edit):
 def test_simulator_edit_reruns_the_studies_and_downstream(repo, edit):
     edit("src/vibroimpact/impact/kernels.py", _append_comment)    # uncommitted
     jobs = scheduled(repo)
-    assert set(jobs) == STUDY_RULES | MAP_RULES | FIGURE_RULES
+    assert set(jobs) == STUDY_RULES | MAP_RULES | FIGURE_RULES | REPORT_RULES | VALIDATION_RULES
     assert "fig16.png" not in {Path(p).name for p in jobs["draw_figure"]}
 
 
@@ -163,12 +168,12 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
     edit("config/test.yaml", _set(("orbits", "harmonic", "delta"),
                                   {"start": -1.5, "stop": 3.0, "step": 0.5}))
     jobs = scheduled(repo)
-    assert set(jobs) == ORBIT_RULES | FIGURE_RULES
+    assert set(jobs) == ORBIT_RULES | FIGURE_RULES | {"orbits_report"}
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
         "fig16.png", "fig15_vs_fig16.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
-    edit("src/vibroimpact/orbits/kernels.py", _append_comment)
-    assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES
+    edit("src/vibroimpact/orbits/kernels.py", _append_comment)     # the stress sample too
+    assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES | {"orbits_report"} | STRESS_RULES
 
 
 def test_outputs_record_the_dirty_flag(repo, edit):

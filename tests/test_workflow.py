@@ -86,7 +86,8 @@ def test_a_users_study_is_built_alone_with_the_papers_noise(workdir, tmp_path):
     assert out.returncode == 0, out.stderr[-3000:]
     rules = {l.split()[0] for l in out.stdout.splitlines()
              if len(l.split()) == 2 and l.split()[1].isdigit()} - {"total", "job"}
-    assert rules == {"generate_noise", "simulate_events", "aggregate_events", "draw_figure", "all"}
+    assert rules == {"generate_noise", "simulate_events", "aggregate_events", "draw_figure",
+                     "study_report", "all"}
     assert "results/figures/mine/fig09.png" in run(workdir, "-n", config=str(mine)).stdout
 
 

@@ -5,6 +5,11 @@
 # trigger reruns exactly the jobs an edit touches, committed or not. Provenance (version,
 # commit, dirty flag, config digest, seed) is written by the jobs at run time, never passed
 # through params (a commit alone must not rerun anything).
+import hashlib
+from pathlib import Path
+import shlex
+import sys
+
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.provenance import source_digest
 from vibroimpact.pipeline.study import Study, orbit_rows
@@ -17,8 +22,9 @@ wildcard_constraints:
     tile="[0-9]+",
     # a study name, or orbits/<name> for an `orbits` entry (their figures never collide)
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
-    # figNN, our own names (fig15_vs_fig16, work_precision), -k: k-th value of a listed parameter
-    fig="[a-z][a-z0-9_]*(-[0-9]+)?",
+    # figNN or fig15_vs_fig16 of the figure table, -k: k-th value of a listed parameter (not a
+    # sweep.png, nor the validation figures)
+    fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?(-[0-9]+)?",
     paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?",
 
 
@@ -37,10 +43,13 @@ CODE = {
                             "pipeline/io", "pipeline/tasks", "_checks", "_files"),
     "figure": source_digest("plotting", "pipeline/figures", "pipeline/tasks", "stats",
                             "_files"),
+    # a report runs its notebook, which calls vibroimpact.reports (and plotting for Fig. 15
+    # against Fig. 16); the notebooks themselves are inputs
+    "report": source_digest("reports", "plotting", "stats"),
 }
 
 # Config keys each job reads from a study entry (nothing else of the entry reaches its params).
-_PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size")
+_PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size", "sweep")
 _READS = {
     "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins"),
     "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map"),
@@ -117,6 +126,12 @@ def figure_options(wildcards):
     return figures.figure_options(entry, wildcards.fig)
 
 
+def figure_caption(wildcards):
+    """What ``{fig}`` of ``{owner}`` shows, with its parameters (the report's caption)."""
+    kind, name, entry = _owner(wildcards)
+    return figures.caption(kind, name, entry, wildcards.fig)
+
+
 def paper_figure_source(wildcards):
     if wildcards.paper_fig not in config.get("paper_figures", {}):
         raise ValueError(f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
@@ -139,6 +154,143 @@ def all_targets():
     for name in sorted(drawn["orbits"]):
         entry = config["orbits"][name]
         targets += [f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)]
+    targets += sweep_targets()              # sweeps.smk: the side-by-side figure of each sweep
+    if config["validation"]["build"]:
+        targets += validation_targets()     # validation.smk: work_precision.png, stress.png
+    return targets + report_targets()
+
+
+# --- reports (reports.smk): one notebook per study, per orbits entry, two for validation -----
+
+#: The interpreter running Snakemake (the .venv's): reports call its papermill and nbconvert.
+PYTHON = shlex.quote(sys.executable)
+
+#: The parameters of each notebook, in its `parameters` cell; each is passed with -p.
+REPORT_PARAMETERS = {
+    "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
+    "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
+                        "figures", "amplitude", "inv_beta"),
+    "periodic_motions": ("name", "orbits", "map", "figures"),
+    "performance": ("work_precision", "figures"),
+    "stability": ("stress", "readme", "figures"),
+}
+
+
+def study_report_kind(entry):
+    """The notebook of a study's report: random force alone, or harmonic plus random."""
+    return "harmonic_random" if float(entry.get("amplitude", 0.0)) != 0.0 else "random_force"
+
+
+def _study_datasets(name):
+    """``{kind: path}`` of the datasets the figures of study ``name`` read."""
+    entry = config["studies"][name]
+    out = {}
+    for fig in {f if isinstance(f, str) else f["name"] for f in entry["figures"]}:
+        names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
+        for kind in figures.FIGURES[fig]["reads"]:
+            out.setdefault(kind, _DATASETS[kind].format(name=names.get(kind, name),
+                                                        noise=names["noise"]))
+    return out
+
+
+def study_report_inputs(wildcards):
+    """The notebook, the datasets and the figures of a study and of its ``report_with``."""
+    entry = config["studies"][wildcards.study]
+    kind = study_report_kind(entry)
+    if wildcards.report != kind:
+        raise ValueError(f"study {wildcards.study}: its report is {kind}, not {wildcards.report}")
+    inputs, shown = {"notebook": f"notebooks/{kind}.ipynb"}, []
+    for name in [wildcards.study, *entry.get("report_with", [])]:
+        for dataset, path in _study_datasets(name).items():
+            inputs.setdefault(dataset, path)
+        shown += [f"results/figures/{name}/{f}.png"
+                  for f in figures.figure_targets(config["studies"][name])]
+    return {**inputs, "figures": shown}
+
+
+def _maps_over(orbits_name):
+    """Map datasets of the built studies that draw Fig. 15 over orbits entry ``orbits_name``."""
+    for name in sorted(PLAN.drawn["studies"]):
+        entry = config["studies"][name]
+        for item in entry["figures"]:
+            if isinstance(item, dict) and item.get("orbits") == orbits_name:
+                return [_DATASETS["map"].format(name=name)]
+    return []
+
+
+def orbits_report_inputs(wildcards):
+    entry = config["orbits"][wildcards.orbits]
+    inputs = {"notebook": "notebooks/periodic_motions.ipynb",
+              "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
+              "figures": [f"results/figures/orbits/{wildcards.orbits}/{f}.png"
+                          for f in figures.figure_targets(entry)]}
+    inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
+    return inputs
+
+
+def validation_report_inputs(wildcards):
+    if wildcards.vreport == "performance":
+        return {"notebook": "notebooks/performance.ipynb",
+                "work_precision": "results/validation/work_precision.nc",
+                "figures": ["results/figures/work_precision.png"]}
+    return {"notebook": "notebooks/stability.ipynb",
+            "stress": "results/validation/stress_sample.nc",
+            "figures": ["results/figures/stress.png"]}
+
+
+def quoted_campaign(wildcards):
+    """The README's table of the full stress campaign, which the stability report quotes: a
+    param, so that editing that table reruns the report and editing the rest of the README
+    does not (the README is passed by path, not as an input)."""
+    if wildcards.get("vreport") != "stability":
+        return ""
+    lines = Path(workflow.basedir, "README.md").read_text().splitlines()
+    start = next((i for i, l in enumerate(lines) if l.strip().startswith("| family |")), None)
+    if start is None:
+        return ""
+    end = next((i for i in range(start, len(lines)) if not lines[i].strip().startswith("|")),
+               len(lines))
+    return hashlib.sha256("\n".join(lines[start:end]).encode()).hexdigest()[:16]
+
+
+def _report_name(wildcards):
+    if "vreport" in wildcards.keys():
+        return wildcards.vreport
+    return wildcards.report if "report" in wildcards.keys() else "periodic_motions"
+
+
+def _nearest(values, target):
+    return min(values, key=lambda v: abs(v - target))
+
+
+def report_arguments(wildcards, input):
+    """``-p name value`` for every parameter of the report's notebook: input paths (``""``
+    when the study has no such dataset), the figures as one space-separated string, and the
+    study's name, forcing amplitude and the 1/beta_f its density findings read."""
+    notebook = _report_name(wildcards)
+    given = {name: " ".join(value) if name == "figures" else str(value)
+             for name, value in input.items()}
+    if "study" in wildcards.keys():
+        entry = config["studies"][wildcards.study]
+        grid = [float(v) for v in STUDIES[wildcards.study].inv_beta]
+        given.update(study=wildcards.study, amplitude=float(entry.get("amplitude", 0.0)),
+                     inv_beta=_nearest(grid, 1.1))      # Figs. 13, 14 of the paper: tau/1.1
+    if "orbits" in wildcards.keys():
+        given["name"] = wildcards.orbits
+    given.setdefault("readme", "README.md")     # the stability report quotes its table
+    values = {name: given.get(name, "") for name in REPORT_PARAMETERS[notebook]}
+    return " ".join(f"-p {name} {shlex.quote(str(value))}" for name, value in values.items())
+
+
+def report_targets():
+    """The HTML report of every built study and orbits entry, and the validation reports."""
+    drawn = PLAN.drawn
+    targets = [f"results/reports/{name}/{study_report_kind(config['studies'][name])}.html"
+               for name in sorted(drawn["studies"])]
+    targets += [f"results/reports/orbits/{name}/periodic_motions.html"
+                for name in sorted(drawn["orbits"])]
+    if config["validation"]["build"]:
+        targets += [f"results/reports/validation/{r}.html" for r in ("performance", "stability")]
     return targets
 
 

@@ -9,7 +9,9 @@ rule draw_figure:
     input:
         figure_inputs,
     output:
-        png="results/figures/{owner}/{fig}.png",
+        # in `snakemake --report`: one category per study or orbits entry
+        png=report("results/figures/{owner}/{fig}.png", caption="../report/figure.rst",
+                   category="{owner}", labels={"figure": "{fig}"}),
         pdf="results/figures/{owner}/{fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"
@@ -23,6 +25,7 @@ rule draw_figure:
         runtime=5,
     params:
         options=figure_options,
+        caption=figure_caption,     # what it shows, with which parameters (report caption)
         code=CODE["figure"],
     script:
         "../scripts/draw_figure.py"
@@ -32,7 +35,8 @@ rule copy_paper_figure:
     input:
         unpack(paper_figure_source),
     output:
-        png="results/figures/{paper_fig}.png",
+        png=report("results/figures/{paper_fig}.png", caption="../report/paper_figure.rst",
+                   category="paper", labels={"figure": "{paper_fig}"}),
         pdf="results/figures/{paper_fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"

@@ -35,11 +35,25 @@ def _parser():
         p.add_argument("--configfile", action="append", default=[], metavar="FILE",
                        help="your config file, layered on config/config.yaml (README); "
                             "repeat for several")
-        p.add_argument("--cores", type=int, default=2, help="cores of the build (default 2)")
+        p.add_argument("--cores", type=_cores, default="all",
+                       help="cores of the build: a number, or all (default: all of them)")
         p.add_argument("--directory", default=".", help="the project directory (default .)")
         p.add_argument("-v", "--verbose", action="store_true",
                        help="also print the schema validator's full output on a config error")
     return parser
+
+
+def _cores(text):
+    """``--cores``: a positive number, or ``all`` (this machine's CPU count)."""
+    if text == "all":
+        return os.cpu_count() or 1
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"--cores {text}: allowed: a number >= 1, or all")
+    return value
 
 
 def _fail(message, code=2):

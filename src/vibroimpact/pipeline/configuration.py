@@ -10,6 +10,9 @@ path, the value and the allowed range, instead of failing minutes into a build:
   file lists it under ``replace`` (it would overwrite the paper's results); with
   ``paper: false`` only the file's own entries are built (the paper's stay available by
   name, e.g. a noise record or an orbits map).
+- :func:`expand_sweeps` turns a study that lists values of zeta, eps, amplitude, rms or
+  seed (a sweep) into one ordinary study per combination, so everything after it sees
+  ordinary studies; an error about one names the sweep and its combination.
 - :func:`check` validates against ``config/schema.yaml`` (filling defaults), rejects
   non-finite numbers (JSON Schema lets ``.nan`` through), checks every cross-field
   relation (records, grids, figures and the blocks they need), and returns the
@@ -22,9 +25,11 @@ from __future__ import annotations
 
 import copy
 from dataclasses import dataclass, field
+import itertools
 import math
 import os
 from pathlib import Path
+import re
 
 import numpy as np
 import yaml
@@ -32,7 +37,9 @@ import yaml
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.study import grid_size, grid_values, map_cap_steps
 
-__all__ = ["ConfigError", "Plan", "read_yaml", "compose", "check", "load", "SECTIONS"]
+__all__ = ["ConfigError", "Plan", "Sweeps", "read_yaml", "compose", "expand_sweeps", "check",
+           "load", "drawn_sweeps", "sweep_figures", "sweep_label", "sweep_labels", "SECTIONS",
+           "SWEEP_KEYS"]
 
 #: Sections whose entries are named; a user's entry replaces a paper entry whole.
 SECTIONS = ("noises", "studies", "orbits", "paper_figures")
@@ -145,6 +152,254 @@ def compose(paper, user):
     return config, own
 
 
+# --- sweeps: a study listing values -----------------------------------------------------------
+
+#: Study keys a list of values sweeps, in the order of the product: the first key varies
+#: slowest, the last fastest (nested loops), so ``eps: [a, b]`` with ``rms: [c, d]`` gives
+#: combinations 0-3 = (a, c), (a, d), (b, c), (b, d).
+SWEEP_KEYS = ("zeta", "eps", "amplitude", "rms", "seed")
+#: Of these, the keys that override the study's `noises` entry (a derived entry per value).
+NOISE_KEYS = ("rms", "seed")
+#: Combinations an error message lists before "...".
+_LISTED = 6
+
+
+def sweep_label(values, sep=" = "):
+    """``"eps = 0.8, rms = 0.3"``: the values of one combination, in `SWEEP_KEYS` order."""
+    def text(value):
+        return _num(value) if isinstance(value, (int, float)) else _short(value)
+    return ", ".join(f"{key}{sep}{text(value)}" for key, value in values.items())
+
+
+def sweep_labels(sweep):
+    """The labels of every combination of a ``config["sweeps"]`` record, in its order."""
+    return [sweep_label(dict(zip(sweep["keys"], row))) for row in sweep["values"]]
+
+
+@dataclass
+class Sweeps:
+    """What :func:`expand_sweeps` made: ``record`` (``config["sweeps"]``, by sweep name:
+    ``studies``, ``keys``, ``values`` one row per study) and, for error messages, how each
+    generated entry is named in the words of the user's file."""
+
+    record: dict = field(default_factory=dict)
+    studies: dict = field(default_factory=dict)     # "studies.s_2" -> ("s", 2)
+    noises: dict = field(default_factory=dict)      # "noises.s_noise0" -> its label
+
+    def _label(self, sweep, indices):
+        n = len(self.record[sweep]["studies"])
+        if len(indices) == 1:
+            k = indices[0]
+            values = dict(zip(self.record[sweep]["keys"], self.record[sweep]["values"][k]))
+            return f"studies.{sweep} (combination {k}: {sweep_label(values, '=')})"
+        if len(indices) == n:
+            return f"studies.{sweep} (all {n} combinations)"
+        return f"studies.{sweep} (combinations {_listed(indices)})"
+
+    def relabel(self, err):
+        """``err`` with each generated entry named by its sweep and combination; a problem
+        that several combinations share is given once, naming them."""
+        names = sorted([*self.studies, *self.noises], key=len, reverse=True)
+        if not names:
+            return err
+        pattern = re.compile(r"(?<![\w.])(" + "|".join(map(re.escape, names)) + r")(?!\w)(\.?)")
+
+        def name(match):
+            path, dot = match.groups()
+            if path in self.noises:
+                label = self.noises[path]
+            else:
+                sweep, k = self.studies[path]
+                label = self._label(sweep, [k])
+            return label + (": " if dot else "")
+
+        groups = {}     # problem with its combination left out -> the combinations, in order
+        for problem in err.problems:
+            first = pattern.search(problem)
+            if first is None or first.group(1) not in self.studies:
+                groups.setdefault((None, pattern.sub(name, problem)), [])
+                continue
+            sweep, k = self.studies[first.group(1)]
+            key = (sweep, problem[:first.start()], first.group(2),
+                   pattern.sub(name, problem[first.end():]))
+            groups.setdefault(key, []).append(k)
+        lines = []
+        for (sweep, *parts), indices in groups.items():
+            if sweep is None:
+                lines.append(parts[0])
+            else:
+                head, dot, tail = parts
+                lines.append(head + self._label(sweep, indices) + (": " if dot else "") + tail)
+        return ConfigError(lines, details=err.details)
+
+
+def _swept(entry):
+    """Whether a study entry is expanded: it lists a value of SWEEP_KEYS or overrides its noise."""
+    return any(isinstance(entry.get(k), list) for k in SWEEP_KEYS) or any(
+        k in entry for k in NOISE_KEYS)
+
+
+def _axes(name, entry, problems, max_studies):
+    """``{key: values}`` of the keys a study lists, or None after recording why not."""
+    axes, ok = {}, True
+    allowed_ = "a number, or a non-empty list of numbers (a sweep: one study per value)"
+    for key in SWEEP_KEYS:
+        if key not in entry:
+            continue
+        value = entry[key]
+        items = value if isinstance(value, list) else [value]
+        if isinstance(value, list) and not value:
+            problems.add(f"studies.{name}.{key}", value, "an empty list sweeps nothing", allowed_)
+            ok = False
+        elif any(isinstance(v, (list, dict)) for v in items):
+            problems.add(f"studies.{name}.{key}", value, "not a number or a list of numbers",
+                         allowed_)
+            ok = False
+        elif isinstance(value, list):
+            axes[key] = value
+    n = math.prod(len(v) for v in axes.values())
+    if ok and max_studies is not None and n > max_studies:
+        sizes = " x ".join(f"{len(v)} {k}" for k, v in axes.items())
+        problems.add(f"studies.{name}", None, f"{sizes} = {n:,} combinations, a study each",
+                     f"at most limits.max_jobs = {max_studies:,} combinations; shorten the "
+                     f"lists or raise limits.max_jobs")
+        ok = False
+    return axes if ok else None
+
+
+def _listed(indices):
+    return ", ".join(map(str, indices[:_LISTED])) + (", ..." if len(indices) > _LISTED else "")
+
+
+def _noise_label(name, override, indices, swept):
+    if not swept:
+        return f"studies.{name} (its noise: {sweep_label(override, '=')})"
+    which = "combination" + ("s" if len(indices) > 1 else "")
+    return f"studies.{name} (noise of {which} {_listed(indices)}: {sweep_label(override, '=')})"
+
+
+def expand_sweeps(config, own=None, *, max_studies=None):
+    """Expand, in place, every study that lists values into one study per combination.
+
+    A study whose ``zeta``, ``eps``, ``amplitude``, ``rms`` or ``seed`` is a list (a
+    *sweep*) becomes the studies ``<name>_0`` ... ``<name>_<N-1>``, one per combination of
+    the listed values, in the order of `SWEEP_KEYS` (the first key slowest, the last
+    fastest); each is a copy of the entry with one value per key and the key ``sweep:
+    {name, index, values}`` (``values``: the listed keys' values of this combination).
+    ``rms`` and ``seed`` override the study's ``noises`` entry: each distinct (rms, seed)
+    pair that differs from the entry gets a copy of it, ``<name>_noise<j>`` (j in order of
+    first use), shared by the combinations that use it; the pair equal to the entry uses the
+    entry itself (a list of rms alone keeps the entry's seed: the records differ only in
+    scale, common random numbers). A study that only overrides rms or seed keeps its name.
+    A study without lists or overrides is left as it is (the same dict).
+
+    Parameters
+    ----------
+    config : dict
+        The composed config (:func:`compose`), not yet validated.
+    own : dict, optional
+        ``{section: names}`` of the user's own entries (:func:`compose`), updated in place:
+        a sweep of the user's is replaced by its studies, and its derived noises are added.
+    max_studies : int, optional
+        Largest number of combinations a sweep may have (``limits.max_jobs``).
+
+    Returns
+    -------
+    Sweeps
+        ``record`` for ``config["sweeps"]`` and the names of the generated entries, to
+        restate an error about them in the user's words (:meth:`Sweeps.relabel`).
+
+    Raises
+    ------
+    ConfigError
+        A hand-written ``sweep`` key, an empty or nested list, too many combinations, or a
+        generated name that is already taken (naming both).
+    """
+    sweeps = Sweeps()
+    studies = config.get("studies")
+    if not isinstance(studies, dict):
+        return sweeps                           # the schema check names the problem
+    noises = config["noises"] if isinstance(config.get("noises"), dict) else {}
+    taken = {"studies": set(studies), "noises": set(noises)}
+    problems, expanded, derived_noises = _Problems(), {}, {}
+    for name, entry in studies.items():
+        if isinstance(entry, dict) and "sweep" in entry:
+            problems.add(f"studies.{name}.sweep", None, "set by the expansion of a sweep, "
+                         "never by hand", "leave it out; list values under zeta, eps, "
+                         "amplitude, rms or seed to sweep them")
+            continue
+        if not isinstance(entry, dict) or not _swept(entry):
+            expanded[name] = entry
+            continue
+        axes = _axes(name, entry, problems, max_studies)
+        if axes is None:
+            continue
+        combos = [dict(zip(axes, c)) for c in itertools.product(*axes.values())]
+        names = [f"{name}_{k}" for k in range(len(combos))] if axes else [name]
+        noise = entry.get("noise")
+        base = noises.get(noise) if isinstance(noise, str) else None
+        derived, users = {}, {}     # (rms, seed) pair -> noise name; noise name -> combinations
+        for k, (study_name, values) in enumerate(zip(names, combos)):
+            if axes and study_name in taken["studies"]:
+                problems.add(f"studies.{name}", None, f"its combination {k} "
+                             f"({sweep_label(values, '=')}) would be named {study_name}, "
+                             f"like the study studies.{study_name}",
+                             f"rename the sweep or studies.{study_name}")
+                continue
+            taken["studies"].add(study_name)
+            study = {key: copy.deepcopy(v) for key, v in entry.items() if key not in NOISE_KEYS}
+            study.update({key: v for key, v in values.items() if key not in NOISE_KEYS})
+            override = {key: values.get(key, entry[key]) for key in NOISE_KEYS if key in entry}
+            if isinstance(base, dict) and any(base.get(key) != value
+                                              for key, value in override.items()):
+                pair = tuple(override.items())
+                if pair not in derived:
+                    derived[pair] = f"{name}_noise{len(derived)}"
+                    if derived[pair] in taken["noises"]:
+                        problems.add(f"studies.{name}", None, f"its noise for "
+                                     f"{sweep_label(override, '=')} would be named "
+                                     f"{derived[pair]}, like the entry noises.{derived[pair]}",
+                                     f"rename the study or noises.{derived[pair]}")
+                    taken["noises"].add(derived[pair])
+                    derived_noises[derived[pair]] = dict(copy.deepcopy(base), **override)
+                    sweeps.noises[f"noises.{derived[pair]}"] = override
+                study["noise"] = derived[pair]
+                users.setdefault(derived[pair], []).append(k)
+            if axes:
+                study["sweep"] = {"name": name, "index": k, "values": values}
+                sweeps.studies[f"studies.{study_name}"] = (name, k)
+            expanded[study_name] = study
+        for noise_name, indices in users.items():
+            override = sweeps.noises[f"noises.{noise_name}"]
+            sweeps.noises[f"noises.{noise_name}"] = _noise_label(name, override, indices,
+                                                                 bool(axes))
+        if axes:
+            sweeps.record[name] = {"studies": names, "keys": list(axes),
+                                   "values": [list(c.values()) for c in combos]}
+        if own is not None and name in own["studies"]:
+            own["studies"].discard(name)
+            own["studies"].update(names)
+            own["noises"].update(derived.values())
+    if problems:
+        raise ConfigError(problems)
+    config["studies"] = expanded
+    if derived_noises:
+        config["noises"].update(derived_noises)
+    return sweeps
+
+
+def drawn_sweeps(config, drawn):
+    """Names of the sweeps whose studies are all among ``drawn["studies"]`` (:attr:`Plan.drawn`):
+    `rule all` draws their side-by-side figures."""
+    return sorted(name for name, sweep in config.get("sweeps", {}).items()
+                  if set(sweep["studies"]) <= drawn["studies"])
+
+
+def sweep_figures(config, drawn):
+    """``results/figures/<sweep>/sweep.png`` of every sweep :func:`drawn_sweeps` gives."""
+    return [f"results/figures/{name}/sweep.png" for name in drawn_sweeps(config, drawn)]
+
+
 # --- schema validation with short messages ----------------------------------------------------
 
 def _path(parts):
@@ -232,6 +487,14 @@ def _schema_at(parts):
     return node
 
 
+def _scalar(node):
+    """The number branch of a number-or-list node (``zeta``: a value or a sweep), else ``node``."""
+    for branch in node.get("oneOf", ()):
+        if branch.get("type") in ("number", "integer"):
+            return branch
+    return node
+
+
 def _describe(parts, node=None):
     node = node if node is not None else _schema_at(parts)
     text = allowed(node) if node else "see config/schema.yaml"
@@ -263,7 +526,9 @@ def _schema_messages(error):
             want = schema.get("type")
             same = ((want == "object" and isinstance(error.instance, dict))
                     or (want == "array" and isinstance(error.instance, list))
-                    or (want == "string" and isinstance(error.instance, str)))
+                    or (want == "string" and isinstance(error.instance, str))
+                    or (want in ("number", "integer")
+                        and isinstance(error.instance, (int, float))))
             if same and not any(s.validator == "type" and not s.relative_path for s in subs):
                 return [m for s in subs for m in _schema_messages(s)]
         return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts)}"]
@@ -303,6 +568,8 @@ def _validator(schema):
 
 
 def _nonfinite(value, parts=()):
+    if len(parts) == 3 and parts[0] == "studies" and parts[2] == "sweep":
+        return      # a sweep's values repeat the study's own keys, reported there
     if isinstance(value, float) and not math.isfinite(value):
         yield list(parts), value
     elif isinstance(value, dict):
@@ -323,8 +590,8 @@ def validate(config, schema):
         ``VIBROIMPACT_VERBOSE=1``).
     """
     _SCHEMA["root"] = schema
-    problems = [f"{_path(p)} = {v}: not a finite number; allowed: {_describe(p)}"
-                for p, v in _nonfinite(config)]
+    problems = [f"{_path(p)} = {v}: not a finite number; allowed: "
+                f"{_describe(p, _scalar(_schema_at(p)))}" for p, v in _nonfinite(config)]
     if problems:
         raise ConfigError(problems)
     errors = sorted(_validator(schema).iter_errors(config), key=lambda e: list(map(str, e.path)))
@@ -505,6 +772,10 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
 
 def _check_study(config, name, entry, problems, limits):
     where = f"studies.{name}"
+    for other in entry.get("report_with", []):
+        if other == name or other not in config["studies"]:
+            problems.add(f"{where}.report_with", other, "no other study of this name",
+                         ", ".join(sorted(set(config["studies"]) - {name})) or "none")
     if entry["noise"] not in config["noises"]:
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
@@ -647,7 +918,10 @@ def check(config, own=None, *, results="results"):
 
 
 def load(user=None, *, root=".", user_files=()):
-    """Read the paper's config, layer ``user`` on it, validate and check: ``(config, plan)``.
+    """Read the paper's config, layer ``user`` on it, expand its sweeps, validate and check.
+
+    Returns ``(config, plan)``; ``config["sweeps"]`` records each sweep's studies and values
+    (:func:`expand_sweeps`).
 
     Parameters
     ----------
@@ -666,9 +940,26 @@ def load(user=None, *, root=".", user_files=()):
     schema = read_yaml(root / "config" / "schema.yaml")
     paper = read_yaml(root / "config" / "config.yaml")
     config, own = compose(paper, user or {})
-    validate(config, schema)
-    plan = check(config, own, results=root / "results")
+    if own is not None and "build" not in ((user or {}).get("validation") or {}):
+        # paper: false builds the file's own entries; the validation runs are the paper's
+        config["validation"] = {**(config.get("validation") or {}), "build": False}
+    sweeps = expand_sweeps(config, own, max_studies=_max_jobs(config, schema))
+    try:
+        validate(config, schema)
+        config["sweeps"] = sweeps.record    # after the schema, which knows only the user's keys
+        plan = check(config, own, results=root / "results")
+    except ConfigError as err:
+        raise sweeps.relabel(err) from None
     return config, plan
+
+
+def _max_jobs(config, schema):
+    """``limits.max_jobs`` of a config not yet validated (the schema's default if unusable)."""
+    limits = config.get("limits")
+    value = limits.get("max_jobs") if isinstance(limits, dict) else None
+    if isinstance(value, int) and not isinstance(value, bool) and value >= 1:
+        return value
+    return schema["properties"]["limits"]["properties"]["max_jobs"]["default"]
 
 
 def _deep_merge(base, extra):
@@ -689,9 +980,12 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 FIGURE_S = 1.5             # one figure, start-up included
+REPORT_S = 4.0             # one report notebook executed and rendered (papermill, nbconvert)
+VALIDATION_S = 85.0        # the work-precision run and the stress sample together
 # Bytes of the outputs (measured file sizes of the default build):
 FILE_OVERHEAD = 20_000
 FIGURE_BYTES = 400_000     # png + pdf
+REPORT_BYTES = 4_000_000   # executed notebook + HTML, figures embedded
 
 
 @dataclass
@@ -800,8 +1094,11 @@ def _time(s):
 
 
 def _study_needs(entry):
-    return {r for f in entry["figures"] for r in figures.FIGURES[
+    needs = {r for f in entry["figures"] for r in figures.FIGURES[
         f if isinstance(f, str) else f["name"]]["reads"]}
+    if "sweep" in entry:
+        needs.add("events")         # the sweep's side-by-side figure reads them
+    return needs
 
 
 def built_entries(config, own=None):
@@ -888,6 +1185,19 @@ def make_plan(config, own=None, *, results="results"):
         row.cpu_s = (cells * len(entry["types"]) * US_PER_ORBIT * 1e-6
                      + row.jobs * JOB_START_S + targets * FIGURE_S)
         plan.rows.append(row)
+    for name in drawn_sweeps(config, drawn):
+        n = len(config["sweeps"][name]["studies"])
+        plan.rows.append(Row(f"sweeps.{name}", f"{n} studies side by side, 1 figure", jobs=1,
+                             bytes=FIGURE_BYTES, cpu_s=FIGURE_S + JOB_START_S))
+    reports = len(drawn["studies"]) + len(drawn["orbits"])
+    if reports:
+        plan.rows.append(Row("reports", f"{reports} notebooks executed, with HTML",
+                             jobs=reports, bytes=reports * REPORT_BYTES,
+                             cpu_s=reports * (REPORT_S + JOB_START_S)))
+    if config["validation"]["build"]:
+        plan.rows.append(Row("validation", "work-precision and stress-sample runs, 2 figures, "
+                             "2 reports", jobs=6, bytes=2 * FIGURE_BYTES + 2 * REPORT_BYTES,
+                             cpu_s=VALIDATION_S + 2 * (FIGURE_S + REPORT_S) + 6 * JOB_START_S))
     copies = drawn["paper_figures"]
     if copies:
         plan.rows.append(Row("paper_figures", f"{len(copies)} copies", jobs=len(copies),

@@ -14,25 +14,58 @@ draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits
 import re
 
 __all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item",
-           "figure_sources", "paper_target"]
+           "figure_sources", "paper_target", "caption"]
 
 FIGURES = {
-    "fig03": dict(owner="study", reads=("trace",)),
-    "fig04": dict(owner="study", reads=("noise",)),
-    "fig05": dict(owner="study", reads=("noise",)),
-    "fig06": dict(owner="study", reads=("spectra",)),
-    "fig07": dict(owner="study", reads=("events",), options=("density_delta",)),
-    "fig08": dict(owner="study", reads=("events",), options=("density_delta",)),
-    "fig09": dict(owner="study", reads=("events",)),
-    "fig10": dict(owner="study", reads=("trace",), harmonic=True),
-    "fig11": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True),
-    "fig12": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True),
-    "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta", harmonic=True),
-    "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta", harmonic=True),
-    "fig15": dict(owner="study", reads=("map",), harmonic=True),
+    "fig03": dict(owner="study", reads=("trace",),
+                  shows="a stretch of the random input r(tau) and the motion x(tau) of the mass "
+                        "from rest, with the wall at delta"),
+    "fig04": dict(owner="study", reads=("noise",),
+                  shows="the autocorrelation of the random input, estimated from its record "
+                        "against the target (paper eq. 8)"),
+    "fig05": dict(owner="study", reads=("noise",),
+                  shows="the power spectral density of the random input, estimated against "
+                        "the target (paper eq. 9)"),
+    "fig06": dict(owner="study", reads=("spectra",),
+                  shows="the PSD of the acceleration a(tau) for several plays delta, with the "
+                        "wall-free response |H|^2 S_f"),
+    "fig07": dict(owner="study", reads=("events",), options=("density_delta",),
+                  shows="the probability density of the velocity after impact for several "
+                        "plays delta"),
+    "fig08": dict(owner="study", reads=("events",), options=("density_delta",),
+                  shows="the probability density of the interval between impacts for several "
+                        "plays delta"),
+    "fig09": dict(owner="study", reads=("events",),
+                  shows="the mean velocity after impact and the mean interval against delta, "
+                        "with batch-means confidence bars, down to the play beyond which no "
+                        "impact occurs"),
+    "fig10": dict(owner="study", reads=("trace",), harmonic=True,
+                  shows="the input sin(beta_f tau) + r(tau) and the motion of the mass from rest"),
+    "fig11": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True,
+                  shows="the PSD of the input sin(beta_f tau) + r(tau): the random part and "
+                        "the line of the harmonic force"),
+    "fig12": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True,
+                  shows="the PSD of the acceleration a(tau) under sin(beta_f tau) + r(tau) for "
+                        "several plays delta"),
+    "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta",
+                  harmonic=True,
+                  shows="the probability density of z_j/z (interval over forcing period) for "
+                        "several plays delta: (1/1) at 1, (2/1) about 1/2, (1/2) at 2"),
+    "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta",
+                  harmonic=True,
+                  shows="the probability density of the velocity after impact under "
+                        "sin(beta_f tau) + r(tau) for several plays delta"),
+    "fig15": dict(owner="study", reads=("map",), harmonic=True,
+                  shows="maps over the (1/beta_f, delta) plane of the probability (%) of the "
+                        "(1/1), (2/1) and (1/2) impact motions under sin(beta_f tau) + r(tau)"),
     "fig15_vs_fig16": dict(owner="study", reads=("map", "orbits"), sources=("orbits",),
-                           harmonic=True),
-    "fig16": dict(owner="orbits", reads=("orbits",)),
+                           harmonic=True,
+                           shows="the probability contours of Fig. 15 over the stable domains "
+                                 "of Fig. 16, with the agreement measures of each motion"),
+    "fig16": dict(owner="orbits", reads=("orbits",),
+                  shows="the domains over the (1/beta_f, delta) plane of stable periodic "
+                        "(m/n) impact motions under sin(beta_f tau) alone, with contours of "
+                        "the degree of stability S"),
 }
 
 _VARIANT = re.compile(r"^(?P<name>[a-z][a-z0-9_]*?)(-(?P<index>[0-9]+))?$")
@@ -118,3 +151,45 @@ def paper_target(entry, name):
     if not targets:
         raise ValueError(f"figures: {name!r} is not listed")
     return targets[0]
+
+
+_PHYSICS_KEYS = ("zeta", "eps", "amplitude", "noise")
+
+
+def _values_text(values):
+    values = list(values) if isinstance(values, (list, tuple)) else values
+    if isinstance(values, dict):
+        return f"{values['start']:g} to {values['stop']:g} in steps of {values['step']:g}"
+    if isinstance(values, list):
+        return ", ".join(f"{v:.4g}" for v in values)
+    return f"{values:.4g}" if isinstance(values, float) else str(values)
+
+
+def caption(kind, name, entry, target):
+    """What figure ``target`` of config entry ``name`` shows and with which parameters: one
+    paragraph (the Snakemake report's caption, ``workflow/report/figure.rst``).
+
+    ``kind`` is ``"study"`` or ``"orbits"``.
+    """
+    fig, _ = figure_variant(target)
+    number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
+    what = FIGURES[fig]["shows"]
+    title = ("Fig. 15 against Fig. 16" if fig == "fig15_vs_fig16" else f"Fig. {number}")
+    parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
+    if kind == "study":
+        if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:
+            parts.append(f"1/beta_f = {_values_text(entry['inv_beta'])}")
+        parts.append(f"delta = {_values_text(entry['delta'])}")
+        options = figure_options(entry, target)
+        if options:
+            parts.append("drawn with " + ", ".join(f"{key} = {_values_text(value)}"
+                                                   for key, value in options.items()))
+    else:
+        parts += [f"1/beta_f = {_values_text(entry['inv_beta'])}",
+                  f"delta = {_values_text(entry['delta'])}",
+                  "types " + ", ".join(f"({m}/{n})" for m, n in entry.get("types", []))]
+    sweep = entry.get("sweep")
+    if sweep:
+        parts.append(f"combination {sweep['index']} of sweep {sweep['name']}")
+    return (f"{title} ({'orbits entry' if kind == 'orbits' else 'study'} {name}): {what}. "
+            f"Parameters: {'; '.join(parts)}.")

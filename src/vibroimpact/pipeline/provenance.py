@@ -3,9 +3,10 @@
 `provenance` is called by each job at run time (never passed through the workflow's params,
 so a commit alone reruns nothing) and records the package version, the git commit of the
 package's source tree with a dirty flag, the config block the job read (YAML text and
-digest), the creation time, the seed and the paper's reference. `source_digest` is what the workflow puts in params instead:
-a digest of the package sources an output depends on, so editing them (committed or not)
-reruns exactly the jobs they feed.
+digest), the creation time, the seed and the paper's reference, and, for a study expanded
+from a sweep, its combination (`sweep_attrs`). `source_digest` is what the workflow puts in
+params instead: a digest of the package sources an output depends on, so editing them
+(committed or not) reruns exactly the jobs they feed.
 """
 import functools
 import hashlib
@@ -13,7 +14,8 @@ import json
 from pathlib import Path
 import subprocess
 
-__all__ = ["config_digest", "config_text", "source_digest", "git_state", "provenance"]
+__all__ = ["config_digest", "config_text", "source_digest", "git_state", "provenance",
+           "sweep_attrs"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -78,12 +80,25 @@ def config_text(obj):
     return yaml.safe_dump(obj, sort_keys=True, default_flow_style=None, width=100)
 
 
+def sweep_attrs(config_block):
+    """``sweep``, ``sweep_index`` and ``sweep_<key>`` (e.g. ``sweep_eps``, ``sweep_rms``) of a
+    study expanded from a sweep (its block's ``sweep`` key,
+    `vibroimpact.pipeline.configuration.expand_sweeps`); empty for any other block."""
+    sweep = config_block.get("sweep") if isinstance(config_block, dict) else None
+    if not sweep:
+        return {}
+    attrs = {"sweep": str(sweep["name"]), "sweep_index": int(sweep["index"])}
+    attrs.update({f"sweep_{key}": value for key, value in sweep["values"].items()})
+    return attrs
+
+
 def provenance(config_block, seed=None):
     """Global attributes every output carries, collected now (at run time).
 
     ``config`` (the block as YAML text: the same block the rule's params carry, so the
     dataset says what it was computed from), ``config_digest``, ``created`` (UTC, ISO
-    8601), ``package_version``, ``git_commit`` and ``git_dirty``, ``paper_reference``.
+    8601), ``package_version``, ``git_commit`` and ``git_dirty``, ``paper_reference``; and
+    :func:`sweep_attrs` for a study of a sweep.
 
     Parameters
     ----------
@@ -103,4 +118,5 @@ def provenance(config_block, seed=None):
                  paper_reference=PAPER_REFERENCE)
     if seed is not None:
         attrs["seed"] = int(seed)
+    attrs.update(sweep_attrs(config_block))
     return attrs

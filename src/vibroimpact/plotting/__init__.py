@@ -15,6 +15,8 @@ Datasets and the figures that read them (docs/figures.md)::
     results/datasets/{study}_events.nc  fig07, fig08, fig09, fig13, fig14
     results/datasets/{study}_map.nc     fig15, fig15_vs_fig16  (harmonic)
     results/orbits/{name}.nc            fig16, fig15_vs_fig16  (orbits)
+    results/validation/work_precision.nc   work_precision      (validation)
+    results/validation/stress_sample.nc    stress              (validation)
 
 Plotting never imports the simulator or the orbit solver; it may use small helpers of
 `vibroimpact.stats`.
@@ -25,10 +27,11 @@ from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement
 from vibroimpact.plotting.orbits import fig16
 from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fig06, fig07,
                                          fig08, fig09)
+from vibroimpact.plotting.validation import stress, work_precision
 
 __all__ = [
     "STYLE_FILE", "style", "axis_label", "critical_delta", "save",
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
     "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
-    "map_agreement",
+    "map_agreement", "work_precision", "stress",
 ]

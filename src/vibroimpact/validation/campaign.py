@@ -1,15 +1,22 @@
 """The whole stress campaign in one call: every family, at full size or as a quick sample.
 
 ``python -m vibroimpact.validation.campaign --quick`` prints one line per family; the test
-suite runs the same families at full size (``tests/stress/``), and a workflow rule can run
-:func:`run_campaign` with ``quick=True`` for a report.
+suite runs the same families at full size (``tests/stress/``), and the workflow runs
+:func:`run_campaign` with ``quick=True`` and stores :func:`campaign_dataset` of its reports
+(``results/validation/stress_sample.nc``).
 """
 import argparse
+import logging
 import tempfile
+
+import numpy as np
+import xarray as xr
 
 from vibroimpact.validation.families import FAMILIES, FULL_CASES, run_family
 from vibroimpact.validation.orbit_families import FAMILIES as ORBIT_FAMILIES, run_orbit_family
 from vibroimpact.validation.streaming import run_streamed_record
+
+log = logging.getLogger(__name__)
 
 #: Cases per simulator family in a quick sample (seconds).
 QUICK_CASES = {name: max(5, n // 20) for name, n in FULL_CASES.items()}
@@ -38,6 +45,93 @@ def run_campaign(seed, quick=False, workdir=None):
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
         reports.append(run_streamed_record(STREAM_SAMPLES[size], seed, tmp))
     return reports
+
+
+#: Counts of a report stored per family (int), with their long_name.
+COUNTS = {
+    "cases": "cases tried",
+    "compared": "events compared one by one with the independent reference",
+    "missed": "reference events the checked code did not produce",
+    "spurious": "events the checked code produced that the reference does not have",
+    "approximated": "events a documented approximation takes as resting contact",
+    "exceptions": "cases in which the checked code raised",
+    "failed": "cases with an exception, a miss, a spurious event or an error above tolerance",
+}
+#: Scalars of the case descriptions kept in ``worst_case`` (shortened to 4 digits).
+CASE_DIGITS = 4
+
+
+def describe_case(case):
+    """One line of a case's inputs: scalars to `CASE_DIGITS` digits, sequences by their length."""
+    if case is None:
+        return ""
+    if not isinstance(case, dict):
+        return str(case)
+    parts = []
+    for key, value in case.items():
+        if isinstance(value, (list, tuple, np.ndarray)):
+            parts.append(f"{key}=[{len(value)} values]")
+        elif isinstance(value, (float, np.floating)):
+            parts.append(f"{key}={float(value):.{CASE_DIGITS}g}")
+        else:
+            parts.append(f"{key}={value}")
+    return ", ".join(parts)
+
+
+def campaign_dataset(reports, attrs=None):
+    """The reports of :func:`run_campaign` as an :class:`xarray.Dataset` along ``family``.
+
+    Parameters
+    ----------
+    reports : sequence of :class:`~vibroimpact.validation.report.FamilyReport`
+    attrs : dict, optional
+        Global attributes (provenance, the seed).
+
+    Returns
+    -------
+    xarray.Dataset
+        Per family: the counts of :data:`COUNTS` (int), ``worst_error`` and ``tolerance`` (in the
+        family's own measure, ``measure``; a family passes when every compared event's error is
+        below its tolerance), ``worst_case`` (the inputs of the worst case, one line),
+        ``first_failure`` (empty when none failed), ``details`` (the family-specific figures,
+        e.g. memory and timings of the streamed record) and ``seconds``. ``seconds`` and
+        ``details`` are flagged ``run_measurement = 1``: they change from run to run, the rest
+        is fixed by the seed.
+    """
+    rows = [r.as_row() for r in reports]
+    data = {name: ("family", np.array([row[name] for row in rows], dtype=np.int64),
+                   dict(long_name=long_name, units="1")) for name, long_name in COUNTS.items()}
+    data.update(
+        worst_error=("family", np.array([float(r.worst_error) for r in reports]),
+                     dict(long_name="largest error over the compared events (in `measure`)",
+                          units="1")),
+        tolerance=("family", np.array([float(r.tolerance) for r in reports]),
+                   dict(long_name="error above which a compared event fails", units="1")),
+        measure=("family", [r.measure for r in reports],
+                 dict(long_name="what worst_error measures", units="1")),
+        worst_case=("family", [describe_case(r.worst_case) for r in reports],
+                    dict(long_name="inputs of the case with the largest error", units="1")),
+        first_failure=("family", [r.failures[0] if r.failures else "" for r in reports],
+                       dict(long_name="the first failing case and what failed", units="1")),
+        details=("family", ["  ".join(f"{k} {v}" for k, v in r.extra.items()) for r in reports],
+                 dict(long_name="family-specific figures", units="1", run_measurement=1)),
+        seconds=("family", np.array([float(r.seconds) for r in reports]),
+                 dict(long_name="wall time spent on the family", units="s", run_measurement=1)),
+    )
+    return xr.Dataset(data, coords=dict(family=("family", [r.family for r in reports],
+                                                dict(long_name="stress family", units="1"))),
+                      attrs=dict(attrs or {}))
+
+
+def stress_sample(seed, workdir=None):
+    """The seeded quick sample of every family (:func:`run_campaign` with ``quick=True``) as a
+    dataset (:func:`campaign_dataset`); the attributes give the seed and the sample's size."""
+    reports = run_campaign(seed, quick=True, workdir=workdir)
+    for report in reports:
+        log.info("%s", report.summary())
+    attrs = dict(seed=int(seed), size="quick", quick_cases=str(QUICK_CASES),
+                 orbit_cases=ORBIT_CASES["quick"], stream_samples=STREAM_SAMPLES["quick"])
+    return campaign_dataset(reports, attrs)
 
 
 def main(argv=None):

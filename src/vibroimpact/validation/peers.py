@@ -1,17 +1,26 @@
-"""Peers for the simulator benchmark: general-purpose integrators given the same problem.
+"""Peers of the simulator: general-purpose integrators given the same problem.
 
 Every peer integrates the oscillator of docs/model.md (x'' + 2 zeta x' + x = r(tau), wall at
 x = delta, restitution eps) under a piecewise-linear random force r(tau) sampled every `dt`
 (no harmonic part), and returns the impacts it found as ``(impact_time, impact_velocity)``
-float64 arrays, impact_velocity being the approach velocity u_{j-0} > 0.
+float64 arrays, impact_velocity being the approach velocity u_{j-0} > 0. They are what a user
+without this package would reach for, set up with care so that the comparison measures the
+methods (`vibroimpact.validation.work_precision` times them against the simulator):
 
-- `solve_ivp_impacts`: scipy.integrate.solve_ivp restarted at every force sample (so no step
-  ever straddles a kink of r) and after every impact (a terminal event on x - delta).
-- `rk4_clamp_impacts`: classical fixed-step RK4 with the wall imposed by clamping, compiled by
-  numba so that the comparison measures the method, not the interpreter.
+- `solve_ivp_impacts`: scipy.integrate.solve_ivp (RK45, DOP853, LSODA, ...) restarted at every
+  force sample (so no step ever straddles a kink of r) and after every impact (a terminal
+  event on x - delta).
+- `rk4_event_impacts`: classical fixed-step RK4 at h = dt / k with event location: the impact
+  is the first upward zero of the step's cubic Hermite interpolant, and the integration
+  restarts there with the rebound. Compiled by numba, since it runs per step.
+- `rk4_clamp_impacts`: fixed-step RK4 with the wall imposed by clamping (no event location:
+  the naive scheme, first order at best in the impact time).
 
 Also here: the bare recurrence that bounds any exact simulator from below
-(`linear_propagator`, `linear_recurrence`) and the work-precision figure (`plot_work_precision`).
+(`linear_propagator`, `linear_recurrence`).
+
+Nothing here is used to compute results: the package's own simulator is
+`vibroimpact.simulate`.
 """
 import math
 
@@ -21,10 +30,10 @@ import scipy.linalg
 from numba import njit
 
 V_STICK = 1e-7
-"""Rebound speed below which the solve_ivp peer leaves the mass at rest on the wall.
+"""Rebound speed below which the event-locating peers leave the mass at rest on the wall.
 
 The rest of the sequence (~2 V_STICK / ((1 - eps) (r - delta)) of time) is skipped: its impacts
-are slower still, in the chatter tail that the benchmark does not compare impact by impact."""
+are slower still, in the chatter tail that the comparison does not take impact by impact."""
 
 
 def _check_problem(zeta, eps, delta, noise, dt):
@@ -176,6 +185,221 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
 
 
 # ---------------------------------------------------------------------------------------------
+# Fixed-step RK4 with event location (cubic Hermite interpolant) and restart at the impact
+# ---------------------------------------------------------------------------------------------
+
+@njit(cache=True)
+def _rk4_step(x, v, s, f0, b, two_zeta):
+    """One classical RK4 step of length s from (x, v); the force is f0 + b * (elapsed time)."""
+    f_half = f0 + 0.5 * b * s
+    f_end = f0 + b * s
+    k1x = v
+    k1v = f0 - x - two_zeta * v
+    xa = x + 0.5 * s * k1x
+    va = v + 0.5 * s * k1v
+    k2x = va
+    k2v = f_half - xa - two_zeta * va
+    xb = x + 0.5 * s * k2x
+    vb = v + 0.5 * s * k2v
+    k3x = vb
+    k3v = f_half - xb - two_zeta * vb
+    xc = x + s * k3x
+    vc = v + s * k3v
+    k4x = vc
+    k4v = f_end - xc - two_zeta * vc
+    return (x + s / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x),
+            v + s / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v))
+
+
+@njit(cache=True)
+def _cubic(c0, c1, c2, c3, theta):
+    return c0 + theta * (c1 + theta * (c2 + theta * c3))
+
+
+@njit(cache=True)
+def _upcrossing(c0, c1, c2, c3, a, b):
+    """Zero of the cubic on [a, b] if it is <= 0 at a and > 0 at b (bisection to the last bit,
+    the cubic being monotone there), else -1."""
+    if not (_cubic(c0, c1, c2, c3, a) <= 0.0 < _cubic(c0, c1, c2, c3, b)):
+        return -1.0
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        if mid <= a or mid >= b:
+            break
+        if _cubic(c0, c1, c2, c3, mid) > 0.0:
+            b = mid
+        else:
+            a = mid
+    return b
+
+
+@njit(cache=True)
+def _first_upcrossing(p0, m0, p1, m1, lo):
+    """First upward zero in [lo, 1] of the cubic Hermite interpolant of a step, or -1.
+
+    p0, p1 are x - delta at the step's ends, m0, m1 the velocities times the step length, and
+    theta in [0, 1] the fraction of the step. The cubic's critical points split [lo, 1] into
+    monotone pieces; the first piece that rises through zero holds the event. A flight that
+    leaves the wall and comes back within one step (both ends below it) is caught too.
+    """
+    c1 = m0
+    c2 = -3.0 * p0 - 2.0 * m0 + 3.0 * p1 - m1
+    c3 = 2.0 * p0 + m0 - 2.0 * p1 + m1
+    # critical points: roots of c1 + 2 c2 theta + 3 c3 theta^2 (stable quadratic formula)
+    qa, qb = 3.0 * c3, 2.0 * c2
+    e1 = e2 = lo
+    if qa == 0.0:
+        if qb != 0.0:
+            e1 = e2 = -c1 / qb
+    else:
+        disc = qb * qb - 4.0 * qa * c1
+        if disc >= 0.0:
+            q = -0.5 * (qb + math.copysign(math.sqrt(disc), qb))
+            r1 = q / qa
+            r2 = c1 / q if q != 0.0 else r1
+            e1, e2 = min(r1, r2), max(r1, r2)
+    e1 = min(max(e1, lo), 1.0)
+    e2 = min(max(e2, lo), 1.0)
+    for a, b in ((lo, e1), (e1, e2), (e2, 1.0)):
+        if b > a:
+            theta = _upcrossing(p0, c1, c2, c3, a, b)
+            if theta >= 0.0:
+                return theta
+    return -1.0
+
+
+@njit(cache=True)
+def _rk4_event_kernel(noise, dt, m, n_intervals, t_end, zeta, eps, delta, x0, v0, v_stick,
+                      impact_time, impact_velocity):
+    """RK4 with m steps per sample, impacts located on the step's cubic Hermite interpolant.
+
+    Mirrors the sample loop of `solve_ivp_impacts` (same resting, sticking and release rules);
+    only the integrator differs. Returns the number of impacts (those beyond the buffers'
+    capacity are counted, not stored).
+    """
+    h = dt / m
+    two_zeta = 2.0 * zeta
+    x = x0
+    v = v0
+    resting = x == delta and v == 0.0
+    stuck = False
+    n_impacts = 0
+    capacity = impact_time.size
+    for k in range(n_intervals):
+        t_a = k * dt
+        t_b = min((k + 1) * dt, t_end)
+        r0 = noise[k]
+        b = (noise[k + 1] - r0) / dt
+        t = t_a
+        t_quiet = t_a
+        node = 1  # next grid point t_a + node * h
+        while t < t_b:
+            if resting:
+                push = r0 + b * (t - t_a) - delta
+                resting = False
+                stuck = push > 0.0 or (push == 0.0 and b > 0.0)
+                if not stuck:  # leaves at once; quiet until r comes back to delta
+                    t_quiet = t_b if b <= 0.0 else min(t_b, t_a + (delta - r0) / b)
+            if stuck:
+                if r0 + b * (t_b - t_a) - delta >= 0.0:
+                    break
+                t = max(t, t_a + (delta - r0) / b)
+                stuck = False
+                x = delta
+                v = 0.0
+                t_quiet = t_b
+                continue
+            t_node = t_b if node >= m else min(t_a + node * h, t_b)
+            if t_node <= t:
+                node += 1
+                continue
+            s = t_node - t
+            f0 = r0 + b * (t - t_a)
+            x1, v1 = _rk4_step(x, v, s, f0, b, two_zeta)
+            lo = max(0.0, (t_quiet - t) / s)
+            theta = -1.0
+            if lo < 1.0:
+                theta = _first_upcrossing(x - delta, s * v, x1 - delta, s * v1, lo)
+            if theta < 0.0:
+                # the wall is impenetrable: an end point beyond it is the scheme's own error
+                x = min(x1, delta)
+                v = v1
+                t = t_node
+                node += 1
+                continue
+            # the state at the event: a fresh RK4 step to it (the interpolant's derivative
+            # would cost an order in the impact velocity)
+            s_impact = theta * s
+            _, u = _rk4_step(x, v, s_impact, f0, b, two_zeta)
+            u = max(u, 0.0)
+            t = t + s_impact
+            if n_impacts < capacity:
+                impact_time[n_impacts] = t
+                impact_velocity[n_impacts] = u
+            n_impacts += 1
+            x = delta
+            v = -eps * u
+            if -v < v_stick:
+                v = 0.0
+                resting = True
+    return n_impacts
+
+
+def rk4_event_impacts(zeta, eps, delta, noise, dt, steps_per_sample=1, x0=None, v0=0.0,
+                      t_end=None, v_stick=V_STICK):
+    """Impacts found by fixed-step RK4 with event location and restart at every impact.
+
+    The fixed-step scheme a careful user would write: classical RK4 at h = dt / k (so every
+    stage sees the force's own linear piece), the impact located inside the step as the first
+    upward zero of the step's cubic Hermite interpolant of x - delta (end values and
+    velocities), the state at the impact recomputed by an RK4 step from the step's start to
+    the impact, and the integration restarted there with the rebound -eps u. It runs per step,
+    so it is compiled by numba (`cache=True`): the comparison with `vibroimpact.simulate`
+    measures the method, not the interpreter.
+
+    Parameters
+    ----------
+    zeta, eps, delta, noise, dt, x0, v0, t_end, v_stick
+        As in `solve_ivp_impacts` (same resting, sticking and release rules).
+    steps_per_sample : int
+        k: RK4 steps per sample interval, h = dt / k.
+
+    Returns
+    -------
+    impact_time, impact_velocity : ndarray of float64
+        Impact instants and approach velocities u_{j-0} >= 0.
+
+    Notes
+    -----
+    Both the step and the interpolant are fourth order, so impact times and velocities
+    converge as h^4 (measured in tests/test_validation_targets.py) while no impact is
+    grazing. After a rebound the interpolant matches the step's start exactly (x = delta and
+    the rebound velocity), so even a flight much shorter than h is located to a relative
+    error of O(h^2). Steps restart from the impact and rejoin the grid t_a + j h at the next
+    grid point. The impact map is eq. 7 of the paper.
+    """
+    noise = _check_problem(zeta, eps, delta, noise, dt)
+    if dt >= math.pi:
+        raise ValueError(f"dt must be < pi for the release rule, got {dt!r}")
+    n, t_end = _n_intervals(noise, dt, t_end)
+    m = int(steps_per_sample)
+    if m < 1:
+        raise ValueError(f"steps_per_sample must be a positive integer, got {steps_per_sample!r}")
+    x = min(0.0, delta) if x0 is None else float(x0)
+    if x > delta:
+        raise ValueError(f"x0 must be <= delta, got {x0!r}")
+    capacity = 4 * n + 16
+    while True:
+        impact_time = np.empty(capacity)
+        impact_velocity = np.empty(capacity)
+        n_impacts = _rk4_event_kernel(noise, dt, m, n, float(t_end), zeta, eps, delta, x,
+                                      float(v0), float(v_stick), impact_time, impact_velocity)
+        if n_impacts <= capacity:
+            return impact_time[:n_impacts], impact_velocity[:n_impacts]
+        capacity = 2 * n_impacts
+
+
+# ---------------------------------------------------------------------------------------------
 # Fixed-step RK4 with clamping at the wall
 # ---------------------------------------------------------------------------------------------
 
@@ -314,47 +538,3 @@ def linear_recurrence(noise, propagator, x0=0.0, v0=0.0):
     phi, g0, g1 = propagator
     return _recurrence_kernel(noise, phi[0, 0], phi[0, 1], phi[1, 0], phi[1, 1],
                               g0[0], g0[1], g1[0], g1[1], float(x0), float(v0))
-
-
-# ---------------------------------------------------------------------------------------------
-# The work-precision figure
-# ---------------------------------------------------------------------------------------------
-
-def plot_work_precision(table):
-    """Work-precision diagram: run time per unit of simulated time against impact error.
-
-    Parameters
-    ----------
-    table : sequence of dict
-        One row per run, with keys ``delta``, ``method`` (a label: the series), ``setting``
-        (tolerance or steps, as text), ``error`` (max of time and relative velocity error,
-        dimensionless) and ``cost`` (seconds of run time per unit of simulated time).
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-        One panel per delta, one line per method.
-    """
-    import matplotlib.pyplot as plt
-
-    deltas = sorted({row["delta"] for row in table}, reverse=True)
-    methods = list(dict.fromkeys(row["method"] for row in table))
-    fig, axes = plt.subplots(1, len(deltas), figsize=(4.2 * len(deltas), 4.0), sharey=True,
-                             squeeze=False, layout="constrained")
-    markers = dict(zip(methods, "os^vD*Ph"))
-    for ax, delta in zip(axes[0], deltas):
-        for method in methods:
-            rows = [r for r in table if r["delta"] == delta and r["method"] == method]
-            rows = [r for r in rows if math.isfinite(r["error"]) and r["error"] > 0.0]
-            if not rows:
-                continue
-            ax.loglog([r["error"] for r in rows], [r["cost"] for r in rows],
-                      marker=markers.get(method, "o"), ms=7 if len(rows) == 1 else 4,
-                      ls="-" if len(rows) > 1 else "none", label=method)
-        ax.set_title(f"delta = {delta:g}")
-        ax.set_xlabel("max error of impact time and relative velocity (1)")
-        ax.grid(True, which="major", alpha=0.3)
-    axes[0, 0].set_ylabel("run time per unit simulated time (s)")
-    axes[0, -1].legend(fontsize=8, loc="best")
-    fig.suptitle("Work-precision, piecewise-linear random force, zeta=0.05, eps=0.5")
-    return fig

@@ -1,0 +1,361 @@
+"""The paper's findings (docs/figures.md, points 1-8), each measured on a run's datasets.
+
+Every function takes the datasets a finding is about (as written by the workflow,
+``docs/datasets.md``) and returns a :class:`Finding`: the paper's claim, what this run
+measured, and whether the claim holds on it (``"yes"``, ``"partly"``, ``"no"``, or ``"n/a"`` when
+the datasets cannot decide it). The report notebooks show them as a table
+(:func:`findings_table`); the workflow tests assert them on the test config. Nothing here is
+typed in from a previous run: change a dataset and the verdict changes with it.
+
+The thresholds are the ones stated with each claim below; "within the resolution" means one
+bin of the density or the frequency grid.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Fewest impacts a play needs before its means and densities take part in a finding
+#: (the batch-means error of a mean over 1000 impacts is a few percent).
+MIN_IMPACTS = 1000
+
+CLAIMS = {
+    1: "Random force: the PSD of a(tau) peaks near the resonance; as delta decreases the peak "
+       "frequency rises and its level falls; at delta = 0 no marked peak remains",
+    2: "Impact velocities become smaller as delta decreases, markedly so for negative delta",
+    3: "The intervals between impacts follow the same trend",
+    4: "Mean velocity and mean interval grow with delta, until past a critical delta no impact "
+       "happens",
+    5: "Harmonic + random: the input's power is concentrated at the forcing frequency; the "
+       "response's power spreads wider and moves to lower frequency as delta decreases",
+    6: "Large play: the density of z_j/z peaks at 1, the (1/1) motion; small play: two curves "
+       "symmetric about 1/2, the (2/1) motion",
+    7: "The velocity after impact is narrowly spread where (1/1) dominates, widely where the "
+       "play is small",
+    8: "Where the periodic motion is stable with a high degree of stability (Fig. 16), it shows "
+       "up with high probability under noise (Fig. 15): the domains look alike",
+}
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One of the paper's findings measured on a run.
+
+    Attributes
+    ----------
+    number : int
+        Its number in docs/figures.md (1-8).
+    claim : str
+        What the paper says.
+    measured : str
+        The numbers this run gives, with the plays and frequencies they are taken at.
+    holds : str
+        ``"yes"``, ``"partly"`` (the stated part holds, the rest not), ``"no"``, or ``"n/a"``
+        (the datasets given cannot decide it; ``measured`` says what is missing).
+    """
+
+    number: int
+    claim: str
+    measured: str
+    holds: str
+
+
+def _finding(number, measured, holds):
+    return Finding(number, CLAIMS[number], measured, holds)
+
+
+def not_available(number, why):
+    """The finding cannot be measured on this study's datasets; ``why`` says what is missing."""
+    return _finding(number, why, "n/a")
+
+
+def _yes(condition):
+    return "yes" if condition else "no"
+
+
+def _increasing(values):
+    return bool(np.all(np.diff(np.asarray(values, dtype=float)) > 0))
+
+
+def _fmt(values, spec=".3g"):
+    return ", ".join(format(float(v), spec) for v in values)
+
+
+def _impacting(events, minimum=MIN_IMPACTS):
+    """The plays with at least ``minimum`` impacts (one 1/beta row), in increasing delta."""
+    keep = events.delta[events.n_impacts >= minimum]
+    return events.sel(delta=keep).sortby("delta")
+
+
+def _row(ds, inv_beta=None):
+    """One 1/beta_f row of a dataset (the nearest to ``inv_beta``, or the only one)."""
+    if "inv_beta" not in ds.dims:
+        return ds
+    if inv_beta is None:
+        if ds.sizes["inv_beta"] != 1:
+            raise ValueError(f"the dataset has {ds.sizes['inv_beta']} rows of 1/beta_f; "
+                             f"give inv_beta")
+        return ds.isel(inv_beta=0)
+    return ds.sel(inv_beta=inv_beta, method="nearest")
+
+
+# --- random force (Figs. 6-9) -----------------------------------------------------------------
+
+def finding1(spectra, band=(0.2, 3.0), flat=3.0):
+    """PSD of a(tau) against delta (Fig. 6).
+
+    Over ``band`` of beta, for the plays delta > 0 in decreasing order, the peak frequency must
+    rise and the peak level fall; at delta = 0 the peak must be below ``flat`` times the median
+    (no marked peak).
+    """
+    s = _row(spectra).sel(beta=slice(*band))
+    positive = s.sel(delta=s.delta[s.delta > 0]).sortby("delta", ascending=False)
+    if positive.sizes["delta"] < 2 or 0.0 not in s.delta.values:
+        return not_available(1, f"needs spectra at two plays > 0 and at delta = 0; this study "
+                                f"has delta = {_fmt(s.delta.values)}")
+    peak_beta = positive.S_a.idxmax("beta").values
+    peak_level = positive.S_a.max("beta").values
+    at_zero = s.S_a.sel(delta=0.0)
+    sharpness = float(at_zero.max() / at_zero.median())
+    rises, falls, flat_at_zero = (_increasing(peak_beta), _increasing(-peak_level),
+                                  sharpness < flat)
+    measured = (f"delta = {_fmt(positive.delta.values)}: peak at beta = {_fmt(peak_beta)}, "
+                f"level {_fmt(peak_level)}; at delta = 0 peak / median = {sharpness:.2f} "
+                f"(< {flat:g} counts as no marked peak)")
+    return _finding(1, measured, _yes(rises and falls and flat_at_zero))
+
+
+def finding2(events):
+    """Mean velocity after impact against delta (Figs. 7, 9): increasing over the plays with
+    impacts, and "markedly so for negative delta": it falls faster, relative to its value,
+    over the negative plays than over as wide a range of positive ones (the mean slope of
+    ln v against delta on [delta_min, 0] exceeds that on [0, -delta_min])."""
+    ev = _impacting(_row(events))
+    if ev.sizes["delta"] < 3:
+        return not_available(2, f"needs three plays with >= {MIN_IMPACTS} impacts")
+    d, v = ev.delta.values, ev.v_after_mean.values
+    measured = (f"mean velocity after impact {v[-1]:.3g} at delta = {d[-1]:.3g} down to "
+                f"{v[0]:.3g} at delta = {d[0]:.3g}"
+                f"{', increasing throughout' if _increasing(v) else ', not monotone'}")
+    marked = True
+    if d[0] < 0 and 0.0 in d and d[-1] >= -d[0]:
+        at = lambda x: float(ev.v_after_mean.sel(delta=x, method="nearest"))
+        slope_neg = np.log(at(0.0) / at(d[0])) / -d[0]
+        slope_pos = np.log(at(-d[0]) / at(0.0)) / -d[0]
+        marked = slope_neg > slope_pos
+        measured += (f"; it falls x {at(0.0) / at(d[0]):.1f} from delta = 0 to {d[0]:.3g} "
+                     f"against x {at(-d[0]) / at(0.0):.1f} from {-d[0]:.3g} to 0")
+    return _finding(2, measured, _yes(_increasing(v) and marked))
+
+
+def finding3(events, lowest=-0.5):
+    """Mean interval between impacts against delta (Figs. 8, 9): increasing over the plays
+    with impacts. Below ``lowest`` the pre-loaded mass rests on the wall for long stretches
+    and the interval grows again (README): the finding is judged on delta >= ``lowest`` and
+    the table says what happens below."""
+    ev = _impacting(_row(events))
+    judged = ev.sel(delta=ev.delta[ev.delta >= lowest])
+    if judged.sizes["delta"] < 3:
+        return not_available(3, f"needs three plays >= {lowest} with >= {MIN_IMPACTS} impacts")
+    z = judged.interval_mean.values
+    measured = (f"mean interval {z[-1]:.3g} at delta = {float(judged.delta[-1]):.3g} down to "
+                f"{z[0]:.3g} at delta = {float(judged.delta[0]):.3g}"
+                f"{', increasing throughout' if _increasing(z) else ', not monotone'}")
+    below = ev.sel(delta=ev.delta[ev.delta < lowest])
+    holds = _yes(_increasing(z))
+    if below.sizes["delta"]:
+        rises_again = bool(np.any(below.interval_mean.values > z[0]))
+        measured += (f"; below delta = {lowest:g}: {_fmt(below.interval_mean.values)} at delta "
+                     f"= {_fmt(below.delta.values)}, contact fraction "
+                     f"{_fmt(below.contact_fraction.values, '.2f')}")
+        if rises_again and holds == "yes":
+            holds = "partly"
+    return _finding(3, measured, holds)
+
+
+def finding4(events, orders=2.0):
+    """Impact rate against delta (Fig. 9): for delta > 0 it never rises and falls by at least
+    ``orders`` orders of magnitude, towards the critical play past which no impact happens."""
+    ev = _row(events).sortby("delta")
+    d, rate = ev.delta.values, ev.impact_rate.values
+    positive = (d > 0) & (rate > 0)
+    if positive.sum() < 3:
+        return not_available(4, "needs three plays > 0 with impacts")
+    low = float(rate[positive].min())
+    at_low = float(d[positive][np.argmin(rate[positive])])
+    fall = np.log10(rate.max() / low)
+    none = d[(d > at_low) & (ev.n_impacts.values == 0)]
+    measured = (f"impact rate falls from {rate.max():.3g} to {low:.3g} per unit time at "
+                f"delta = {at_low:.3g} ({fall:.1f} orders of magnitude); "
+                + (f"no impact from delta = {none.min():.3g} on" if none.size else
+                   "every play of the grid still has impacts"))
+    falling = bool(np.all(np.diff(rate[d > 0]) <= 0)) and fall >= orders
+    return _finding(4, measured, _yes(falling))
+
+
+def random_force(events=None, spectra=None):
+    """Findings 1-4 of a random-force study; those whose datasets are missing are ``n/a``."""
+    found = [finding1(spectra) if spectra is not None else
+             not_available(1, "this study draws no spectrum of a(tau) (Fig. 6)")]
+    for number, fn in ((2, finding2), (3, finding3), (4, finding4)):
+        found.append(fn(events) if events is not None else
+                     not_available(number, "this study has no impact statistics (Figs. 7-9)"))
+    return found
+
+
+# --- harmonic plus random force (Figs. 11-15) --------------------------------------------------
+
+def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0):
+    """Input and response spectra under ``amplitude sin(beta_f tau) + r(tau)`` (Figs. 11, 12).
+
+    The input: the line carries ``amplitude^2/2`` against the random part's power (the
+    integral of its one-sided PSD); concentrated means > 80 %. The response, per 1/beta_f:
+    its share of power within ``halfwidth`` of beta_f must fall as delta decreases (spreads
+    wider), and its centroid over ``0 < beta <= band`` fall (moves to lower frequency).
+    """
+    lines, shares, centroids = [], [], []
+    spread_all, lower_all = True, True
+    for inv_beta in np.atleast_1d(spectra.inv_beta.values):
+        s = spectra.sel(inv_beta=inv_beta).sortby("delta")
+        beta = s.beta.values
+        step = beta[1] - beta[0]
+        random_power = 2 * float(s.S_f.sum()) * step / (2 * np.pi)
+        line = 0.5 * amplitude ** 2
+        lines.append(line / (line + random_power))
+        if s.sizes["delta"] < 2:
+            return not_available(5, "needs spectra of a(tau) at two plays")
+        near = np.abs(beta - 1 / inv_beta) < halfwidth
+        inside = (beta > 0) & (beta <= band)
+        share = s.S_a.isel(beta=near).sum("beta") / s.S_a.sum("beta")
+        centroid = ((s.S_a * s.beta).isel(beta=inside).sum("beta")
+                    / s.S_a.isel(beta=inside).sum("beta"))
+        shares.append(f"1/beta_f = {inv_beta:.3g}: {float(share[-1]):.2f} at delta = "
+                      f"{float(s.delta[-1]):.3g} -> {float(share[0]):.2f} at delta = "
+                      f"{float(s.delta[0]):.3g}")
+        centroids.append(f"{float(centroid[-1]):.2f} -> {float(centroid[0]):.2f}")
+        spread_all &= float(share[0]) < float(share[-1])
+        lower_all &= float(centroid[0]) < float(centroid[-1])
+    concentrated = min(lines) > 0.8
+    measured = (f"line share of the input power {_fmt(lines, '.2f')}; response power within "
+                f"+-{halfwidth:g} of beta_f, " + "; ".join(shares)
+                + f"; centroid (beta <= {band:g}) " + ", ".join(centroids))
+    holds = "yes" if concentrated and spread_all and lower_all else (
+        "partly" if concentrated and spread_all else "no")
+    return _finding(5, measured, holds)
+
+
+def _peaks_below_one(ratio, density):
+    """The two largest values of a z_j/z density below 1, one on each side of 1/2."""
+    low, high = (ratio < 0.5), (ratio >= 0.5) & (ratio < 1.0)
+    if not low.any() or not high.any():
+        return np.nan, np.nan
+    return ratio[low][np.argmax(density[low])], ratio[high][np.argmax(density[high])]
+
+
+def _motion(events, name):
+    return events.motion_probability.sel(motion=name)
+
+
+def finding6(events, inv_beta=1.1, symmetric=0.1):
+    """Density of z_j/z (Fig. 13) at the row nearest ``inv_beta``.
+
+    Large play: at the play where (1/1) is most probable, the density's mode lies within 0.05
+    of 1 and P(1/1) > 0.5. Small play: at the smaller play where (2/1) is most
+    probable, the two peaks below 1 add up to 1 within ``symmetric`` and P(2/1) > 0.5.
+    """
+    ev = _impacting(_row(events, inv_beta))
+    motions = [str(m) for m in ev.motion.values] if "motion" in ev.dims else []
+    if "ratio_density" not in ev or not {"1/1", "2/1"} <= set(motions) or ev.sizes["delta"] < 2:
+        return not_available(6, "needs the z_j/z densities and the (1/1), (2/1) probabilities "
+                                "of a harmonic study at two plays")
+    ratio = ev.ratio.values
+    p11, p21 = _motion(ev, "1/1"), _motion(ev, "2/1")
+    large = float(ev.delta[int(p11.argmax("delta"))])
+    mode = float(ratio[int(ev.ratio_density.sel(delta=large).argmax("ratio"))])
+    smaller = ev.sel(delta=ev.delta[ev.delta < large])
+    at = f"1/beta_f = {float(ev.inv_beta):.3g}: "
+    large_ok = abs(mode - 1.0) < 0.05 and float(p11.sel(delta=large)) > 0.5
+    measured = (at + f"delta = {large:.3g}: mode of z_j/z {mode:.2f}, P(1/1) = "
+                f"{float(p11.sel(delta=large)):.2f}")
+    small_ok = False
+    if smaller.sizes["delta"]:
+        small = float(smaller.delta[int(_motion(smaller, "2/1").argmax("delta"))])
+        lo, hi = _peaks_below_one(ratio, ev.ratio_density.sel(delta=small).values)
+        small_ok = (abs(lo + hi - 1.0) < symmetric and float(p21.sel(delta=small)) > 0.5)
+        measured += (f"; delta = {small:.3g}: peaks at {lo:.2f} and {hi:.2f} (sum "
+                     f"{lo + hi:.2f}), P(2/1) = {float(p21.sel(delta=small)):.2f}")
+    if "1/2" in motions:
+        p12 = _motion(ev, "1/2")
+        sub = float(ev.delta[int(p12.argmax("delta"))])
+        measured += f"; (1/2) most probable at delta = {sub:.3g}: P = {float(p12.max()):.2f}"
+    return _finding(6, measured, _yes(large_ok and small_ok))
+
+
+def _cv(events, delta):
+    """Coefficient of variation of the velocity after impact from its density at ``delta``."""
+    d = events.v_after_density.sel(delta=delta).values
+    v = events.v_after.values
+    mean = (v * d).sum() / d.sum()
+    return float(np.sqrt(((v - mean) ** 2 * d).sum() / d.sum()) / mean)
+
+
+def finding7(events, inv_beta=1.1, ratio=0.5):
+    """Spread of the velocity after impact (Fig. 14) at the row nearest ``inv_beta``: its
+    coefficient of variation where (1/1) is most probable must be below ``ratio`` times the
+    smallest at the smaller plays where (1/1) is not dominant (P(1/1) < 0.5)."""
+    ev = _impacting(_row(events, inv_beta))
+    if "motion_probability" not in ev or "1/1" not in [str(m) for m in ev.motion.values]:
+        return not_available(7, "needs the velocity densities and P(1/1) of a harmonic study")
+    p11 = _motion(ev, "1/1")
+    large = float(ev.delta[int(p11.argmax("delta"))])
+    small = ev.delta[(ev.delta < large) & (p11 < 0.5)].values
+    if small.size == 0:
+        return not_available(7, f"no play below delta = {large:.3g} where (1/1) is not dominant")
+    cv_large, cv_small = _cv(ev, large), [_cv(ev, d) for d in small]
+    measured = (f"1/beta_f = {float(ev.inv_beta):.3g}: coefficient of variation "
+                f"{cv_large:.2f} at delta = {large:.3g} (P(1/1) = {float(p11.max()):.2f}) "
+                f"against {_fmt(cv_small, '.2f')} at delta = {_fmt(small)}")
+    return _finding(7, measured, _yes(cv_large < ratio * min(cv_small)))
+
+
+def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5):
+    """Fig. 15 against Fig. 16, from :func:`vibroimpact.plotting.maps.map_agreement`.
+
+    Where: of the cells where a motion has probability >= 50 %, at least ``inside`` lie in
+    its stable domain (motions with fewer than ``min_cells`` such cells are not judged). How
+    strongly: Spearman's rank correlation of probability and S inside the domain at least
+    ``correlation``. Both: ``yes``; where only: ``partly``.
+    """
+    judged = {m: a for m, a in agreement.items() if a["n_dominant"] >= min_cells}
+    if not judged:
+        return not_available(8, f"no motion has {min_cells} cells with probability >= 50 %")
+    parts = [f"({m}) {a['n_dominant']} cells >= 50 %: {100 * a['dominant_inside']:.0f} % inside, "
+             f"domain covered {100 * a['domain_covered']:.0f} %, rank correlation with S "
+             f"{a['rank_correlation']:.2f}" for m, a in judged.items()]
+    where = all(a["dominant_inside"] >= inside for a in judged.values())
+    strongly = all(np.isfinite(a["rank_correlation"]) and a["rank_correlation"] >= correlation
+                   for a in judged.values())
+    return _finding(8, "; ".join(parts), "yes" if where and strongly else (
+        "partly" if where else "no"))
+
+
+def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, inv_beta=1.1):
+    """Findings 5-8 of a harmonic-plus-random study; those whose datasets are missing are
+    ``n/a``. ``agreement`` is :func:`vibroimpact.plotting.maps.map_agreement` of its map with
+    an orbits map."""
+    found = [finding5(spectra, amplitude) if spectra is not None else
+             not_available(5, "this study draws no spectrum of a(tau) (Fig. 12)")]
+    for number, fn in ((6, finding6), (7, finding7)):
+        found.append(fn(events, inv_beta) if events is not None else
+                     not_available(number, "this study has no impact densities (Figs. 13, 14)"))
+    found.append(finding8(agreement) if agreement is not None else
+                 not_available(8, "this study has no probability map compared with an orbits "
+                                  "map (fig15_vs_fig16)"))
+    return found
+
+
+def findings_table(found):
+    """The findings as a table (pandas DataFrame): number, claim, measured, holds."""
+    import pandas as pd
+
+    return pd.DataFrame([dict(finding=f.number, claim=f.claim, measured=f.measured,
+                              holds=f.holds) for f in found]).set_index("finding")

@@ -1,0 +1,103 @@
+# Report notebooks (notebooks/*.ipynb), executed by papermill from `shell:` rules: every input
+# path and parameter is passed with -p, the notebook is a declared input, the executed notebook
+# and its HTML rendering (nbconvert) are declared outputs under results/reports/<study>/, and
+# the notebook's output goes to the rule's log. (Snakemake's `notebook:` directive would keep
+# the executed notebook only as a log.) Both files are written in a temporary directory and
+# moved into place when both exist, so a failed run leaves no report a later run would trust.
+localrules:
+    study_report,
+    orbits_report,
+    validation_report,
+
+
+wildcard_constraints:
+    report="random_force|harmonic_random",
+    vreport="performance|stability",
+
+
+REPORT_SHELL = (
+    'tmp=$(mktemp -d "$(dirname {output.ipynb})/.report.XXXXXX"); '
+    'trap \'rm -rf "$tmp"\' EXIT; '
+    "{params.python} -m papermill {input.notebook} $tmp/report.ipynb --kernel python3 --log-output "
+    "--no-progress-bar {params.arguments} > {log} 2>&1; "
+    "{params.python} -m nbconvert --to html $tmp/report.ipynb >> {log} 2>&1; "
+    "mv $tmp/report.html {output.html}; mv $tmp/report.ipynb {output.ipynb}"
+)
+
+
+rule study_report:
+    input:
+        unpack(study_report_inputs),
+    output:
+        ipynb="results/reports/{study}/{report}.ipynb",
+        html=report("results/reports/{study}/{report}.html", caption="../report/report.rst",
+                    category="{study}", labels={"figure": "report: {report}"}),
+    log:
+        "results/logs/report/{study}/{report}.log",
+    benchmark:
+        "results/benchmarks/report/{study}/{report}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB + 400,
+        runtime=10,
+    conda:
+        "../envs/vibroimpact.yaml"
+    params:
+        arguments=report_arguments,
+        python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
+        code=CODE["report"],
+    shell:
+        REPORT_SHELL
+
+
+rule orbits_report:
+    input:
+        unpack(orbits_report_inputs),
+    output:
+        ipynb="results/reports/orbits/{orbits}/periodic_motions.ipynb",
+        html=report("results/reports/orbits/{orbits}/periodic_motions.html",
+                    caption="../report/report.rst", category="orbits/{orbits}",
+                    labels={"figure": "report: periodic motions"}),
+    log:
+        "results/logs/report/orbits/{orbits}.log",
+    benchmark:
+        "results/benchmarks/report/orbits/{orbits}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB + 400,
+        runtime=10,
+    conda:
+        "../envs/vibroimpact.yaml"
+    params:
+        arguments=report_arguments,
+        python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
+        code=CODE["report"],
+    shell:
+        REPORT_SHELL
+
+
+rule validation_report:
+    input:
+        unpack(validation_report_inputs),
+    output:
+        ipynb="results/reports/validation/{vreport}.ipynb",
+        html=report("results/reports/validation/{vreport}.html",
+                    caption="../report/report.rst", category="validation",
+                    labels={"figure": "report: {vreport}"}),
+    log:
+        "results/logs/report/validation/{vreport}.log",
+    benchmark:
+        "results/benchmarks/report/validation/{vreport}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB + 400,
+        runtime=10,
+    conda:
+        "../envs/vibroimpact.yaml"
+    params:
+        arguments=report_arguments,
+        python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
+        quoted=quoted_campaign,     # README's campaign table (stability report)
+        code=CODE["report"],
+    shell:
+        REPORT_SHELL
