@@ -2,7 +2,6 @@
 localrules:
     aggregate_events,
     aggregate_spectra,
-    aggregate_orbits,
     aggregate_map,
 
 

@@ -1,3 +1,9 @@
+# Orbit tiles are solved as jobs (SLURM: grouped, workflow/profiles/slurm); joining
+# them into one dataset is cheap: run where Snakemake runs.
+localrules:
+    aggregate_orbits,
+
+
 rule solve_orbit_tile:
     output:
         "results/orbits/{orbits}/tiles/{tile}.nc",
