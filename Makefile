@@ -1,6 +1,7 @@
 # `make` installs into .venv and builds every figure and report of the default config;
 # `make test` installs and runs the fast suite, the slow (stress/convergence) suite, the
-# end-to-end workflow suite, and the import-layer contract.
+# end-to-end workflow and SLURM suites (one session: the test config is built once; the
+# SLURM suite installs and starts a one-node cluster, as root), and the import-layer contract.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
