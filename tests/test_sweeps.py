@@ -182,6 +182,12 @@ def test_a_problem_of_every_combination_is_given_once():
     assert len(text.splitlines()) == 1
 
 
+def test_an_unknown_report_with_is_named_once_without_the_sweeps_own_studies():
+    text = _problems(_user(report_with=["motionmap"]))
+    assert text.startswith("studies.eps_sweep (all 6 combinations): report_with = motionmap")
+    assert len(text.splitlines()) == 1 and "eps_sweep_" not in text
+
+
 def test_a_bad_noise_override_names_the_combinations_using_it():
     text = _problems(_user(rms=[-0.1, 0.5]))
     assert ("studies.eps_sweep (noise of combinations 0, 2, 4: rms=-0.1): rms = -0.1: "

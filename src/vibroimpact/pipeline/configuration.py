@@ -772,10 +772,14 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
 
 def _check_study(config, name, entry, problems, limits):
     where = f"studies.{name}"
+    siblings = {name}           # itself, or every study of its sweep
+    if "sweep" in entry:
+        siblings = set(config.get("sweeps", {}).get(entry["sweep"]["name"], {}).get(
+            "studies", [name]))
     for other in entry.get("report_with", []):
-        if other == name or other not in config["studies"]:
+        if other in siblings or other not in config["studies"]:
             problems.add(f"{where}.report_with", other, "no other study of this name",
-                         ", ".join(sorted(set(config["studies"]) - {name})) or "none")
+                         ", ".join(sorted(set(config["studies"]) - siblings)) or "none")
     if entry["noise"] not in config["noises"]:
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
