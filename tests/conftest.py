@@ -40,6 +40,17 @@ def snakemake(workdir, *args, config="config/test.yaml", check=True, cores=2, ti
     return out
 
 
+def scheduled_rules(workdir, target):
+    """Rules a dry run would execute for ``target`` (from the job stats table)."""
+    out = snakemake(workdir, target, "-n", "--quiet", "rules")
+    rules = set()
+    for line in out.stdout.splitlines():
+        parts = line.split()
+        if len(parts) == 2 and parts[1].isdigit() and parts[0] not in ("total", "job"):
+            rules.add(parts[0])
+    return rules
+
+
 @pytest.fixture(scope="session")
 def built(tmp_path_factory):
     """The test config built end to end, once per session (tests marked ``workflow`` or

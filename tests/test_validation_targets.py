@@ -13,7 +13,7 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
-from conftest import make_workdir, snakemake
+from conftest import make_workdir, scheduled_rules
 from vibroimpact import plotting
 from vibroimpact.validation import peers
 from vibroimpact.validation.campaign import COUNTS, campaign_dataset
@@ -212,17 +212,6 @@ def test_figures_save_png_and_pdf(wp, stress_ds, tmp_path):
 
 # --- the rules -----------------------------------------------------------------------------------
 
-def _scheduled(workdir, target):
-    """Rules a dry run of the test config would execute for ``target``."""
-    out = snakemake(workdir, target, "-n", "--quiet", "rules")
-    rules = set()
-    for line in out.stdout.splitlines():
-        parts = line.split()
-        if len(parts) == 2 and parts[1].isdigit() and parts[0] not in ("total", "job"):
-            rules.add(parts[0])
-    return rules
-
-
 @pytest.fixture(scope="module")
 def workdir(tmp_path_factory):
     return make_workdir(tmp_path_factory.mktemp("validation_wf"))
@@ -233,8 +222,8 @@ def workdir(tmp_path_factory):
     ("stress", {"sample_stress_families", "draw_validation_figure"}),
 ])
 def test_a_validation_figure_schedules_only_its_rules(workdir, figure, rules):
-    assert _scheduled(workdir, f"results/figures/{figure}.png") == rules
-    assert _scheduled(workdir, f"results/figures/{figure}.pdf") == rules
+    assert scheduled_rules(workdir, f"results/figures/{figure}.png") == rules
+    assert scheduled_rules(workdir, f"results/figures/{figure}.pdf") == rules
 
 
 @pytest.mark.workflow

@@ -11,22 +11,12 @@ import pytest
 import xarray as xr
 import yaml
 
-from conftest import ROOT, SNAKEMAKE, _data_files, assert_same_data, make_workdir, snakemake
+from conftest import (ROOT, SNAKEMAKE, _data_files, assert_same_data, make_workdir,
+                      scheduled_rules, snakemake)
 
 FIGURES = [f"fig{n:02d}" for n in range(3, 17)] + ["fig15_vs_fig16"]
 _workdir = make_workdir
 run = snakemake
-
-
-def scheduled_rules(workdir, target):
-    """Rules a dry run would execute for ``target`` (from the job stats table)."""
-    out = run(workdir, target, "-n", "--quiet", "rules")
-    rules = set()
-    for line in out.stdout.splitlines():
-        parts = line.split()
-        if len(parts) == 2 and parts[1].isdigit() and parts[0] not in ("total", "job"):
-            rules.add(parts[0])
-    return rules
 
 
 @pytest.fixture(scope="module")
