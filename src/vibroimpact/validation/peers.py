@@ -418,25 +418,7 @@ def _rk4_clamp_kernel(noise, dt, m, n_intervals, zeta, eps, delta, x0, v0,
         b = (noise[k + 1] - r0) / dt
         for j in range(m):
             s = j * h
-            f1 = r0 + b * s
-            f2 = f1 + b * 0.5 * h
-            f3 = f1 + b * h
-            k1x = v
-            k1v = f1 - x - two_zeta * v
-            xa = x + 0.5 * h * k1x
-            va = v + 0.5 * h * k1v
-            k2x = va
-            k2v = f2 - xa - two_zeta * va
-            xb = x + 0.5 * h * k2x
-            vb = v + 0.5 * h * k2v
-            k3x = vb
-            k3v = f2 - xb - two_zeta * vb
-            xc = x + h * k3x
-            vc = v + h * k3v
-            k4x = vc
-            k4v = f3 - xc - two_zeta * vc
-            x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x)
-            v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v)
+            x, v = _rk4_step(x, v, h, r0 + b * s, b, two_zeta)
             if x > delta:
                 x = delta
                 if v > 0.0:
