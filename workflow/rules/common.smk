@@ -13,6 +13,7 @@ import sys
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.provenance import source_digest
 from vibroimpact.pipeline.study import Study, orbit_rows
+from vibroimpact.reports.notebook import markdown_table
 
 
 wildcard_constraints:
@@ -244,13 +245,11 @@ def quoted_campaign(wildcards):
     does not (the README is passed by path, not as an input)."""
     if wildcards.get("vreport") != "stability":
         return ""
-    lines = Path(workflow.basedir, "README.md").read_text().splitlines()
-    start = next((i for i, l in enumerate(lines) if l.strip().startswith("| family |")), None)
-    if start is None:
-        return ""
-    end = next((i for i in range(start, len(lines)) if not lines[i].strip().startswith("|")),
-               len(lines))
-    return hashlib.sha256("\n".join(lines[start:end]).encode()).hexdigest()[:16]
+    try:
+        table = markdown_table(Path(workflow.basedir, "README.md"), "| family |")
+    except ValueError:
+        return ""       # no table to quote: the report says so when it runs
+    return hashlib.sha256(table.to_csv().encode()).hexdigest()[:16]
 
 
 def _report_name(wildcards):
