@@ -83,7 +83,7 @@ def test_ratio_statistics_only_with_a_harmonic_force(record):
 
 
 def test_batch_statistics_and_their_lag1_warning(record, caplog):
-    # A forcing period of 2000 time units over a record of 4000 makes the impact statistics
+    # A forcing period of 2000 time units (amplitude 0.8) over a record of 4000 makes the impact statistics
     # drift: the 20 batch means then follow the slow cycle (lag-1 correlation ~0.7, far above
     # 2/sqrt(20) = 0.45) and the cell warns. The stationary cell (delta = 0, noise only) has
     # a lag-1 correlation near 0 and stays silent.
@@ -97,7 +97,7 @@ def test_batch_statistics_and_their_lag1_warning(record, caplog):
     assert np.nansum(v_after * np.diff(BINS["v_after"])) + calm["v_after_beyond"] == \
         pytest.approx(1.0, abs=1e-12)
     with caplog.at_level(logging.WARNING, logger="vibroimpact"):
-        drift = cells.event_statistics(record, NOISE.dt, delta=0.5, amplitude=0.5,
+        drift = cells.event_statistics(record, NOISE.dt, delta=0.5, amplitude=0.8,
                                        beta_f=2 * np.pi / 2000, **kw)
     assert drift["v_after_lag1"] > 2 / np.sqrt(20) and drift["interval_lag1"] > 2 / np.sqrt(20)
     messages = [r.getMessage() for r in caplog.records]

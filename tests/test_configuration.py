@@ -164,10 +164,10 @@ def test_progress_is_logged_at_a_bounded_rate_and_at_the_end(caplog):
     with caplog.at_level("INFO", logger="vibroimpact"):
         for _ in range(1000):
             now[0] += 0.1                    # 100 s of cells, one every 0.1 s
-            progress.cell_done({"n_impacts": 3, "simulated_time": 2.0})
+            progress.cell_done({"n_collisions": 3, "simulated_time": 2.0})
     lines = [r.getMessage() for r in caplog.records]
     assert len(lines) == 5                   # every 20 s of 100 s; the 5th is the last cell
-    assert lines[0].startswith("progress tile 0: 200 of 1000 cells, 600 impacts, 400 time")
+    assert lines[0].startswith("progress tile 0: 200 of 1000 cells, 600 collisions, 400 time")
     assert "~80 s left" in lines[0]
-    assert lines[-1].startswith("progress tile 0: 1000 of 1000 cells, 3000 impacts")
+    assert lines[-1].startswith("progress tile 0: 1000 of 1000 cells, 3000 collisions")
     assert "~0 s left" in lines[-1]

@@ -20,7 +20,7 @@ def random_events(v=None, z=None, rate=None):
     z = np.array([0.4, 0.35, 1.0, 3.0, 8.0, 40.0, 300.0]) if z is None else z
     rate = np.array([3.0, 2.9, 1.0, 0.3, 0.1, 0.01, 0.001]) if rate is None else rate
     n = np.full(DELTA.size, 50_000)
-    data = dict(v_after_mean=v, interval_mean=z, impact_rate=rate, n_impacts=n,
+    data = dict(v_after_mean=v, interval_mean=z, collision_rate=rate, n_collisions=n,
                 contact_fraction=np.array([0.9, 0.6, 0, 0, 0, 0, 0.0]))
     return xr.Dataset({k: (("inv_beta", "delta"), np.asarray(x, float)[None])
                        for k, x in data.items()}, coords=dict(inv_beta=[1.0], delta=DELTA))
@@ -76,7 +76,7 @@ def harmonic_events(p11=(0.0, 0.1, 0.2, 0.9, 0.95, 0.6, 0.3), p21=(0.0, 0.7, 0.8
         dens_v.append(np.exp(-0.5 * ((v - 2.0) / (2.0 * c)) ** 2))
     p = np.stack([p11, p21, np.zeros(DELTA.size)], axis=-1)
     ds = xr.Dataset(
-        {"n_impacts": (("inv_beta", "delta"), np.full((1, DELTA.size), 10_000)),
+        {"n_collisions": (("inv_beta", "delta"), np.full((1, DELTA.size), 10_000)),
          "ratio_density": (("inv_beta", "delta", "ratio"), np.array(dens_r)[None]),
          "v_after_density": (("inv_beta", "delta", "v_after"), np.array(dens_v)[None]),
          "motion_probability": (("inv_beta", "delta", "motion"), p[None])},

@@ -19,11 +19,12 @@ def _map_cell(noise, inv_beta, delta, **kw):
 
 
 def _alone(noise, inv_beta, delta, transient, t_end):
-    """The cell simulated by itself over ``[0, t_end]``: impacts after the transient."""
+    """The cell simulated by itself over ``[0, t_end]``: its collisions after the transient."""
     res = simulate(ZETA, EPS, delta, noise=noise, dt=DT, amplitude=1.0, beta=1.0 / inv_beta,
                    t_end=t_end)
-    keep = res.impact_time >= transient
-    return res, res.impact_step[keep], res.impact_offset[keep], res.impact_velocity[keep]
+    keep = res.collision_time >= transient
+    return (res, res.collision_step[keep], res.collision_offset[keep],
+            res.collision_velocity[keep])
 
 
 # (inv_beta, delta) inside the stable domain of each type (Fig. 16), where the motion from
@@ -68,7 +69,8 @@ def test_without_noise_below_the_wall_there_is_no_impact():
     """1/beta = 0.3: the wall-free response has amplitude 1/|1 - beta^2| ~ 0.1 < delta = 1."""
     noise = np.zeros(100_000)
     cell = _map_cell(noise, 0.3, 1.0, transient=200.0, max_periods=5000)
-    assert cell["n_impacts"] == 0 and not cell["probability"].any()
+    assert cell["n_collisions"] == 0 and not cell["probability"].any()
+    assert not cell["stick_probability"].any()
     assert cell["reached"] and cell["simulated_time"] == pytest.approx(2000.0, abs=DT)
 
 
@@ -81,17 +83,18 @@ def record():
 @pytest.mark.parametrize("inv_beta, delta", [(2.6, -0.75), (1.4, 0.7), (0.9, 1.3), (2.0, 0.95)])
 def test_a_map_cell_is_bit_identical_to_the_cell_alone(record, inv_beta, delta):
     """Stopping at precision checks (chunks of any length) changes nothing: `simulate` to the
-    cell's record end gives the same impacts, and classifying them the same probabilities, to
-    the last bit."""
+    cell's record end gives the same collisions, and classifying them the same probabilities,
+    to the last bit."""
     cell = _map_cell(record, inv_beta, delta, transient=200.0, max_periods=1500,
                      target_stderr=0.02)
     assert cell["n_checks"] >= 2 or cell["reached"]
-    _, step, offset, u = _alone(record, inv_beta, delta, 200.0, cell["record_end"])
+    res, step, offset, u = _alone(record, inv_beta, delta, 200.0, cell["record_end"])
     z = stats.impact_intervals(step, offset, DT)
+    stuck = res.collision_stuck[res.collision_time >= 200.0][:-1]
     p = stats.impact_motion_probabilities(z, 1.0 / inv_beta, total_time=cell["simulated_time"],
-                                          motions=MOTIONS)
-    assert list(cell["probability"]) == list(p.values())
-    assert cell["n_impacts"] == u.size and cell["v_after_mean"] == EPS * u.mean()
+                                          motions=MOTIONS, stuck=stuck)
+    assert list(cell["probability"]) + list(cell["stick_probability"]) == list(p.values())
+    assert cell["n_collisions"] == u.size and cell["v_after_mean"] == EPS * u.mean()
 
 
 def test_a_cell_stops_at_its_precision_or_at_the_cap(record):

@@ -160,7 +160,7 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
     for line, label, d in zip(lines, labels, [2.0, 0.5, 0.0, -0.5]):   # nearest, largest first
         cell = events.sel(delta=d)
         assert label.split("=")[1].split()[0] == f"{d:g}"
-        assert f"({int(cell['n_impacts']):,} impacts" in label
+        assert f"({int(cell['n_collisions']):,} collisions" in label
         beyond = float(cell[f"{var}_beyond"])
         assert (f"{100 * beyond:.3g} % beyond axis" in label) == (beyond > 1e-3), label
     if var == "interval":   # intervals at the largest play overrun the 10-unit axis
@@ -185,7 +185,7 @@ def test_density_delta_without_impacts_keeps_its_line(data):
 def test_fig09_bars_scale_and_markers(data):
     events = data["events"]
     ds = events.isel(inv_beta=0)
-    n = ds["n_impacts"].values
+    n = ds["n_collisions"].values
     few = (n > 0) & (n < plotting.random.FEW_IMPACTS)
     enough = n >= plotting.random.FEW_IMPACTS
     assert few.any() and (n == 0).any(), "the fixture must hold a few-impact and an empty cell"
@@ -209,7 +209,7 @@ def test_fig09_bars_scale_and_markers(data):
         np.testing.assert_array_equal(squares[0].get_xdata(), ds["delta"].values[few])
         assert squares[0].get_markerfacecolor() == "white"
     labels = [t.get_text() for t in fig.legends[0].get_texts()]     # one legend, both panels
-    assert any("fewer than 20 impacts" in s for s in labels)
+    assert any("fewer than 20 collisions" in s for s in labels)
     assert any("no impact" in s for s in labels)
     assert any("t = 2.093" in s for s in labels)
     assert ax_v.get_ylabel() == axis_label(ds["v_after_mean"])
@@ -339,7 +339,7 @@ def test_every_figure_states_its_parameters(data):
 def test_units_other_than_dimensionless_appear_in_labels(data):
     events = data["events"].copy()
     events["v_after_mean"] = events["v_after_mean"].assign_attrs(units="m/s")
-    assert plotting.fig09(events).axes[0].get_ylabel() == "mean velocity after impact [m/s]"
+    assert plotting.fig09(events).axes[0].get_ylabel() == "mean velocity after impact (per collision) [m/s]"
 
 
 def test_missing_parameter_attribute_is_named(data):

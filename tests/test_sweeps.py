@@ -301,7 +301,7 @@ def test_the_side_by_side_figure_draws_each_combinations_means(sweep_events):
     ax_v, ax_z = fig.axes
     for k, ds in enumerate(events):
         cell = ds.isel(inv_beta=0)
-        enough = np.asarray(cell["n_impacts"]) >= 20
+        enough = np.asarray(cell["n_collisions"]) >= 20
         # the k-th errorbar container of each panel: its points and its +-t s.e. bars (1e-9)
         for ax, name in ((ax_v, "v_after"), (ax_z, "interval")):
             line, _, (bars,) = ax.containers[k].lines

@@ -239,7 +239,7 @@ def test_finding1_psd_peak_moves_up_and_falls_with_delta(spectra):
 
 
 def _impacting(events, minimum=1000):
-    return events.sel(delta=events.delta[events.n_impacts >= minimum])
+    return events.sel(delta=events.delta[events.n_collisions >= minimum])
 
 
 @pytest.mark.workflow
@@ -264,7 +264,7 @@ def test_finding3_intervals_follow_the_same_trend(events):
 def test_finding4_means_grow_until_impacts_cease(events):
     """The mean interval grows without bound as delta rises: the impact rate falls by orders
     of magnitude, towards the critical delta past which no impact happens in the record."""
-    rate = events.impact_rate.values
+    rate = events.collision_rate.values
     assert np.all(np.diff(rate[events.delta.values > 0]) < 0)
     assert rate[-1] < 0.01 * rate.max()
 
@@ -339,18 +339,21 @@ def test_map_cells_are_bit_identical_to_the_cell_alone(built):
 
     ds = xr.load_dataset(built / "results" / "datasets" / "motion_map_map.nc")
     noise, dt, _ = io.read_noise(built / "results" / "noise" / "harmonic_input.nc")
-    busiest = np.unravel_index(np.argmax(ds.n_impacts.values), ds.n_impacts.shape)
+    busiest = np.unravel_index(np.argmax(ds.n_impacts_resolved.values),
+                               ds.n_impacts_resolved.shape)
     for i, j in (busiest, (1, 4)):
         cell = ds.isel(inv_beta=i, delta=j)
         beta = 1.0 / float(cell.inv_beta)
         res = simulate(ds.attrs["zeta"], ds.attrs["eps"], float(cell.delta), noise=noise, dt=dt,
                        amplitude=1.0, beta=beta, t_end=float(cell.record_end))
-        keep = res.impact_time >= ds.attrs["transient"]
-        z = stats.impact_intervals(res.impact_step[keep], res.impact_offset[keep], dt)
+        keep = res.collision_time >= ds.attrs["transient"]
+        z = stats.impact_intervals(res.collision_step[keep], res.collision_offset[keep], dt)
         p = stats.impact_motion_probabilities(z, beta, ds.attrs["motion_window"],
-                                              total_time=float(cell.simulated_time))
-        assert list(cell.probability.values) == list(p.values())
+                                              total_time=float(cell.simulated_time),
+                                              stuck=res.collision_stuck[keep][:-1])
+        assert (list(cell.probability.values) + list(cell.stick_probability.values)
+                == list(p.values()))
     assert ds.reached.values.mean() > 0.9
     for name in ("probability", "probability_stderr", "n_switches", "few_switches",
-                 "impact_rate", "v_after_mean", "simulated_time"):
+                 "collision_rate", "v_after_mean", "simulated_time", "stick_probability"):
         assert ds[name].attrs.get("long_name"), name

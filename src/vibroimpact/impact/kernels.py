@@ -53,6 +53,16 @@ ELASTIC_MICRO_FLIGHT = 1e-6
 #: fewer than STEP_HEADROOM / 16 more of them, are taken as resting contact.
 MANY_EVENTS = 4096
 MICRO_HEIGHT = 1e-12
+#: Event tolerances in units of the round-off EPS64 of the quantity's scale: an arrival slower
+#: than TOUCH_ULPS is a touch, not an impact; a gap below WALL_ULPS (GAP_ULPS in the contact
+#: search) is on the wall; a push f - delta below FORCE_ULPS has no sign. With the
+#: CHATTER_TIME_TOL, ELASTIC_MICRO_FLIGHT and MICRO_HEIGHT above they are every tolerance that
+#: decides an event; no collision statistic depends on them (tests/test_collisions.py changes
+#: them all by three orders of magnitude).
+TOUCH_ULPS = 64.0
+WALL_ULPS = 16.0
+GAP_ULPS = 8.0
+FORCE_ULPS = 8.0
 #: Impacts and sticking events one step may write; the driver flushes buffers before a step
 #: when less room than this is left.
 STEP_HEADROOM = 1 << 16
@@ -359,7 +369,7 @@ def _newton_from(a, ga, va, acc, M3, H):
 @njit(cache=True, error_model="numpy")
 def tolg_wall(c, P):
     """Round-off of ``x - delta`` near the wall: separations below it are not resolvable."""
-    return 16.0 * EPS64 * (abs(P[P_DELTA]) + abs(c[C_F_LIN]) + abs(P[P_AQ]) + c[C_R])
+    return WALL_ULPS * EPS64 * (abs(P[P_DELTA]) + abs(c[C_F_LIN]) + abs(P[P_AQ]) + c[C_R])
 
 
 @njit(cache=True, error_model="numpy")
@@ -434,7 +444,7 @@ def first_contact(c, P, H, at_wall):
     va = c[C_V0]
     acc = c[C_G2]
     if at_wall:
-        tolv = 64.0 * EPS64 * vscale
+        tolv = TOUCH_ULPS * EPS64 * vscale
         if va > tolv:
             return ROOT, 0.0, va, 0.0           # starts on the wall moving into it
         if va >= -tolv:
@@ -490,8 +500,8 @@ def first_contact(c, P, H, at_wall):
             return (ROOT if va > 0.0 else TOUCH), a, va, 0.0
         a = a + step
         ga, va, acc = seg_eval(a, c, P)
-        if ga >= -8.0 * EPS64 * (abs(c[C_XD]) + a * vscale):
-            if va <= 64.0 * EPS64 * vscale:
+        if ga >= -GAP_ULPS * EPS64 * (abs(c[C_XD]) + a * vscale):
+            if va <= TOUCH_ULPS * EPS64 * vscale:
                 return TOUCH, a, va, 0.0
             if ga >= 0.0:
                 return ROOT, a, va, 0.0
@@ -507,7 +517,7 @@ def force_tol(c, P):
     agree: a mass they disagreed on would be released and stuck again forever. It depends
     on the force's size and the step length ``h``, never on the time left in the step.
     """
-    return 8.0 * EPS64 * (abs(c[C_F_LIN]) + abs(P[P_DELTA]) + abs(P[P_A]) + abs(c[C_B]) * P[P_DT] + 1e-300)
+    return FORCE_ULPS * EPS64 * (abs(c[C_F_LIN]) + abs(P[P_DELTA]) + abs(P[P_A]) + abs(c[C_B]) * P[P_DT] + 1e-300)
 
 
 @njit(cache=True, error_model="numpy")
@@ -716,7 +726,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         s = min(s + sig, H)
         x = delta
         at_wall = True
-        if code == ROOT and u <= 64.0 * EPS64 * (abs(b) + abs(P[P_AQ]) * P[P_BETA] + c[C_R] + abs(v)):
+        if code == ROOT and u <= TOUCH_ULPS * EPS64 * (abs(b) + abs(P[P_AQ]) * P[P_BETA] + c[C_R] + abs(v)):
             code = TOUCH          # arrives with zero velocity within round-off: grazing touch
         if code == TOUCH:
             v = min(u, 0.0)

@@ -12,6 +12,7 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
+from vibroimpact.stats.collisions import DEFAULT_REBOUND_FLOOR, group_collisions
 
 _BUFFER = 2 * kernels.STEP_HEADROOM
 
@@ -41,9 +42,39 @@ class SimulationResult:
     contact_time : float
         Total time spent resting on the wall.
     t_end, x_end, v_end : float
-        Final time and state; ``stuck_end`` tells whether the mass rests on the wall there.
+        Final time and state; ``stuck_end`` tells whether the mass rests on the wall there,
+        and ``stuck_since`` since when (NaN when it does not). In a chunk of
+        :func:`simulate_chunks` other than the last, a sticking phase still going on at the
+        chunk's end is in ``stick_start``/``stick_end`` of the chunk where it ends.
+    n_collisions : int
+        Collisions: impacts grouped with the chatter sequence they start and the sticking
+        that follows, up to the release (docs/figures.md, "Collisions, chatter and sticking";
+        :mod:`vibroimpact.stats.collisions`). Unlike ``n_impacts``, which counts every
+        rebound the kernel resolved before summing a chatter tail, it depends on no numerical
+        tolerance; every impact statistic counts collisions.
+    collision_time, collision_step, collision_offset : ndarray, shape (n_collisions,)
+        Instant of each collision's first impact (and its split form, as for impacts).
+    collision_velocity : ndarray of float64, shape (n_collisions,)
+        Approach velocity of each collision's first impact; its velocity after impact (that
+        of its first rebound) is ``eps * collision_velocity``.
+    collision_rebounds : ndarray of int64, shape (n_collisions,)
+        Rebounds of each collision leaving the wall at speed ``>= rebound_floor``.
+    collision_stuck : ndarray of bool, shape (n_collisions,)
+        Whether a sticking phase followed (before the next collision).
+    collision_stick_time : ndarray of float64, shape (n_collisions,)
+        Time resting on the wall in those phases.
+    collision_duration : ndarray of float64, shape (n_collisions,)
+        Time from its first impact to the release (stuck), or to its last impact.
+    impact_collision : ndarray of int64, shape (n,)
+        Index of the collision each impact belongs to.
+    rebound_floor : float
+        The velocity floor of ``collision_rebounds``.
     params : dict
         The physical inputs.
+
+    In a chunk of :func:`simulate_chunks` the collision fields are those of the chunk's own
+    impacts (a collision across a chunk boundary is split); :func:`concatenate_results`
+    groups the whole record again.
     """
 
     impact_time: np.ndarray
@@ -63,7 +94,31 @@ class SimulationResult:
     x_end: float
     v_end: float
     stuck_end: bool
+    stuck_since: float
+    n_collisions: int
+    collision_time: np.ndarray
+    collision_step: np.ndarray
+    collision_offset: np.ndarray
+    collision_velocity: np.ndarray
+    collision_rebounds: np.ndarray
+    collision_stuck: np.ndarray
+    collision_stick_time: np.ndarray
+    collision_duration: np.ndarray
+    impact_collision: np.ndarray
+    rebound_floor: float
     params: dict = field(default_factory=dict)
+
+
+def _collision_fields(impact_step, impact_offset, impact_velocity, stick_start, stick_end,
+                      dt, eps, floor):
+    """The ``collision_*`` fields of a :class:`SimulationResult` (keyword arguments)."""
+    c = group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end,
+                         dt=dt, eps=eps, floor=floor)
+    return dict(n_collisions=int(c.first.size), collision_time=c.time, collision_step=c.step,
+                collision_offset=c.offset, collision_velocity=c.velocity,
+                collision_rebounds=c.rebounds, collision_stuck=c.stuck,
+                collision_stick_time=c.stick_time, collision_duration=c.duration,
+                impact_collision=c.impact_collision, rebound_floor=c.floor)
 
 
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
@@ -172,7 +227,8 @@ def _raise_status(status, k, dt, r, k0, diag, P):
 
 
 def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None,
-                    v0=0.0, t_end=None, *, record_every=0, chunk_size=2**20):
+                    v0=0.0, t_end=None, *, record_every=0, chunk_size=2**20,
+                    rebound_floor=DEFAULT_REBOUND_FLOOR):
     """Simulate chunk by chunk; yield one :class:`SimulationResult` per chunk of samples.
 
     Same arguments as :func:`simulate`. Each chunk carries the events of its stretch of
@@ -187,9 +243,10 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     """
     zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size = _check_inputs(
         zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size)
+    rebound_floor = _checks.real("rebound_floor", rebound_floor, low=0.0, low_open=True)
     P = kernel_parameters(zeta, eps, delta, dt, amplitude, beta)
     params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
-                  x0=x0, v0=v0)
+                  x0=x0, v0=v0, rebound_floor=rebound_floor)
     Aq, phi = P[kernels.P_AQ], P[kernels.P_PHI]
     state = np.array([x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE,
                       -math.sin(phi), math.cos(phi)])
@@ -272,6 +329,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
     cat = lambda key, dtype: np.concatenate(parts[key]) if parts[key] else np.empty(0, dtype)
     imp_step = cat("imp_step", np.int64)
     imp_off = cat("imp_off", np.float64)
+    imp_u = cat("imp_u", np.float64)
     stk_time = cat("stk_step", np.int64) * dt + cat("stk_off", np.float64)
     stk_kind = cat("stk_kind", np.float64)
     starts, ends = [], []
@@ -283,15 +341,23 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
             ends.append(t)
             stick_open[0] = None
     stuck = mode == kernels.STUCK
+    stuck_since = stick_open[0] if stick_open[0] is not None else math.nan
     if final and stick_open[0] is not None:
         starts.append(stick_open[0])   # still resting on the wall at the record's end
         ends.append(t_chunk)
         stick_open[0] = None
+    # a sticking phase still open at the chunk's end ends there for the chunk's collisions
+    open_start = [] if stick_open[0] is None else [stick_open[0]]
+    collisions = _collision_fields(
+        imp_step, imp_off, imp_u,
+        np.asarray(starts + open_start, dtype=np.float64),
+        np.asarray(ends + [t_chunk] * len(open_start), dtype=np.float64),
+        dt, params["eps"], params["rebound_floor"])
     n = int(buf.grid_n[0])
     grid_time = (np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt if stride else np.empty(0)
     return SimulationResult(
         impact_time=imp_step * dt + imp_off,
-        impact_velocity=cat("imp_u", np.float64),
+        impact_velocity=imp_u,
         impact_step=imp_step,
         impact_offset=imp_off,
         stick_start=np.asarray(starts, dtype=np.float64),
@@ -307,12 +373,15 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         x_end=float(x),
         v_end=float(v),
         stuck_end=bool(stuck),
+        stuck_since=float(stuck_since),
         params=params,
+        **collisions,
     )
 
 
 def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None, v0=0.0,
-             t_end=None, *, record_every=0, chunk_size=2**20):
+             t_end=None, *, record_every=0, chunk_size=2**20,
+             rebound_floor=DEFAULT_REBOUND_FLOOR):
     """Exact motion of the impact oscillator under a sampled random force plus a harmonic force.
 
     Parameters
@@ -341,6 +410,9 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
         Record ``a(tau) = delta - x(tau)`` every ``record_every`` samples (0: do not record).
     chunk_size : int, keyword-only
         Samples per chunk streamed through the kernel.
+    rebound_floor : float, keyword-only
+        Velocity floor (``> 0``) of ``collision_rebounds``: rebounds leaving the wall slower
+        are not counted (default 0.01, :data:`vibroimpact.stats.DEFAULT_REBOUND_FLOOR`).
 
     Returns
     -------
@@ -359,11 +431,14 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
     inside a step are caught. A chatter sequence is followed impact by impact until its
     remaining geometric tail is summed in closed form to within ``CHATTER_TIME_TOL``
     (see :mod:`vibroimpact.impact.kernels`); the mass then sticks until ``f(tau) - delta`` turns
-    negative (the release instant is an exact root).
+    negative (the release instant is an exact root). The ``collision_*`` fields group the
+    impacts into collisions, the unit of every impact statistic: their values do not depend
+    on where the kernel stops resolving a chatter sequence.
     """
     chunks = list(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                   beta=beta, x0=x0, v0=v0, t_end=t_end,
-                                  record_every=record_every, chunk_size=chunk_size))
+                                  record_every=record_every, chunk_size=chunk_size,
+                                  rebound_floor=rebound_floor))
     return concatenate_results(chunks)
 
 
@@ -371,6 +446,14 @@ def concatenate_results(chunks):
     """Join consecutive chunk results into one :class:`SimulationResult`."""
     last = chunks[-1]
     cat = lambda name: np.concatenate([getattr(c, name) for c in chunks])
+    start, end = cat("stick_start"), cat("stick_end")
+    if last.stuck_end and not (start.size and start[-1] == last.stuck_since):
+        # a sticking phase open at the end of a chunk that is not the record's last
+        start, end = np.append(start, last.stuck_since), np.append(end, last.t_end)
+    collisions = _collision_fields(cat("impact_step"), cat("impact_offset"),
+                                   cat("impact_velocity"), start, end,
+                                   last.params["dt"], last.params["eps"],
+                                   last.params["rebound_floor"])
     return SimulationResult(
         impact_time=cat("impact_time"), impact_velocity=cat("impact_velocity"),
         impact_step=cat("impact_step"), impact_offset=cat("impact_offset"),
@@ -380,5 +463,5 @@ def concatenate_results(chunks):
         n_chatter=sum(c.n_chatter for c in chunks),
         contact_time=float(sum(c.contact_time for c in chunks)),
         t_end=last.t_end, x_end=last.x_end, v_end=last.v_end, stuck_end=last.stuck_end,
-        params=last.params,
+        stuck_since=last.stuck_since, params=last.params, **collisions,
     )

@@ -53,8 +53,13 @@ def _lag1_check(name, result, cell):
 def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                      transient=0.0, t_end=None, bins, n_batches=stats.DEFAULT_N_BATCHES,
                      motion_window=stats.DEFAULT_MOTION_WINDOW, motions=stats.DEFAULT_MOTIONS,
-                     chunk_size=2**20):
-    """Impact statistics of one cell (Figs. 7-9, 13, 14).
+                     rebound_floor=stats.DEFAULT_REBOUND_FLOOR, chunk_size=2**20):
+    """Collision statistics of one cell (Figs. 7-9, 13, 14).
+
+    Every statistic counts collisions (:mod:`vibroimpact.stats.collisions`): an impact after
+    a free flight with the chatter and sticking it starts. The velocity after impact is that
+    of a collision's first rebound, the interval runs from one collision's first impact to
+    the next's; none depends on a tolerance of the simulator.
 
     Parameters
     ----------
@@ -64,7 +69,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         Physical parameters (``beta_f``: frequency ratio of ``amplitude * sin(beta_f tau)``;
         unused when ``amplitude == 0``).
     transient : float
-        Time discarded before statistics (impacts before it are dropped).
+        Time discarded before statistics (collisions that begin before it are dropped).
     t_end : float, optional
         End of the record used (default: the whole noise record); longer than the record
         raises ValueError.
@@ -77,17 +82,23 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         Half-width w of the impact-motion classification (docs/figures.md, fig15).
     motions : sequence of (m, n)
         Motions whose probabilities are reported (harmonic force only).
+    rebound_floor : float
+        Velocity floor of the rebound counts (``rebounds_mean``, the per-rebound view).
 
     Returns
     -------
     dict
-        Scalars ``n_impacts, impact_rate, simulated_time, n_batches, v_after_mean,
+        Scalars ``n_collisions, collision_rate, simulated_time, n_batches, v_after_mean,
         v_after_stderr, v_after_lag1, interval_mean, interval_stderr, interval_lag1,
-        contact_fraction, n_chatter, v_after_beyond, interval_beyond`` and arrays
+        contact_fraction, stuck_fraction, stick_time_mean, rebounds_mean, n_rebounds,
+        rebound_v_after_mean, v_after_beyond, interval_beyond`` and arrays
         ``v_after_density(_stderr), interval_density(_stderr)`` (on the bins). With a
-        harmonic force (``amplitude != 0``) also ``ratio_density(_stderr)``, ``ratio_beyond`` and
-        ``motion_probability`` (one value per motion of ``motions``); without one there is
-        no forcing period, so these are absent.
+        harmonic force (``amplitude != 0``) also ``ratio_density(_stderr)``, ``ratio_beyond``,
+        ``motion_probability`` (one value per motion of ``motions``, with free flights) and
+        ``motion_stick_probability`` (their impact-stick variants, whose collisions stick);
+        without one there is no forcing period, so these are absent. The per-rebound view (``n_rebounds``,
+        ``rebound_v_after_mean``) counts every rebound leaving the wall at speed
+        ``>= rebound_floor``.
 
     Notes
     -----
@@ -101,21 +112,15 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
     n_batches = int(n_batches)
     harmonic = amplitude != 0.0
-    steps, offsets, u_minus = [], [], []
-    n_chatter = 0
-    contact = 0.0
+    events = _EventRecord(dt)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=t_end, chunk_size=chunk_size):
-        keep = chunk.impact_time >= transient
-        steps.append(chunk.impact_step[keep])
-        offsets.append(chunk.impact_offset[keep])
-        u_minus.append(chunk.impact_velocity[keep])
-        n_chatter += chunk.n_chatter
-        contact += _clipped_contact(chunk.stick_start, chunk.stick_end, transient)
-    steps, offsets, u_minus = (np.concatenate(a) for a in (steps, offsets, u_minus))
+        events.add(chunk)
+    col = events.collisions(eps, rebound_floor, transient)
+    contact = _clipped_contact(*events.sticking(), transient)
     duration = t_end - transient
-    v_after = stats.velocity_after_impact(u_minus, eps)
-    z = stats.impact_intervals(steps, offsets, dt)
+    v_after = stats.velocity_after_impact(col.velocity, eps)
+    z = col.intervals
     cell = (f"cell delta={delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
     v_stats = stats.batch_means(v_after, n_batches) if v_after.size else None
     z_stats = stats.batch_means(z, n_batches) if z.size else None
@@ -123,10 +128,12 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     _lag1_check("the interval", z_stats, cell)
     v_dens = stats.density(v_after, bins["v_after"], total=v_after.size, n_batches=n_batches)
     z_dens = stats.density(z, bins["interval"], total=z.size, n_batches=n_batches)
+    rebound_v = events.rebound_speeds(eps, rebound_floor, transient)
     nan = math.nan
+    mean = lambda a: float(a.mean()) if a.size else nan
     out = dict(
-        n_impacts=int(u_minus.size),
-        impact_rate=u_minus.size / duration,
+        n_collisions=int(v_after.size),
+        collision_rate=v_after.size / duration,
         simulated_time=duration,
         n_batches=n_batches,
         v_after_mean=v_stats.mean if v_stats else nan,
@@ -136,7 +143,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         interval_stderr=z_stats.stderr if z_stats else nan,
         interval_lag1=z_stats.lag1 if z_stats else nan,
         contact_fraction=contact / duration,
-        n_chatter=int(n_chatter),
+        stuck_fraction=mean(col.stuck.astype(float)),
+        stick_time_mean=mean(col.stick_time),
+        rebounds_mean=mean(col.rebounds.astype(float)),
+        n_rebounds=int(rebound_v.size),
+        rebound_v_after_mean=mean(rebound_v),
         v_after_density=v_dens.density, v_after_density_stderr=v_dens.stderr,
         v_after_beyond=v_dens.beyond,
         interval_density=z_dens.density, interval_density_stderr=z_dens.stderr,
@@ -145,14 +156,61 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     if harmonic:
         ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
                                    n_batches=n_batches)
-        motion = stats.impact_motion_probabilities(z, beta_f, motion_window,
-                                                   total_time=duration, motions=motions)
+        motion = list(stats.impact_motion_probabilities(
+            z, beta_f, motion_window, total_time=duration, motions=motions,
+            stuck=col.stuck[:-1]).values())           # the motions, then their stick variants
         out.update(ratio_density=ratio_dens.density, ratio_density_stderr=ratio_dens.stderr,
                    ratio_beyond=ratio_dens.beyond,
-                   motion_probability=np.array(list(motion.values())))   # order of motions
+                   motion_probability=np.array(motion[:len(motions)]),
+                   motion_stick_probability=np.array(motion[len(motions):]))
     return out
 
 
+class _EventRecord:
+    """The impacts and sticking phases of a streamed record, gathered chunk by chunk.
+
+    Collisions are grouped on the whole record at the end (a chatter sequence may cross a
+    chunk boundary). Impacts are kept from the start of the record, so that a collision that
+    begins before the transient is grouped as it happened and then dropped.
+    """
+
+    def __init__(self, dt):
+        self.dt = dt
+        self.stuck_since = math.nan
+        self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
+        self.open_start = None
+        self.t_end = 0.0
+
+    def add(self, chunk):
+        self.steps.append(chunk.impact_step)
+        self.offsets.append(chunk.impact_offset)
+        self.u.append(chunk.impact_velocity)
+        self.starts.append(chunk.stick_start)
+        self.ends.append(chunk.stick_end)
+        self.t_end = chunk.t_end
+        self.stuck_since = chunk.stuck_since
+        if len(self.steps) > 1:           # keep one array per kind: checks regroup each time
+            for name in ("steps", "offsets", "u", "starts", "ends"):
+                setattr(self, name, [np.concatenate(getattr(self, name))])
+
+    def sticking(self):
+        """Sticking phases so far; one still open ends at the last chunk's end."""
+        start, end = self.starts[0], self.ends[0]
+        if math.isfinite(self.stuck_since) and not (start.size and start[-1] == self.stuck_since):
+            start, end = np.append(start, self.stuck_since), np.append(end, self.t_end)
+        return start, end
+
+    def rebound_speeds(self, eps, floor, transient):
+        """Speeds ``eps u`` of the rebounds at or after ``transient`` that reach ``floor``."""
+        t = self.steps[0] * self.dt + self.offsets[0]
+        v = eps * self.u[0][t >= transient]
+        return v[v >= floor]
+
+    def collisions(self, eps, floor, transient):
+        """Collisions of the record so far that begin at or after ``transient``."""
+        start, end = self.sticking()
+        return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
+                                      dt=self.dt, eps=eps, floor=floor).after(transient)
 def _clipped_contact(start, end, transient):
     """Time resting on the wall after ``transient``."""
     return float(np.sum(np.clip(end, transient, None) - np.clip(start, transient, None)))
@@ -245,8 +303,12 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     Returns
     -------
     dict
-        ``probability, stderr`` (per motion), ``n_switches, n_impacts, impact_rate,
-        v_after_mean, simulated_time, record_end`` (the last simulated instant: simulating
+        ``probability, stderr`` (per motion, on the intervals between collisions, motions
+        with free flights), ``stick_probability, stick_stderr`` (their impact-stick
+        variants: a collision of the group ends sticking),
+        ``n_switches, n_collisions, collision_rate, v_after_mean`` (of collisions),
+        ``n_impacts_resolved`` (every rebound the kernel resolved: a numerical count, for cost
+        models only), ``simulated_time, record_end`` (the last simulated instant: simulating
         the cell alone to ``t_end = record_end`` reproduces it bit for bit), ``reached``
         (every stderr at target), ``few_switches`` (1 to ``min_switches - 1`` switches: the
         probabilities say where the record started), ``n_checks``.
@@ -260,23 +322,19 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next)
-    steps, offsets, u_minus = [], [], []
+    events = _EventRecord(dt)
     k, n_checks, request = 0, 0, None
     try:
         while True:
             chunk = gen.send(request) if request is not None else next(gen)
-            keep = chunk.impact_time >= transient
-            steps.append(chunk.impact_step[keep])
-            offsets.append(chunk.impact_offset[keep])
-            u_minus.append(chunk.impact_velocity[keep])
+            events.add(chunk)
             k += chunk.n_steps
             n_checks += 1
-            s, o = np.concatenate(steps), np.concatenate(offsets)
-            steps, offsets = [s], [o]
-            res = stats.motion_statistics(s * dt + o, stats.impact_intervals(s, o, dt), beta_f,
-                                          transient, k * dt, window=window, motions=motions,
-                                          n_batches=n_batches)
-            worst = float(res.stderr.max())
+            col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
+            res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
+                                          window=window, motions=motions, n_batches=n_batches,
+                                          stuck=col.stuck)
+            worst = float(max(res.stderr.max(), res.stick_stderr.max()))
             reached = worst <= target_stderr
             mixed_ok = res.n_switches == 0 or res.n_switches >= min_switches
             if (reached and mixed_ok) or k >= n_cap:
@@ -288,10 +346,13 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             request = n_next - k
     finally:
         gen.close()
-    u = np.concatenate(u_minus)
     duration = k * dt - transient
-    return dict(probability=res.probability, stderr=res.stderr, n_switches=res.n_switches,
-                n_impacts=int(u.size), impact_rate=u.size / duration,
-                v_after_mean=float(eps * u.mean()) if u.size else math.nan,
+    n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
+    return dict(probability=res.probability, stderr=res.stderr,
+                stick_probability=res.stick_probability, stick_stderr=res.stick_stderr,
+                n_switches=res.n_switches,
+                n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
+                n_impacts_resolved=n_resolved,
+                v_after_mean=float(eps * col.velocity.mean()) if col.time.size else math.nan,
                 simulated_time=duration, record_end=k * dt, reached=bool(reached),
                 few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks)

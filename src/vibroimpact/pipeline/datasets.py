@@ -14,35 +14,43 @@ META = {
     "inv_beta": ("inverse forcing frequency ratio 1/beta_f", "1"),
     "delta": ("play delta", "1"),
     "cell": ("cell index", "1"),
-    "v_after": ("velocity after impact", "1"),
-    "interval": ("interval between adjacent impacts z_j", "1"),
+    "v_after": ("velocity after impact (a collision's first rebound)", "1"),
+    "interval": ("interval between collisions z_j", "1"),
     "ratio": ("interval ratio z_j / z", "1"),
     "motion": ("impact motion (m/n)", "1"),
     "beta": ("frequency ratio beta = omega/omega_0", "1"),
-    "n_impacts": ("number of impacts", "1"),
-    "impact_rate": ("impacts per unit time", "1"),
+    "n_collisions": ("number of collisions (an impact after a free flight, with its chatter and sticking)", "1"),
+    "collision_rate": ("collisions per unit time", "1"),
+    "n_impacts_resolved": ("impacts the simulator resolved one by one (numerical: set by its chatter tolerance; cost models only)", "1"),
+    "stuck_fraction": ("fraction of collisions that end sticking on the wall", "1"),
+    "stick_time_mean": ("mean time on the wall per collision", "1"),
+    "rebounds_mean": ("mean rebounds per collision leaving faster than the rebound floor", "1"),
+    "n_rebounds": ("rebounds leaving faster than the rebound floor (per-rebound view)", "1"),
+    "rebound_v_after_mean": ("mean velocity after a rebound, rebounds above the floor (per-rebound view)", "1"),
     "simulated_time": ("record length after the transient", "1"),
-    "v_after_mean": ("mean velocity after impact", "1"),
+    "v_after_mean": ("mean velocity after impact (per collision)", "1"),
     "v_after_stderr": ("standard error of the mean velocity after impact (batch means)", "1"),
     "v_after_lag1": ("lag-1 autocorrelation of the batch means of the velocity after impact", "1"),
-    "interval_mean": ("mean interval between adjacent impacts", "1"),
+    "interval_mean": ("mean interval between collisions", "1"),
     "interval_stderr": ("standard error of the mean interval (batch means)", "1"),
     "interval_lag1": ("lag-1 autocorrelation of the batch means of the interval", "1"),
     "n_batches": ("batches B of the batch-means standard errors (t quantile: B - 1 dof)", "1"),
     "contact_fraction": ("fraction of time resting on the wall", "1"),
-    "n_chatter": ("chatter sequences ended by sticking", "1"),
     "v_after_density": ("probability density of the velocity after impact", "1"),
     "v_after_density_stderr": ("batch-means standard error of the velocity density", "1"),
     "v_after_beyond": ("fraction of velocities after impact beyond the last bin", "1"),
-    "interval_density": ("probability density of the interval between impacts", "1"),
+    "interval_density": ("probability density of the interval between collisions", "1"),
     "interval_density_stderr": ("batch-means standard error of the interval density", "1"),
     "interval_beyond": ("fraction of intervals beyond the last bin", "1"),
     "ratio_density": ("probability density of z_j / z", "1"),
     "ratio_density_stderr": ("batch-means standard error of the density of z_j / z", "1"),
     "ratio_beyond": ("fraction of ratios z_j / z beyond the last bin", "1"),
-    "motion_probability": ("probability of the impact motion (fraction of time)", "1"),
-    "probability": ("probability of the impact motion (fraction of time)", "1"),
+    "motion_probability": ("probability of the impact motion with free flights (fraction of time)", "1"),
+    "motion_stick_probability": ("probability of the motion's impact-stick variant (fraction of time)", "1"),
+    "probability": ("probability of the impact motion with free flights (fraction of time)", "1"),
     "probability_stderr": ("batch-means standard error of the probability", "1"),
+    "stick_probability": ("probability of the motion's impact-stick variant: a collision sticks (fraction of time)", "1"),
+    "stick_probability_stderr": ("batch-means standard error of the stick probability", "1"),
     "n_switches": ("changes between classified motions in the record", "1"),
     "few_switches": ("1: between 1 and min_switches - 1 switches (probabilities not stationary)", "1"),
     "reached": ("1: every probability reached the target standard error", "1"),
@@ -66,10 +74,11 @@ META = {
     "impact_velocity": ("approach velocity at impact", "1"),
 }
 
-_EVENT_SCALARS = ("n_impacts", "impact_rate", "simulated_time", "n_batches", "v_after_mean",
-                  "v_after_stderr", "v_after_lag1", "interval_mean", "interval_stderr",
-                  "interval_lag1", "contact_fraction", "n_chatter", "v_after_beyond",
-                  "interval_beyond")
+_EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches",
+                  "v_after_mean", "v_after_stderr", "v_after_lag1", "interval_mean",
+                  "interval_stderr", "interval_lag1", "contact_fraction", "stuck_fraction",
+                  "stick_time_mean", "rebounds_mean", "n_rebounds", "rebound_v_after_mean",
+                  "v_after_beyond", "interval_beyond")
 _EVENT_DENSITIES = (("v_after_density", "v_after"), ("v_after_density_stderr", "v_after"),
                     ("interval_density", "interval"), ("interval_density_stderr", "interval"))
 #: Statistics that need a forcing period: present only for a harmonic study (amplitude != 0).
@@ -128,14 +137,14 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
     centres = {k: 0.5 * (e[1:] + e[:-1]) for k, e in edges.items() if k in used}
     coords = dict(_cell_coords(cells), **centres)
     if harmonic:
-        data["motion_probability"] = (("cell", "motion"),
-                                      np.stack([r["motion_probability"] for r in results]))
+        for name in ("motion_probability", "motion_stick_probability"):
+            data[name] = (("cell", "motion"), np.stack([r[name] for r in results]))
         coords["motion"] = _motion_names(motions)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
-_MAP_SCALARS = ("n_switches", "few_switches", "reached", "n_impacts", "impact_rate",
-                "v_after_mean", "simulated_time", "record_end", "n_checks", "cpu_time")
+_MAP_SCALARS = ("n_switches", "few_switches", "reached", "n_collisions", "collision_rate",
+                "n_impacts_resolved", "v_after_mean", "simulated_time", "record_end", "n_checks", "cpu_time")
 
 
 def map_tile(cells, results, motions, attrs):
@@ -149,6 +158,10 @@ def map_tile(cells, results, motions, attrs):
         data[flag] = ("cell", data[flag][1].astype("int8"))     # netCDF has no bool
     data["probability"] = (("cell", "motion"), np.stack([r["probability"] for r in results]))
     data["probability_stderr"] = (("cell", "motion"), np.stack([r["stderr"] for r in results]))
+    data["stick_probability"] = (("cell", "motion"),
+                                 np.stack([r["stick_probability"] for r in results]))
+    data["stick_probability_stderr"] = (("cell", "motion"),
+                                        np.stack([r["stick_stderr"] for r in results]))
     coords = dict(_cell_coords(cells), motion=_motion_names(motions))
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 

@@ -46,7 +46,7 @@ def logged(path):
 class Progress:
     """A job's progress over its cells, logged at most every ``every`` seconds and at the end.
 
-    Each line: cells done of total, impacts, simulated time, the rate and the time left
+    Each line: cells done of total, collisions, simulated time, the rate and the time left
     (README, "Progress of a build"): a long tile says where it stands without flooding its log.
     """
 
@@ -56,12 +56,12 @@ class Progress:
         self.what, self.total, self.every = what, int(total), float(every)
         self.clock = clock or time.monotonic
         self.start = self.last = self.clock()
-        self.done, self.impacts, self.simulated = 0, 0, 0.0
+        self.done, self.collisions, self.simulated = 0, 0, 0.0
 
     def cell_done(self, result):
-        """Count one cell (its ``n_impacts`` and ``simulated_time`` when it has them)."""
+        """Count one cell (its ``n_collisions`` and ``simulated_time`` when it has them)."""
         self.done += 1
-        self.impacts += int(result.get("n_impacts", 0))
+        self.collisions += int(result.get("n_collisions", 0))
         self.simulated += float(result.get("simulated_time", 0.0))
         now = self.clock()
         if self.done < self.total and now - self.last < self.every:
@@ -69,8 +69,8 @@ class Progress:
         self.last = now
         elapsed = max(now - self.start, 1e-9)
         rate = self.done / elapsed
-        log.info("progress %s: %d of %d cells, %d impacts, %.4g time units simulated, "
-                 "%.3g cells/s, ~%.0f s left", self.what, self.done, self.total, self.impacts,
+        log.info("progress %s: %d of %d cells, %d collisions, %.4g time units simulated, "
+                 "%.3g cells/s, ~%.0f s left", self.what, self.done, self.total, self.collisions,
                  self.simulated, rate, (self.total - self.done) / rate)
 
 
@@ -105,6 +105,13 @@ def _record_attrs(block, t_end, n_samples, dt):
                 record_length=end - float(block["transient"]))
 
 
+def _rebound_floor(block):
+    """The study's rebound floor (schema default: ``stats.DEFAULT_REBOUND_FLOOR``)."""
+    from vibroimpact.stats.collisions import DEFAULT_REBOUND_FLOOR
+
+    return float(block.get("rebound_floor", DEFAULT_REBOUND_FLOOR))
+
+
 def _physics(study, cell):
     return dict(zeta=study.zeta, eps=study.eps, delta=cell.delta, amplitude=study.amplitude,
                 beta_f=1.0 / cell.inv_beta)
@@ -124,13 +131,15 @@ def events_tile(name, block, tile, noise_path, out):
         results.append(cells.event_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
             t_end=block.get("t_end"), bins=edges, n_batches=int(block["n_batches"]),
-            motion_window=float(block["motion_window"]), motions=study.motions))
+            motion_window=float(block["motion_window"]), motions=study.motions,
+            rebound_floor=_rebound_floor(block)))
         progress.cell_done(results[-1])
     ds = datasets.events_tile(study.tile(tile, "events"), results, edges,
                               dict(_study_attrs(study, block, noise_attrs),
                                    **_record_attrs(block, block.get("t_end"), len(samples), dt),
                                    n_batches=int(block["n_batches"]), bins=config_text(block["bins"]),
-                                   motion_window=float(block["motion_window"])),
+                                   motion_window=float(block["motion_window"]),
+                                   rebound_floor=_rebound_floor(block)),
                               motions=study.motions)
     io.write_dataset(ds, out)
 
@@ -162,9 +171,9 @@ def map_tile(name, block, tile, noise_path, out):
             min_time=float(spec["min_time"]), max_periods=int(spec["max_periods"]),
             min_switches=int(spec["min_switches"]))
         result["cpu_time"] = time.process_time() - start
-        log.debug("cell %d: inv_beta=%g delta=%g: %.0f time units, %d impacts, %.3f s%s",
+        log.debug("cell %d: inv_beta=%g delta=%g: %.0f time units, %d collisions, %.3f s%s",
                   cell.index, cell.inv_beta, cell.delta, result["simulated_time"],
-                  result["n_impacts"], result["cpu_time"],
+                  result["n_collisions"], result["cpu_time"],
                   "" if result["reached"] else ", target precision not reached")
         results.append(result)
         progress.cell_done(result)

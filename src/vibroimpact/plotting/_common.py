@@ -333,7 +333,7 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None):
 
     The band is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile
     of B - 1 dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number
-    of impacts and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
+    of collisions and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
     (``{quantity}_beyond``).
     """
     fig, (ax,) = _figure()
@@ -347,9 +347,9 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None):
         t = t_quantile(np.asarray(_require(ds, "n_batches", "the confidence band")), CONFIDENCE)
     for color, k in zip(_colors(len(index)), index):
         cell = ds.isel(delta=k)
-        n = int(cell["n_impacts"])
+        n = int(cell["n_collisions"])
         y = np.asarray(cell[var], dtype=float)
-        impacts = f"{n:,} impacts" if n else "no impacts"
+        impacts = f"{n:,} collisions" if n else "no impacts"
         label = rf"$\delta$ = {_num(cell['delta'])}  ({impacts}{_beyond_text(beyond[k])})"
         ax.plot(cell[x], y, color=color, label=label)
         if has_band:
@@ -393,12 +393,19 @@ def _require_harmonic(events, figure):
                          f"with ratio_density); got amplitude = {events.attrs.get('amplitude')!r}")
 
 
+#: What an impact statistic counts, printed on every figure of one (docs/figures.md).
+COLLISION_NOTE = ("per collision: an impact after a free flight with the chatter and sticking it "
+                  "starts; v = first rebound, z_j = first impact to first impact")
+
+
 def _events_params(events, i_beta):
-    """Parameter line of an events/spectra dataset at inv_beta index `i_beta`."""
+    """Parameter line of an events/spectra dataset at inv_beta index `i_beta`; an events
+    dataset (collision statistics) adds `COLLISION_NOTE` on a line of its own."""
     inv_beta = float(events["inv_beta"][i_beta])
     harmonic = float(_attr(events, "amplitude")) != 0.0
-    return f"{_system_text(events)};  " + _forcing_text(
+    line = f"{_system_text(events)};  " + _forcing_text(
         events, inv_beta=inv_beta if harmonic else None)
+    return line + (f"\n{COLLISION_NOTE}" if "n_collisions" in events else "")
 
 
 # --------------------------------------------------------------------------------------------

@@ -31,7 +31,8 @@ def _map_text(ds):
     """The map's statistics: window, target precision, share reached, record lengths."""
     reached = float(np.mean(ds["reached"].values))
     t = ds["simulated_time"].values
-    return (rf"w = {_num(_attr(ds, 'motion_window'))}; each cell from rest over one noise record, "
+    return (rf"z_j between collisions (chatter and sticking grouped), w = {_num(_attr(ds, 'motion_window'))}; "
+            rf"each cell from rest over one noise record, "
             rf"to s.e. $\leq$ {100 * float(_attr(ds, 'target_stderr')):.3g} pp "
             rf"({100 * reached:.1f} % of cells) or {int(_attr(ds, 'max_periods'))} periods; "
             rf"record {t.min():.0f}-{t.max():.0f} (median {np.median(t):.0f})")
@@ -78,22 +79,29 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
     Returns
     -------
     matplotlib.figure.Figure
-        One contour map per motion: filled bands and labelled lines of the probability in
-        percent; hatched where the record switched between motions only 1 to
+        One contour map per motion with free flights (the periodic impact motions of Fig. 16)
+        and, when the dataset has ``stick_probability``, one of their impact-stick variants
+        together (a collision of the motion ends sticking: the impact-chatter-stick cycle of
+        a pre-loaded wall, which `periodic_orbits` does not return): filled bands and
+        labelled lines of the probability in percent; hatched where the record switched between motions only 1 to
         ``min_switches - 1`` times (its numbers say where it started, not the long-run
         share); dots where the cap stopped the cell before the target precision.
     """
     motions = [str(m) for m in motion_map["motion"].values]
+    panels = [(f"({m})", motion_map["probability"].sel(motion=m).values) for m in motions]
+    if "stick_probability" in motion_map:
+        panels.append((" + ".join(f"({m})" for m in motions) + " with sticking",
+                       motion_map["stick_probability"].sum("motion").values))
     x, y = _grid(motion_map)
-    fig = Figure(figsize=(4.0 * len(motions) + 1.0, 4.4))
+    fig = Figure(figsize=(4.0 * len(panels) + 1.0, 4.4))
     FigureCanvasAgg(fig)
-    axes = fig.subplots(1, len(motions), sharex=True, sharey=True, squeeze=False).ravel()
+    axes = fig.subplots(1, len(panels), sharex=True, sharey=True, squeeze=False).ravel()
     few = motion_map["few_switches"].values.astype(bool)
     short = ~motion_map["reached"].values.astype(bool)
     fill_levels = [0.0, *levels, 100.0]
     shaded = None
-    for ax, name in zip(axes, motions):
-        p = 100.0 * motion_map["probability"].sel(motion=name).values
+    for ax, (title, prob) in zip(axes, panels):
+        p = 100.0 * prob
         shaded = ax.contourf(x, y, p.T, levels=fill_levels, cmap="Blues", vmin=-10, vmax=100)
         lines = ax.contour(x, y, p.T, levels=levels, colors="k", linewidths=0.6)
         ax.clabel(lines, fmt="%d", fontsize=6)
@@ -101,7 +109,7 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         if short.any():
             i, j = np.nonzero(short)
             ax.plot(x[i], y[j], ls="none", marker=".", ms=1.5, color="C3")
-        ax.set_title(f"({name})")
+        ax.set_title(title, fontsize=9 if len(title) > 12 else None)
     _finish_axes(axes, motion_map)
     fig.colorbar(shaded, ax=axes.tolist(), label="probability of the motion (%)", shrink=0.85)
     handles = [Patch(facecolor="white", edgecolor="k", hatch=FEW_SWITCHES_HATCH,

@@ -164,9 +164,9 @@ def fig07(events, density_delta=None):
 
 @_styled
 def fig08(events, density_delta=None):
-    """Fig. 8: probability density of the interval between adjacent impacts (as fig07)."""
+    """Fig. 8: probability density of the interval between collisions (as fig07)."""
     fig, _ = _density_figure(events, 0, "interval_density",
-                             "Fig. 8  Probability density of the interval between impacts",
+                             "Fig. 8  Probability density of the interval between collisions",
                              _events_params(events, 0), density_delta)
     return fig
 
@@ -177,20 +177,20 @@ def critical_delta(events, inv_beta_index=0):
     Parameters
     ----------
     events : xarray.Dataset
-        Events dataset with ``n_impacts(inv_beta, delta)``.
+        Events dataset with ``n_collisions(inv_beta, delta)``.
     inv_beta_index : int, optional
         Which forcing frequency.
 
     Returns
     -------
     float
-        The largest delta with ``n_impacts > 0`` when every larger delta has none, i.e. no
+        The largest delta with ``n_collisions > 0`` when every larger delta has none, i.e. no
         impact occurs for delta > critical_delta; NaN when the largest swept delta still has
         impacts (the sweep does not reach the critical play) or when no delta has any.
         The true threshold lies between this value and the next swept delta.
     """
     ds = events.isel(inv_beta=inv_beta_index).sortby("delta")
-    hit = np.flatnonzero(np.asarray(ds["n_impacts"]) > 0)
+    hit = np.flatnonzero(np.asarray(ds["n_collisions"]) > 0)
     if hit.size == 0 or hit[-1] == ds["delta"].size - 1:
         return float("nan")
     return float(ds["delta"][hit[-1]])
@@ -204,7 +204,7 @@ def fig09(events):
     ----------
     events : xarray.Dataset
         Events dataset of a fine delta sweep (inv_beta index 0): ``v_after_mean``,
-        ``v_after_stderr``, ``interval_mean``, ``interval_stderr``, ``n_impacts``,
+        ``v_after_stderr``, ``interval_mean``, ``interval_stderr``, ``n_collisions``,
         ``n_batches``.
 
     Returns
@@ -213,7 +213,7 @@ def fig09(events):
         Two stacked axes sharing delta; (b), the mean interval, on a log scale. Bars are
         +-t batch-means standard errors, t the Student quantile of B - 1 dof at
         `CONFIDENCE` (as `vibroimpact.stats.BatchMeans.interval`). Means resting on fewer
-        than `FEW_IMPACTS` impacts are open squares without bars; deltas without impacts
+        than `FEW_IMPACTS` collisions are open squares without bars; deltas without impacts
         are open circles on the lower edge of each axes. A vertical line (gid
         ``"critical_delta"``) marks :func:`critical_delta` on both axes, and a shaded span
         reaches to the first impact-free delta, where the true threshold lies.
@@ -222,7 +222,7 @@ def fig09(events):
     fig.set_figheight(FIG09_HEIGHT)
     ds = events.isel(inv_beta=0).sortby("delta")
     delta = np.asarray(ds["delta"], dtype=float)
-    n = np.asarray(ds["n_impacts"])
+    n = np.asarray(ds["n_collisions"])
     none, few = n == 0, (n > 0) & (n < FEW_IMPACTS)
     enough = n >= FEW_IMPACTS
     n_batches = np.asarray(_require(ds, "n_batches", "fig09's confidence bars"))
@@ -263,7 +263,7 @@ def fig09(events):
     marks = [Line2D([], [], color="0.3", marker="o", markersize=3.5, label=bar_label)]
     if few.any():
         marks.append(Line2D([], [], ls="none", marker="s", mfc="white", color="0.3",
-                            markersize=4.5, label=f"fewer than {FEW_IMPACTS} impacts (no bar)"))
+                            markersize=4.5, label=f"fewer than {FEW_IMPACTS} collisions (no bar)"))
     if none.any():
         marks.append(Line2D([], [], ls="none", marker="o", mfc="white", color="0.45",
                             markersize=4, label="no impact in the record"))
@@ -271,6 +271,6 @@ def fig09(events):
     axes[1].set_xlabel(axis_label(ds["delta"]))
     _panel_tag(axes[0], "(a)")
     _panel_tag(axes[1], "(b)")
-    _header(fig, "Fig. 9  Mean velocity after impact and mean interval between impacts",
+    _header(fig, "Fig. 9  Mean velocity after impact and mean interval between collisions",
             _events_params(events, 0))
     return fig

@@ -88,7 +88,7 @@ def sweep_means(datasets, labels):
         The events datasets of a sweep's studies (``results/datasets/<sweep>_<k>_events.nc``)
         in the order of its combinations; inv_beta index 0 of each is drawn. Each needs
         ``v_after_mean``, ``v_after_stderr``, ``interval_mean``, ``interval_stderr``,
-        ``n_impacts``, ``n_batches`` and the global attributes ``zeta``, ``eps``,
+        ``n_collisions``, ``n_batches`` and the global attributes ``zeta``, ``eps``,
         ``amplitude``, ``noise_rms`` (``sweep``, the sweep's name, for the title).
     labels : sequence of str
         One legend label per dataset, its combination's values (``"eps = 0.8, rms = 0.3"``).
@@ -99,7 +99,7 @@ def sweep_means(datasets, labels):
         Two stacked axes sharing delta, as Fig. 9 (`vibroimpact.plotting.fig09`): (a) the
         mean velocity after impact, (b) the mean interval on a log scale. Bars are +-t
         batch-means standard errors (t the Student quantile of B - 1 dof at `CONFIDENCE`);
-        means resting on fewer than `FEW_IMPACTS` impacts are open squares without bars;
+        means resting on fewer than `FEW_IMPACTS` collisions are open squares without bars;
         deltas without impacts are left out. With two or more swept keys the first one's
         value gives the colour and the others' the line style, else each combination has
         its colour; each combination's points are shifted by a fixed small offset in delta
@@ -121,7 +121,7 @@ def sweep_means(datasets, labels):
     for ds, label, (color, ls), offset in zip(datasets, labels, _styles(datasets), offsets):
         cell = ds.isel(inv_beta=0).sortby("delta")
         delta = np.asarray(cell["delta"], dtype=float) + offset
-        impacts = np.asarray(_require(cell, "n_impacts", "the sweep figure"))
+        impacts = np.asarray(_require(cell, "n_collisions", "the sweep figure"))
         enough, few = impacts >= FEW_IMPACTS, (impacts > 0) & (impacts < FEW_IMPACTS)
         n_batches = np.asarray(_require(cell, "n_batches", "the sweep figure's bars"))
         batches.update(int(b) for b in np.unique(n_batches[enough]))
@@ -147,7 +147,7 @@ def sweep_means(datasets, labels):
     _panel_tag(axes[1], "(b)")
     if any_few:
         handles.append(Line2D([], [], ls="none", marker="s", mfc="white", color="0.3",
-                              markersize=4.5, label=f"fewer than {FEW_IMPACTS} impacts (no bar)"))
+                              markersize=4.5, label=f"fewer than {FEW_IMPACTS} collisions (no bar)"))
     t_text = (f"t = {_num(t_quantile(batches.pop(), CONFIDENCE))}" if len(batches) == 1
               else "t of B - 1 dof")
     title = rf"mean $\pm$ t$\cdot$batch-means s.e. ({100 * CONFIDENCE:g} %, {t_text})"

@@ -81,8 +81,8 @@ def _fmt(values, spec=".3g"):
 
 
 def _impacting(events, minimum=MIN_IMPACTS):
-    """The plays with at least ``minimum`` impacts (one 1/beta row), in increasing delta."""
-    keep = events.delta[events.n_impacts >= minimum]
+    """The plays with at least ``minimum`` collisions (one 1/beta row), in increasing delta."""
+    keep = events.delta[events.n_collisions >= minimum]
     return events.sel(delta=keep).sortby("delta")
 
 
@@ -173,18 +173,18 @@ def finding3(events, lowest=-0.5):
 
 
 def finding4(events, orders=2.0):
-    """Impact rate against delta (Fig. 9): for delta > 0 it never rises and falls by at least
+    """Collision rate against delta (Fig. 9): for delta > 0 it never rises and falls by at least
     ``orders`` orders of magnitude, towards the critical play past which no impact happens."""
     ev = _row(events).sortby("delta")
-    d, rate = ev.delta.values, ev.impact_rate.values
+    d, rate = ev.delta.values, ev.collision_rate.values
     positive = (d > 0) & (rate > 0)
     if positive.sum() < 3:
         return not_available(4, "needs three plays > 0 with impacts")
     low = float(rate[positive].min())
     at_low = float(d[positive][np.argmin(rate[positive])])
     fall = np.log10(rate.max() / low)
-    none = d[(d > at_low) & (ev.n_impacts.values == 0)]
-    measured = (f"impact rate falls from {rate.max():.3g} to {low:.3g} per unit time at "
+    none = d[(d > at_low) & (ev.n_collisions.values == 0)]
+    measured = (f"collision rate falls from {rate.max():.3g} to {low:.3g} per unit time at "
                 f"delta = {at_low:.3g} ({fall:.1f} orders of magnitude); "
                 + (f"no impact from delta = {none.min():.3g} on" if none.size else
                    "every play of the grid still has impacts"))

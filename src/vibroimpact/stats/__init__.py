@@ -6,6 +6,8 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
 
 - `spectra`: Welch PSDs in the paper's convention (eqs. 8, 9) and the one conversion helper;
 - `events`: intervals, velocities after impact, densities, batch means;
+- `collisions`: impacts grouped with the chatter and sticking they start (the unit of every
+  impact statistic);
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
 - `theory`: the wall-free linear response, elastic impacts under white noise.
 
@@ -14,7 +16,7 @@ needs one helper does not import the others' scipy modules.
 """
 import importlib
 
-_SUBMODULES = ("spectra", "events", "motions", "theory")
+_SUBMODULES = ("spectra", "events", "collisions", "motions", "theory")
 _WHERE = {
     "PSD_DETREND": "spectra", "WelchAccumulator": "spectra", "welch_psd": "spectra",
     "onesided_to_angular": "spectra", "variance_from_psd": "spectra",
@@ -22,6 +24,8 @@ _WHERE = {
     "DEFAULT_N_BATCHES": "events", "impact_intervals": "events",
     "velocity_after_impact": "events", "interval_ratio": "events", "Density": "events",
     "density": "events", "BatchMeans": "events", "batch_means": "events", "t_quantile": "events",
+    "DEFAULT_REBOUND_FLOOR": "collisions", "Collisions": "collisions",
+    "group_collisions": "collisions",
     "DEFAULT_MOTION_WINDOW": "motions", "DEFAULT_MOTIONS": "motions",
     "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
     "count_motion_switches": "motions", "MotionStatistics": "motions",

@@ -80,11 +80,17 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
     matters for user-supplied motions; the greedy pairing reads a (2/1) record in time order
     and pairs a run of short intervals (r1, r2), (r3, r4), ...
     """
+    return _classify(ratio, window, motions)[0]
+
+
+def _classify(ratio, window, motions):
+    """Labels (as `classify_impact_intervals`) and the first interval of each one's group."""
     ratio = np.asarray(ratio, dtype=float)
     _checks.real("window", window, low=0.0, high=0.5, low_open=True)
     motions = _check_motions(motions)
     match = _match_masks(ratio, window, motions)
     labels = np.full(ratio.size, -1, dtype=np.int64)
+    group = np.arange(ratio.size)
     lengths = [m for m, _ in motions]
     free_from = 0
     for j in np.flatnonzero(match.any(axis=0)):
@@ -92,35 +98,63 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
             continue
         i = int(np.argmax(match[:, j]))
         labels[j:j + lengths[i]] = i
+        group[j:j + lengths[i]] = j
         free_from = j + lengths[i]
-    return labels
+    return labels, group
+
+
+def _with_sticking(labels, group, stuck):
+    """Per interval: its motion's group holds a collision that ended sticking."""
+    stuck = np.asarray(stuck, dtype=bool)
+    if stuck.shape != labels.shape:
+        raise ValueError(f"stuck must hold one flag per interval ({labels.size}), got shape "
+                         f"{stuck.shape}")
+    if not labels.size:
+        return stuck.copy()
+    # any sticking among the intervals of each group: a cumulative count over the group
+    count = np.concatenate([[0], np.cumsum(stuck)])
+    return (count[_group_ends(group) + 1] - count[group]) > 0
+
+
+def _group_ends(group):
+    """Index of the last interval of each interval's group (groups are contiguous)."""
+    n = group.size
+    starts = np.flatnonzero(np.diff(np.concatenate([[-1], group])) != 0)
+    stops = np.append(starts[1:], n) - 1
+    return np.repeat(stops, np.diff(np.append(starts, n)))
 
 
 def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_MOTION_WINDOW,
                                 total_time: float | None = None,
-                                motions=DEFAULT_MOTIONS) -> dict[str, float]:
+                                motions=DEFAULT_MOTIONS, stuck=None) -> dict[str, float]:
     """Probability of each impact motion: fraction of the recorded time it covers (fig15).
 
     Parameters
     ----------
     intervals : array_like of float, shape (N,)
-        Intervals z_j between adjacent impacts in time order (`impact_intervals`).
+        Intervals z_j between adjacent collisions in time order (`Collisions.intervals`).
     beta : float
         Forcing frequency ratio of ``sin(beta tau)``; the forcing period is ``z = 2 pi / beta``.
     window : float, optional
         Half-width w on r_j = z_j / z (default 0.1, config value in the workflow).
     total_time : float, optional
         Recorded time the probabilities refer to (>= sum of intervals). Default: the time
-        from the first to the last impact, ``sum(intervals)``.
+        from the first to the last collision, ``sum(intervals)``.
     motions : sequence of (m, n), optional
         Motions to report, default (1/1), (2/1), (1/2). Generic (m/n) are classified by the
         same rule (m consecutive intervals summing to n periods within w).
+    stuck : array_like of bool, shape (N,), optional
+        Whether the collision that starts each interval ended sticking
+        (`Collisions.stuck`). Given, a motion whose group holds such a collision is the
+        *impact-stick* variant of the motion, reported apart under the key ``"m/n stick"``,
+        and ``"m/n"`` keeps the motions with free flights only (those of Fig. 16).
 
     Returns
     -------
     dict
-        ``{"1/1": p11, "2/1": p21, "1/2": p12}`` (keys ``"m/n"``), each in [0, 1]; their sum is
-        at most 1. With no interval, every probability is 0 (no impact motion occurred).
+        ``{"1/1": p11, "2/1": p21, "1/2": p12}`` (keys ``"m/n"``), each in [0, 1], and with
+        `stuck` also ``"1/1 stick"``, ...; their sum is at most 1. With no interval, every
+        probability is 0 (no impact motion occurred).
 
     Notes
     -----
@@ -137,9 +171,19 @@ def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_
     elif not np.isfinite(total_time) or total_time < covered * (1.0 - 1e-12):
         raise ValueError(f"total_time must be >= the sum of the intervals ({covered!r}), "
                          f"got {total_time!r}")
-    labels = classify_impact_intervals(interval_ratio(intervals, beta), window, motions)
-    return dict(zip(map(_motion_key, motions), _fractions(intervals, labels, len(motions),
-                                                             total_time)))
+    labels, group = _classify(interval_ratio(intervals, beta), window, motions)
+    keys = list(map(_motion_key, motions))
+    if stuck is None:
+        return dict(zip(keys, _fractions(intervals, labels, len(motions), total_time)))
+    classes = _refine(labels, _with_sticking(labels, group, stuck), len(motions))
+    values = _fractions(intervals, classes, 2 * len(motions), total_time)
+    return dict(zip(keys + [f"{k} stick" for k in keys], values))
+
+
+def _refine(labels, sticking, n_motions):
+    """Class of each interval: its motion ``i``, or ``i + n_motions`` for the motion's
+    impact-stick variant; -1 unclassified."""
+    return np.where(labels >= 0, labels + n_motions * sticking, -1)
 
 
 def _fractions(intervals, labels, n_motions, total_time):
@@ -181,19 +225,22 @@ class MotionStatistics(NamedTuple):
     stderr: np.ndarray        #: (n_motions,) batch-means standard error of `probability`
     n_switches: int           #: changes between classified motions (`count_motion_switches`)
     labels: np.ndarray        #: (N,) motion index of each interval, -1 if none
+    #: (n_motions,) fraction covered by the motions' impact-stick variants (NaN without `stuck`)
+    stick_probability: np.ndarray = np.empty(0)
+    stick_stderr: np.ndarray = np.empty(0)    #: its batch-means standard error
 
 
 def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_stop: float, *,
                       window: float = DEFAULT_MOTION_WINDOW, motions=DEFAULT_MOTIONS,
-                      n_batches: int = 20) -> MotionStatistics:
+                      n_batches: int = 20, stuck=None) -> MotionStatistics:
     """Probabilities of the (m/n) motions over ``[t_start, t_stop]`` with standard errors.
 
     Parameters
     ----------
     impact_time : array_like of float, shape (N + 1,)
-        Impact instants in ``[t_start, t_stop]``, increasing.
+        Collision instants (first impacts) in ``[t_start, t_stop]``, increasing.
     intervals : array_like of float, shape (N,)
-        The intervals between them in full precision (`impact_intervals`).
+        The intervals between them in full precision (`Collisions.intervals`).
     beta : float
         Forcing frequency ratio (period ``z = 2 pi / beta``).
     t_start, t_stop : float
@@ -202,6 +249,11 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
         As for `classify_impact_intervals`.
     n_batches : int
         B equal stretches of time for the standard errors (>= 2).
+    stuck : array_like of bool, shape (N + 1,) or (N,), optional
+        Whether each collision ended sticking (`Collisions.stuck`; the last collision's flag
+        is not used). Given, the impact-stick variants are counted apart
+        (`impact_motion_probabilities`): ``probability`` keeps the motions with free flights
+        and ``stick_probability`` holds the variants.
 
     Returns
     -------
@@ -228,25 +280,39 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     if t.size != z.size + 1 and not (t.size == 0 and z.size == 0):
         raise ValueError(f"impact_time must hold one more value than intervals, got "
                          f"{t.size} and {z.size}")
-    labels = classify_impact_intervals(interval_ratio(z, beta), window, motions)
-    probability = np.array(_fractions(z, labels, len(motions), duration))
-    if z.size == 0:
-        zero = np.zeros(len(motions))
-        return MotionStatistics(probability, zero, 0, labels)
-    # covered time of each motion up to each impact, then at the stretch edges (linear within
-    # an interval of that motion, flat elsewhere)
-    onehot = labels[None, :] == np.arange(len(motions))[:, None]          # (n_motions, N)
-    cover = np.concatenate([np.zeros((len(motions), 1)), np.cumsum(z * onehot, axis=1)], axis=1)
-    edges = float(t_start) + duration * np.arange(n_batches + 1) / n_batches
-    j = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 1)   # impact before
+    labels, group = _classify(interval_ratio(z, beta), window, motions)
+    n_motions = len(motions)
+    classes, n_classes = labels, n_motions
+    if stuck is not None:
+        stuck = np.asarray(stuck, dtype=bool)[: z.size]
+        classes = _refine(labels, _with_sticking(labels, group, stuck), n_motions)
+        n_classes = 2 * n_motions
+    probability = np.array(_fractions(z, classes, n_classes, duration))
+    stderr = np.zeros(n_classes)
+    if z.size:
+        stderr = _batch_stderr(t, z, classes, n_classes, float(t_start), duration, n_batches)
+    nan = np.full(n_motions, np.nan)
+    stick, stick_err = ((probability[n_motions:], stderr[n_motions:]) if stuck is not None
+                        else (nan, nan.copy()))
+    return MotionStatistics(probability[:n_motions], stderr[:n_motions],
+                            count_motion_switches(labels), labels, stick, stick_err)
+
+
+def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches):
+    """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
+    # covered time of each class up to each collision, then at the stretch edges (linear
+    # within an interval of that class, flat elsewhere)
+    onehot = classes[None, :] == np.arange(n_classes)[:, None]            # (n_classes, N)
+    cover = np.concatenate([np.zeros((n_classes, 1)), np.cumsum(z * onehot, axis=1)], axis=1)
+    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
+    j = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 1)   # collision before
     inside = (edges > t[0]) & (j < z.size)                                   # within interval j
     jj = np.minimum(j, z.size - 1)
     extra = np.where(inside[None, :] & onehot[:, jj], np.minimum(edges - t[j], z[jj])[None, :],
                      0.0)
     at_edges = np.where(edges[None, :] > t[0], cover[:, j] + extra, 0.0)
-    batches = np.diff(at_edges, axis=1) * (n_batches / duration)           # (n_motions, B)
-    stderr = batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
-    return MotionStatistics(probability, stderr, count_motion_switches(labels), labels)
+    batches = np.diff(at_edges, axis=1) * (n_batches / duration)           # (n_classes, B)
+    return batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
 
 
 def motion_map_agreement(probability, stable, S, threshold: float = 0.5) -> dict[str, float]:
