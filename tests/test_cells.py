@@ -83,9 +83,9 @@ def test_ratio_statistics_only_with_a_harmonic_force(record):
 
 
 def test_batch_statistics_and_their_lag1_warning(record, caplog):
-    # A forcing period of 2000 time units (amplitude 0.8) over a record of 4000 makes the impact statistics
-    # drift: the 20 batch means then follow the slow cycle (lag-1 correlation ~0.7, far above
-    # 2/sqrt(20) = 0.45) and the cell warns. The stationary cell (delta = 0, noise only) has
+    # A forcing period of 2000 time units (amplitude 0.8) over a record of 4000 makes the
+    # collision statistics drift: the 20 batch means follow the slow cycle (lag-1 ~0.55-0.7,
+    # above 2/sqrt(20) = 0.45) and the cell warns. The stationary cell (delta = 0, noise only) has
     # a lag-1 correlation near 0 and stays silent.
     kw = dict(zeta=0.05, eps=0.5, transient=50.0, bins=BINS, n_batches=20)
     with caplog.at_level(logging.WARNING, logger="vibroimpact"):
