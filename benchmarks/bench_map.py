@@ -17,7 +17,10 @@ noise record its cells ran over, then prints:
    fit on the sample) and the ratio of their total times. Also checks that the rerun cells
    reproduce the stored ones (n_impacts, record_end, probabilities);
 5. a linear scaling check: every cell of a box of the plane at the map's resolution and at
-   twice it in both directions (grid steps halved), CPU totals and their ratio.
+   twice it in both directions (grid steps halved), CPU totals and their ratio;
+6. with ``--peer-rev REV``: the map's cells (every ``--peer-stride``-th) timed with this tree
+   and with revision REV (a git worktree), same arguments, each side in a fresh warmed
+   process (``benchmarks/map_cells_cpu.py``): the CPU ratio on the same cells.
 
 Timings are CPU times (time.process_time), numba compiled and warmed before any timing;
 nothing is asserted.
@@ -28,6 +31,7 @@ Usage::
         --noise results/noise/harmonic_input.nc
     python benchmarks/bench_map.py ... --cells 20 --scaling-box 1.0,1.2,0,0.5
     python benchmarks/bench_map.py ... --no-scaling
+    python benchmarks/bench_map.py ... --peer-rev 7b5ef46 --only-peer-rev
 """
 import os
 
@@ -35,6 +39,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # before numba loads: one threa
 
 import argparse  # noqa: E402
 import math  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -54,6 +59,12 @@ GRID_TOL = 1e-9  # slack when selecting grid values inside a box
 
 # ---------------------------------------------------------------------------------------------
 # dataset
+
+
+def _impacts(ds):
+    """Impacts the kernel resolved per cell (``n_impacts_resolved``; ``n_impacts`` in maps
+    built before collisions became the unit of the statistics): the cost driver."""
+    return ds["n_impacts_resolved"] if "n_impacts_resolved" in ds else ds["n_impacts"]
 
 
 def load_map(path):
@@ -105,7 +116,7 @@ def summary(ds):
           f"{'max':>10}")
     quantile_row("simulated_time", ds["simulated_time"], "time units (after the transient)")
     quantile_row("cpu_time", ds["cpu_time"], "s")
-    quantile_row("n_impacts", ds["n_impacts"], "impacts (after the transient)")
+    quantile_row("n_impacts", _impacts(ds), "impacts (after the transient)")
     if capped.any():
         print(f"the {int(capped.sum())} capped cells (reached == 0) hold "
               f"{float(ds['cpu_time'].where(capped).sum()) / float(ds['cpu_time'].sum()):.1%} of "
@@ -158,7 +169,7 @@ def print_fit_header():
 
 def cost_model(ds, dt):
     steps = (ds["record_end"].values / dt).ravel()
-    impacts = ds["n_impacts"].values.ravel()
+    impacts = _impacts(ds).values.ravel()
     cpu = ds["cpu_time"].values.ravel()
     fit = fit_cost(cpu, steps, impacts)
     print(f"\n== 3. Cost model of the stored CPU times, all {cpu.size} cells: cpu_time ~ a * steps "
@@ -197,7 +208,7 @@ def warm_up(samples, dt, kw):
 
 def sample_cells(ds, n, rng):
     """n cells, half from the top quartile of n_impacts, half from the rest (fixed seed)."""
-    impacts = ds["n_impacts"].transpose("inv_beta", "delta").values.ravel()
+    impacts = _impacts(ds).transpose("inv_beta", "delta").values.ravel()
     q75 = np.quantile(impacts, 0.75)
     busy = np.flatnonzero(impacts >= q75)
     rest = np.flatnonzero(impacts < q75)
@@ -212,7 +223,7 @@ def peer(ds, samples, dt, kw, n_cells, repeats, seed):
     n_delta = ds.sizes["delta"]
     pick, q75 = sample_cells(ds, n_cells, np.random.default_rng(seed))
     print(f"\n== 4. Peer in this run: {pick.size} cells (seed {seed}; "
-          f"{int(np.sum(flat['n_impacts'].values.ravel()[pick] >= q75))} from the top quartile, "
+          f"{int(np.sum(_impacts(flat).values.ravel()[pick] >= q75))} from the top quartile, "
           f"n_impacts >= {q75:.0f}), best of {repeats} CPU timings each ==")
     print("simulate = vibroimpact.simulate(zeta, eps, delta, noise, dt, amplitude, beta = "
           "1/inv_beta, t_end = record_end): the plain simulator over the cell's fixed length; "
@@ -231,12 +242,12 @@ def peer(ds, samples, dt, kw, n_cells, repeats, seed):
         after = int(np.sum(res.impact_time >= kw["transient"]))
         rows.append(dict(
             inv_beta=inv_beta, delta=delta, steps=t_end / dt, impacts_all=int(res.n_impacts),
-            impacts_after=int(cell["n_impacts"]), sim=t_sim, map=t_map,
+            impacts_after=int(cell["n_impacts_resolved"]), sim=t_sim, map=t_map,
             stored_cpu=float(stored["cpu_time"]),
             same_end=cell["record_end"] == t_end,
-            same_impacts=cell["n_impacts"] == int(stored["n_impacts"]),
+            same_impacts=cell["n_impacts_resolved"] == int(_impacts(stored)),
             same_prob=bool(np.array_equal(cell["probability"], stored["probability"].values)),
-            sim_matches_cell=after == cell["n_impacts"]))
+            sim_matches_cell=after == cell["n_impacts_resolved"]))
 
     steps = np.array([r["steps"] for r in rows])
     imp = np.array([r["impacts_all"] for r in rows])
@@ -277,6 +288,52 @@ def peer(ds, samples, dt, kw, n_cells, repeats, seed):
           f"after the transient == the cell's n_impacts {sum(r['sim_matches_cell'] for r in rows)}"
           f"/{n}")
     return fit_sim, fit_map
+
+
+def peer_revision(ds, noise_path, kw, rev, stride):
+    """Section 6: every ``stride``-th cell of the map with this tree and with revision ``rev``
+    (a git worktree), each in a fresh process running benchmarks/map_cells_cpu.py."""
+    import json
+    import subprocess
+    import tempfile
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    flat = ds.transpose("inv_beta", "delta", "motion")
+    cells = [(float(b), float(d)) for b in flat.inv_beta.values for d in flat.delta.values]
+    cells = cells[::stride]
+    job = json.dumps(dict(noise=str(noise_path), cells=cells,
+                          kwargs={k: (list(map(list, v)) if k == "motions" else v)
+                                  for k, v in kw.items()}))
+    print(f"\n== 6. This tree against revision {rev} on {len(cells)} cells (every {stride}-th "
+          f"cell of the map), the same motion_map_cell arguments, one process each, warmed ==")
+    results = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        where = Path(tmp) / "peer"
+        subprocess.run(["git", "worktree", "add", "-f", "--detach", str(where), rev], cwd=root,
+                       check=True, capture_output=True)
+        try:
+            for name, src in (("this tree", root / "src"), (f"revision {rev}", where / "src")):
+                env = dict(os.environ, PYTHONPATH=str(src))
+                out = subprocess.run([sys.executable, str(root / "benchmarks" / "map_cells_cpu.py")],
+                                     input=job, capture_output=True, text=True, env=env,
+                                     check=True)
+                results[name] = json.loads(out.stdout)
+        finally:
+            subprocess.run(["git", "worktree", "remove", "--force", str(where)], cwd=root,
+                           check=False, capture_output=True)
+    now, base = results["this tree"], results[f"revision {rev}"]
+    cpu_now, cpu_base = np.array(now["cpu"]), np.array(base["cpu"])
+    print(f"{'':<22} {'CPU total s':>12} {'median ms':>10} {'q90 ms':>8} {'max ms':>8}  package")
+    for name, r in results.items():
+        c = np.array(r["cpu"])
+        print(f"{name:<22} {c.sum():>12.2f} {np.median(c) * 1e3:>10.2f} "
+              f"{np.quantile(c, 0.9) * 1e3:>8.2f} {c.max() * 1e3:>8.2f}  {r['package']}")
+    print(f"ratio revision {rev} / this tree: {cpu_base.sum() / cpu_now.sum():.2f} x the CPU "
+          f"(median per cell {np.median(cpu_base / np.maximum(cpu_now, 1e-9)):.2f})")
+    busy = cpu_base >= np.quantile(cpu_base, 0.9)
+    print(f"on the busiest tenth of the cells for {rev}: {cpu_base[busy].sum():.2f} s against "
+          f"{cpu_now[busy].sum():.2f} s ({cpu_base[busy].sum() / cpu_now[busy].sum():.2f} x)")
 
 
 def box_grid(ds, box):
@@ -352,6 +409,12 @@ def main(argv=None):
                         metavar="IB_LO,IB_HI,D_LO,D_HI",
                         help="box of the scaling check (default 1.0,1.5,-0.5,0.5)")
     parser.add_argument("--no-scaling", action="store_true", help="skip the scaling check")
+    parser.add_argument("--peer-rev", metavar="REV",
+                        help="also time the map's cells with this git revision (section 6)")
+    parser.add_argument("--peer-stride", type=int, default=1,
+                        help="with --peer-rev: every this-many-th cell (default 1: all)")
+    parser.add_argument("--only-peer-rev", action="store_true",
+                        help="with --peer-rev: skip sections 4 and 5")
     args = parser.parse_args(argv)
 
     start = time.perf_counter(), time.process_time()
@@ -376,9 +439,12 @@ def main(argv=None):
 
     print(f"\nwarm-up (numba compile, one short call of each): "
           f"{warm_up(samples, dt, kw):.2f} s CPU")
-    peer(ds, samples, dt, kw, args.cells, args.repeats, args.seed)
-    if not args.no_scaling:
-        scaling(ds, samples, dt, kw, args.scaling_box)
+    if not args.only_peer_rev:
+        peer(ds, samples, dt, kw, args.cells, args.repeats, args.seed)
+        if not args.no_scaling:
+            scaling(ds, samples, dt, kw, args.scaling_box)
+    if args.peer_rev:
+        peer_revision(ds, args.noise, kw, args.peer_rev, args.peer_stride)
     print(f"\ntotal: {time.perf_counter() - start[0]:.1f} s wall, "
           f"{time.process_time() - start[1]:.1f} s CPU")
 

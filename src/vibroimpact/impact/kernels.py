@@ -40,9 +40,11 @@ RESYNC_EVERY = 1024
 #: Maximum number of root-search iterations in one segment (never reached in practice: the
 #: search converges quadratically; a near-grazing approach takes ~30).
 MAX_SEARCH = 400
-#: Estimated error (in time) below which the remaining geometric tail of a chatter sequence is
-#: summed in closed form and the mass is set sticking at the accumulation point.
-CHATTER_TIME_TOL = 1e-12
+#: Bound (in time) on the error of a chatter sequence's accumulation point, summed in closed
+#: form (:func:`chatter_tail`, a proved bracket): the sticking onset, and so the time on the
+#: wall, is exact to it; nothing else depends on it (the release is the push's own root, and
+#: the rebounds left unresolved, slower than ~1e-4, never change the collisions).
+CHATTER_TIME_TOL = 1e-6
 #: Elastic (eps = 1) micro-bounces shorter than this are taken as resting contact: with eps = 1
 #: a pressed mass loses bounce energy only to damping, so bounces shrink like 1/k and never
 #: accumulate; a flight of 1e-6 rises ~1e-13 F above the wall.
@@ -625,6 +627,55 @@ def release_time(c, P, H):
 
 
 @njit(cache=True, error_model="numpy")
+def chatter_tail(w, F0, dF0, prev, Hs, P):
+    """Where a chatter sequence accumulates, proved, or -1 when it cannot be proved yet.
+
+    The mass leaves the wall at speed ``w`` with the push ``F0 = f - delta > 0`` (slope
+    ``dF0``). Over a window ``[0, W]`` inside the step (``W <= Hs``: ``r`` is linear there)
+    ``F`` lies in ``F0 +- (|dF0| W + A beta^2 W^2 / 2)``; while the speed stays below ``2 w``
+    and the gap ``a = delta - x`` below ``a_max``, the acceleration towards the wall,
+    ``x'' = F - 2 zeta x' + a``, lies in ``[g_lo, g_hi]``, ``rho = g_hi / g_lo``. A flight
+    from speed ``w_k`` then lasts ``[2 w_k / g_hi, 2 w_k / g_lo]`` and returns at
+    ``w_k [rho^-1/2, rho^1/2]``, so with ``q = eps rho^1/2 < 1`` the rebounds accumulate at
+    ``T`` in ``[T_lo, T_hi] = [2 w / (g_hi (1 - eps / rho^1/2)), 2 w / (g_lo (1 - q))]``,
+    where the push is still positive (``g_lo > 0``): the mass sticks there. Returns the
+    midpoint when ``T_hi - T_lo <= CHATTER_TIME_TOL`` (the stated bound on the sticking
+    onset), ``T_hi <= W``, and the unresolved rebounds are proved to shrink in velocity and
+    in flight time (``eps rho^3/2 < 1``) starting below the flight that brought the mass
+    here (``prev > 2 w / g_lo``), so that grouping the resolved impacts into collisions
+    (:mod:`vibroimpact.stats.collisions`) is the same as with every rebound resolved.
+    """
+    zeta, eps = P[P_ZETA], P[P_EPS]
+    MF = abs(P[P_A]) * P[P_BETA] * P[P_BETA] * BOUND_SAFETY
+    W = 3.0 * w / (F0 * (1.0 - eps))       # 1.5 x the constant-push estimate
+    for _ in range(4):
+        if W > Hs:
+            return -1.0
+        spread = (abs(dF0) * W + 0.5 * MF * W * W) * BOUND_SAFETY
+        g_lo = F0 - spread - 4.0 * zeta * w
+        if g_lo <= 0.0:
+            return -1.0
+        g_hi = F0 + spread + 4.0 * zeta * w + 2.0 * w * w / g_lo
+        rho = g_hi / g_lo
+        if rho >= 4.0:                      # the speed bound 2 w needs rho^1/2 <= 2
+            return -1.0
+        root = math.sqrt(rho)
+        q = eps * root
+        if q >= 1.0:
+            return -1.0
+        T_hi = 2.0 * w / (g_lo * (1.0 - q)) * BOUND_SAFETY
+        if T_hi <= W:
+            if eps * rho * root >= 1.0 or prev <= 2.0 * w / g_lo:
+                return -1.0
+            T_lo = 2.0 * w / (g_hi * (1.0 - eps / root)) / BOUND_SAFETY
+            if T_hi - T_lo > CHATTER_TIME_TOL:
+                return -1.0
+            return 0.5 * (T_lo + T_hi)
+        W = 1.01 * T_hi
+    return -1.0
+
+
+@njit(cache=True, error_model="numpy")
 def _record_event(buf_step, buf_off, buf_val, n, k, s, val):
     buf_step[n] = k
     buf_off[n] = s
@@ -679,15 +730,19 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         Hs = H - s
         if just_hit and v < 0.0 and c[C_F0] > 0.0:
             # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
-            # sum the tail in closed form once its neglected terms are below CHATTER_TIME_TOL
+            # the tail is summed in closed form as soon as chatter_tail proves where it ends
             wv, F, dF = -v, c[C_F0], c[C_DF0]
             if eps < 1.0:
-                tail = 2.0 * wv / (F * (1.0 - eps))
-                ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_TIME_TOL
+                n = cnt[0] - 1              # the impact just recorded, and the one before it
+                prev = ((imp_step[n] - imp_step[n - 1]) * P[P_DT] + (imp_off[n] - imp_off[n - 1])
+                        if n >= 1 else 0.0)
+                tail = chatter_tail(wv, F, dF, prev, Hs, P)
+                ok = tail >= 0.0
+                F_end = 1.0
             else:
                 tail = 2.0 * wv / F
                 ok = tail <= ELASTIC_MICRO_FLIGHT
-            F_end = F + dF * tail - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail
+                F_end = F + dF * tail - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail
             micro = n_events >= MANY_EVENTS and (
                 wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
                 or 2.0 * wv / F <= 16.0 * H / STEP_HEADROOM)

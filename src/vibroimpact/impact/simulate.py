@@ -325,6 +325,28 @@ def _state_at(state, P, k):
     return x, v, mode
 
 
+def _pair_sticking(time, kind, stick_open):
+    """Sticking intervals from the kernel's onsets (kind 1) and releases (kind 0) in time
+    order; ``stick_open[0]`` holds an onset whose release is still to come (or None)."""
+    onset = kind == 1.0
+    first_open = stick_open[0] is not None
+    # onsets and releases alternate, starting with an onset or, with one open, a release
+    if onset.size and np.array_equal(onset, (np.arange(onset.size) + first_open) % 2 == 0):
+        on = np.concatenate([[stick_open[0]] if first_open else [], time[onset]])
+        off = time[~onset]
+        stick_open[0] = float(on[-1]) if on.size > off.size else None
+        return list(on[:off.size]), list(off)
+    starts, ends = [], []
+    for t, k in zip(time, kind):
+        if k == 1.0:
+            stick_open[0] = t
+        elif stick_open[0] is not None:
+            starts.append(stick_open[0])
+            ends.append(t)
+            stick_open[0] = None
+    return starts, ends
+
+
 def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final):
     cat = lambda key, dtype: np.concatenate(parts[key]) if parts[key] else np.empty(0, dtype)
     imp_step = cat("imp_step", np.int64)
@@ -332,14 +354,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
     imp_u = cat("imp_u", np.float64)
     stk_time = cat("stk_step", np.int64) * dt + cat("stk_off", np.float64)
     stk_kind = cat("stk_kind", np.float64)
-    starts, ends = [], []
-    for t, kind in zip(stk_time, stk_kind):
-        if kind == 1.0:
-            stick_open[0] = t
-        elif stick_open[0] is not None:
-            starts.append(stick_open[0])
-            ends.append(t)
-            stick_open[0] = None
+    starts, ends = _pair_sticking(stk_time, stk_kind, stick_open)
     stuck = mode == kernels.STUCK
     stuck_since = stick_open[0] if stick_open[0] is not None else math.nan
     if final and stick_open[0] is not None:

@@ -91,15 +91,23 @@ def _classify(ratio, window, motions):
     match = _match_masks(ratio, window, motions)
     labels = np.full(ratio.size, -1, dtype=np.int64)
     group = np.arange(ratio.size)
-    lengths = [m for m, _ in motions]
-    free_from = 0
-    for j in np.flatnonzero(match.any(axis=0)):
-        if j < free_from:
-            continue
-        i = int(np.argmax(match[:, j]))
-        labels[j:j + lengths[i]] = i
-        group[j:j + lengths[i]] = j
-        free_from = j + lengths[i]
+    lengths = np.array([m for m, _ in motions])
+    candidates = np.flatnonzero(match.any(axis=0))
+    first = np.argmax(match[:, candidates], axis=0)       # the first motion matching there
+    if (lengths == 1).all():
+        starts, chosen = candidates, first               # nothing to skip
+    else:
+        # the greedy scan, on plain ints: a group claims its m intervals
+        kept, free_from = [], 0
+        for k, (j, m) in enumerate(zip(candidates.tolist(), lengths[first].tolist())):
+            if j >= free_from:
+                kept.append(k)
+                free_from = j + m
+        starts, chosen = candidates[kept], first[kept]
+    m = lengths[chosen]
+    at = np.repeat(starts, m) + (np.arange(m.sum()) - np.repeat(np.cumsum(m) - m, m))
+    labels[at] = np.repeat(chosen, m)
+    group[at] = np.repeat(starts, m)
     return labels, group
 
 
