@@ -101,7 +101,7 @@ def test_simulate_reports_collisions_beside_its_impacts():
     high = simulate(0.05, 0.5, -0.5, noise=noise, dt=DT, rebound_floor=0.2)
     assert high.rebound_floor == 0.2 and np.all(high.collision_rebounds <= res.collision_rebounds)
     with pytest.raises(ValueError, match="rebound_floor"):
-        simulate(0.05, 0.5, -0.5, noise=noise, dt=DT, rebound_floor=0.0)
+        simulate(0.05, 0.5, -0.5, noise=noise, dt=DT, rebound_floor=1e-4)
 
 
 @pytest.mark.parametrize("inv_beta, delta", [(2.0, -0.5), (3.0, -0.5), (2.5, -0.7)])
@@ -166,23 +166,26 @@ def _run(factors, tmp_path, tag):
 @pytest.mark.slow
 def test_no_collision_statistic_depends_on_an_event_tolerance(tmp_path):
     """The tolerances scaled by 1e3 and 1e-3: every statistic a figure or finding uses is
-    bit-identical; the sticking time moves by the change of the chatter tail's accumulation
-    point (<= 1e-9 relative). The number of impacts the kernel resolved does move (by 10-30 %
-    in the chatter cells): the tolerances did take effect."""
+    bit-identical, but the time on the wall, whose sticking onsets (chatter accumulation
+    points) are exact to CHATTER_TIME_TOL: it moves by at most that bound per collision. The
+    number of impacts the kernel resolved does move (by 10-40 % in the chatter cells): the
+    tolerances did take effect."""
+    from vibroimpact.impact import kernels
+
     base = _run({}, tmp_path, "base")
     for tag, factors in (("loose", LOOSE), ("tight", TIGHT)):
         other = _run(factors, tmp_path, tag)
-        expected = [getattr(__import__("vibroimpact.impact.kernels").impact.kernels, n) * f
-                    for n, f in sorted(factors.items())]
+        expected = [getattr(kernels, n) * f for n, f in sorted(factors.items())]
         assert np.allclose(other["applied"], expected, rtol=1e-12), tag
+        bound = max(kernels.CHATTER_TIME_TOL, kernels.CHATTER_TIME_TOL * factors["CHATTER_TIME_TOL"])
         for key, value in base.items():
-            if key == "applied":
+            if key == "applied" or key.endswith("n_impacts_resolved"):
                 continue
-            name = key.split("/")[1]
-            if name == "n_impacts_resolved":
-                continue
-            if name in ("contact_fraction", "stick_time_mean"):
-                assert np.allclose(other[key], value, rtol=1e-9, atol=0), (tag, key)
+            case, name = key.split("/")
+            if name == "stick_time_mean":
+                assert abs(other[key] - value) <= bound, (tag, key)
+            elif name == "contact_fraction":       # <= bound per collision over the record
+                assert abs(other[key] - value) <= bound * base[f"{case}/collision_rate"], (tag, key)
             else:
                 assert np.array_equal(other[key], value, equal_nan=True), (tag, key)
         chatter = [k for k in base if k.endswith("n_impacts_resolved") and "_m" in k]

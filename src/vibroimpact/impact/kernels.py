@@ -45,6 +45,10 @@ MAX_SEARCH = 400
 #: wall, is exact to it; nothing else depends on it (the release is the push's own root, and
 #: the rebounds left unresolved, slower than ~1e-4, never change the collisions).
 CHATTER_TIME_TOL = 1e-6
+#: A chatter tail is summed only once its rebounds leave the wall slower than this: every
+#: faster rebound is resolved, so counts of rebounds above a floor >= it (the statistics'
+#: ``rebound_floor``, >= 1e-3) are exact whatever CHATTER_TIME_TOL.
+RESOLVED_REBOUND = 1e-3
 #: Elastic (eps = 1) micro-bounces shorter than this are taken as resting contact: with eps = 1
 #: a pressed mass loses bounce energy only to damping, so bounces shrink like 1/k and never
 #: accumulate; a flight of 1e-6 rises ~1e-13 F above the wall.
@@ -639,13 +643,15 @@ def chatter_tail(w, F0, dF0, prev, Hs, P):
     ``w_k [rho^-1/2, rho^1/2]``, so with ``q = eps rho^1/2 < 1`` the rebounds accumulate at
     ``T`` in ``[T_lo, T_hi] = [2 w / (g_hi (1 - eps / rho^1/2)), 2 w / (g_lo (1 - q))]``,
     where the push is still positive (``g_lo > 0``): the mass sticks there. Returns the
-    midpoint when ``T_hi - T_lo <= CHATTER_TIME_TOL`` (the stated bound on the sticking
-    onset), ``T_hi <= W``, and the unresolved rebounds are proved to shrink in velocity and
+    midpoint when ``w < RESOLVED_REBOUND``, ``T_hi - T_lo <= CHATTER_TIME_TOL`` (the stated
+    bound on the sticking onset), ``T_hi <= W``, and the unresolved rebounds are proved to shrink in velocity and
     in flight time (``eps rho^3/2 < 1``) starting below the flight that brought the mass
     here (``prev > 2 w / g_lo``), so that grouping the resolved impacts into collisions
     (:mod:`vibroimpact.stats.collisions`) is the same as with every rebound resolved.
     """
     zeta, eps = P[P_ZETA], P[P_EPS]
+    if w >= RESOLVED_REBOUND:
+        return -1.0
     MF = abs(P[P_A]) * P[P_BETA] * P[P_BETA] * BOUND_SAFETY
     W = 3.0 * w / (F0 * (1.0 - eps))       # 1.5 x the constant-push estimate
     for _ in range(4):

@@ -12,7 +12,8 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
-from vibroimpact.stats.collisions import DEFAULT_REBOUND_FLOOR, group_collisions
+from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR,
+                                          group_collisions)
 
 _BUFFER = 2 * kernels.STEP_HEADROOM
 
@@ -243,7 +244,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     """
     zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size = _check_inputs(
         zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size)
-    rebound_floor = _checks.real("rebound_floor", rebound_floor, low=0.0, low_open=True)
+    rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
     P = kernel_parameters(zeta, eps, delta, dt, amplitude, beta)
     params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
                   x0=x0, v0=v0, rebound_floor=rebound_floor)
@@ -426,8 +427,9 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
     chunk_size : int, keyword-only
         Samples per chunk streamed through the kernel.
     rebound_floor : float, keyword-only
-        Velocity floor (``> 0``) of ``collision_rebounds``: rebounds leaving the wall slower
-        are not counted (default 0.01, :data:`vibroimpact.stats.DEFAULT_REBOUND_FLOOR`).
+        Velocity floor (``>= 1e-3``, the slowest rebound the kernel always resolves) of
+        ``collision_rebounds``: rebounds leaving the wall slower are not counted (default
+        0.01, :data:`vibroimpact.stats.DEFAULT_REBOUND_FLOOR`).
 
     Returns
     -------

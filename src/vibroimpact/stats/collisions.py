@@ -40,16 +40,18 @@ import numpy as np
 
 from vibroimpact import _checks
 
-__all__ = ["DEFAULT_REBOUND_FLOOR", "Collisions", "group_collisions"]
+__all__ = ["DEFAULT_REBOUND_FLOOR", "MIN_REBOUND_FLOOR", "Collisions", "group_collisions"]
 
 #: Default velocity floor of the rebound counts: rebounds leaving the wall slower than this are
 #: not counted. A rebound at speed ``v`` rises ``v**2 / (2 F)`` above the wall under a push
 #: ``F = f - delta``; at ``v = 0.01`` and ``F ~ 0.5`` that is 1e-4 static deflections, below the
 #: contact deformation the rigid-wall model neglects (the paper's velocities after impact are
-#: of order 0.1-1, the linear response's rms velocity about 1). The simulator resolves
-#: rebounds individually down to about 1e-6 (and 4e-6 with its chatter tolerance 1000 times
-#: looser), so the count above this floor is the same whatever the tolerance.
+#: of order 0.1-1, the linear response's rms velocity about 1). The simulator resolves every
+#: rebound faster than `MIN_REBOUND_FLOOR` individually, whatever its tolerances, so the count
+#: above any floor >= that is exact.
 DEFAULT_REBOUND_FLOOR = 0.01
+#: Smallest floor allowed: ``vibroimpact.impact.kernels.RESOLVED_REBOUND``.
+MIN_REBOUND_FLOOR = 1e-3
 
 
 class Collisions(NamedTuple):
@@ -112,7 +114,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         Restitution coefficient (rebound speed ``eps * u``).
     floor : float
         Rebounds leaving the wall at speed ``>= floor`` are counted in ``rebounds``
-        (default `DEFAULT_REBOUND_FLOOR`; ``> 0``).
+        (default `DEFAULT_REBOUND_FLOOR`; ``>= MIN_REBOUND_FLOOR``).
 
     Returns
     -------
@@ -125,7 +127,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     end = np.asarray(stick_end, dtype=float)
     dt = _checks.real("dt", dt, low=0.0, low_open=True)
     eps = _checks.eps(eps)
-    floor = _checks.real("rebound_floor", floor, low=0.0, low_open=True)
+    floor = _checks.real("rebound_floor", floor, low=MIN_REBOUND_FLOOR)
     if not (step.shape == offset.shape == u.shape) or step.ndim != 1:
         raise ValueError(f"impact_step, impact_offset and impact_velocity must be 1-D of one "
                          f"length, got {step.shape}, {offset.shape}, {u.shape}")
