@@ -6,13 +6,14 @@ the kernel's parameter vector, streams the force record through the kernel in ch
 :class:`SimulationResult`.
 """
 from dataclasses import dataclass, field
+from functools import cached_property
 import math
 
 import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
-from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR,
+from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR, Collisions,
                                           group_collisions)
 
 _BUFFER = 2 * kernels.STEP_HEADROOM
@@ -73,9 +74,10 @@ class SimulationResult:
     params : dict
         The physical inputs.
 
-    In a chunk of :func:`simulate_chunks` the collision fields are those of the chunk's own
-    impacts (a collision across a chunk boundary is split); :func:`concatenate_results`
-    groups the whole record again.
+    The collision fields are computed on first access (``collisions`` holds them all). In a
+    chunk of :func:`simulate_chunks` they are those of the chunk's own impacts (a collision
+    across a chunk boundary is split); :func:`concatenate_results` groups the whole record
+    again.
     """
 
     impact_time: np.ndarray
@@ -96,30 +98,33 @@ class SimulationResult:
     v_end: float
     stuck_end: bool
     stuck_since: float
-    n_collisions: int
-    collision_time: np.ndarray
-    collision_step: np.ndarray
-    collision_offset: np.ndarray
-    collision_velocity: np.ndarray
-    collision_rebounds: np.ndarray
-    collision_stuck: np.ndarray
-    collision_stick_time: np.ndarray
-    collision_duration: np.ndarray
-    impact_collision: np.ndarray
-    rebound_floor: float
     params: dict = field(default_factory=dict)
 
+    # The collision fields are computed on first use (most streaming consumers group the
+    # impacts of many chunks themselves) and cached; a frozen dataclass keeps a __dict__.
+    @cached_property
+    def collisions(self) -> Collisions:
+        """The impacts grouped into collisions (:func:`vibroimpact.stats.group_collisions`);
+        the ``collision_*`` attributes are its fields."""
+        start, end = self.stick_start, self.stick_end
+        if self.stuck_end and not (start.size and start[-1] == self.stuck_since):
+            # a sticking phase still open at the end of a chunk ends there for its collisions
+            start, end = np.append(start, self.stuck_since), np.append(end, self.t_end)
+        return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
+                                start, end, dt=self.params["dt"], eps=self.params["eps"],
+                                floor=self.params["rebound_floor"])
 
-def _collision_fields(impact_step, impact_offset, impact_velocity, stick_start, stick_end,
-                      dt, eps, floor):
-    """The ``collision_*`` fields of a :class:`SimulationResult` (keyword arguments)."""
-    c = group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end,
-                         dt=dt, eps=eps, floor=floor)
-    return dict(n_collisions=int(c.first.size), collision_time=c.time, collision_step=c.step,
-                collision_offset=c.offset, collision_velocity=c.velocity,
-                collision_rebounds=c.rebounds, collision_stuck=c.stuck,
-                collision_stick_time=c.stick_time, collision_duration=c.duration,
-                impact_collision=c.impact_collision, rebound_floor=c.floor)
+    n_collisions = property(lambda self: int(self.collisions.first.size))
+    collision_time = property(lambda self: self.collisions.time)
+    collision_step = property(lambda self: self.collisions.step)
+    collision_offset = property(lambda self: self.collisions.offset)
+    collision_velocity = property(lambda self: self.collisions.velocity)
+    collision_rebounds = property(lambda self: self.collisions.rebounds)
+    collision_stuck = property(lambda self: self.collisions.stuck)
+    collision_stick_time = property(lambda self: self.collisions.stick_time)
+    collision_duration = property(lambda self: self.collisions.duration)
+    impact_collision = property(lambda self: self.collisions.impact_collision)
+    rebound_floor = property(lambda self: self.collisions.floor)
 
 
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
@@ -362,13 +367,6 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         starts.append(stick_open[0])   # still resting on the wall at the record's end
         ends.append(t_chunk)
         stick_open[0] = None
-    # a sticking phase still open at the chunk's end ends there for the chunk's collisions
-    open_start = [] if stick_open[0] is None else [stick_open[0]]
-    collisions = _collision_fields(
-        imp_step, imp_off, imp_u,
-        np.asarray(starts + open_start, dtype=np.float64),
-        np.asarray(ends + [t_chunk] * len(open_start), dtype=np.float64),
-        dt, params["eps"], params["rebound_floor"])
     n = int(buf.grid_n[0])
     grid_time = (np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt if stride else np.empty(0)
     return SimulationResult(
@@ -391,7 +389,6 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         stuck_end=bool(stuck),
         stuck_since=float(stuck_since),
         params=params,
-        **collisions,
     )
 
 
@@ -463,14 +460,6 @@ def concatenate_results(chunks):
     """Join consecutive chunk results into one :class:`SimulationResult`."""
     last = chunks[-1]
     cat = lambda name: np.concatenate([getattr(c, name) for c in chunks])
-    start, end = cat("stick_start"), cat("stick_end")
-    if last.stuck_end and not (start.size and start[-1] == last.stuck_since):
-        # a sticking phase open at the end of a chunk that is not the record's last
-        start, end = np.append(start, last.stuck_since), np.append(end, last.t_end)
-    collisions = _collision_fields(cat("impact_step"), cat("impact_offset"),
-                                   cat("impact_velocity"), start, end,
-                                   last.params["dt"], last.params["eps"],
-                                   last.params["rebound_floor"])
     return SimulationResult(
         impact_time=cat("impact_time"), impact_velocity=cat("impact_velocity"),
         impact_step=cat("impact_step"), impact_offset=cat("impact_offset"),
@@ -480,5 +469,5 @@ def concatenate_results(chunks):
         n_chatter=sum(c.n_chatter for c in chunks),
         contact_time=float(sum(c.contact_time for c in chunks)),
         t_end=last.t_end, x_end=last.x_end, v_end=last.v_end, stuck_end=last.stuck_end,
-        stuck_since=last.stuck_since, params=last.params, **collisions,
+        stuck_since=last.stuck_since, params=last.params,
     )

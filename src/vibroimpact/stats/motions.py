@@ -97,18 +97,44 @@ def _classify(ratio, window, motions):
     if (lengths == 1).all():
         starts, chosen = candidates, first               # nothing to skip
     else:
-        # the greedy scan, on plain ints: a group claims its m intervals
-        kept, free_from = [], 0
-        for k, (j, m) in enumerate(zip(candidates.tolist(), lengths[first].tolist())):
-            if j >= free_from:
-                kept.append(k)
-                free_from = j + m
+        kept = _greedy(candidates, lengths[first])
         starts, chosen = candidates[kept], first[kept]
     m = lengths[chosen]
     at = np.repeat(starts, m) + (np.arange(m.sum()) - np.repeat(np.cumsum(m) - m, m))
     labels[at] = np.repeat(chosen, m)
     group[at] = np.repeat(starts, m)
     return labels, group
+
+
+def _greedy(j, m):
+    """Indices of the candidate groups (starts ``j``, lengths ``m``) that the greedy scan in
+    time order keeps: a group claims its ``m`` intervals, and a candidate inside a kept group
+    is skipped.
+
+    A candidate beyond the reach of every earlier one is kept for sure; the others form
+    clusters behind such a candidate. A cluster of consecutive (2/n) candidates (a run of
+    short intervals) keeps every other one; any other cluster is scanned one by one.
+    """
+    n = j.size
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    reach = np.maximum.accumulate(np.concatenate([[-1], (j + m)[:-1]]))
+    sure = j >= reach
+    cluster = np.cumsum(sure) - 1
+    head = np.flatnonzero(sure)
+    pos = np.arange(n) - head[cluster]
+    step_ok = np.ones(n, bool)
+    step_ok[1:] = (np.diff(j) == 1) | sure[1:]
+    plain = np.bincount(cluster, weights=~((m == 2) & step_ok), minlength=head.size) == 0
+    keep = np.where(plain[cluster], pos % 2 == 0, sure)
+    for c in np.flatnonzero(~plain & (np.bincount(cluster, minlength=head.size) > 1)):
+        members = np.flatnonzero(cluster == c)
+        free_from = -1
+        for k in members.tolist():
+            keep[k] = j[k] >= free_from
+            if keep[k]:
+                free_from = j[k] + m[k]
+    return np.flatnonzero(keep)
 
 
 def _with_sticking(labels, group, stuck):
