@@ -394,8 +394,8 @@ def _require_harmonic(events, figure):
 
 
 #: What an impact statistic counts, printed on every figure of one (docs/figures.md).
-COLLISION_NOTE = ("per collision: an impact after a free flight with the chatter and sticking it "
-                  "starts; v = first rebound, z_j = first impact to first impact")
+COLLISION_NOTE = ("per collision: an impact after a free flight, with its chatter and sticking;  "
+                  "v of its first rebound, z_j from first impact to first impact")
 
 
 def _events_params(events, i_beta):

@@ -31,10 +31,10 @@ def _map_text(ds):
     """The map's statistics: window, target precision, share reached, record lengths."""
     reached = float(np.mean(ds["reached"].values))
     t = ds["simulated_time"].values
-    return (rf"z_j between collisions (chatter and sticking grouped), w = {_num(_attr(ds, 'motion_window'))}; "
-            rf"each cell from rest over one noise record, "
+    return (rf"z_j between collisions (chatter and sticking grouped), "
+            rf"w = {_num(_attr(ds, 'motion_window'))};  each cell from rest over one noise record, "
             rf"to s.e. $\leq$ {100 * float(_attr(ds, 'target_stderr')):.3g} pp "
-            rf"({100 * reached:.1f} % of cells) or {int(_attr(ds, 'max_periods'))} periods; "
+            rf"({100 * reached:.1f} % of cells) or {int(_attr(ds, 'max_periods'))} periods;  "
             rf"record {t.min():.0f}-{t.max():.0f} (median {np.median(t):.0f})")
 
 

@@ -147,29 +147,28 @@ def finding2(events):
     return _finding(2, measured, _yes(_increasing(v) and marked))
 
 
-def finding3(events, lowest=-0.5):
-    """Mean interval between impacts against delta (Figs. 8, 9): increasing over the plays
-    with impacts. Below ``lowest`` the pre-loaded mass rests on the wall for long stretches
-    and the interval grows again (README): the finding is judged on delta >= ``lowest`` and
-    the table says what happens below."""
+def finding3(events):
+    """Mean interval between collisions against delta (Figs. 8, 9): increasing over the plays
+    with impacts. On a pre-loaded wall the mass rests long on it between collisions, so the
+    interval may grow again at the lowest plays: ``yes`` when it increases over every play,
+    ``partly`` when it increases from some play <= 0 upwards (the table says where it turns
+    and the contact fraction below), ``no`` otherwise."""
     ev = _impacting(_row(events))
-    judged = ev.sel(delta=ev.delta[ev.delta >= lowest])
-    if judged.sizes["delta"] < 3:
-        return not_available(3, f"needs three plays >= {lowest} with >= {MIN_IMPACTS} impacts")
-    z = judged.interval_mean.values
-    measured = (f"mean interval {z[-1]:.3g} at delta = {float(judged.delta[-1]):.3g} down to "
-                f"{z[0]:.3g} at delta = {float(judged.delta[0]):.3g}"
-                f"{', increasing throughout' if _increasing(z) else ', not monotone'}")
-    below = ev.sel(delta=ev.delta[ev.delta < lowest])
-    holds = _yes(_increasing(z))
-    if below.sizes["delta"]:
-        rises_again = bool(np.any(below.interval_mean.values > z[0]))
-        measured += (f"; below delta = {lowest:g}: {_fmt(below.interval_mean.values)} at delta "
-                     f"= {_fmt(below.delta.values)}, contact fraction "
-                     f"{_fmt(below.contact_fraction.values, '.2f')}")
-        if rises_again and holds == "yes":
-            holds = "partly"
-    return _finding(3, measured, holds)
+    if ev.sizes["delta"] < 3:
+        return not_available(3, f"needs three plays with >= {MIN_IMPACTS} collisions")
+    d, z = ev.delta.values, ev.interval_mean.values
+    rising = np.diff(z) > 0
+    # the first play from which the mean interval increases all the way up
+    turn = int(rising.size - np.argmin(rising[::-1])) if not rising.all() else 0
+    measured = (f"mean interval {z[-1]:.3g} at delta = {d[-1]:.3g} down to {z[turn]:.3g} at "
+                f"delta = {d[turn]:.3g}, increasing from there up")
+    if turn == 0:
+        return _finding(3, measured + " over every play", "yes")
+    below = ev.isel(delta=slice(0, turn))
+    measured += (f"; below it: {_fmt(below.interval_mean.values)} at delta = "
+                 f"{_fmt(below.delta.values)}, contact fraction "
+                 f"{_fmt(below.contact_fraction.values, '.2f')}")
+    return _finding(3, measured, "partly" if d[turn] <= 0.0 else "no")
 
 
 def finding4(events, orders=2.0):
