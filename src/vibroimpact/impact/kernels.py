@@ -43,12 +43,17 @@ MAX_SEARCH = 400
 #: Bound (in time) on the error of a chatter sequence's accumulation point, summed in closed
 #: form (:func:`chatter_tail`, a proved bracket): the sticking onset, and so the time on the
 #: wall, is exact to it; nothing else depends on it (the release is the push's own root, and
-#: the rebounds left unresolved, slower than ~1e-4, never change the collisions).
-CHATTER_TIME_TOL = 1e-6
-#: A chatter tail is summed only once its rebounds leave the wall slower than this: every
-#: faster rebound is resolved, so counts of rebounds above a floor >= it (the statistics'
-#: ``rebound_floor``, >= 1e-3) are exact whatever CHATTER_TIME_TOL.
-RESOLVED_REBOUND = 1e-3
+#: the rebounds left unresolved, slower than RESOLVED_REBOUND, never change the collisions).
+CHATTER_TIME_TOL = 1e-7
+#: Where chatter_tail cannot bracket the tail inside the step (a tail across a sample point,
+#: eps near 1), it is summed once the first-order estimate of its neglected terms,
+#: ``T (2 zeta w + |F'| T) / F`` with ``T = 2 w / (F (1 - eps))``, is below this.
+CHATTER_ESTIMATE_TOL = 1e-12
+#: A chatter tail is summed only once its rebounds leave the wall slower than this (so that
+#: every later approach, at most twice as fast, is below 1e-4): every faster rebound is
+#: resolved, so counts of rebounds above a floor >= 1e-4 (the statistics' ``rebound_floor``)
+#: are exact whatever CHATTER_TIME_TOL, and every impact faster than 1e-4 is in the record.
+RESOLVED_REBOUND = 5e-5
 #: Elastic (eps = 1) micro-bounces shorter than this are taken as resting contact: with eps = 1
 #: a pressed mass loses bounce energy only to damping, so bounces shrink like 1/k and never
 #: accumulate; a flight of 1e-6 rises ~1e-13 F above the wall.
@@ -62,7 +67,8 @@ MICRO_HEIGHT = 1e-12
 #: Event tolerances in units of the round-off EPS64 of the quantity's scale: an arrival slower
 #: than TOUCH_ULPS is a touch, not an impact; a gap below WALL_ULPS (GAP_ULPS in the contact
 #: search) is on the wall; a push f - delta below FORCE_ULPS has no sign. With the
-#: CHATTER_TIME_TOL, ELASTIC_MICRO_FLIGHT and MICRO_HEIGHT above they are every tolerance that
+#: CHATTER_TIME_TOL, CHATTER_ESTIMATE_TOL, ELASTIC_MICRO_FLIGHT and MICRO_HEIGHT above they are
+#: every tolerance that
 #: decides an event; no collision statistic depends on them (tests/test_collisions.py changes
 #: them all by three orders of magnitude).
 TOUCH_ULPS = 64.0
@@ -745,6 +751,13 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
                 tail = chatter_tail(wv, F, dF, prev, Hs, P)
                 ok = tail >= 0.0
                 F_end = 1.0
+                if not ok:
+                    # no bracket inside the step (a tail across a sample point, eps near 1):
+                    # the first-order estimate once its neglected terms are below round-off
+                    tail = 2.0 * wv / (F * (1.0 - eps))
+                    ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_ESTIMATE_TOL
+                    F_end = (F + dF * tail
+                             - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail)
             else:
                 tail = 2.0 * wv / F
                 ok = tail <= ELASTIC_MICRO_FLIGHT

@@ -424,7 +424,7 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
     chunk_size : int, keyword-only
         Samples per chunk streamed through the kernel.
     rebound_floor : float, keyword-only
-        Velocity floor (``>= 1e-3``, the slowest rebound the kernel always resolves) of
+        Velocity floor (``>= 1e-4``: the kernel resolves every faster rebound) of
         ``collision_rebounds``: rebounds leaving the wall slower are not counted (default
         0.01, :data:`vibroimpact.stats.DEFAULT_REBOUND_FLOOR`).
 

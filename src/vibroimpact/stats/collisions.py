@@ -50,8 +50,8 @@ __all__ = ["DEFAULT_REBOUND_FLOOR", "MIN_REBOUND_FLOOR", "Collisions", "group_co
 #: rebound faster than `MIN_REBOUND_FLOOR` individually, whatever its tolerances, so the count
 #: above any floor >= that is exact.
 DEFAULT_REBOUND_FLOOR = 0.01
-#: Smallest floor allowed: ``vibroimpact.impact.kernels.RESOLVED_REBOUND``.
-MIN_REBOUND_FLOOR = 1e-3
+#: Smallest floor allowed: twice ``vibroimpact.impact.kernels.RESOLVED_REBOUND``.
+MIN_REBOUND_FLOOR = 1e-4
 
 
 class Collisions(NamedTuple):
