@@ -75,7 +75,7 @@ def study_settings(ds, name=""):
     import pandas as pd
 
     keys = ("zeta", "eps", "amplitude", "transient", "t_end", "record_length", "n_batches",
-            "motion_window", "nperseg", "target_stderr", "max_periods")
+            "motion_window", "rebound_floor", "nperseg", "target_stderr", "max_periods")
     values = {"entry": name} if name else {}
     values.update({k: ds.attrs[k] for k in keys if k in ds.attrs})
     values.update({k: ds.attrs[k] for k in sorted(ds.attrs) if k.startswith("sweep")})
@@ -95,17 +95,22 @@ def map_agreement(motion_map, orbits):
 
 
 def map_summary(motion_map):
-    """Per motion of a probability map (Fig. 15): cells with probability >= 50 %, the
-    largest probability; and the cells that reached the target error or were hatched."""
+    """Per motion of a probability map (Fig. 15), with free flights and, when the map has
+    them, with sticking: cells with probability >= 50 %, the largest probability; and the
+    cells that reached the target error or were hatched."""
     import pandas as pd
     from IPython.display import Markdown
 
     if motion_map is None:
         return Markdown("*This study has no probability map (Fig. 15).*")
-    p = motion_map.probability
-    rows = {f"({m})": {"cells with P >= 50 %": int((p.sel(motion=m) >= 0.5).sum()),
-                       "largest P": f"{float(p.sel(motion=m).max()):.2f}"}
-            for m in motion_map.motion.values}
+    rows = {}
+    for name, label in (("probability", "({m})"), ("stick_probability", "({m}) with sticking")):
+        if name not in motion_map:
+            continue
+        for m in motion_map.motion.values:
+            p = motion_map[name].sel(motion=m)
+            rows[label.format(m=m)] = {"cells with P >= 50 %": int((p >= 0.5).sum()),
+                                       "largest P": f"{float(p.max()):.2f}"}
     table = pd.DataFrame.from_dict(rows, orient="index")
     cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
     table.attrs["note"] = (f"{cells} cells; {100 * float(motion_map.reached.mean()):.1f} % reached "
