@@ -66,11 +66,10 @@ MANY_EVENTS = 4096
 MICRO_HEIGHT = 1e-12
 #: Event tolerances in units of the round-off EPS64 of the quantity's scale: an arrival slower
 #: than TOUCH_ULPS is a touch, not an impact; a gap below WALL_ULPS (GAP_ULPS in the contact
-#: search) is on the wall; a push f - delta below FORCE_ULPS has no sign. With the
-#: CHATTER_TIME_TOL, CHATTER_ESTIMATE_TOL, ELASTIC_MICRO_FLIGHT and MICRO_HEIGHT above they are
-#: every tolerance that
-#: decides an event; no collision statistic depends on them (tests/test_collisions.py changes
-#: them all by three orders of magnitude).
+#: search) is on the wall; a push f - delta below FORCE_ULPS has no sign. With
+#: CHATTER_TIME_TOL, CHATTER_ESTIMATE_TOL, ELASTIC_MICRO_FLIGHT and MICRO_HEIGHT above they
+#: are every tolerance that decides an event; no collision statistic depends on them
+#: (tests/test_collisions.py changes them all by three orders of magnitude).
 TOUCH_ULPS = 64.0
 WALL_ULPS = 16.0
 GAP_ULPS = 8.0
@@ -650,10 +649,11 @@ def chatter_tail(w, F0, dF0, prev, Hs, P):
     ``T`` in ``[T_lo, T_hi] = [2 w / (g_hi (1 - eps / rho^1/2)), 2 w / (g_lo (1 - q))]``,
     where the push is still positive (``g_lo > 0``): the mass sticks there. Returns the
     midpoint when ``w < RESOLVED_REBOUND``, ``T_hi - T_lo <= CHATTER_TIME_TOL`` (the stated
-    bound on the sticking onset), ``T_hi <= W``, and the unresolved rebounds are proved to shrink in velocity and
-    in flight time (``eps rho^3/2 < 1``) starting below the flight that brought the mass
-    here (``prev > 2 w / g_lo``), so that grouping the resolved impacts into collisions
-    (:mod:`vibroimpact.stats.collisions`) is the same as with every rebound resolved.
+    bound on the sticking onset), ``T_hi <= W``, and the unresolved rebounds are proved to
+    shrink in velocity and in flight time (``eps rho^3/2 < 1``) starting below the flight
+    that brought the mass here (``prev > 2 w / g_lo``), so that grouping the resolved
+    impacts into collisions (:mod:`vibroimpact.stats.collisions`) is the same as with every
+    rebound resolved.
     """
     zeta, eps = P[P_ZETA], P[P_EPS]
     if w >= RESOLVED_REBOUND:

@@ -124,7 +124,7 @@ class SimulationResult:
     collision_stick_time = property(lambda self: self.collisions.stick_time)
     collision_duration = property(lambda self: self.collisions.duration)
     impact_collision = property(lambda self: self.collisions.impact_collision)
-    rebound_floor = property(lambda self: self.collisions.floor)
+    rebound_floor = property(lambda self: self.params["rebound_floor"])
 
 
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
