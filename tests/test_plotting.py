@@ -104,8 +104,13 @@ def test_fig03_input_and_motion_with_impacts(data):
     assert ax_a.get_ylabel() == axis_label(trace["a"])
     assert ax_a.get_xlabel() == axis_label(trace["tau"])
     marks = [ln for ln in ax_a.get_lines() if ln.get_marker() == "v"]
-    assert len(marks) == 1 and len(marks[0].get_xdata()) == trace.sizes["impact"] > 3
+    rebounds = [ln for ln in ax_a.get_lines() if ln.get_marker() == "|"]
+    n_collisions = np.unique(trace["impact_collision"].values).size
+    assert len(marks) == 1 and len(marks[0].get_xdata()) == n_collisions > 3
+    # the chatter rebounds are told apart from the collisions that start them
+    assert len(marks[0].get_xdata()) + len(rebounds[0].get_xdata()) == trace.sizes["impact"]
     np.testing.assert_array_equal(marks[0].get_ydata(), 0.0)    # impacts sit on the wall a = 0
+    assert any(t.startswith("collision: first impact") for t in _legend_texts(ax_a))
 
 
 def test_fig04_fig05_describe_the_noise_from_its_file(data):

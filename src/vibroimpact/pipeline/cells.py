@@ -251,7 +251,8 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
 
 
 def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
-    """A short sampled record from rest (Figs. 3 and 10): force, a(tau) and impacts.
+    """A short sampled record from rest (Figs. 3 and 10): force, a(tau), impacts and the
+    collision of each impact.
 
     ``t_end`` longer than the noise record raises ValueError.
     """
@@ -263,7 +264,8 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
     r = np.asarray(noise[k[0] : k[-1] + 1], dtype=float)
     f = r + amplitude * np.sin(beta_f * res.grid_time)
     return dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
-                impact_time=res.impact_time, impact_velocity=res.impact_velocity)
+                impact_time=res.impact_time, impact_velocity=res.impact_velocity,
+                impact_collision=res.impact_collision)
 
 
 def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,

@@ -72,6 +72,7 @@ META = {
     "x": ("displacement x(tau)", "1"),
     "impact_time": ("impact instant", "1"),
     "impact_velocity": ("approach velocity at impact", "1"),
+    "impact_collision": ("collision of the impact (index; its first impact starts it)", "1"),
 }
 
 _EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches",
@@ -232,7 +233,8 @@ def trace_dataset(tr, attrs):
     ds = xr.Dataset(
         dict(r=("tau", tr["r"]), f=("tau", tr["f"]), a=("tau", tr["a"]), x=("tau", tr["x"]),
              impact_time=("impact", tr["impact_time"]),
-             impact_velocity=("impact", tr["impact_velocity"])),
+             impact_velocity=("impact", tr["impact_velocity"]),
+             impact_collision=("impact", tr["impact_collision"])),
         coords=dict(tau=tr["tau"]), attrs=attrs)
     return _annotate(ds)
 

@@ -248,9 +248,21 @@ def _trace_figure(trace, title, harmonic):
     ax_a.plot(tau, trace["a"], color="C0", lw=1.0)
     ax_a.axhline(0.0, color="0.2", lw=1.4, label="wall (a = 0)")
     t_imp = np.asarray(trace["impact_time"])
-    t_imp = t_imp[(t_imp >= float(tau[0])) & (t_imp <= float(tau[-1]))]
-    ax_a.plot(t_imp, np.zeros_like(t_imp), ls="none", marker="v", color="C3",
-              markersize=5, label=f"impact ({t_imp.size})")
+    shown = (t_imp >= float(tau[0])) & (t_imp <= float(tau[-1]))
+    if "impact_collision" in trace:
+        # a collision's first impact, and the rebounds of its chatter apart (docs/figures.md)
+        col = np.asarray(trace["impact_collision"])
+        first = np.ones(col.size, bool)
+        first[1:] = col[1:] != col[:-1]
+        rebound = shown & ~first
+        ax_a.plot(t_imp[rebound], np.zeros(int(rebound.sum())), ls="none", marker="|",
+                  color="0.35", markersize=7, label=f"chatter rebound ({int(rebound.sum())})")
+        shown &= first
+        label = f"collision: first impact ({int(shown.sum())})"
+    else:
+        label = f"impact ({int(shown.sum())})"
+    ax_a.plot(t_imp[shown], np.zeros(int(shown.sum())), ls="none", marker="v", color="C3",
+              markersize=5, label=label)
     ax_a.set_ylim(bottom=min(-0.06 * float(trace["a"].max()), float(trace["a"].min())))
     _headroom(ax_a)
     ax_a.set_ylabel(axis_label(trace["a"]))
