@@ -178,7 +178,6 @@ class _EventRecord:
         self.dt = dt
         self.stuck_since = math.nan
         self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
-        self.open_start = None
         self.t_end = 0.0
 
     def add(self, chunk):
@@ -211,6 +210,8 @@ class _EventRecord:
         start, end = self.sticking()
         return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor).after(transient)
+
+
 def _clipped_contact(start, end, transient):
     """Time resting on the wall after ``transient``."""
     return float(np.sum(np.clip(end, transient, None) - np.clip(start, transient, None)))
