@@ -83,9 +83,10 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         and, when the dataset has ``stick_probability``, one of their impact-stick variants
         together (a collision of the motion ends sticking: the impact-chatter-stick cycle of
         a pre-loaded wall, which `periodic_orbits` does not return): filled bands and
-        labelled lines of the probability in percent; hatched where the record switched between motions only 1 to
-        ``min_switches - 1`` times (its numbers say where it started, not the long-run
-        share); dots where the cap stopped the cell before the target precision.
+        labelled lines of the probability in percent; hatched where the record switched
+        between motions only 1 to ``min_switches - 1`` times (its numbers say where it
+        started, not the long-run share); dots where the cap stopped the cell before the
+        target precision.
     """
     motions = [str(m) for m in motion_map["motion"].values]
     panels = [(f"({m})", motion_map["probability"].sel(motion=m).values) for m in motions]
