@@ -14,7 +14,7 @@ import numpy as np
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
 from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR, Collisions,
-                                          group_collisions)
+                                          close_open_phase, group_collisions)
 
 _BUFFER = 2 * kernels.STEP_HEADROOM
 
@@ -106,10 +106,9 @@ class SimulationResult:
     def collisions(self) -> Collisions:
         """The impacts grouped into collisions (:func:`vibroimpact.stats.group_collisions`);
         the ``collision_*`` attributes are its fields."""
-        start, end = self.stick_start, self.stick_end
-        if self.stuck_end and not (start.size and start[-1] == self.stuck_since):
-            # a sticking phase still open at the end of a chunk ends there for its collisions
-            start, end = np.append(start, self.stuck_since), np.append(end, self.t_end)
+        # a sticking phase still open at the end of a chunk ends there for its collisions
+        start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                      self.t_end)
         return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
                                 start, end, dt=self.params["dt"], eps=self.params["eps"],
                                 floor=self.params["rebound_floor"])

@@ -194,10 +194,8 @@ class _EventRecord:
 
     def sticking(self):
         """Sticking phases so far; one still open ends at the last chunk's end."""
-        start, end = self.starts[0], self.ends[0]
-        if math.isfinite(self.stuck_since) and not (start.size and start[-1] == self.stuck_since):
-            start, end = np.append(start, self.stuck_since), np.append(end, self.t_end)
-        return start, end
+        return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                      self.t_end)
 
     def rebound_speeds(self, eps, floor, transient):
         """Speeds ``eps u`` of the rebounds at or after ``transient`` that reach ``floor``."""

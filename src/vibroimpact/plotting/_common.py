@@ -255,8 +255,9 @@ def _trace_figure(trace, title, harmonic):
         first = np.ones(col.size, bool)
         first[1:] = col[1:] != col[:-1]
         rebound = shown & ~first
-        ax_a.plot(t_imp[rebound], np.zeros(int(rebound.sum())), ls="none", marker="|",
-                  color="0.35", markersize=7, label=f"chatter rebound ({int(rebound.sum())})")
+        if rebound.any():
+            ax_a.plot(t_imp[rebound], np.zeros(int(rebound.sum())), ls="none", marker="|",
+                      color="0.35", markersize=7, label=f"chatter rebound ({int(rebound.sum())})")
         shown &= first
         label = f"collision: first impact ({int(shown.sum())})"
     else:

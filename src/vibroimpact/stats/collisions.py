@@ -40,7 +40,8 @@ import numpy as np
 
 from vibroimpact import _checks
 
-__all__ = ["DEFAULT_REBOUND_FLOOR", "MIN_REBOUND_FLOOR", "Collisions", "group_collisions"]
+__all__ = ["DEFAULT_REBOUND_FLOOR", "MIN_REBOUND_FLOOR", "Collisions", "group_collisions",
+           "close_open_phase"]
 
 #: Default velocity floor of the rebound counts: rebounds leaving the wall slower than this are
 #: not counted. A rebound at speed ``v`` rises ``v**2 / (2 F)`` above the wall under a push
@@ -86,6 +87,15 @@ class Collisions(NamedTuple):
             step=self.step[keep], offset=self.offset[keep], time=self.time[keep],
             velocity=self.velocity[keep], rebounds=self.rebounds[keep], stuck=self.stuck[keep],
             stick_time=self.stick_time[keep], duration=self.duration[keep])
+
+
+def close_open_phase(stick_start, stick_end, stuck_since, t_end):
+    """The sticking phases of a record with one still going on at its end (begun at
+    ``stuck_since``, NaN if none, and not yet among them) ending at ``t_end``."""
+    start, end = np.asarray(stick_start, dtype=float), np.asarray(stick_end, dtype=float)
+    if np.isfinite(stuck_since) and not (start.size and start[-1] == stuck_since):
+        start, end = np.append(start, stuck_since), np.append(end, t_end)
+    return start, end
 
 
 def _next_true(mask):
