@@ -85,8 +85,13 @@ def _vlines_at(ax):
                   if _is_reference(ln) and np.ptp(np.asarray(ln.get_xdata(), float)) == 0)
 
 
+def _legend(ax):
+    """The legend of `ax`, or of its figure when the figure holds it (below the axes)."""
+    return ax.get_legend() or ax.figure.legends[0]
+
+
 def _legend_texts(ax):
-    return [t.get_text() for t in ax.get_legend().get_texts()]
+    return [t.get_text() for t in _legend(ax).get_texts()]
 
 
 def _title(fig):
@@ -118,7 +123,7 @@ def test_fig04_fig05_describe_the_noise_from_its_file(data):
     fig4, fig5 = plotting.fig04(noise), plotting.fig05(noise)
     for fig in (fig4, fig5):
         text = _title(fig)
-        for part in ("band_limited noise", "rms = 0.5", r"$\Delta\tau$ = 0.1",
+        for part in ("band-limited white noise", "rms = 0.5", r"$\Delta\tau$ = 0.1",
                      r"$\beta_c$ = 4", "seed 19740914", "60,001 samples"):
             assert part in text, (part, text)
     (ax4,) = fig4.axes
@@ -157,7 +162,7 @@ def test_fig06_one_curve_per_delta_and_linear_reference(data):
 @pytest.mark.parametrize("name, var", [("fig07", "v_after"), ("fig08", "interval")])
 def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, var):
     events = data["events"].isel(inv_beta=0)
-    (ax,) = getattr(plotting, name)(data["events"], density_delta=DENSITY_DELTA).axes
+    ax = getattr(plotting, name)(data["events"], density_delta=DENSITY_DELTA).axes[0]
     lines = _data_lines(ax)
     labels = _legend_texts(ax)
     assert len(lines) == len(DENSITY_DELTA)
@@ -171,18 +176,22 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
     if var == "interval":   # intervals at the largest play overrun the 10-unit axis
         assert "beyond axis" in labels[0]
     # band = +-t batch-means s.e., t of B - 1 = 19 dof
-    assert "batch-means" in ax.get_legend().get_title().get_text()
-    assert f"t = {t:.4g}" in ax.get_legend().get_title().get_text()
-    y = np.asarray(events[f"{var}_density"].sel(delta=0.0))
-    se = np.asarray(events[f"{var}_density_stderr"].sel(delta=0.0))
+    assert "batch-means" in _legend(ax).get_title().get_text()
+    assert f"t = {t:.4g}" in _legend(ax).get_title().get_text()
+    # the band of a bin drawn on its own (>= MIN_BIN_COUNT values) is density +- t s.e.
+    cell = events.sel(delta=0.0)
+    y = np.asarray(cell[f"{var}_density"])
+    se = np.asarray(cell[f"{var}_density_stderr"])
+    counts = plotting.bin_counts(cell, f"{var}_density")[1]
+    alone = counts >= plotting.MIN_BIN_COUNT
     band = ax.collections[2].get_paths()[0].vertices[:, 1]              # delta = 0: third curve
-    assert np.nanmax(band) == pytest.approx(np.nanmax(y + t * se), rel=1e-12)
+    assert np.nanmax(band) == pytest.approx(np.max((y + t * se)[alone]), rel=1e-12)
     assert ax.get_ylabel() == axis_label(events[f"{var}_density"])
-    assert ax.get_xlabel() == axis_label(events[var])
+    assert ax.figure.axes[-1].get_xlabel() == axis_label(events[var])
 
 
 def test_density_delta_without_impacts_keeps_its_line(data):
-    (ax,) = plotting.fig07(data["events"], density_delta=[6.0, 0.0]).axes
+    ax = plotting.fig07(data["events"], density_delta=[6.0, 0.0]).axes[0]
     assert len(_data_lines(ax)) == 2
     assert "no impacts" in _legend_texts(ax)[0]
 
@@ -282,18 +291,23 @@ def test_fig11_draws_the_harmonic_part_as_a_line_of_power_half(data):
 
 def test_fig13_ratio_density_with_motion_marks(data):
     events = data["events_h"]
-    (ax,) = plotting.fig13(events, inv_beta=1.1, density_delta=DENSITY_DELTA).axes
-    assert len(_data_lines(ax)) == len(DENSITY_DELTA)
-    assert _vlines_at(ax) == [0.5, 1.0, 2.0]
-    chain = [ln for ln in ax.get_lines() if ln.get_linestyle() == "-."]
-    assert len(chain) == 1 and chain[0].get_xdata()[0] == 0.5
-    assert ax.get_ylabel() == axis_label(events["ratio_density"])
-    assert "batch-means" in ax.get_legend().get_title().get_text()
+    ax, ax_lin = plotting.fig13(events, inv_beta=1.1, density_delta=DENSITY_DELTA).axes
+    assert ax.get_yscale() == "log" and ax_lin.get_yscale() == "linear"
+    for a in (ax, ax_lin):
+        assert len(_data_lines(a)) == len(DENSITY_DELTA)
+        assert _vlines_at(a) == [0.5, 1.0, 2.0]
+        chain = [ln for ln in a.get_lines() if _is_reference(ln) and ln.get_linestyle() == "-."]
+        assert len(chain) == 1 and chain[0].get_xdata()[0] == 0.5
+        assert a.get_ylabel() == axis_label(events["ratio_density"])
+    assert "batch-means" in _legend(ax).get_title().get_text()
 
 
 def test_fig14_velocity_density_at_one_forcing_frequency(data):
-    (ax,) = plotting.fig14(data["events_h"], inv_beta=1.4, density_delta=DENSITY_DELTA).axes
-    assert len(_data_lines(ax)) == len(DENSITY_DELTA)
+    ax, ax_lin = plotting.fig14(data["events_h"], inv_beta=1.4, density_delta=DENSITY_DELTA).axes
+    assert len(_data_lines(ax)) == len(_data_lines(ax_lin)) == len(DENSITY_DELTA)
+    # neighbouring curves differ in line style and marker, not only in colour
+    styles = [(ln.get_linestyle(), ln.get_marker()) for ln in _data_lines(ax)]
+    assert all(a[0] != b[0] and a[1] != b[1] for a, b in zip(styles, styles[1:]))
     assert r"\sin(\tau/1.4)" in _title(ax.figure)
 
 
@@ -337,14 +351,16 @@ def test_every_figure_states_its_parameters(data):
     for fig in figs:
         text = _title(fig)
         assert r"$\zeta$ = 0.05" in text and r"$\varepsilon$ = 0.5" in text
-        assert "rms$_r$ = 0.5" in text and "band_limited" in text and r"$\beta_c$ = 4" in text
+        assert "rms$_r$ = 0.5" in text and "band-limited white" in text and r"$\beta_c$ = 4" in text
+        assert "band_limited" not in text and "noise '" not in text     # no config keys
     assert r"$\delta$ = 0" in _title(figs[0])
 
 
 def test_units_other_than_dimensionless_appear_in_labels(data):
     events = data["events"].copy()
     events["v_after_mean"] = events["v_after_mean"].assign_attrs(units="m/s")
-    assert plotting.fig09(events).axes[0].get_ylabel() == "mean velocity after impact (per collision) [m/s]"
+    assert plotting.fig09(events).axes[0].get_ylabel() == (
+        r"mean velocity after impact $\overline{\varepsilon u_{j-0}}$ [m/s]")
 
 
 def test_missing_parameter_attribute_is_named(data):
@@ -427,3 +443,41 @@ def test_fig15_vs_fig16_prints_the_agreement_and_refuses_another_system():
     assert any("100 % inside" in t for t in texts)
     with pytest.raises(ValueError, match="zeta"):
         plotting.fig15_vs_fig16(ds, orbits.assign_attrs(zeta=0.06))
+
+
+# ------------------------------------------------------------------------- sparse-bin rule
+
+def test_merge_sparse_bins_keeps_full_bins_and_merges_sparse_runs():
+    edges = np.arange(11.0)
+    counts = np.array([0, 3, 50, 4, 0, 7, 1, 12, 2, 0])
+    left, right, count = plotting.merge_sparse_bins(edges, counts, min_count=10)
+    # bin 1 (3 values) meets the full bin 2 before it holds 10: dropped; 3..5 hold 4+0+7 = 11;
+    # bin 6 (1 value) meets the full bin 7: dropped; 8..9 end below 10: dropped
+    assert left.tolist() == [2.0, 3.0, 7.0]
+    assert right.tolist() == [3.0, 6.0, 8.0]
+    assert count.tolist() == [50, 11, 12]
+    # every value drawn is counted once, and no drawn bin holds fewer than min_count
+    assert (count >= 10).all() and count.sum() <= counts.sum()
+
+
+def test_merge_sparse_bins_with_min_count_one_changes_nothing_but_empty_bins():
+    edges = np.linspace(0.0, 1.0, 6)
+    counts = np.array([1, 0, 2, 5, 0])
+    left, right, count = plotting.merge_sparse_bins(edges, counts, min_count=1)
+    assert count.tolist() == [1, 2, 5] and left.tolist() == [edges[0], edges[2], edges[3]]
+
+
+def test_density_figure_draws_no_point_below_the_sparse_bin_count(data):
+    """A single value in a bin cannot show: every drawn density is >= MIN_BIN_COUNT / (n W)."""
+    events = data["events"].copy(deep=True)
+    cell = dict(inv_beta=0, delta=int(np.argmin(np.abs(events["delta"].values))))
+    n = int(events["n_collisions"][cell])
+    width = float(events["v_after"][1] - events["v_after"][0])
+    dens = events["v_after_density"][cell].values
+    dens[-1] = 1.0 / (n * width)                # one value in the last bin, far in the tail
+    events["v_after_density"][cell] = dens
+    ax = plotting.fig07(events, density_delta=[0.0]).axes[0]
+    (line,) = _data_lines(ax)
+    x = np.asarray(line.get_xdata(), dtype=float)
+    assert np.nanmax(x) < float(events["v_after"][-1]) - 0.5 * width   # the lone bin is not drawn
+    assert ax.get_xlim()[1] < float(events["v_after"][-1])              # nor the axis taken to it

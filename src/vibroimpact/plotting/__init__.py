@@ -2,8 +2,11 @@
 
 Every function takes already opened :class:`xarray.Dataset` objects laid out as in
 ``docs/datasets.md`` and returns a Figure; none of them touches a file. :func:`save` is the
-only writer (the workflow's figure rule calls it). Axis labels come from each variable's
-``long_name`` and ``units`` attributes; the look comes from the one style file
+only writer (the workflow's figure rule calls it). Axis labels come from one vocabulary in
+the paper's symbols, `LABELS` (a variable outside it is labelled by its ``long_name`` and
+``units``); every density figure follows one sparse-bin rule (`MIN_BIN_COUNT`,
+:func:`merge_sparse_bins`) and draws a family of curves with colour, line style and marker
+(:func:`family_styles`); the look comes from the one style file
 ``vibroimpact.mplstyle``, applied by :func:`style`. Every figure prints the parameters it
 was computed with (zeta, eps, delta, the input's rms and spectrum, the harmonic forcing).
 
@@ -21,7 +24,9 @@ Datasets and the figures that read them (docs/figures.md)::
 Plotting never imports the simulator or the orbit solver; it may use small helpers of
 `vibroimpact.stats`.
 """
-from vibroimpact.plotting._common import STYLE_FILE, axis_label, save, style
+from vibroimpact.plotting._common import (LABELS, MIN_BIN_COUNT, STYLE_FILE, axis_label,
+                                          bin_counts, family_styles, merge_sparse_bins, save,
+                                          style)
 from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
 from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement
 from vibroimpact.plotting.orbits import fig16
@@ -30,7 +35,8 @@ from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fi
 from vibroimpact.plotting.validation import stress, work_precision
 
 __all__ = [
-    "STYLE_FILE", "style", "axis_label", "critical_delta", "save",
+    "STYLE_FILE", "style", "axis_label", "critical_delta", "save", "LABELS", "MIN_BIN_COUNT",
+    "bin_counts", "family_styles", "merge_sparse_bins",
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
     "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
     "map_agreement", "work_precision", "stress",

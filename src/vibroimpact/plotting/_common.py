@@ -76,18 +76,51 @@ def _figure(nrows=1, sharex=True, height_ratios=None):
     return fig, list(axes)
 
 
+#: The one labelling vocabulary of every figure: a quantity's axis label in the paper's
+#: symbols (eq. 2 ff.: tau, delta, beta = omega/omega_0, z_j, u_{j-0} the approach velocity
+#: at the j-th collision, epsilon u_{j-0} the velocity after it), keyed by the variable name
+#: the datasets use. A variable not listed here is labelled by its CF ``long_name``.
+LABELS = {
+    "tau": r"time $\tau$",
+    "lag": r"time lag $\tau^*$",
+    "delta": r"play $\delta$",
+    "inv_beta": r"inverse forcing frequency $1/\beta_f$",
+    "beta": r"frequency ratio $\beta = \omega/\omega_0$",
+    "r": r"random force $r(\tau)$",
+    "f": r"input force $f(\tau)$",
+    "a": r"displacement from the wall $a(\tau)$",
+    "x": r"displacement $x(\tau)$",
+    "phi_estimate": r"autocorrelation $\varphi_f(\tau^*)$",
+    "phi_r": r"autocorrelation $\varphi_f(\tau^*)$",
+    "v_after": r"velocity after impact $\varepsilon u_{j-0}$",
+    "interval": r"interval between collisions $z_j$",
+    "ratio": r"$z_j/z$,  $z = 2\pi/\beta_f$",
+    "v_after_density": r"probability density of $\varepsilon u_{j-0}$",
+    "interval_density": r"probability density of $z_j$",
+    "ratio_density": r"probability density of $z_j/z$",
+    "v_after_mean": r"mean velocity after impact $\overline{\varepsilon u_{j-0}}$",
+    "interval_mean": r"mean interval $\overline{z_j}$",
+    "S_a": r"PSD $S_a(\beta)$ of $a(\tau)$",
+    "S_estimate": r"PSD $S_f(\beta)$",
+    "S_f": r"PSD $S_f(\beta)$",
+    "S": r"degree of stability $S$",
+}
+
+
 def axis_label(da, extra=""):
-    """Axis label ``"long_name [units]"`` of a DataArray (units omitted when dimensionless).
+    """Axis label of a DataArray: its entry of `LABELS`, else ``"long_name [units]"``.
+
+    Units are omitted when dimensionless (every quantity of the paper is).
 
     Parameters
     ----------
     da : xarray.DataArray
-        Variable or coordinate with CF attributes ``long_name`` and ``units``; the variable
-        name stands in for a missing ``long_name``.
+        Variable or coordinate; a name outside `LABELS` is labelled by its CF attribute
+        ``long_name`` (the variable name when that is missing) and ``units``.
     extra : str, optional
         Appended after the name, before the units (e.g. a convention note).
     """
-    name = str(da.attrs.get("long_name", da.name)) + extra
+    name = str(LABELS.get(da.name, da.attrs.get("long_name", da.name))) + extra
     units = da.attrs.get("units")
     if units is None or str(units) in DIMENSIONLESS:
         return name
@@ -100,6 +133,8 @@ def _psd_label(da):
     A long_name that says "two-sided" but not "angular" (the writers' names) gets "angular"
     added there; one that says neither gets the whole note appended.
     """
+    if da.name in LABELS:
+        return axis_label(da, " (two-sided, angular)")
     name = str(da.attrs.get("long_name", da.name))
     if "angular" in name:
         return axis_label(da)
@@ -175,9 +210,20 @@ def _system_text(ds):
     return rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
 
 
+#: How a figure names each noise kind (`vibroimpact.noise.KINDS`), never the config key.
+NOISE_KINDS = {"white": "white", "band_limited": "band-limited white",
+               "lowpass2": "2nd-order low-pass"}
+
+
+def _kind_text(attrs):
+    """The noise kind in words (``"band-limited white"``); an unknown kind as it is stored."""
+    kind = str(attrs["noise_kind"])
+    return NOISE_KINDS.get(kind, kind)
+
+
 def _spectrum_parts(attrs):
-    """``["band_limited", "beta_c = 4"]``: the input's spectrum from ``noise_*`` attributes."""
-    parts = [str(attrs["noise_kind"])] if "noise_kind" in attrs else []
+    """``["band-limited white", "beta_c = 4"]``: the input's spectrum from ``noise_*`` attributes."""
+    parts = [_kind_text(attrs)] if "noise_kind" in attrs else []
     return parts + _filter_parts(attrs)
 
 
@@ -188,27 +234,33 @@ def _filter_parts(attrs):
 
 
 def _noise_text(ds):
-    """``rms_r = ...``, the spectrum and the noise's name, from the dataset's global attributes."""
+    """``rms_r = ...`` and the spectrum, from the dataset's global attributes (the config's
+    name of the noise record is provenance, in the dataset and the report, not on a figure)."""
     rms = ds.attrs.get("noise_rms")
     parts = [] if rms is None else [f"rms$_r$ = {_num(rms)}"]
     parts += _spectrum_parts(ds.attrs)
-    name = ds.attrs.get("noise")
-    if isinstance(name, str) and name:
-        parts.append(f"noise '{name}'")
     return ", ".join(parts)
 
 
+def _sine_argument(beta_f):
+    r"""Argument of the harmonic in mathtext, as the paper writes it: ``1.1\,\tau`` for
+    beta_f = 1.1 and ``\tau/1.1`` for beta_f = 1/1.1, whichever prints shorter (4 digits)."""
+    beta_f = float(beta_f)
+    times, over = _num(beta_f), _num(1.0 / beta_f)
+    return rf"{times}\,\tau" if len(times) <= len(over) else rf"\tau/{over}"
+
+
 def _forcing_text(ds, beta_f=None, inv_beta=None):
-    """``f(tau) = A sin(...) + r(tau)``; the harmonic written as sin(tau/inv_beta) if given."""
+    """``f(tau) = A sin(1.1 tau) + r(tau)`` at beta_f (or 1/inv_beta), with the noise."""
     amplitude = float(_attr(ds, "amplitude"))
     if amplitude == 0.0:
         harmonic = ""
     else:
-        arg = rf"\tau/{_num(inv_beta)}" if inv_beta is not None else rf"{_num(beta_f)}\,\tau"
+        arg = _sine_argument(beta_f if inv_beta is None else 1.0 / float(inv_beta))
         scale = "" if amplitude == 1.0 else f"{_num(amplitude)}"
         harmonic = rf"{scale}$\sin({arg})$ + "
     noise = _noise_text(ds)
-    return rf"f($\tau$) = {harmonic}r($\tau$)" + (f" ({noise})" if noise else "")
+    return rf"$f(\tau)$ = {harmonic}$r(\tau)$" + (f" ({noise})" if noise else "")
 
 
 def _spectrum_text(noise):
@@ -222,7 +274,7 @@ def _spectrum_text(noise):
     spectrum = [f"rms = {_num(_attr(noise, 'noise_rms'))}", rf"$\Delta\tau$ = {_num(dt)}",
                 *_filter_parts(attrs)]
     n = int(attrs["n_samples"]) if "n_samples" in attrs else int(noise["r"].size)
-    return (f"{_attr(noise, 'noise_kind')} noise: {', '.join(spectrum)};  "
+    return (f"{_kind_text(noise.attrs)} noise: {', '.join(spectrum)};  "
             f"seed {_attr(noise, 'seed')}, {n:,} samples")
 
 
@@ -341,62 +393,210 @@ def _beyond_text(fraction):
     return f", {100.0 * fraction:.3g} % beyond axis"
 
 
-def _density_figure(events, i_beta, var, title, params, density_delta=None):
+#: The sparse-bin rule of every density figure: a bin is drawn on its own only when it holds
+#: at least this many values; a run of neighbouring sparser bins is merged until the run holds
+#: that many (one point at the run's centre, density = count / (n * run width)), and a run
+#: that ends below it is not drawn. With 10 values the relative error of a merged bin is
+#: below about 1/sqrt(10) ~ 0.3, so no single value spikes down the log axis.
+MIN_BIN_COUNT = 10
+#: Line styles and markers of a family of curves, with the colours: neighbouring members
+#: differ in all three (cycled when a family has more members).
+FAMILY_LINESTYLES = ("-", "--", "-.", ":")
+FAMILY_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+#: Markers drawn per curve (spread over its points, staggered between the curves).
+MARKERS_PER_CURVE = 9
+
+
+def family_styles(n):
+    """Colour, line style and marker of each of `n` curves of a family (a list of dicts)."""
+    colors = _colors(n)
+    return [dict(color=colors[k], ls=FAMILY_LINESTYLES[k % len(FAMILY_LINESTYLES)],
+                 marker=FAMILY_MARKERS[k % len(FAMILY_MARKERS)]) for k in range(n)]
+
+
+def _markevery(n_points, k, n_curves):
+    """Evenly spread marker positions of curve `k` of `n_curves`, staggered between curves."""
+    step = max(n_points // MARKERS_PER_CURVE, 1)
+    return (int(step * k / max(n_curves, 1)) % step, step)
+
+
+def merge_sparse_bins(edges, counts, min_count=MIN_BIN_COUNT):
+    """Bins of a histogram after the sparse-bin rule (`MIN_BIN_COUNT`).
+
+    Parameters
+    ----------
+    edges : array_like, shape (n + 1,)
+        Bin edges, increasing.
+    counts : array_like, shape (n,)
+        Values in each bin (non-negative integers).
+    min_count : int, optional
+        Fewest values a drawn bin holds.
+
+    Returns
+    -------
+    left, right, count : numpy.ndarray
+        The drawn bins: every bin holding ``>= min_count`` values as it is, and each run of
+        neighbouring sparser bins merged, from left to right, until the run holds
+        ``min_count`` values. A run that meets a full bin, or the last bin, before it holds
+        that many is dropped (not drawn), as are empty bins outside every run that holds values.
+    """
+    edges = np.asarray(edges, dtype=float)
+    counts = np.asarray(counts)
+    if edges.size != counts.size + 1:
+        raise ValueError(f"need len(edges) == len(counts) + 1, got {edges.size} and {counts.size}")
+    if min_count < 1:
+        raise ValueError(f"min_count must be >= 1, got {min_count}")
+    left, right, count = [], [], []
+    start, total = None, 0
+    for i, c in enumerate(counts):
+        if c >= min_count:
+            start, total = None, 0          # an unfinished sparse run before it is dropped
+            left.append(edges[i]), right.append(edges[i + 1]), count.append(c)
+            continue
+        if start is None:
+            if c == 0:
+                continue                    # a run starts at its first value
+            start = i
+        total += c
+        if total >= min_count:
+            left.append(edges[start]), right.append(edges[i + 1]), count.append(total)
+            start, total = None, 0
+    return np.array(left), np.array(right), np.array(count)
+
+
+def bin_counts(cell, var):
+    """Values per bin of density `var` of one cell: ``density * n * width``, rounded.
+
+    `n` is what the density is normalised by (`vibroimpact.stats.density` with ``total``):
+    one value per collision for the velocity, one per interval (collisions - 1) for the
+    interval and z_j/z. The product is an integer to round-off (checked).
+    """
+    x = cell[var].dims[-1]
+    edges = _bin_edges(cell[x])
+    n = int(cell["n_collisions"]) - (0 if var.startswith("v_after") else 1)
+    exact = np.nan_to_num(np.asarray(cell[var], dtype=float)) * max(n, 0) * np.diff(edges)
+    counts = np.rint(exact)
+    if np.any(np.abs(exact - counts) > 1e-6 * np.maximum(counts, 1.0)):
+        raise ValueError(f"{var} times n * width is not a count: the density is not normalised "
+                         f"by n = {n} values (see vibroimpact.stats.density)")
+    return edges, counts.astype(np.int64), n
+
+
+def _bin_edges(centres):
+    """Edges of evenly spaced bins from their centres."""
+    c = np.asarray(centres, dtype=float)
+    half = 0.5 * (c[1] - c[0]) if c.size > 1 else 0.5
+    return np.concatenate([c - half, [c[-1] + half]])
+
+
+def _drawn_density(cell, var, band):
+    """``(x, density, stderr)`` polyline of one cell's density after the sparse-bin rule.
+
+    A bin drawn as it is gives one point at its centre; a merged run gives two, at its ends,
+    with the run's density (a plateau: the density is known only as the run's mean); the line
+    breaks (NaN) where bins between two drawn ones were empty or dropped. A merged run's
+    standard error combines its bins' as independent, ``sqrt(sum (se_i w_i)^2) / W``
+    (neighbouring bins' batch means are nearly uncorrelated); ``None`` without a ``band``.
+    """
+    edges, counts, n = bin_counts(cell, var)
+    left, right, count = merge_sparse_bins(edges, counts)
+    w = np.diff(edges)
+    lo = np.searchsorted(edges, left + 0.5 * w[0]) - 1     # first bin of each drawn bin
+    hi = np.searchsorted(edges, right - 0.5 * w[0])         # one past its last
+    se_bins = (None if band is None
+               else np.nan_to_num(np.asarray(cell[band], dtype=float)) * w)
+    xs, ys, ses = [], [], []
+    for j in range(count.size):
+        if j and lo[j] != hi[j - 1]:
+            xs.append(np.nan), ys.append(np.nan), ses.append(np.nan)
+        width = right[j] - left[j]
+        y = count[j] / (n * width)
+        se = np.nan if se_bins is None else np.sqrt(np.sum(se_bins[lo[j]:hi[j]] ** 2)) / width
+        ends = [0.5 * (left[j] + right[j])] if hi[j] - lo[j] == 1 else [left[j], right[j]]
+        xs += ends
+        ys += [y] * len(ends)
+        ses += [se] * len(ends)
+    return np.array(xs), np.array(ys), None if band is None else np.array(ses)
+
+
+def _density_figure(events, i_beta, var, title, params, density_delta=None, linear=False):
     """One density curve per density delta at inv_beta index `i_beta`, with a confidence band.
 
-    The band is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile
-    of B - 1 dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number
-    of collisions and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
-    (``{quantity}_beyond``).
+    Panel (a) has a log density axis (the tails matter as much as the bulk); with `linear`,
+    panel (b) draws the same curves on a linear axis, where the spread of the bulk reads.
+    Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`). The band
+    is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile of B - 1
+    dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number of
+    collisions and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
+    (``{quantity}_beyond``). The x axis ends at the last drawn bin.
+
+    Returns
+    -------
+    (Figure, list of Axes)
     """
-    fig, (ax,) = _figure()
+    fig, axes = _figure(2 if linear else 1, height_ratios=(1.3, 1.0) if linear else None)
     ds = events.isel(inv_beta=i_beta)
     index = _density_deltas(events, density_delta)
     x = _require(ds, var, "this figure").dims[-1]
     beyond = _require(ds, f"{var.removesuffix('_density')}_beyond", "this figure")
-    band = f"{var}_stderr"
-    has_band = band in ds
-    if has_band:
+    band = f"{var}_stderr" if f"{var}_stderr" in ds else None
+    if band is not None:
         t = t_quantile(np.asarray(_require(ds, "n_batches", "the confidence band")), CONFIDENCE)
-    for color, k in zip(_colors(len(index)), index):
+    styles = family_styles(len(index))
+    edges = _bin_edges(ds[x])
+    x_end, top, low = edges[0], 0.0, np.inf
+    for j, (style, k) in enumerate(zip(styles, index)):
         cell = ds.isel(delta=k)
         n = int(cell["n_collisions"])
-        y = np.asarray(cell[var], dtype=float)
+        xs, y, se = _drawn_density(cell, var, band)
         impacts = f"{n:,} collisions" if n else "no impacts"
         label = rf"$\delta$ = {_num(cell['delta'])}  ({impacts}{_beyond_text(beyond[k])})"
-        ax.plot(cell[x], y, color=color, label=label)
-        if has_band:
-            half = t[k] * np.asarray(cell[band], dtype=float)
-            ax.fill_between(cell[x], np.clip(y - half, 1e-300, None), y + half, color=color,
-                            alpha=0.2, lw=0)
-    # log scale: chatter puts a tall spike at small velocities and intervals, and the
-    # distributions' tails matter as much as their bulk
-    top = np.nanmax([np.nanmax(np.asarray(ds.isel(delta=k)[var], dtype=float), initial=0.0)
-                     for k in index] + [0.0])
+        for ax in axes:
+            ax.plot(xs, y, color=style["color"], ls=style["ls"], marker=style["marker"],
+                    markersize=3.5, markevery=_markevery(xs.size, j, len(index)),
+                    label=label if ax is axes[0] else None)
+            if se is not None and xs.size:
+                half = t[k] * se
+                ax.fill_between(xs, np.clip(y - half, 1e-300, None), y + half,
+                                color=style["color"], alpha=0.15, lw=0)
+        if xs.size:
+            last = np.searchsorted(edges, xs[-1] - 1e-9 * abs(xs[-1]))   # its bin's right edge
+            x_end = max(x_end, edges[min(last, edges.size - 1)])
+            top = max(top, float(np.nanmax(y)))
+            low = min(low, float(np.nanmin(y)))
+    ax_log = axes[0]
     if top > 0.0:
-        ax.set_yscale("log")
-        ax.set_ylim(top * DENSITY_DECADES, top * 3.0)
+        ax_log.set_yscale("log")
+        ax_log.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
     else:
-        ax.set_ylim(bottom=0.0)
-    _bin_limits(ax, ds[x])
-    ax.set_xlabel(axis_label(ds[x]))
-    ax.set_ylabel(axis_label(ds[var]))
-    title_text = None
-    if has_band:
+        ax_log.set_ylim(bottom=0.0)
+    for ax in axes[1:]:
+        ax.set_ylim(0.0, 1.08 * top if top > 0.0 else 1.0)
+    for ax in axes:
+        ax.set_xlim(edges[0], x_end if x_end > edges[0] else edges[-1])
+        ax.set_ylabel(axis_label(ds[var]))
+    axes[-1].set_xlabel(axis_label(ds[x]))
+    if linear:
+        _panel_tag(axes[0], "(a) log scale")
+        _panel_tag(axes[1], "(b) linear scale")
+    rule = (f"bins with < {MIN_BIN_COUNT} values merged with their neighbours (plateaus), "
+            "runs still below not drawn")
+    title_text = rule
+    if band is not None:
         b = np.unique(np.asarray(ds["n_batches"])[index])
         t_text = (f"t = {_num(t[index[0]])}, B = {int(b[0])} batches" if b.size == 1
                   else "t of B - 1 dof")
         title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
-                      f"({100 * CONFIDENCE:g} %, {t_text})")
-    if len(index) > LEGEND_INSIDE:
+                      f"({100 * CONFIDENCE:g} %, {t_text})\n{rule}")
+    if len(index) > LEGEND_INSIDE or linear:
         # a legend this tall would hide the curves' peaks: below the axes instead
-        fig.set_figheight(fig.get_figheight() * 1.3)
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncols=2, title=title_text,
-                  title_fontsize=8, fontsize=8)
+        fig.set_figheight(fig.get_figheight() * (1.2 if linear else 1.3))
+        fig.legend(loc="outside lower center", ncols=2, title=title_text, title_fontsize=7.5,
+                   fontsize=7.5)
     else:
-        ax.legend(loc="upper right", title=title_text, title_fontsize=8)
+        ax_log.legend(loc="upper right", title=title_text, title_fontsize=7.5)
     _header(fig, title, params)
-    return fig, ax
+    return fig, axes
 
 
 def _require_harmonic(events, figure):
@@ -407,8 +607,8 @@ def _require_harmonic(events, figure):
 
 
 #: What an impact statistic counts, printed on every figure of one (docs/figures.md).
-COLLISION_NOTE = ("per collision: an impact after a free flight, with its chatter and sticking;  "
-                  "v of its first rebound, z_j from first impact to first impact")
+COLLISION_NOTE = (r"per collision (an impact after a free flight, with its chatter and sticking);  "
+                  r"$\varepsilon u_{j-0}$: its first rebound, $z_j$: first impact to first impact")
 
 
 def _events_params(events, i_beta):

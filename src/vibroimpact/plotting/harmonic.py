@@ -114,8 +114,9 @@ def fig13(events, inv_beta, density_delta=None):
     Returns
     -------
     matplotlib.figure.Figure
-        One axes: one line per density delta, a dash-dot line at z_j/z = 1/2 (the symmetry
-        axis of the (2/1) motion) and dotted marks at 1 ((1/1) motion) and 2 ((1/2) motion).
+        (a) log and (b) linear density axes: one line per density delta, a dash-dot line at
+        z_j/z = 1/2 (the symmetry axis of the (2/1) motion) and dotted marks at 1 ((1/1)
+        motion) and 2 ((1/2) motion).
 
     Raises
     ------
@@ -124,17 +125,16 @@ def fig13(events, inv_beta, density_delta=None):
     """
     _require_harmonic(events, "fig13")
     i = _nearest(events["inv_beta"], inv_beta)
-    fig, ax = _density_figure(
+    fig, axes = _density_figure(
         events, i, "ratio_density",
         r"Fig. 13  Probability density of $z_j/z$, the interval over the forcing period",
-        _events_params(events, i), density_delta)
+        _events_params(events, i), density_delta, linear=True)
     marks = ((0.5, "-.", "(2/1)"), (1.0, ":", "(1/1)"), (2.0, ":", "(1/2)"))
-    for x, ls, _ in marks:
-        ax.axvline(x, color="0.3", ls=ls, lw=1.0)
-    motions = ax.secondary_xaxis("top")
-    motions.set_xticks([x for x, _, _ in marks], labels=[m for _, _, m in marks], fontsize=8)
-    motions.tick_params(length=0, colors="0.3")
-    motions.spines["top"].set_visible(False)
+    for ax in axes:
+        for x, ls, motion in marks:
+            ax.axvline(x, color="0.3", ls=ls, lw=1.0)
+            ax.text(x, 0.97, f" {motion}", transform=ax.get_xaxis_transform(), ha="left",
+                    va="top", fontsize=8, color="0.3")
     return fig
 
 
@@ -149,5 +149,5 @@ def fig14(events, inv_beta, density_delta=None):
     i = _nearest(events["inv_beta"], inv_beta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",
-                             _events_params(events, i), density_delta)
+                             _events_params(events, i), density_delta, linear=True)
     return fig

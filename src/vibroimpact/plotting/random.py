@@ -154,11 +154,12 @@ def fig07(events, density_delta=None):
     Returns
     -------
     matplotlib.figure.Figure
-        One axes, one line per (distinct) density delta with a shaded 95 % band.
+        (a) log and (b) linear density axes, one line per (distinct) density delta with a
+        shaded 95 % band; sparse bins merged (`MIN_BIN_COUNT`).
     """
     fig, _ = _density_figure(events, 0, "v_after_density",
                              "Fig. 7  Probability density of the velocity after impact",
-                             _events_params(events, 0), density_delta)
+                             _events_params(events, 0), density_delta, linear=True)
     return fig
 
 
