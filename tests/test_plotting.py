@@ -210,9 +210,10 @@ def test_fig09_bars_scale_and_markers(data):
     assert ax_v.get_yscale() == "linear" and ax_z.get_yscale() == "log"
     t = t_quantile(20)
     for ax, name in ((ax_v, "v_after"), (ax_z, "interval")):
-        marks = [ln for ln in ax.get_lines() if ln.get_gid() == "critical_delta"]
-        assert len(marks) == 1
-        np.testing.assert_array_equal(marks[0].get_xdata(), d_c)
+        # the plays without a collision in the record: shaded from d_c on, not a threshold line
+        spans = [p for p in ax.patches if p.get_gid() == "no_collision"]
+        assert len(spans) == 1
+        assert spans[0].get_x() == pytest.approx(d_c)
         # bars: +-t standard errors, t of 19 dof (Student, as BatchMeans.interval)
         segments = ax.containers[0].lines[2][0].get_segments()
         half = np.array([0.5 * (s[1, 1] - s[0, 1]) for s in segments])
@@ -220,16 +221,39 @@ def test_fig09_bars_scale_and_markers(data):
         np.testing.assert_allclose(half, expected[np.isfinite(expected)], rtol=1e-12)
         squares = [ln for ln in ax.get_lines() if ln.get_marker() == "s"]
         assert len(squares) == 1
-        np.testing.assert_array_equal(squares[0].get_xdata(), ds["delta"].values[few])
+        # an interval needs two collisions: one collision is a cross in (a), nothing in (b)
+        shown = few & (n > 1) & np.isfinite(ds[f"{name}_mean"].values)
+        np.testing.assert_array_equal(squares[0].get_xdata(), ds["delta"].values[shown])
         assert squares[0].get_markerfacecolor() == "white"
     labels = [t.get_text() for t in fig.legends[0].get_texts()]     # one legend, both panels
     assert any("fewer than 20 collisions" in s for s in labels)
-    assert any("no impact" in s for s in labels)
+    assert any(f"no collision in this record for $\\delta$ > {d_c:g}" in s for s in labels)
     assert any("t = 2.093" in s for s in labels)
     assert ax_v.get_ylabel() == axis_label(ds["v_after_mean"])
     assert ax_z.get_ylabel() == axis_label(ds["interval_mean"])
     assert ax_z.get_xlabel() == axis_label(ds["delta"])
-    assert any(f"{d_c:g}" in t.get_text() for t in ax_v.texts)  # annotated
+
+
+def test_fig09_draws_rice_asymptotes_of_the_wall_free_response(data):
+    """Rice's rate checked against its closed form at one point, independent of the code:
+    sigma_x = sigma_v = sqrt(S0 / 4 zeta) for white noise of two-sided level S0."""
+    events = data["events"].copy()
+    zeta, s0 = 0.05, 0.02
+    sigma = np.sqrt(s0 / (4 * zeta))
+    events.attrs.update(linear_sigma_x=sigma, linear_sigma_v=sigma)
+    fig = plotting.fig09(events)
+    ax_v, ax_z = fig.axes
+    (v_line,) = [ln for ln in ax_v.get_lines() if ln.get_gid() == "rice"]
+    (z_line,) = [ln for ln in ax_z.get_lines() if ln.get_gid() == "rice"]
+    eps = float(events.attrs["eps"])
+    np.testing.assert_allclose(v_line.get_ydata(), eps * sigma * np.sqrt(np.pi / 2), rtol=1e-12)
+    d, z = (np.asarray(v, dtype=float) for v in z_line.get_data())
+    # mean interval between up-crossings of d: 2 pi exp(d^2 / 2 sigma^2) (sigma_v = sigma_x)
+    np.testing.assert_allclose(z, 2 * np.pi * np.exp(d**2 / (2 * sigma**2)), rtol=1e-12)
+    assert d.min() == pytest.approx(plotting.random.RICE_FROM_SIGMA * sigma)
+    events.attrs.pop("linear_sigma_x")
+    assert not [ln for ax in plotting.fig09(events).axes for ln in ax.get_lines()
+                if ln.get_gid() == "rice"]
 
 
 def test_events_store_batch_lag1_and_no_ratio_statistics_without_harmonic(data):
@@ -252,7 +276,7 @@ def test_critical_delta_undefined_when_the_sweep_never_stops_impacting(data):
     empty = data["events"].sel(delta=[4.5, 6.0])
     assert np.isnan(critical_delta(impacting)) and np.isnan(critical_delta(empty))
     fig = plotting.fig09(impacting)
-    assert not [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_gid()]
+    assert not [p for ax in fig.axes for p in ax.patches if p.get_gid() == "no_collision"]
 
 
 def test_fig10_harmonic_input_and_motion(data):

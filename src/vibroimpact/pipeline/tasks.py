@@ -10,6 +10,7 @@ import contextlib
 import logging
 import sys
 
+from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.figures import figure_variant
 from vibroimpact.pipeline.provenance import config_text, provenance
@@ -229,6 +230,11 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
     attrs = dict(parts[0].attrs)
     attrs.update(provenance(block, attrs.get("seed")))
     if kind == "events":
+        if float(attrs.get("amplitude", 0.0)) == 0.0:
+            # the wall-free response's std's: fig09 draws Rice's large-play asymptotes
+            sigma_x, sigma_v = stats.linear_response_std(
+                io.noise_spec(attrs).psd_piecewise_linear, study.zeta)
+            attrs.update(linear_sigma_x=sigma_x, linear_sigma_v=sigma_v)
         ds = datasets.aggregate_events(parts, study, attrs)
     elif kind == "map":
         ds = datasets.aggregate_map(parts, study, attrs)

@@ -3,17 +3,19 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
 
 from vibroimpact.plotting._common import (
     CONFIDENCE, FEW_IMPACTS, SPECTRUM_BETA_MAX, STOP_BAND_LEVEL, _attr, _density_figure,
     _events_params, _figure, _header, _headroom, _num, _panel_tag, _psd_label, _require,
     _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label, t_quantile)
+from vibroimpact.stats.theory import upcrossing_rate
 
 #: fig05 draws the PSD of the piecewise-linear force as its own line when it differs from the
 #: target of the samples by more than this fraction of the target's peak on the axis shown.
 VISIBLE_DIFFERENCE = 0.01
 #: Height (inches) of fig09: two panels plus the legend below them.
-FIG09_HEIGHT = 6.6
+FIG09_HEIGHT = 7.4
 
 
 def fig03(trace):
@@ -173,7 +175,11 @@ def fig08(events, density_delta=None):
 
 
 def critical_delta(events, inv_beta_index=0):
-    """Smallest swept delta above which the record holds no impact (fig09's marker).
+    """Largest swept delta with a collision in the record, when every larger one has none.
+
+    Not a physical threshold: under a Gaussian force the collision rate falls with delta
+    (as Rice's up-crossing rate, `vibroimpact.stats.upcrossing_rate`) but never reaches
+    zero; this is the largest play the record's largest excursion reached.
 
     Parameters
     ----------
@@ -185,16 +191,19 @@ def critical_delta(events, inv_beta_index=0):
     Returns
     -------
     float
-        The largest delta with ``n_collisions > 0`` when every larger delta has none, i.e. no
-        impact occurs for delta > critical_delta; NaN when the largest swept delta still has
-        impacts (the sweep does not reach the critical play) or when no delta has any.
-        The true threshold lies between this value and the next swept delta.
+        The largest delta with ``n_collisions > 0`` when every larger delta has none; NaN
+        when the largest swept delta still has collisions or when no delta has any.
     """
     ds = events.isel(inv_beta=inv_beta_index).sortby("delta")
     hit = np.flatnonzero(np.asarray(ds["n_collisions"]) > 0)
     if hit.size == 0 or hit[-1] == ds["delta"].size - 1:
         return float("nan")
     return float(ds["delta"][hit[-1]])
+
+
+#: Rice's asymptotes are drawn from this many wall-free stds sigma_x of play upwards (where
+#: the wall's memory is short against the mean interval, `stats.upcrossing_rate`).
+RICE_FROM_SIGMA = 1.5
 
 
 @_styled
@@ -206,7 +215,8 @@ def fig09(events):
     events : xarray.Dataset
         Events dataset of a fine delta sweep (inv_beta index 0): ``v_after_mean``,
         ``v_after_stderr``, ``interval_mean``, ``interval_stderr``, ``n_collisions``,
-        ``n_batches``.
+        ``n_batches``; attributes ``record_length`` and, to draw Rice's asymptotes,
+        ``linear_sigma_x`` and ``linear_sigma_v``.
 
     Returns
     -------
@@ -214,61 +224,86 @@ def fig09(events):
         Two stacked axes sharing delta; (b), the mean interval, on a log scale. Bars are
         +-t batch-means standard errors, t the Student quantile of B - 1 dof at
         `CONFIDENCE` (as `vibroimpact.stats.BatchMeans.interval`). Means resting on fewer
-        than `FEW_IMPACTS` collisions are open squares without bars; deltas without impacts
-        are open circles on the lower edge of each axes. A vertical line (gid
-        ``"critical_delta"``) marks :func:`critical_delta` on both axes, and a shaded span
-        reaches to the first impact-free delta, where the true threshold lies.
+        than `FEW_IMPACTS` collisions are open squares without bars (an interval needs two
+        collisions). Rice's large-play asymptotes (gid ``"rice"``): the mean velocity after
+        impact ``eps sigma_v sqrt(pi/2)`` and the mean interval ``1/nu+(delta)``, with the
+        record length, beyond which no interval can be measured. The plays with no
+        collision in the record are shaded (gid ``"no_collision"``), from
+        :func:`critical_delta` on: a property of this record, not a threshold.
     """
     fig, axes = _figure(2)
     fig.set_figheight(FIG09_HEIGHT)
     ds = events.isel(inv_beta=0).sortby("delta")
     delta = np.asarray(ds["delta"], dtype=float)
     n = np.asarray(ds["n_collisions"])
-    none, few = n == 0, (n > 0) & (n < FEW_IMPACTS)
-    enough = n >= FEW_IMPACTS
     n_batches = np.asarray(_require(ds, "n_batches", "fig09's confidence bars"))
     t = t_quantile(n_batches, CONFIDENCE)
+    enough = n >= FEW_IMPACTS
     batches = np.unique(n_batches[enough] if enough.any() else n_batches)
     t_text = (f"t = {_num(t_quantile(batches[0], CONFIDENCE))}, {int(batches[0])} batches"
               if batches.size == 1 else "t of B - 1 dof")
     bar_label = rf"mean $\pm$ t$\cdot$batch-means s.e. ({100 * CONFIDENCE:g} %, {t_text})"
     d_c = critical_delta(events)
-    for ax, name, color in zip(axes, ("v_after", "interval"), ("C0", "C1")):
+    record = ds.attrs.get("record_length")
+    sigma = (ds.attrs.get("linear_sigma_x"), ds.attrs.get("linear_sigma_v"))
+    rice = sigma[0] is not None and sigma[1] is not None
+    if rice:
+        sigma_x, sigma_v = (float(v) for v in sigma)
+        d_rice = np.linspace(max(RICE_FROM_SIGMA * sigma_x, delta.min()), delta.max(), 200)
+        eps = float(_attr(ds, "eps"))
+        asymptotes = (np.full_like(d_rice, eps * sigma_v * np.sqrt(np.pi / 2.0)),
+                      1.0 / upcrossing_rate(d_rice, sigma_x, sigma_v))
+    few_any = False
+    for k, (ax, name, color) in enumerate(zip(axes, ("v_after", "interval"), ("C0", "C1"))):
         mean = np.asarray(ds[f"{name}_mean"], dtype=float)
         err = t * np.asarray(ds[f"{name}_stderr"], dtype=float)
         ax.errorbar(delta[enough], mean[enough], yerr=err[enough], color=color, marker="o",
                     markersize=3.5)
-        if few.any():
-            ax.plot(delta[few], mean[few], ls="none", marker="s", mfc="white", color=color,
-                    markersize=4.5)
-        if none.any():
-            # on the lower edge of the axes: "zero" on the linear axis, the floor of the log one
-            ax.plot(delta[none], np.zeros(none.sum()), ls="none", marker="o", mfc="white",
-                    color="0.45", markersize=4, clip_on=False, zorder=5,
-                    transform=ax.get_xaxis_transform())
+        few = ~enough & np.isfinite(mean) & (n > 1)
+        few_any |= bool(few.any())
+        ax.plot(delta[few], mean[few], ls="none", marker="s", mfc="white", color=color,
+                markersize=4.5)
+        ax.plot(delta[n == 1], mean[n == 1], ls="none", marker="x", color=color, markersize=4.5)
+        if rice:
+            (line,) = ax.plot(d_rice, asymptotes[k], color="0.25", ls="--", lw=1.1)
+            line.set_gid("rice")
         if np.isfinite(d_c):
-            line = ax.axvline(d_c, color="C3", ls="--", lw=1.1)
-            line.set_gid("critical_delta")
-            ax.axvspan(d_c, delta[delta > d_c][0], color="C3", alpha=0.12, lw=0)
+            span = ax.axvspan(d_c, delta.max(), color="0.85", lw=0, zorder=0)
+            span.set_gid("no_collision")
         ax.set_ylabel(axis_label(ds[f"{name}_mean"]))
     axes[0].set_ylim(bottom=0.0)
-    # the mean interval spans orders of magnitude (about 1 to 3.5e5 over the default sweep)
+    # the mean interval spans orders of magnitude (about 1 to 1e5 over the default sweep)
     axes[1].set_yscale("log")
-    if np.isfinite(d_c):
-        axes[0].annotate(rf"$\delta_c$ = {_num(d_c)}: no impact for $\delta > \delta_c$",
-                         xy=(d_c, 0.12), xycoords=("data", "axes fraction"),
-                         xytext=(-8, 0), textcoords="offset points", ha="right", va="center",
-                         color="C3", fontsize=8.5,
-                         bbox={"boxstyle": "round", "fc": "white", "ec": "none", "alpha": 0.8})
+    measured = np.asarray(ds["interval_mean"], dtype=float)
+    if np.isfinite(measured).any():
+        axes[1].set_ylim(0.5 * np.nanmin(measured),
+                         20.0 * max(np.nanmax(measured), float(record or 0.0)))
+    if record is not None:
+        axes[1].axhline(float(record), color="0.45", ls=":", lw=1.0)
     # one legend for both panels, below them, so it never hides a point
     marks = [Line2D([], [], color="0.3", marker="o", markersize=3.5, label=bar_label)]
-    if few.any():
+    if few_any:
         marks.append(Line2D([], [], ls="none", marker="s", mfc="white", color="0.3",
                             markersize=4.5, label=f"fewer than {FEW_IMPACTS} collisions (no bar)"))
-    if none.any():
-        marks.append(Line2D([], [], ls="none", marker="o", mfc="white", color="0.45",
-                            markersize=4, label="no impact in the record"))
-    fig.legend(handles=marks, loc="outside lower center", ncols=min(len(marks), 2))
+    if (n == 1).any():
+        marks.append(Line2D([], [], ls="none", marker="x", color="0.3", markersize=4.5,
+                            label="a single collision in the record (no interval, no bar)"))
+    if rice:
+        marks.append(Line2D([], [], color="0.25", ls="--", lw=1.1,
+                            label=r"Rice, large $\delta$: (a) $\varepsilon\sigma_v\sqrt{\pi/2}$, "
+                                  r"(b) $1/\nu^+(\delta)$, $\nu^+ = \frac{\sigma_v}{2\pi\sigma_x}"
+                                  r"e^{-\delta^2/2\sigma_x^2}$ "
+                                  rf"($\sigma_x$ = {_num(sigma_x)}, $\sigma_v$ = {_num(sigma_v)}: "
+                                  "wall-free response)"))
+    if record is not None:
+        marks.append(Line2D([], [], color="0.45", ls=":", lw=1.0,
+                            label=f"(b) record length {float(record):.3g}: no longer "
+                                  "interval can be seen"))
+    if np.isfinite(d_c):
+        marks.append(Patch(color="0.85", label=rf"no collision in this record for $\delta$ > "
+                                               rf"{_num(d_c)} (its largest excursion; the "
+                                               "rate only falls, never to zero)"))
+    fig.legend(handles=marks, loc="outside lower center", ncols=1, fontsize=7.5)
     axes[1].set_xlabel(axis_label(ds["delta"]))
     _panel_tag(axes[0], "(a)")
     _panel_tag(axes[1], "(b)")

@@ -31,7 +31,8 @@ _WHERE = {
     "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
     "count_motion_switches": "motions", "MotionStatistics": "motions",
     "motion_statistics": "motions", "motion_map_agreement": "motions",
-    "linear_response_std": "theory", "elastic_impact_rate": "theory", "rayleigh_pdf": "theory",
+    "linear_response_std": "theory", "elastic_impact_rate": "theory",
+    "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory",
 }
 __all__ = list(_WHERE)

@@ -87,6 +87,36 @@ def elastic_impact_rate(delta, sigma_x: float, sigma_v: float):
     return rate if rate.ndim else float(rate)
 
 
+def upcrossing_rate(delta, sigma_x: float, sigma_v: float):
+    """Rice's rate of up-crossings of the level delta by the wall-free Gaussian response.
+
+    Parameters
+    ----------
+    delta : float or array_like
+        Level (the play).
+    sigma_x, sigma_v : float
+        Wall-free response std's (`linear_response_std`).
+
+    Returns
+    -------
+    float or ndarray
+        ``nu+(delta) = (1/2pi) (sigma_v/sigma_x) exp(-delta^2 / 2 sigma_x^2)`` per unit tau.
+
+    Notes
+    -----
+    For any restitution, once the play is large against sigma_x an impact is a rare
+    excursion of a response the wall has not disturbed since the last one (its memory, 1/zeta,
+    is short against 1/nu+): the collision rate tends to nu+(delta), the mean interval
+    between collisions to ``1 / nu+``, and the approach velocity to the flux-weighted
+    (Rayleigh) density `rayleigh_pdf`, mean ``sigma_v sqrt(pi/2)`` (Rice 1944). Several
+    collisions of one excursion, and the wall's memory at smaller plays, make the measured
+    interval shorter than ``1 / nu+``.
+    """
+    d = np.asarray(delta, dtype=float) / sigma_x
+    rate = (sigma_v / sigma_x) / (2.0 * np.pi) * np.exp(-0.5 * d * d)
+    return rate if rate.ndim else float(rate)
+
+
 def rayleigh_pdf(u, sigma_v: float):
     """Density of the approach velocity at impact for elastic impacts under white noise.
 
