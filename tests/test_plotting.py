@@ -14,7 +14,7 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
-from vibroimpact import plotting
+from vibroimpact import plotting, stats
 from vibroimpact.orbits import orbit_map, periodic_orbits
 from vibroimpact.pipeline import datasets, tasks
 from vibroimpact.plotting import axis_label, critical_delta
@@ -237,6 +237,9 @@ def test_fig09_bars_scale_and_markers(data):
 def test_fig09_draws_rice_asymptotes_of_the_wall_free_response(data):
     """Rice's rate checked against its closed form at one point, independent of the code:
     sigma_x = sigma_v = sqrt(S0 / 4 zeta) for white noise of two-sided level S0."""
+    # the aggregation stores the wall-free std's for the random force alone, not with a sine
+    assert data["events"].attrs["linear_sigma_x"] > 0 and data["events"].attrs["linear_sigma_v"] > 0
+    assert "linear_sigma_x" not in data["events_h"].attrs
     events = data["events"].copy()
     zeta, s0 = 0.05, 0.02
     sigma = np.sqrt(s0 / (4 * zeta))
@@ -295,6 +298,24 @@ def test_fig11_fig12_select_the_nearest_forcing_frequency(data):
         assert r"\sin(\tau/1.1)" in _title(fig)
     assert _vlines_at(fig12.axes[0]) == [pytest.approx(1 / 1.1)]
     assert len(_data_lines(fig12.axes[0])) == spectra.sizes["delta"] + 1
+
+
+def test_fig12_states_the_resolution_and_each_line_power(data):
+    """Welch peak heights depend on the resolution; the legend gives what does not."""
+    spectra = data["spectra_h"]
+    ax = plotting.fig12(spectra, inv_beta=1.1).axes[0]
+    step = float(spectra["beta"][1] - spectra["beta"][0])
+    assert f"resolution $\\Delta\\beta$ = {step:.3g}" in _legend(ax).get_title().get_text()
+    cells = spectra.isel(inv_beta=_nearest_index(spectra["inv_beta"], 1.1))
+    texts = _legend_texts(ax)
+    for d in cells["delta"].values:
+        power = stats.line_power(cells["beta"], cells["S_a"].sel(delta=d), 1.1 ** -1)
+        assert any(t.startswith(f"$\\delta$ = {d:g} ") and f"power {power:.3g})" in t
+                   for t in texts), (d, power, texts)
+
+
+def _nearest_index(coord, value):
+    return int(np.argmin(np.abs(np.asarray(coord, float) - value)))
 
 
 def test_fig11_draws_the_harmonic_part_as_a_line_of_power_half(data):

@@ -17,6 +17,7 @@ from matplotlib.figure import Figure
 
 from vibroimpact._files import atomic_path
 from vibroimpact.stats.events import t_quantile
+from vibroimpact.stats.spectra import line_power
 
 #: The house style sheet (the only place rcParams are set).
 STYLE_FILE = Path(__file__).with_name("vibroimpact.mplstyle")
@@ -337,19 +338,41 @@ def _response_spectra(spectra, i_beta, title, params, beta_max, lin_label):
     ds = ds.isel(beta=np.flatnonzero(np.asarray(ds["beta"]) <= beta_max))
     deltas = np.asarray(ds["delta"], dtype=float)
     order = np.argsort(deltas)[::-1]
-    for color, k in zip(_colors(deltas.size), order):
-        ax.plot(ds["beta"], ds["S_a"].isel(delta=k), color=color,
-                label=rf"$\delta$ = {_num(deltas[k])}")
-    ax.plot(ds["beta"], ds["S_lin"], color="k", ls="--", lw=1.1, label=lin_label)
-    if float(_attr(spectra, "amplitude")) != 0.0:
+    harmonic = float(_attr(spectra, "amplitude")) != 0.0
+    beta_f = 1.0 / float(spectra["inv_beta"][i_beta])
+    full = spectra.isel(inv_beta=i_beta)
+    for style, k in zip(family_styles(deltas.size), order):
+        label = rf"$\delta$ = {_num(deltas[k])}"
+        if harmonic:
+            power = line_power(full["beta"], full["S_a"].isel(delta=k), beta_f)
+            label += rf"  (line at $\beta_f$: power {power:.3g})"
+        ax.plot(ds["beta"], ds["S_a"].isel(delta=k), color=style["color"], ls=style["ls"],
+                lw=1.2, label=label)
+    ax.plot(ds["beta"], ds["S_lin"], color="k", ls=(0, (1.5, 1.5)), lw=1.1, label=lin_label)
+    if harmonic:
         _mark_forcing(ax, float(spectra["inv_beta"][i_beta]))
     ax.set_yscale("log")
     ax.set_xlim(0.0, float(ds["beta"].max()))
     ax.set_xlabel(axis_label(ds["beta"]))
     ax.set_ylabel(_psd_label(ds["S_a"]))
-    ax.legend(loc="upper right", ncols=1 if deltas.size < 7 else 2)
+    ax.legend(loc="upper right", ncols=1 if deltas.size < 7 else 2, fontsize=7.5,
+              title=_welch_text(full, harmonic), title_fontsize=7)
     _header(fig, title, params)
     return fig
+
+
+def _welch_text(ds, lines):
+    """Legend title of a Welch spectrum: its resolution, segments and, with spectral `lines`,
+    why their peak heights are not comparable but their powers are (`stats.line_power`)."""
+    step = float(ds["beta"][1] - ds["beta"][0])
+    segments = np.asarray(ds["n_segments"]) if "n_segments" in ds else np.array([])
+    text = rf"Welch, Hann window: resolution $\Delta\beta$ = {step:.3g}"
+    if segments.size:
+        text += f", {int(segments.min()):,} segments"
+    if lines:
+        text += ("\n" r"a line's peak height grows as 1/$\Delta\beta$; its power "
+                 r"$\frac{1}{\pi}\int (S - S_{\rm background})\,d\beta$ does not")
+    return text
 
 
 def _mark_forcing(ax, inv_beta):

@@ -5,7 +5,8 @@ import numpy as np
 
 from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
-    _num, _psd_label, _require_harmonic, _response_spectra, _styled, _trace_figure, axis_label)
+    _num, _psd_label, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
+    axis_label)
 
 
 def fig10(trace):
@@ -69,8 +70,8 @@ def fig11(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
                   rf"{_num(beta_f)}: power $A^2/2$ = {_num(amplitude ** 2 / 2)}")
     ax.set_xlim(0.0, float(ds["beta"].max()))
     ax.set_xlabel(axis_label(ds["beta"]))
-    ax.set_ylabel(r"PSD of the input (two-sided, angular)")
-    ax.legend(loc="upper right", fontsize=7)
+    ax.set_ylabel(r"PSD $S_f(\beta)$ of the input (two-sided, angular)")
+    ax.legend(loc="upper right", fontsize=7, title=_welch_text(ds, False), title_fontsize=7)
     _header(fig, "Fig. 11  Power spectral density of the harmonic plus random input",
             _events_params(spectra, i))
     return fig
@@ -92,11 +93,14 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
     Returns
     -------
     matplotlib.figure.Figure
-        As :func:`fig06`; S_lin (random part only) dashed, the forcing frequency dotted.
+        As :func:`fig06`; S_lin (random part only) dashed, the forcing frequency dotted;
+        each delta's legend entry gives the power of the response's line at beta_f
+        (`vibroimpact.stats.line_power`), comparable with Fig. 11's A^2/2 where the Welch
+        peak heights are not, and the legend's title the resolution.
     """
     i = _nearest(spectra["inv_beta"], inv_beta)
     return _response_spectra(
-        spectra, i, "Fig. 12  Power spectral density of the displacement a(τ) of the mass",
+        spectra, i, r"Fig. 12  Power spectral density of the displacement $a(\tau)$ of the mass",
         _events_params(spectra, i), beta_max, r"linear $|H|^2 S_r$ (random part only)")
 
 

@@ -137,7 +137,7 @@ def fig06(spectra, beta_max=SPECTRUM_BETA_MAX):
         One log-y axes: one curve per delta (viridis, largest delta first) and S_lin dashed.
     """
     return _response_spectra(
-        spectra, 0, "Fig. 6  Power spectral density of the displacement a(τ) of the mass",
+        spectra, 0, r"Fig. 6  Power spectral density of the displacement $a(\tau)$ of the mass",
         _events_params(spectra, 0), beta_max, r"linear $|H|^2 S_f$ (no impacts)")
 
 

@@ -20,7 +20,7 @@ _SUBMODULES = ("spectra", "events", "collisions", "motions", "theory")
 _WHERE = {
     "PSD_DETREND": "spectra", "WelchAccumulator": "spectra", "welch_psd": "spectra",
     "onesided_to_angular": "spectra", "variance_from_psd": "spectra",
-    "linear_psd_response": "spectra",
+    "linear_psd_response": "spectra", "line_power": "spectra",
     "DEFAULT_N_BATCHES": "events", "impact_intervals": "events",
     "velocity_after_impact": "events", "interval_ratio": "events", "Density": "events",
     "density": "events", "BatchMeans": "events", "batch_means": "events", "t_quantile": "events",

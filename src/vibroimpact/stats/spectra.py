@@ -26,7 +26,7 @@ from scipy import integrate, signal
 
 from vibroimpact import _checks
 
-__all__ = ["PSD_DETREND", "WelchAccumulator", "welch_psd", "onesided_to_angular",
+__all__ = ["PSD_DETREND", "WelchAccumulator", "welch_psd", "onesided_to_angular", "line_power",
            "variance_from_psd", "linear_psd_response"]
 
 #: Detrending of every PSD estimate in the package (input force and response alike): the mean
@@ -257,6 +257,45 @@ def variance_from_psd(beta, S) -> float:
     ``sum(P) df`` (the end bins carry half weight on both sides).
     """
     return float(integrate.trapezoid(np.asarray(S, float), np.asarray(beta, float)) / np.pi)
+
+
+#: A spectral line's power is summed over this many bins either side of it: Welch's Hann
+#: window puts all but ~1e-4 of a line's power within +-3 bins of its frequency.
+LINE_HALF_WIDTH = 4
+#: The continuous background under a line: the median of the PSD between `LINE_HALF_WIDTH`
+#: and this many bins from the line on both sides.
+LINE_BACKGROUND = 24
+
+
+def line_power(beta, S, beta_line: float) -> float:
+    """Power of a spectral line at ``beta_line`` in a two-sided angular Welch PSD.
+
+    Parameters
+    ----------
+    beta, S : array_like
+        PSD on an evenly spaced grid beta >= 0 (`welch_psd`), eq. (9)'s convention.
+    beta_line : float
+        Frequency of the line (e.g. the forcing's beta_f).
+
+    Returns
+    -------
+    float
+        ``(1/pi) sum (S - background) dbeta`` over the `LINE_HALF_WIDTH` bins either side of
+        the bin nearest ``beta_line``: the variance the line carries (``A^2 / 2`` for
+        ``A sin(beta_f tau)``), independent of the frequency resolution, where the peak
+        height of the line is not (it grows as 1 / dbeta). NaN when the line's bins do not
+        fit in the grid (the background takes what fits of its bins on either side).
+    """
+    beta = np.asarray(beta, dtype=float)
+    S = np.asarray(S, dtype=float)
+    step = beta[1] - beta[0]
+    k = int(np.rint((beta_line - beta[0]) / step))
+    if k - LINE_HALF_WIDTH < 0 or k + LINE_HALF_WIDTH >= beta.size:
+        return float("nan")
+    near = S[k - LINE_HALF_WIDTH:k + LINE_HALF_WIDTH + 1]
+    side = np.r_[S[max(k - LINE_BACKGROUND, 0):k - LINE_HALF_WIDTH],
+                 S[k + LINE_HALF_WIDTH + 1:k + LINE_BACKGROUND + 1]]
+    return float(np.sum(near - np.median(side)) * step / np.pi)
 
 
 def linear_psd_response(beta, S_f, zeta: float):
