@@ -64,7 +64,7 @@ def test_finding1_fails_with_a_falling_peak_frequency_or_a_peak_at_zero():
 
 
 def harmonic_events(p11=(0.0, 0.1, 0.2, 0.9, 0.95, 0.6, 0.3), p21=(0.0, 0.7, 0.8, 0.05, 0, 0, 0),
-                    cv=(1.5, 0.7, 0.6, 0.2, 0.15, 0.3, 0.4)):
+                    cv=(1.5, 0.7, 0.6, 0.2, 0.15, 0.2, 0.22)):
     """One row at 1/beta_f = 1.1: (2/1) at small plays, (1/1) at large ones."""
     ratio = np.linspace(0.0125, 3.9875, 160)
     v = np.linspace(0.0125, 4.9875, 200)
@@ -92,6 +92,12 @@ def test_findings_6_and_7_hold_and_fail_with_the_data():
     assert findings.finding6(no_21).holds == "no"
     wide = harmonic_events(cv=(1.5, 0.7, 0.3, 0.25, 0.2, 0.3, 0.4))   # as wide where (1/1) is
     assert findings.finding7(wide).holds == "no"
+    # narrow where (1/1) dominates, but wide at the largest play, where it does not
+    wide_large = harmonic_events(cv=(1.5, 0.7, 0.6, 0.2, 0.15, 0.2, 0.6))
+    found = findings.finding7(wide_large)
+    assert found.holds == "partly" and f"larger plays {DELTA[-1]:.3g}" in found.measured
+    # read only over the plays a figure draws: without the largest, it holds
+    assert findings.finding7(wide_large, deltas=DELTA[:-1]).holds == "yes"
 
 
 def test_finding8_where_and_how_strongly():

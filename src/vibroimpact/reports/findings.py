@@ -297,23 +297,46 @@ def _cv(events, delta):
     return float(np.sqrt(((v - mean) ** 2 * d).sum() / d.sum()) / mean)
 
 
-def finding7(events, inv_beta=1.1, ratio=0.5):
-    """Spread of the velocity after impact (Fig. 14) at the row nearest ``inv_beta``: its
-    coefficient of variation where (1/1) is most probable must be below ``ratio`` times the
-    smallest at the smaller plays where (1/1) is not dominant (P(1/1) < 0.5)."""
+def finding7(events, inv_beta=1.1, ratio=0.5, deltas=None):
+    """Spread of the velocity after impact (Fig. 14) at the row nearest ``inv_beta``, read
+    over every play the figure draws (``deltas``; default every play with impacts).
+
+    A play is *narrow* when its coefficient of variation is below ``ratio`` times the
+    smallest one among the small plays where (1/1) is not dominant (P(1/1) < 0.5, below the
+    smallest play where it is). "yes": every play where (1/1) dominates is narrow, and so is
+    every larger play; "partly": the plays where (1/1) dominates are narrow but a larger one is
+    not (its P(1/1) is given: another motion shares it); "no": a play where (1/1) dominates is
+    not narrow.
+    """
     ev = _impacting(_row(events, inv_beta))
     if "motion_probability" not in ev or "1/1" not in [str(m) for m in ev.motion.values]:
         return not_available(7, "needs the velocity densities and P(1/1) of a harmonic study")
+    if deltas is not None:
+        keep = [d for d in ev.delta.values if np.min(np.abs(np.asarray(deltas, float) - d)) < 1e-9]
+        ev = ev.sel(delta=keep)
     p11 = _motion(ev, "1/1")
-    large = float(ev.delta[int(p11.argmax("delta"))])
-    small = ev.delta[(ev.delta < large) & (p11 < 0.5)].values
-    if small.size == 0:
-        return not_available(7, f"no play below delta = {large:.3g} where (1/1) is not dominant")
-    cv_large, cv_small = _cv(ev, large), [_cv(ev, d) for d in small]
-    measured = (f"1/beta_f = {float(ev.inv_beta):.3g}: coefficient of variation "
-                f"{cv_large:.2f} at delta = {large:.3g} (P(1/1) = {float(p11.max()):.2f}) "
-                f"against {_fmt(cv_small, '.2f')} at delta = {_fmt(small)}")
-    return _finding(7, measured, _yes(cv_large < ratio * min(cv_small)))
+    d = ev.delta.values
+    dominant = p11.values >= 0.5
+    if not dominant.any():
+        return not_available(7, f"(1/1) dominates at no play drawn (delta = {_fmt(d)})")
+    small = (d < d[dominant].min()) & ~dominant
+    if not small.any():
+        return not_available(7, f"no play below delta = {d[dominant].min():.3g} where (1/1) "
+                                f"is not dominant")
+    cv = np.array([_cv(ev, x) for x in d])
+    limit = ratio * cv[small].min()
+    narrow = cv < limit
+    larger = d > d[dominant].min()
+    wide_large = larger & ~narrow
+    parts = [f"{x:.3g}: {c:.2f} (P(1/1) {p:.2f})" for x, c, p in zip(d, cv, p11.values)]
+    measured = (f"1/beta_f = {float(ev.inv_beta):.3g}, coefficient of variation at delta = "
+                + "; ".join(parts) + f". Narrow: below {limit:.2f} ({ratio:g} x the smallest "
+                f"at the small plays {_fmt(d[small])})")
+    if wide_large.any():
+        measured += (f"; wide at the larger plays {_fmt(d[wide_large])}, where (1/1) is not "
+                     f"alone")
+    holds = ("no" if not narrow[dominant].all() else "partly" if wide_large.any() else "yes")
+    return _finding(7, measured, holds)
 
 
 def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5):
@@ -337,15 +360,18 @@ def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5):
         "partly" if where else "no"))
 
 
-def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, inv_beta=1.1):
+def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, inv_beta=1.1,
+                    density_delta=None):
     """Findings 5-8 of a harmonic-plus-random study; those whose datasets are missing are
     ``n/a``. ``agreement`` is :func:`vibroimpact.plotting.maps.map_agreement` of its map with
-    an orbits map."""
+    an orbits map; ``density_delta``, the plays Fig. 14 draws, are those finding 7 reads
+    (default: every play with impacts)."""
     found = [finding5(spectra, amplitude) if spectra is not None else
              not_available(5, "this study draws no spectrum of a(tau) (Fig. 12)")]
-    for number, fn in ((6, finding6), (7, finding7)):
-        found.append(fn(events, inv_beta) if events is not None else
-                     not_available(number, "this study has no impact densities (Figs. 13, 14)"))
+    missing = "this study has no impact densities (Figs. 13, 14)"
+    found.append(finding6(events, inv_beta) if events is not None else not_available(6, missing))
+    found.append(finding7(events, inv_beta, deltas=density_delta) if events is not None else
+                 not_available(7, missing))
     found.append(finding8(agreement) if agreement is not None else
                  not_available(8, "this study has no probability map compared with an orbits "
                                   "map (fig15_vs_fig16)"))
