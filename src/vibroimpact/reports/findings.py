@@ -13,6 +13,7 @@ bin of the density or the frequency grid.
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import stats
 
 #: Fewest impacts a play needs before its means and densities take part in a finding
 #: (the batch-means error of a mean over 1000 impacts is a few percent).
@@ -104,8 +105,9 @@ def finding1(spectra, band=(0.2, 3.0), flat=3.0):
     """PSD of a(tau) against delta (Fig. 6).
 
     Over ``band`` of beta, for the plays delta > 0 in decreasing order, the peak frequency must
-    rise and the peak level fall; at delta = 0 the peak must be below ``flat`` times the median
-    (no marked peak).
+    rise (never fall by a bin of the spectrum, and end higher than it starts: plays too large
+    to be hit share the linear peak's bin) and the peak level fall; at delta = 0 the peak must
+    be below ``flat`` times the median (no marked peak).
     """
     s = _row(spectra).sel(beta=slice(*band))
     positive = s.sel(delta=s.delta[s.delta > 0]).sortby("delta", ascending=False)
@@ -116,8 +118,9 @@ def finding1(spectra, band=(0.2, 3.0), flat=3.0):
     peak_level = positive.S_a.max("beta").values
     at_zero = s.S_a.sel(delta=0.0)
     sharpness = float(at_zero.max() / at_zero.median())
-    rises, falls, flat_at_zero = (_increasing(peak_beta), _increasing(-peak_level),
-                                  sharpness < flat)
+    step = float(s.beta[1] - s.beta[0])
+    rises = bool(np.all(np.diff(peak_beta) > -0.5 * step) and peak_beta[-1] > peak_beta[0])
+    falls, flat_at_zero = _increasing(-peak_level), sharpness < flat
     measured = (f"delta = {_fmt(positive.delta.values)}: peak at beta = {_fmt(peak_beta)}, "
                 f"level {_fmt(peak_level)}; at delta = 0 peak / median = {sharpness:.2f} "
                 f"(< {flat:g} counts as no marked peak)")
@@ -297,26 +300,27 @@ def _cv(events, delta):
     return float(np.sqrt(((v - mean) ** 2 * d).sum() / d.sum()) / mean)
 
 
-def finding7(events, inv_beta=1.1, ratio=0.5, deltas=None):
+def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     """Spread of the velocity after impact (Fig. 14) at the row nearest ``inv_beta``, read
     over every play the figure draws (``deltas``; default every play with impacts).
 
-    A play is *narrow* when its coefficient of variation is below ``ratio`` times the
-    smallest one among the small plays where (1/1) is not dominant (P(1/1) < 0.5, below the
-    smallest play where it is). "yes": every play where (1/1) dominates is narrow, and so is
-    every larger play; "partly": the plays where (1/1) dominates are narrow but a larger one is
-    not (its P(1/1) is given: another motion shares it); "no": a play where (1/1) dominates is
-    not narrow.
+    The spread is the coefficient of variation (CV) of the density. A play is *narrow* when
+    its CV lies nearer the CV at the play where (1/1) is most probable than the smallest CV
+    of the small plays where (1/1) is not dominant (P(1/1) < 0.5, below the smallest play
+    where it is). "yes": the spread falls as P(1/1) grows along the plays (Spearman rank
+    correlation <= ``correlation``) and every play where (1/1) dominates (P >= 0.5) or that is
+    larger is narrow; "partly": the spread falls with P(1/1) but such a play is wide; "no":
+    it does not fall with P(1/1).
     """
     ev = _impacting(_row(events, inv_beta))
     if "motion_probability" not in ev or "1/1" not in [str(m) for m in ev.motion.values]:
         return not_available(7, "needs the velocity densities and P(1/1) of a harmonic study")
     if deltas is not None:
-        keep = [d for d in ev.delta.values if np.min(np.abs(np.asarray(deltas, float) - d)) < 1e-9]
-        ev = ev.sel(delta=keep)
-    p11 = _motion(ev, "1/1")
+        wanted = np.asarray(deltas, dtype=float)
+        ev = ev.sel(delta=[d for d in ev.delta.values if np.min(np.abs(wanted - d)) < 1e-9])
+    p11 = _motion(ev, "1/1").values
     d = ev.delta.values
-    dominant = p11.values >= 0.5
+    dominant = p11 >= 0.5
     if not dominant.any():
         return not_available(7, f"(1/1) dominates at no play drawn (delta = {_fmt(d)})")
     small = (d < d[dominant].min()) & ~dominant
@@ -324,18 +328,16 @@ def finding7(events, inv_beta=1.1, ratio=0.5, deltas=None):
         return not_available(7, f"no play below delta = {d[dominant].min():.3g} where (1/1) "
                                 f"is not dominant")
     cv = np.array([_cv(ev, x) for x in d])
-    limit = ratio * cv[small].min()
-    narrow = cv < limit
-    larger = d > d[dominant].min()
-    wide_large = larger & ~narrow
-    parts = [f"{x:.3g}: {c:.2f} (P(1/1) {p:.2f})" for x, c, p in zip(d, cv, p11.values)]
+    limit = 0.5 * (cv[np.argmax(p11)] + cv[small].min())
+    rho = float(stats.spearmanr(p11, cv).statistic)
+    wide = (dominant | (d > d[dominant].min())) & (cv >= limit)
+    parts = [f"{x:.3g}: {c:.2f} (P(1/1) {p:.2f})" for x, c, p in zip(d, cv, p11)]
     measured = (f"1/beta_f = {float(ev.inv_beta):.3g}, coefficient of variation at delta = "
-                + "; ".join(parts) + f". Narrow: below {limit:.2f} ({ratio:g} x the smallest "
-                f"at the small plays {_fmt(d[small])})")
-    if wide_large.any():
-        measured += (f"; wide at the larger plays {_fmt(d[wide_large])}, where (1/1) is not "
-                     f"alone")
-    holds = ("no" if not narrow[dominant].all() else "partly" if wide_large.any() else "yes")
+                + "; ".join(parts) + f". Rank correlation with P(1/1) {rho:.2f}; narrow below "
+                f"{limit:.2f}")
+    if wide.any():
+        measured += f"; wide at delta = {_fmt(d[wide])}, where (1/1) is not alone"
+    holds = "no" if not rho <= correlation else "partly" if wide.any() else "yes"
     return _finding(7, measured, holds)
 
 
