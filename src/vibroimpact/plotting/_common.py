@@ -299,7 +299,7 @@ def _trace_figure(trace, title, harmonic):
     _panel_tag(ax_f, "(a)")
 
     ax_a.plot(tau, trace["a"], color="C0", lw=1.0)
-    ax_a.axhline(0.0, color="0.2", lw=1.4, label="wall (a = 0)")
+    ax_a.axhline(0.0, color="0.2", lw=1.4, label=r"wall ($a = 0$)")
     t_imp = np.asarray(trace["impact_time"])
     shown = (t_imp >= float(tau[0])) & (t_imp <= float(tau[-1]))
     if "impact_collision" in trace:
