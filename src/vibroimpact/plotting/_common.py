@@ -289,10 +289,10 @@ def _trace_figure(trace, title, harmonic):
     tau = trace["tau"]
     force = trace["f"] if harmonic else trace["r"]
     ax_f.axhline(0.0, color="0.5", lw=0.6)
-    ax_f.plot(tau, force, color="C0", lw=0.9, label=force.attrs.get("long_name", force.name))
+    ax_f.plot(tau, force, color="C0", lw=0.9, label=axis_label(force))
     if harmonic:
         ax_f.plot(tau, trace["f"] - trace["r"], color="0.35", lw=0.9, ls="--",
-                  label="harmonic part")
+                  label=r"harmonic part $f - r$")
         _headroom(ax_f)
         ax_f.legend(loc="upper right", ncols=2)
     ax_f.set_ylabel(axis_label(force))
