@@ -1,6 +1,8 @@
 # The validation targets (docs/figures.md, "Beyond the paper"): the work-precision run of the
-# simulator against its peers, and a seeded quick sample of the stress families. Each dataset
-# job measures wall times, so it runs alone on one core; drawing is cheap and runs locally.
+# simulator against its peers, and a seeded quick sample of the stress families; drawing is
+# cheap and runs locally. The work-precision job compares wall times, so it holds every core
+# of the run (threads = --cores): no other job of the build runs beside it. On SLURM its
+# profile asks for a node to itself (workflow/profiles/slurm).
 localrules:
     draw_validation_figure,
 
@@ -38,7 +40,7 @@ rule measure_work_precision:
         "results/logs/measure_work_precision.log",
     benchmark:
         "results/benchmarks/measure_work_precision.tsv"
-    threads: 1
+    threads: workflow.cores
     resources:
         mem_mb=BASE_MEM_MB + 200,
         runtime=10,
