@@ -96,7 +96,7 @@ def test_a_build_beyond_a_limit_is_refused_with_the_estimate_and_the_key():
     with pytest.raises(configuration.ConfigError) as info:
         configuration.load(user, root=ROOT)
     text = str(info.value)
-    assert "limits.max_cells = 1,000" in text and "5,288 simulation cells" in text
+    assert "limits.max_cells = 1,000" in text and "5,292 simulation cells" in text
     assert "raise limits.max_cells" in text
 
 
