@@ -237,6 +237,10 @@ def test_work_precision_figure(wp):
     assert r"$\tau$" in axes[0].get_ylabel() and "$e$" in axes[0].get_xlabel()
     fig.canvas.draw()
     assert _inside_and_apart(fig, axes) >= 4
+    renderer = fig.canvas.get_renderer()
+    for text in fig.texts:          # the header and the footnote fit the figure's width
+        box = text.get_window_extent(renderer)
+        assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1, text.get_text()
     for ax, delta in zip(axes, [1.0, 0.0]):
         assert f"= {delta:g}:" in ax.get_title()
         stars = [ln for ln in ax.get_lines() if ln.get_gid() == "simulator"]

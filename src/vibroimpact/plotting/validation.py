@@ -6,6 +6,8 @@ return a Figure; neither imports the simulator or the validation code.
 """
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -52,6 +54,10 @@ LABEL_OFFSETS = [(4, 3, "left", "bottom"), (4, -3, "left", "top"),
                  (0, 6, "center", "bottom"), (0, -6, "center", "top"),
                  (7, 0, "left", "center"), (-7, 0, "right", "center")]
 FAR = 2.6
+#: Font size of the footnote, and its characters per inch of figure width (wrapped to fit;
+#: its mathtext has no spaces, so it is never broken inside).
+FOOTNOTE_SIZE = 7
+FOOTNOTE_CHARS_PER_INCH = 17
 #: Font size of the setting labels, and their clearance (pixels) from every other mark.
 LABEL_SIZE = 6.5
 LABEL_PAD = 1.0
@@ -328,7 +334,10 @@ def work_precision(ds):
     if missing:
         notes.append(f"{missing} runs found no impact (not drawn)")
     if notes:  # the figure's x label sits below the legend: the footnote's place
-        fig.supxlabel("\n".join(notes), x=0.005, ha="left", fontsize=7, color="0.2",
+        chars = int(fig.get_figwidth() * FOOTNOTE_CHARS_PER_INCH)
+        text = "\n".join(textwrap.fill(line, chars, subsequent_indent="  ")
+                         for note in notes for line in note.split("\n"))
+        fig.supxlabel(text, x=0.005, ha="left", fontsize=FOOTNOTE_SIZE, color="0.2",
                       gid="footnote")
     renderer = fig.canvas.get_renderer()
     _fit_header(fig, renderer)
