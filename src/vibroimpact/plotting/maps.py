@@ -1,23 +1,288 @@
-"""Fig. 15, the probability maps of the impact motions, and their comparison with Fig. 16."""
+"""Fig. 15, the probability maps of the impact motions, and their comparison with Fig. 16.
+
+Also what every map over the (1/beta, delta) plane shares (Fig. 16 imports it from here):
+cells drawn whole (`cell_rectangles`, `cell_outline`), the few-switches marking, contour
+labels placed only where lines are well apart, the type colours and S levels.
+"""
 from __future__ import annotations
 
+import contourpy
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection, PatchCollection
+from matplotlib.contour import ContourSet
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
+from matplotlib.path import Path
+from scipy.spatial import cKDTree
 
 from vibroimpact import stats
 from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _styled,
                                           _system_text, axis_label)
-from vibroimpact.plotting.orbits import S_LEVELS, TYPE_COLORS
 
 #: Probability contours (%) of Fig. 15 (the paper draws 10 % steps).
 PROBABILITY_LEVELS = (10, 20, 30, 40, 50, 60, 70, 80, 90)
 #: Probability contours (%) drawn over the stable domains in the comparison with Fig. 16.
 COMPARISON_LEVELS = (20, 50, 80)
-#: Hatching of cells whose record switched too rarely between motions to be trusted.
-FEW_SWITCHES_HATCH = "////"
+
+
+# --------------------------------------------------------------------------------------------
+# What every map over the (1/beta, delta) plane shares (Figs. 15, 16 and their comparison)
+# --------------------------------------------------------------------------------------------
+
+#: Contour levels of the degree of stability S (%).
+S_LEVELS = (5, 10, 20, 30, 40, 50, 60, 70, 80, 90)
+#: One colour per motion type: the Okabe-Ito qualitative palette, which readers with the
+#: common colour-vision deficiencies can also tell apart (black last).
+TYPE_COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
+#: Font size (pt) of contour labels and of the words written in a map's regions.
+MAP_TEXT_SIZE = 7.5
+#: A contour label keeps this distance (fraction of the panel's width and height) from the
+#: labels already placed, and `LINE_CLEARANCE` from every other contour line, so that labels
+#: sit only where the lines are well apart.
+LABEL_SPACING = 0.1
+LINE_CLEARANCE = 0.02
+#: A line shorter than this (fraction of the panel's size) gets no label.
+LABELLED_LENGTH = 0.1
+#: Look of the cells whose record switched between motions only 1 to min_switches - 1 times
+#: (their probabilities are not stationary): whole cells, hatched over a light veil so the
+#: hatch reads on the dark bands too, their union outlined.
+FEW_SWITCHES_STYLE = dict(facecolor=(1.0, 1.0, 1.0, 0.55), edgecolor="0.1", hatch="/////",
+                          linewidth=0.0)
+
+
+def cell_edges(centres):
+    """Edges of the cells around evenly or unevenly spaced increasing `centres` (n + 1)."""
+    c = np.asarray(centres, dtype=float)
+    if c.size == 1:
+        return np.array([c[0] - 0.5, c[0] + 0.5])
+    mid = 0.5 * (c[1:] + c[:-1])
+    return np.concatenate([[2.0 * c[0] - mid[0]], mid, [2.0 * c[-1] - mid[-1]]])
+
+
+def cell_outline(x, y, mask, border=False, only=None):
+    """Segments of the cell edges between the cells in `mask` and those outside.
+
+    Parameters
+    ----------
+    x, y : array_like, shape (nx,), (ny,)
+        Cell centres.
+    mask : ndarray of bool, shape (nx, ny)
+    border : bool
+        Also outline the flagged cells along the grid's border (else a region that runs off
+        the grid stays open there: it goes on beyond the map).
+    only : ndarray of bool, shape (nx, ny), optional
+        Outline only the edges of the cells of `mask` that are also in `only`.
+
+    Returns
+    -------
+    list of ((x0, y0), (x1, y1))
+    """
+    xe, ye = cell_edges(x), cell_edges(y)
+    mode = "constant" if border else "edge"
+    m = np.pad(np.asarray(mask, bool), 1, mode=mode)
+    k = m & np.pad(np.ones(m[1:-1, 1:-1].shape, bool) if only is None else only, 1, mode=mode)
+    a, b = np.nonzero((m[1:, 1:-1] != m[:-1, 1:-1])             # edges at x = xe[a]
+                      & (k[1:, 1:-1] | k[:-1, 1:-1]))
+    segments = [((xe[i], ye[j]), (xe[i], ye[j + 1])) for i, j in zip(a, b)]
+    a, b = np.nonzero((m[1:-1, 1:] != m[1:-1, :-1])             # edges at y = ye[b]
+                      & (k[1:-1, 1:] | k[1:-1, :-1]))
+    return segments + [((xe[i], ye[j]), (xe[i + 1], ye[j])) for i, j in zip(a, b)]
+
+
+def cell_rectangles(x, y, mask):
+    """One :class:`~matplotlib.patches.Rectangle` per cell in `mask` (centres `x`, `y`)."""
+    xe, ye = cell_edges(x), cell_edges(y)
+    return [Rectangle((xe[i], ye[j]), xe[i + 1] - xe[i], ye[j + 1] - ye[j])
+            for i, j in zip(*np.nonzero(mask))]
+
+
+def mark_few_switches(ax, x, y, few):
+    """Hatch the whole cells whose probabilities are not stationary and outline their union.
+
+    The hatched collection has gid ``"few_switches"``; its paths are the cells' rectangles.
+    """
+    if not few.any():
+        return
+    ax.add_collection(PatchCollection(cell_rectangles(x, y, few), gid="few_switches",
+                                      **FEW_SWITCHES_STYLE), autolim=False)
+    ax.add_collection(LineCollection(cell_outline(x, y, few, border=True), colors="0.1",
+                                     linewidths=0.7, capstyle="projecting"), autolim=False)
+
+
+def few_switches_handle(motion_map, short=False):
+    """Legend entry of :func:`mark_few_switches` (the same style, written once)."""
+    n = int(_attr(motion_map, "min_switches")) - 1
+    text = "few switches" if short else f"1 to {n} switches between motions"
+    return Patch(**{**FEW_SWITCHES_STYLE, "linewidth": 0.7},
+                 label=f"{text}: probabilities not stationary")
+
+
+def _lines(ax, cs):
+    """The vertex arrays of a ContourSet's lines, per level, in axes coordinates."""
+    to_axes = ax.transData + ax.transAxes.inverted()
+    out = []
+    for path in cs.get_paths():
+        v = to_axes.transform(path.vertices) if len(path.vertices) else path.vertices
+        if path.codes is None:
+            starts = np.array([0]) if len(v) else np.array([], int)
+        else:
+            starts = np.flatnonzero(path.codes == Path.MOVETO)
+        pieces = np.split(v, starts[1:]) if len(starts) else []
+        out.append([piece for piece in pieces if len(piece) > 1])
+    return out
+
+
+def label_contours(ax, cs, fmt, avoid=()):
+    """Label the lines of `cs` only where they are well apart, at `MAP_TEXT_SIZE`.
+
+    Each line gets at most one label, at the vertex nearest its middle that lies
+    `LINE_CLEARANCE` from every line of another level (and from the vertex arrays `avoid`,
+    data coordinates) and `LABEL_SPACING` from the labels already placed; longest lines
+    first, a level's second label only after every level had its chance at a first one.
+    Returns the label texts (none when `cs` is None).
+    """
+    if cs is None:
+        return []
+    to_axes = ax.transData + ax.transAxes.inverted()
+    lines = _lines(ax, cs)
+    extra = [to_axes.transform(np.asarray(v, float)) for v in avoid if len(v)]
+    trees = {}
+    for k in range(len(lines)):
+        near = [v for j, level in enumerate(lines) if j != k for v in level] + extra
+        trees[k] = cKDTree(np.concatenate(near)) if near else None
+    candidates = sorted(((np.sum(np.hypot(*np.diff(v, axis=0).T)), k, v)
+                         for k, level in enumerate(lines) for v in level),
+                        key=lambda c: -c[0])
+    candidates = [c for c in candidates if c[0] >= LABELLED_LENGTH]
+    kept, labelled, done = [], set(), set()
+    for first in (True, False):
+        for n, (_, k, v) in enumerate(candidates):
+            if n in done or (first and k in labelled):
+                continue
+            ok = np.all((v > LINE_CLEARANCE) & (v < 1.0 - LINE_CLEARANCE), axis=1)
+            if trees[k] is not None:
+                ok &= trees[k].query(v, p=np.inf)[0] >= LINE_CLEARANCE
+            for i in np.argsort(np.abs(np.arange(len(v)) - 0.5 * (len(v) - 1))):
+                if ok[i] and all(np.max(np.abs(v[i] - q)) >= LABEL_SPACING for q in kept):
+                    kept.append(v[i])
+                    labelled.add(k)
+                    done.add(n)
+                    break
+    if not kept:
+        return []
+    to_data = to_axes.inverted()
+    return ax.clabel(cs, fmt=fmt, fontsize=MAP_TEXT_SIZE, inline=True, inline_spacing=3,
+                     manual=[tuple(to_data.transform(q)) for q in kept])
+
+
+#: Neighbouring cells whose probabilities differ by `CLIFF_JUMP` (pp) or more are a cliff:
+#: every contour level between them would run through the same half cell, so only the
+#: `CLIFF_LEVEL` line is drawn there, smoothed over `CLIFF_SMOOTHING` vertices (the grid
+#: places it only to within a cell, and its steps are the grid's, not the map's).
+CLIFF_JUMP = 40.0
+CLIFF_LEVEL = 50.0
+CLIFF_SMOOTHING = 5
+#: A piece of line left between two cliffs shorter than this (cells) is dropped: it would
+#: read as a dash along the cliff.
+CLIFF_STUB = 5.0
+
+
+def _cliff_flags(p):
+    """``(across_x, across_y)``: the grid edges between neighbouring cells that are a cliff."""
+    return tuple(np.abs(np.diff(p, axis=axis)) >= CLIFF_JUMP for axis in (0, 1))
+
+
+def _on_cliff(v, x, y, across_x, across_y):
+    """Which vertices of a contour line lie on a cliff edge of the grid."""
+    tol_x, tol_y = 1e-9 * np.ptp(x), 1e-9 * np.ptp(y)
+    jy = np.clip(np.searchsorted(y, v[:, 1]), 0, y.size - 1)
+    jy = np.where(np.abs(y[jy - 1] - v[:, 1]) < np.abs(y[jy] - v[:, 1]), jy - 1, jy)
+    ix = np.clip(np.searchsorted(x, v[:, 0]), 0, x.size - 1)
+    ix = np.where(np.abs(x[ix - 1] - v[:, 0]) < np.abs(x[ix] - v[:, 0]), ix - 1, ix)
+    on_row = np.abs(y[jy] - v[:, 1]) <= tol_y        # on an edge across x, between columns
+    on_col = np.abs(x[ix] - v[:, 0]) <= tol_x
+    i = np.clip(np.searchsorted(x, v[:, 0]) - 1, 0, x.size - 2)
+    j = np.clip(np.searchsorted(y, v[:, 1]) - 1, 0, y.size - 2)
+    return (on_row & across_x[i, jy]) | (on_col & across_y[ix, j])
+
+
+def _smoothed(v):
+    """Moving average of a line's vertices over `CLIFF_SMOOTHING`, its ends kept."""
+    half = CLIFF_SMOOTHING // 2
+    if len(v) <= 2 * half + 1:
+        return v
+    kernel = np.ones(CLIFF_SMOOTHING) / CLIFF_SMOOTHING
+    out = v.copy()
+    out[half:-half] = np.column_stack([np.convolve(v[:, k], kernel, mode="valid")
+                                       for k in (0, 1)])
+    return out
+
+
+def _runs(v, keep):
+    """Maximal runs of consecutive segments of `v` flagged in `keep`, as vertex arrays."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], keep.astype(int), [0]])))
+    return [v[a:b + 1] for a, b in zip(edges[::2], edges[1::2])]
+
+
+def probability_contours(ax, x, y, p, levels, **line_kw):
+    """Contours of a probability map (%) with each cliff drawn as one line.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+    x, y : ndarray, shape (nx,), (ny,)
+        Cell centres (increasing); the lines are interpolated between them.
+    p : ndarray, shape (nx, ny)
+        Probability (%).
+    levels : sequence of float
+    **line_kw
+        ``colors``, ``linewidths`` ... of :class:`~matplotlib.contour.ContourSet`.
+
+    Returns
+    -------
+    (ContourSet, list of ndarray)
+        The contour lines off the cliffs (to be labelled; None when there are none), and the
+        `CLIFF_LEVEL` line along the cliffs, smoothed (vertex arrays, data coordinates; the
+        caller draws them).
+
+    Notes
+    -----
+    Where the probability jumps by `CLIFF_JUMP` or more between neighbouring cells (e.g.
+    from no impact at all to one motion only) the grid does not resolve where in between
+    each level is crossed: its lines would pile up along the cell row, labels on top of each
+    other. There only the `CLIFF_LEVEL` line is kept; a segment is on a cliff when both its
+    ends lie on grid edges between such cells.
+    """
+    across_x, across_y = _cliff_flags(p)
+    generator = contourpy.contour_generator(x, y, p.T, line_type=contourpy.LineType.Separate)
+
+    cell = np.array([np.ptp(x) / max(x.size - 1, 1), np.ptp(y) / max(y.size - 1, 1)])
+
+    def stub(run, on):
+        """A short piece that ends on a cliff (not a small closed loop of the map)."""
+        length = np.sum(np.hypot(*(np.diff(run, axis=0) / cell).T))
+        return length < CLIFF_STUB and (on[0] or on[-1])
+
+    def split(level):
+        kept, steep = [], []
+        for v in generator.lines(level):
+            on = _on_cliff(v, x, y, across_x, across_y)
+            cliff = on[1:] & on[:-1]
+            edges = np.flatnonzero(np.diff(np.concatenate([[0], (~cliff).astype(int), [0]])))
+            for a, b in zip(edges[::2], edges[1::2]):
+                if stub(v[a:b + 1], on[a:b + 1]):
+                    cliff[a:b] = True            # part of the cliff it lies along
+            kept += _runs(v, ~cliff)
+            steep += _runs(v, cliff)
+        return kept, steep
+
+    segs = [split(level)[0] for level in levels]
+    cliff = [_smoothed(v) for v in split(CLIFF_LEVEL)[1]]
+    if not any(segs):
+        return None, cliff
+    return ContourSet(ax, levels, segs, **line_kw), cliff
 
 
 def _map_forcing_text(ds):
@@ -31,8 +296,9 @@ def _map_text(ds):
     """The map's statistics: window, target precision, share reached, record lengths."""
     reached = float(np.mean(ds["reached"].values))
     t = ds["simulated_time"].values
-    return (rf"z_j between collisions (chatter and sticking grouped), "
-            rf"w = {_num(_attr(ds, 'motion_window'))};  each cell from rest over one noise record, "
+    return (rf"$z_j$ between collisions (chatter and sticking grouped), "
+            rf"$w$ = {_num(_attr(ds, 'motion_window'))};  "
+            "each cell from rest over one noise record, "
             rf"to s.e. $\leq$ {100 * float(_attr(ds, 'target_stderr')):.3g} pp "
             rf"({100 * reached:.1f} % of cells) or {int(_attr(ds, 'max_periods'))} periods;  "
             rf"record {t.min():.0f}-{t.max():.0f} (median {np.median(t):.0f})")
@@ -42,11 +308,10 @@ def _grid(ds):
     return ds["inv_beta"].values, ds["delta"].values
 
 
-def _few_switches(ax, x, y, few):
-    """Hatch the cells whose probabilities are not stationary (`motion_map_cell`)."""
-    if few.any():
-        ax.contourf(x, y, few.T.astype(float), levels=[0.5, 1.5], colors="none",
-                    hatches=[FEW_SWITCHES_HATCH])
+def _cliff_handle(lw):
+    return Line2D([], [], color="k", lw=lw,
+                  label=f"cliff: {CLIFF_JUMP:g} pp or more between neighbouring cells "
+                        f"(only the {CLIFF_LEVEL:g} % line drawn, smoothed)")
 
 
 def _finish_figure(fig, motion_map, handles, title):
@@ -82,11 +347,12 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         One contour map per motion with free flights (the periodic impact motions of Fig. 16)
         and, when the dataset has ``stick_probability``, one of their impact-stick variants
         together (a collision of the motion ends sticking: the impact-chatter-stick cycle of
-        a pre-loaded wall, which `periodic_orbits` does not return): filled bands and
-        labelled lines of the probability in percent; hatched where the record switched
-        between motions only 1 to ``min_switches - 1`` times (its numbers say where it
-        started, not the long-run share); dots where the cap stopped the cell before the
-        target precision.
+        a pre-loaded wall, which `periodic_orbits` does not return): filled bands and lines
+        of the probability in percent, labelled where they are apart (`label_contours`), a
+        cliff drawn as one line (`probability_contours`); whole cells hatched where the
+        record switched between motions only 1 to ``min_switches - 1`` times (its numbers
+        say where it started, not the long-run share; `mark_few_switches`); dots where the
+        cap stopped the cell before the target precision.
     """
     motions = [str(m) for m in motion_map["motion"].values]
     panels = [(f"({m})", motion_map["probability"].sel(motion=m).values) for m in motions]
@@ -100,22 +366,25 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
     few = motion_map["few_switches"].values.astype(bool)
     short = ~motion_map["reached"].values.astype(bool)
     fill_levels = [0.0, *levels, 100.0]
-    shaded = None
+    shaded, has_cliff = None, False
     for ax, (title, prob) in zip(axes, panels):
         p = 100.0 * prob
         shaded = ax.contourf(x, y, p.T, levels=fill_levels, cmap="Blues", vmin=-10, vmax=100)
-        lines = ax.contour(x, y, p.T, levels=levels, colors="k", linewidths=0.6)
-        ax.clabel(lines, fmt="%d", fontsize=6)
-        _few_switches(ax, x, y, few)
+        lines, cliff = probability_contours(ax, x, y, p, levels, colors="k", linewidths=0.6)
+        ax.add_collection(LineCollection(cliff, colors="k", linewidths=1.0, gid="cliff"),
+                          autolim=False)
+        label_contours(ax, lines, "%d", avoid=cliff)
+        has_cliff |= bool(cliff)
+        mark_few_switches(ax, x, y, few)
         if short.any():
             i, j = np.nonzero(short)
             ax.plot(x[i], y[j], ls="none", marker=".", ms=1.5, color="C3")
         ax.set_title(title, fontsize=9 if len(title) > 12 else None)
     _finish_axes(axes, motion_map)
     fig.colorbar(shaded, ax=axes.tolist(), label="probability of the motion (%)", shrink=0.85)
-    handles = [Patch(facecolor="white", edgecolor="k", hatch=FEW_SWITCHES_HATCH,
-                     label=f"1 to {int(_attr(motion_map, 'min_switches')) - 1} switches "
-                           "between motions: not stationary")]
+    handles = [few_switches_handle(motion_map)] if few.any() else []
+    if has_cliff:
+        handles.append(_cliff_handle(1.0))
     if short.any():
         handles.append(Line2D([], [], ls="none", marker=".", color="C3",
                               label="target precision not reached (cap)"))
@@ -150,9 +419,11 @@ def _agreement_text(a):
     def pct(v):
         return "n/a" if not np.isfinite(v) else f"{100 * v:.0f} %"
     rho = "n/a" if not np.isfinite(a["rank_correlation"]) else f"{a['rank_correlation']:.2f}"
-    return (f"P ≥ 50 %: {a['n_dominant']} cells, {pct(a['dominant_inside'])} inside\n"
-            f"domain with P ≥ 50 %: {pct(a['domain_covered'])}\n"
-            f"rank corr. (P, S) inside: {rho}")
+    return (rf"$P \geq 50$ %: {a['n_dominant']} cells, {pct(a['dominant_inside'])} inside"
+            "\n"
+            rf"domain with $P \geq 50$ %: {pct(a['domain_covered'])}"
+            "\n"
+            rf"rank corr. $(P, S)$ inside: {rho}")
 
 
 @_styled
@@ -192,6 +463,7 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(agreement), sharex=True, sharey=True, squeeze=False).ravel()
     few = motion_map["few_switches"].values.astype(bool)
+    has_cliff = False
     for k, (ax, name) in enumerate(zip(axes, agreement)):
         sel = orbits.sel(type=name)
         stable = sel["n_stable"].values > 0
@@ -203,20 +475,26 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
             ax.contour(xo, yo, stable.T.astype(float), levels=[0.5], colors="0.3",
                        linewidths=1.0)
         p = 100.0 * motion_map["probability"].sel(motion=name).values
-        lines = ax.contour(x, y, p.T, levels=levels, colors=[color],
-                           linewidths=[0.8, 1.8, 0.8][:len(levels)] if len(levels) == 3 else 1.2)
-        ax.clabel(lines, fmt="%d %%", fontsize=6)
-        _few_switches(ax, x, y, few)
+        widths = [1.8 if level == CLIFF_LEVEL else 0.8 for level in levels]
+        lines, cliff = probability_contours(ax, x, y, p, levels, colors=[color],
+                                            linewidths=widths)
+        ax.add_collection(LineCollection(cliff, colors=[color], linewidths=1.8, gid="cliff"),
+                          autolim=False)
+        label_contours(ax, lines, "%d %%", avoid=cliff)
+        has_cliff |= bool(cliff)
+        mark_few_switches(ax, x, y, few)
         ax.text(0.98, 0.02, _agreement_text(agreement[name]), transform=ax.transAxes,
                 ha="right", va="bottom", fontsize=6.5,
                 bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.85, pad=2))
         ax.set_title(f"({name})")
     _finish_axes(axes, motion_map)
     handles = [Patch(facecolor="0.88", edgecolor="0.3", label=r"stable under $\sin(\beta_f\tau)$ alone (Fig. 16)"),
-               Line2D([], [], color="0.55", lw=0.4, label="its degree of stability S (%)"),
+               Line2D([], [], color="0.55", lw=0.4, label="its degree of stability $S$ (%)"),
                Line2D([], [], color="k", lw=1.8,
-                      label=f"probability {', '.join(map(str, levels))} % with noise (Fig. 15)"),
-               Patch(facecolor="white", edgecolor="k", hatch=FEW_SWITCHES_HATCH,
-                     label="few switches: not stationary")]
+                      label=f"probability {', '.join(map(str, levels))} % with noise (Fig. 15)")]
+    if has_cliff:
+        handles.append(_cliff_handle(1.8))
+    if few.any():
+        handles.append(few_switches_handle(motion_map, short=True))
     return _finish_figure(fig, motion_map, handles,
                           "Fig. 15 over Fig. 16  Likely motions under noise and stable periodic motions")

@@ -3,23 +3,38 @@ from __future__ import annotations
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.collections import LineCollection
+from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from scipy import ndimage
 
 from vibroimpact.plotting._common import _attr, _header, _styled, _system_text, axis_label
+from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
+                                       cell_outline, label_contours)
 
-REASON_COLORS = {1: "white", 2: "0.82", 3: "#f4b6b6"}
-#: Contour levels of the degree of stability S (%).
-S_LEVELS = (5, 10, 20, 30, 40, 50, 60, 70, 80, 90)
-#: Levels of the filled S map: steps fine enough that no band edge reads as a line.
-S_FILL_LEVELS = np.linspace(0.0, 100.0, 101)
-#: One colour per motion type in panel (a): the Okabe-Ito qualitative palette, which readers
-#: with the common colour-vision deficiencies can also tell apart (black last).
-TYPE_COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
-#: Labels of S contours closer than this (fraction of the panel's width and height) to an
-#: already placed one are dropped, so the labels stay readable.
-LABEL_SPACING = 0.1
+#: Why a cell has no stable motion (the dataset's ``reason``): colour, the words written in
+#: its regions, and the legend's cause (paper Section 5: no solution satisfying eqs. (10),
+#: (11), (13) in its domains D, V, X; eq. (22) violated in its domain U).
+REASONS = {
+    1: ("white", "no solution", "no solution of eqs. (10), (11)"),
+    2: ("0.84", "crosses\nthe wall", "solutions cross the wall: eq. (13) violated"),
+    3: ("#f4b6b6", "unstable", "solutions unstable: eq. (22) violated (the paper's U)"),
+}
+#: Text colour of each reason's region words (dark enough on its own fill).
+REASON_TEXT_COLORS = {1: "0.25", 2: "0.2", 3: "#8b1a1a"}
+#: A reason is named in its largest connected region when that holds `LARGEST_NAMED` of the
+#: panel's cells or more, and in every other region holding `NAMED_SHARE` or more.
+LARGEST_NAMED = 0.002
+NAMED_SHARE = 0.05
+#: Free space (pt) kept around a region's word.
+WORD_MARGIN = 2.5
+#: Longest leader (share of the panel) from a region's word to a region too thin to hold it.
+LEADER_LENGTH = 0.3
+#: Width (pt) of a stable domain's edge: thin, so a domain one or two cells wide still
+#: shows its colour.
+EDGE_WIDTH = 0.8
 #: lam within this relative distance of eps e^(-zeta z / m) counts as complex multipliers.
 COMPLEX_RTOL = 1e-7
 
@@ -54,24 +69,84 @@ def complex_multipliers(orbits, m, n):
         return lam <= lam_c[:, None] * (1.0 + COMPLEX_RTOL)
 
 
-def _thin_labels(ax, lines):
-    """Label the contour `lines` where the labels keep `LABEL_SPACING` from each other."""
-    texts = ax.clabel(lines, fmt="%d", fontsize=6, inline=False)
-    to_axes = ax.transData + ax.transAxes.inverted()
-    kept = []
-    for text in sorted(texts, key=lambda t: t.get_position()[0]):
-        xy = to_axes.transform(text.get_position())
-        if all(np.max(np.abs(xy - other)) >= LABEL_SPACING for other, _ in kept):
-            kept.append((xy, text.get_position()))
-    for text in list(texts):
-        text.remove()
-    lines.labelTexts.clear()
-    lines.labelXYs.clear()
-    lines.labelCValues.clear()
-    if kept:
-        ax.clabel(lines, fmt="%d", fontsize=6, inline=True, inline_spacing=2,
-                  manual=[xy for _, xy in kept])
+def _box_cells(ax, word, shape):
+    """Cells (along 1/beta, along delta; odd numbers) that `word` covers at `MAP_TEXT_SIZE`.
 
+    Measured on the axes as laid out when called, with `WORD_MARGIN` each side.
+    """
+    renderer = ax.figure.canvas.get_renderer()
+    probe = ax.text(0.0, 0.0, word, fontsize=MAP_TEXT_SIZE, linespacing=1.0)
+    box, axes_box = probe.get_window_extent(renderer), ax.get_window_extent(renderer)
+    probe.remove()
+    pad = 2.0 * WORD_MARGIN * ax.figure.dpi / 72.0
+    cells = [(box.width + pad) / axes_box.width * shape[0],
+             (box.height + pad) / axes_box.height * shape[1]]
+    return tuple(int(np.ceil(c)) // 2 * 2 + 1 for c in cells)
+
+
+def _name_regions(ax, x, y, reason, stable):
+    """Write each reason's words in its sizable regions (with a leader to those too thin).
+
+    A word goes where its box fits inside the region (on two lines if it must), as deep
+    inside as it can; a region too thin for it gets the word on the nearest free cells (no
+    stable domain, no other word) within `LEADER_LENGTH`, with a line to the region's
+    deepest point that crosses no stable domain. The texts have gid ``reason-<code>``.
+    """
+    taken = stable.copy()
+    scale = np.array([1.0 / x.size, 1.0 / y.size])        # a cell, as a share of the panel
+    for code in (3, 2, 1):       # the thin unstable regions first: they need space near them
+        word = REASONS[code][1]
+        mask = reason == code
+        parts, n = ndimage.label(mask)
+        sizes = ndimage.sum_labels(mask, parts, np.arange(1, n + 1))
+        style = dict(fontsize=MAP_TEXT_SIZE, ha="center", va="center", linespacing=1.0,
+                     color=REASON_TEXT_COLORS[code], gid=f"reason-{code}")
+        wordings = [(w, _box_cells(ax, w, mask.shape))
+                    for w in dict.fromkeys([word, word.replace(" ", "\n")])]
+        for rank, k in enumerate(np.argsort(-sizes)):
+            if sizes[k] < (NAMED_SHARE if rank else LARGEST_NAMED) * mask.size:
+                break
+            part = parts == k + 1
+            depth = ndimage.distance_transform_edt(np.pad(part, 1), sampling=scale)[1:-1, 1:-1]
+            for text, (bw, bh) in wordings:
+                fits = _fits(part & ~taken, bw, bh)
+                if fits.any():
+                    i, j = np.unravel_index(np.argmax(np.where(fits, depth, -1.0)), part.shape)
+                    ax.text(x[i], y[j], text, **style)
+                    break
+            else:
+                text, (bw, bh) = wordings[0]
+                target = np.unravel_index(np.argmax(depth), part.shape)
+                spot = _leader_spot(_fits(~stable & ~taken & ~part, bw, bh), target, stable,
+                                    scale)
+                if spot is None:
+                    continue
+                i, j = spot
+                ax.annotate(text, xy=(x[target[0]], y[target[1]]), xytext=(x[i], y[j]),
+                            arrowprops=dict(arrowstyle="-", color=style["color"], lw=0.6,
+                                            shrinkA=2, shrinkB=0), **style)
+            taken[max(i - bw // 2 - 1, 0):i + bw // 2 + 2,
+                  max(j - bh // 2 - 1, 0):j + bh // 2 + 2] = True
+
+
+def _leader_spot(free, target, stable, scale):
+    """The cell of `free` nearest to `target` within `LEADER_LENGTH` whose straight line to
+    it crosses no `stable` cell, or None."""
+    cells = np.argwhere(free)
+    distance = np.hypot(*((cells - target) * scale).T)
+    for c in np.argsort(distance):
+        if distance[c] > LEADER_LENGTH:
+            return None
+        path = np.rint(np.linspace(cells[c], target, 50)).astype(int)
+        if not stable[path[:, 0], path[:, 1]].any():
+            return tuple(cells[c])
+    return None
+
+
+def _fits(allowed, bw, bh):
+    """Cells on which a box of bw x bh cells, centred, covers only `allowed` cells."""
+    return ndimage.minimum_filter(allowed.astype(np.uint8), size=(bw, bh), mode="constant",
+                                  cval=0) > 0
 
 @_styled
 def fig16(orbits):
@@ -87,12 +162,20 @@ def fig16(orbits):
     -------
     matplotlib.figure.Figure
         Panel (a) outlines the stable domain of every type, one qualitative colour each.
-        One panel per type then shows the degree of stability S in colour (1 % steps), the
-        stable domain's edge (bold), the regions where only unstable solutions exist (red)
-        or solutions exist but cross the wall (grey); white is no solution at all.
-        Labelled thin contours of S are drawn where the multipliers are real; where they are
+        One panel per type then shows, cell by cell, the degree of stability S in colour and
+        why the other cells have no stable motion (`REASONS`: no solution, solutions that
+        cross the wall, only unstable solutions), the causes written in their regions; the
+        stable domain's edge is a thin line along the cells where the domain is three cells
+        thick or more; a thinner one is shown by its colour alone. Labelled thin contours of
+        S (`label_contours`) are drawn where the multipliers are real; where they are
         complex S depends on 1/beta alone (`complex_multipliers`), so no contour is drawn
         there and a dotted line marks that region's edge.
+
+    Notes
+    -----
+    The paper (Section 5) names D, V, X the domains without a solution satisfying eqs. (10),
+    (11) and (13), and U the domain where eq. (22) (stability) fails, without saying which
+    letter is which region on its figure: the legend maps causes to letters, not regions.
     """
     types = [str(t) for t in orbits["type"].values]
     ncols = 3
@@ -102,42 +185,49 @@ def fig16(orbits):
     axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
     x = orbits["inv_beta"].values
     y = orbits["delta"].values
+    xe, ye = cell_edges(x), cell_edges(y)
     overview = axes[0]
-    shaded = None
+    reason_cmap = ListedColormap([REASONS[c][0] for c in sorted(REASONS)])
+    shaded, regions = None, []
     for i, name in enumerate(types):
         sel = orbits.sel(type=name)
         color = TYPE_COLORS[i % len(TYPE_COLORS)]
         stable = sel["n_stable"].values > 0
-        if stable.any():
-            overview.contour(x, y, stable.T.astype(float), levels=[0.5], colors=[color],
-                             linewidths=1.8)
+        overview.add_collection(LineCollection(cell_outline(x, y, stable), colors=[color],
+                                               linewidths=1.3, capstyle="projecting"))
         overview.plot([], [], color=color, lw=1.8, label=f"({name})")
         ax = axes[i + 1]
-        reason = sel["reason"].values.T
-        for code, colour in REASON_COLORS.items():
-            mask = np.where(reason == code, 1.0, np.nan)
-            ax.contourf(x, y, mask, levels=[0.5, 1.5], colors=[colour])
+        reason = sel["reason"].values
+        ax.pcolormesh(xe, ye, np.ma.masked_where(stable, reason).T, cmap=reason_cmap,
+                      vmin=min(REASONS) - 0.5, vmax=max(REASONS) + 0.5, rasterized=True)
         S = np.where(stable, sel["S"].values, np.nan)
-        if np.isfinite(S).any():
+        # cell by cell (a domain one cell wide included), rasterized in the PDF
+        shaded = ax.pcolormesh(xe, ye, np.ma.masked_invalid(S).T, cmap="viridis_r", vmin=0.0,
+                               vmax=100.0, rasterized=True)
+        if stable.any():
             m, n = (int(k) for k in name.split("/"))
             cplx = complex_multipliers(sel, m, n) & stable
-            # 1 % steps: coarser filled bands draw their edges as lines across the plateau
-            # (opaque, edges in the face colour: translucent bands show their seams as lines)
-            shaded = ax.contourf(x, y, S.T, levels=S_FILL_LEVELS, cmap="viridis_r")
-            shaded.set_edgecolor("face")
             real = np.where(cplx, np.nan, S).T
             if np.isfinite(real).any():
                 lines = ax.contour(x, y, real, levels=S_LEVELS, colors="k", linewidths=0.5)
-                _thin_labels(ax, lines)
+                label_contours(ax, lines, "%d")
             if cplx.any() and (stable & ~cplx).any():
-                # between stable cells only: the domain's own edge is the bold line
+                # between stable cells only: the domain's own edge is drawn below
                 edge = np.where(stable, cplx, np.nan).T
                 ax.contour(x, y, edge, levels=[0.5], colors="0.1",
                            linewidths=0.9, linestyles=":")
-            ax.contour(x, y, stable.T.astype(float), levels=[0.5], colors="k", linewidths=1.8)
+            # where the domain is at least three cells thick: a thinner one is its colour alone
+            thick = ndimage.binary_opening(stable, structure=np.ones((3, 3), bool))
+            ax.add_collection(LineCollection(cell_outline(x, y, stable, only=thick), colors="k",
+                                             linewidths=EDGE_WIDTH, capstyle="projecting",
+                                             gid="stable-edge"))
+        regions.append((ax, reason, stable))
         ax.set_title(f"({name})")
     overview.set_title("(a) stable domains")
-    overview.legend(loc="upper right")
+    overview.legend(loc="lower right")
+    for ax in axes:
+        ax.set_xlim(xe[0], xe[-1])
+        ax.set_ylim(ye[0], ye[-1])
     for ax in axes[len(types) + 1:]:
         ax.set_visible(False)
     for ax in axes:
@@ -147,17 +237,25 @@ def fig16(orbits):
     for ax in axes[len(types) + 1 - ncols:len(types) + 1]:
         ax.xaxis.set_tick_params(labelbottom=True)
         ax.set_xlabel(axis_label(orbits["inv_beta"]))
-    handles = [Patch(facecolor=REASON_COLORS[3], label="only unstable (U)"),
-               Patch(facecolor=REASON_COLORS[2], label="inadmissible: crosses the wall"),
-               Patch(facecolor="white", edgecolor="0.6", label="no solution (D, V, X)"),
-               Line2D([], [], color="0.1", lw=0.9, ls=":",
-                      label=r"edge of complex multipliers (inside: $S = 100(1 - "
-                            r"\varepsilon e^{-\zeta z/m})$, no contours)")]
+    present = set(np.unique(orbits["reason"].values).tolist())
+    handles = [Patch(facecolor=colour, edgecolor="0.6", label=cause)
+               for code, (colour, _, cause) in REASONS.items() if code in present]
+    handles += [Line2D([], [], color="k", lw=EDGE_WIDTH,
+                       label="edge of the stable domain (where 3 cells thick or more)"),
+                Line2D([], [], color="0.1", lw=0.9, ls=":",
+                       label=r"edge of complex multipliers (inside: $S = 100(1 - "
+                             r"\varepsilon e^{-\zeta z/m})$, no contours)")]
     if shaded is not None:
-        fig.colorbar(shaded, ax=axes[1:].tolist(), label="degree of stability S (%)", shrink=0.8,
+        fig.colorbar(shaded, ax=axes[1:].tolist(), label=axis_label(orbits["S"]), shrink=0.8,
                      ticks=np.arange(0, 101, 10))
-    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
+    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7,
+               title="the paper's D, V, X: no solution satisfying eqs. (10), (11), (13) "
+                     "(white and grey here; it does not say which letter is which region)",
+               title_fontsize=7)
     _header(fig, "Fig. 16  Parameter domains of stable periodic impact motions",
-            rf"{_system_text(orbits)};  f($\tau$) = $\sin(\beta_f\tau)$; bold: stable domain, "
-            "thin: contours of S (%)")
+            rf"{_system_text(orbits)};  f($\tau$) = $\sin(\beta_f\tau)$;  thin lines: "
+            r"contours of the degree of stability $S$ (%)")
+    fig.draw_without_rendering()       # the words are fitted to the panels' final size
+    for ax, reason, stable in regions:
+        _name_regions(ax, x, y, reason, stable)
     return fig
