@@ -289,7 +289,7 @@ def _map_forcing_text(ds):
     """``f(tau) = A sin(beta_f tau) + r(tau) (noise)``, beta_f the map's coordinate."""
     amplitude = float(_attr(ds, "amplitude"))
     scale = "" if amplitude == 1.0 else _num(amplitude)
-    return rf"f($\tau$) = {scale}$\sin(\beta_f\tau)$ + r($\tau$) ({_noise_text(ds)})"
+    return rf"$f(\tau)$ = {scale}$\sin(\beta_f\tau) + r(\tau)$ ({_noise_text(ds)})"
 
 
 def _map_text(ds):

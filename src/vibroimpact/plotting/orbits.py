@@ -253,7 +253,7 @@ def fig16(orbits):
                      "(white and grey here; it does not say which letter is which region)",
                title_fontsize=7)
     _header(fig, "Fig. 16  Parameter domains of stable periodic impact motions",
-            rf"{_system_text(orbits)};  f($\tau$) = $\sin(\beta_f\tau)$;  thin lines: "
+            rf"{_system_text(orbits)};  $f(\tau) = \sin(\beta_f\tau)$;  thin lines: "
             r"contours of the degree of stability $S$ (%)")
     fig.draw_without_rendering()       # the words are fitted to the panels' final size
     for ax, reason, stable in regions:
