@@ -1,4 +1,5 @@
-# `make` installs into .venv and builds every figure and report of the default config;
+# `make` installs into .venv and builds every figure and report of the default config, then
+# Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the fast suite, the slow (stress/convergence) suite, the
 # end-to-end workflow and SLURM suites (one session: the test config is built once; the
 # SLURM suite installs and starts a one-node cluster, as root), and the import-layer contract.
@@ -11,10 +12,15 @@ CORES  ?= all
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
 
-.PHONY: all plan test test-fast test-slow bench lint clean
-# checks the config, prints the plan, recovers from a killed run, then runs Snakemake
+.PHONY: all plan report test test-fast test-slow bench lint clean
+# checks the config, prints the plan, recovers from a killed run, then runs Snakemake; then
+# writes Snakemake's report of the build, whole or not at all
 all: $(STAMP)
 	$(BIN)/python -m vibroimpact run --cores $(CORES) $(CONFIG_ARGS)
+	$(BIN)/python -m vibroimpact report $(CONFIG_ARGS)
+
+report: $(STAMP)
+	$(BIN)/python -m vibroimpact report $(CONFIG_ARGS)
 
 plan: $(STAMP)
 	$(BIN)/python -m vibroimpact plan --cores $(CORES) $(CONFIG_ARGS)

@@ -9,6 +9,7 @@ import hashlib
 from pathlib import Path
 import shlex
 import sys
+from types import SimpleNamespace
 
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.provenance import source_digest
@@ -133,6 +134,28 @@ def figure_caption(wildcards):
     return figures.caption(kind, name, entry, wildcards.fig)
 
 
+def _paper_figure_of(wildcards):
+    """The paper figure (``fig07`` ...) that this config copies from ``{fig}`` of ``{owner}``,
+    or None."""
+    png = f"results/figures/{wildcards.owner}/{wildcards.fig}.png"
+    for paper_fig in sorted(PLAN.drawn["paper_figures"]):
+        if paper_figure_source(SimpleNamespace(paper_fig=paper_fig))["png"] == png:
+            return paper_fig
+    return None
+
+
+def figure_report_category(wildcards):
+    """``{fig}`` of ``{owner}`` in `snakemake --report`: under ``paper`` when it is a paper
+    figure, else under its owner (each figure once: the paper's copies are not marked)."""
+    return "paper" if _paper_figure_of(wildcards) else wildcards.owner
+
+
+def figure_report_labels(wildcards):
+    """The report's label of ``{fig}``: under ``paper`` the paper's name (``fig11``, not the
+    study's ``fig11-0``; the caption names the study)."""
+    return {"figure": _paper_figure_of(wildcards) or wildcards.fig}
+
+
 def paper_figure_source(wildcards):
     if wildcards.paper_fig not in config.get("paper_figures", {}):
         raise ValueError(f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
@@ -195,12 +218,15 @@ def _study_datasets(name):
 
 
 def study_report_inputs(wildcards):
-    """The notebook, the datasets and the figures of a study and of its ``report_with``."""
+    """The notebook, the datasets and the figures of a study and of its ``report_with``, and
+    the study's noise record (its provenance row, whether or not a figure draws it)."""
     entry = config["studies"][wildcards.study]
     kind = study_report_kind(entry)
     if wildcards.report != kind:
         raise ValueError(f"study {wildcards.study}: its report is {kind}, not {wildcards.report}")
-    inputs, shown = {"notebook": f"notebooks/{kind}.ipynb"}, []
+    inputs = {"notebook": f"notebooks/{kind}.ipynb",
+              "noise": _DATASETS["noise"].format(noise=entry["noise"])}
+    shown = []
     for name in [wildcards.study, *entry.get("report_with", [])]:
         for dataset, path in _study_datasets(name).items():
             inputs.setdefault(dataset, path)

@@ -9,9 +9,10 @@ rule draw_figure:
     input:
         figure_inputs,
     output:
-        # in `snakemake --report`: one category per study or orbits entry
+        # in `snakemake --report`, once: under `paper` when it is a paper figure (its copy
+        # results/figures/figNN.png is not marked), else in its study's or orbits entry's
         png=report("results/figures/{owner}/{fig}.png", caption="../report/figure.rst",
-                   category="{owner}", labels={"figure": "{fig}"}),
+                   category=figure_report_category, labels=figure_report_labels),
         pdf="results/figures/{owner}/{fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"
@@ -35,8 +36,7 @@ rule copy_paper_figure:
     input:
         unpack(paper_figure_source),
     output:
-        png=report("results/figures/{paper_fig}.png", caption="../report/paper_figure.rst",
-                   category="paper", labels={"figure": "{paper_fig}"}),
+        png="results/figures/{paper_fig}.png",      # in the report as its source (draw_figure)
         pdf="results/figures/{paper_fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"

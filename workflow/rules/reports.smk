@@ -4,6 +4,9 @@
 # the notebook's output goes to the rule's log. (Snakemake's `notebook:` directive would keep
 # the executed notebook only as a log.) Both files are written in a temporary directory and
 # moved into place when both exist, so a failed run leaves no report a later run would trust.
+# The HTML reads offline: `vibroimpact.reports.notebook` renders it with nbconvert's template
+# minus what it loads from the network, the maths turned into MathML at build time. Snakemake's
+# report shows a rendering without the images (`.summary.html`): it holds every figure once.
 localrules:
     study_report,
     orbits_report,
@@ -20,8 +23,12 @@ REPORT_SHELL = (
     'trap \'rm -rf "$tmp"\' EXIT; '
     "{params.python} -m papermill {input.notebook} $tmp/report.ipynb --kernel python3 --log-output "
     "--no-progress-bar {params.arguments} > {log} 2>&1; "
-    "{params.python} -m nbconvert --to html $tmp/report.ipynb >> {log} 2>&1; "
-    "mv $tmp/report.html {output.html}; mv $tmp/report.ipynb {output.ipynb}"
+    "{params.python} -m vibroimpact.reports.notebook $tmp/report.ipynb $tmp/report.html "
+    ">> {log} 2>&1; "
+    "{params.python} -m vibroimpact.reports.notebook --no-figures $tmp/report.ipynb "
+    "$tmp/summary.html >> {log} 2>&1; "
+    "mv $tmp/summary.html {output.summary}; mv $tmp/report.html {output.html}; "
+    "mv $tmp/report.ipynb {output.ipynb}"
 )
 
 
@@ -30,8 +37,11 @@ rule study_report:
         unpack(study_report_inputs),
     output:
         ipynb="results/reports/{study}/{report}.ipynb",
-        html=report("results/reports/{study}/{report}.html", caption="../report/report.rst",
-                    category="{study}", labels={"figure": "report: {report}"}),
+        html="results/reports/{study}/{report}.html",
+        # in `snakemake --report` without its images: the report holds each figure once
+        summary=report("results/reports/{study}/{report}.summary.html",
+                       caption="../report/report.rst", category="{study}",
+                       labels={"figure": "report: {report}"}),
     log:
         "results/logs/report/{study}/{report}.log",
     benchmark:
@@ -55,9 +65,10 @@ rule orbits_report:
         unpack(orbits_report_inputs),
     output:
         ipynb="results/reports/orbits/{orbits}/periodic_motions.ipynb",
-        html=report("results/reports/orbits/{orbits}/periodic_motions.html",
-                    caption="../report/report.rst", category="orbits/{orbits}",
-                    labels={"figure": "report: periodic motions"}),
+        html="results/reports/orbits/{orbits}/periodic_motions.html",
+        summary=report("results/reports/orbits/{orbits}/periodic_motions.summary.html",
+                       caption="../report/report.rst", category="orbits/{orbits}",
+                       labels={"figure": "report: periodic motions"}),
     log:
         "results/logs/report/orbits/{orbits}.log",
     benchmark:
@@ -81,9 +92,10 @@ rule validation_report:
         unpack(validation_report_inputs),
     output:
         ipynb="results/reports/validation/{vreport}.ipynb",
-        html=report("results/reports/validation/{vreport}.html",
-                    caption="../report/report.rst", category="validation",
-                    labels={"figure": "report: {vreport}"}),
+        html="results/reports/validation/{vreport}.html",
+        summary=report("results/reports/validation/{vreport}.summary.html",
+                       caption="../report/report.rst", category="validation",
+                       labels={"figure": "report: {vreport}"}),
     log:
         "results/logs/report/validation/{vreport}.log",
     benchmark:

@@ -7,6 +7,10 @@
           file (naming it), clears a lock left by a killed run when no run is alive in this
           directory, and replaces itself with ``snakemake`` (the default profile,
           ``profiles/default``, reruns the jobs a crash interrupted).
+``report`` writes Snakemake's own report of the build (``snakemake --report``: every figure
+          once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
+          all: it is rendered elsewhere and moved into place only when complete (``make``
+          runs it after ``run``).
 
 A config file with a YAML syntax error is reported with its file, line and column here,
 before Snakemake's own loader (which drops the location) ever sees it.
@@ -30,17 +34,27 @@ def _parser():
         description="Check, plan and build the vibroimpact workflow (README).")
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("plan", "check the config and print what a build would make"),
-                       ("run", "check, prepare and build (extra arguments go to snakemake)")):
+                       ("run", "check, prepare and build (extra arguments go to snakemake)"),
+                       ("report", "write Snakemake's report of the build (after run)")):
         p = sub.add_parser(name, help=text, description=text)
         p.add_argument("--configfile", action="append", default=[], metavar="FILE",
                        help="your config file, layered on config/config.yaml (README); "
                             "repeat for several")
-        p.add_argument("--cores", type=_cores, default="all",
-                       help="cores of the build: a number, or all (default: all of them)")
+        if name == "report":
+            p.add_argument("--output", default=REPORT, metavar="FILE",
+                           help=f"the report, relative to the project directory (default "
+                                f"{REPORT}; .html)")
+        else:
+            p.add_argument("--cores", type=_cores, default="all",
+                           help="cores of the build: a number, or all (default: all of them)")
         p.add_argument("--directory", default=".", help="the project directory (default .)")
         p.add_argument("-v", "--verbose", action="store_true",
                        help="also print the schema validator's full output on a config error")
     return parser
+
+
+#: Where ``report`` writes Snakemake's report (README, "Reports").
+REPORT = "results/report.html"
 
 
 def _cores(text):
@@ -103,10 +117,35 @@ def _clear_stale_lock(root, config_args):
     return 0
 
 
+def write_report(root, config_args, output=REPORT):
+    """``snakemake --report`` into a scratch directory, then moved to ``root / output`` in
+    one rename (:func:`vibroimpact._files.atomic_path`): a report that fails or is
+    interrupted leaves the previous ``output`` as it was, never a half-written one."""
+    import tempfile
+
+    target = root / output
+    if target.suffix != ".html":
+        return _fail(f"--output {output}: allowed: a file name ending in .html")
+    with tempfile.TemporaryDirectory(prefix="vibroimpact-report-") as scratch:
+        draft = Path(scratch) / "report.html"
+        sys.stdout.flush()
+        code = subprocess.run([_snakemake(), "--report", str(draft), *config_args],
+                              cwd=root).returncode
+        if code != 0 or not draft.is_file():
+            return _fail(f"snakemake --report failed (exit {code}); {output} is left as it was",
+                         code=1)
+        with _files.atomic_path(target) as tmp:
+            shutil.copyfile(draft, tmp)
+    print(f"vibroimpact: Snakemake's report: {output} ({target.stat().st_size / 1e6:.1f} MB)",
+          file=sys.stderr)
+    return 0
+
+
 def main(argv=None):
     args, extra = _parser().parse_known_args(argv)
-    if args.command == "plan" and extra:
-        return _fail(f"unknown arguments {extra}; plan takes --configfile, --cores, -v")
+    if args.command in ("plan", "report") and extra:
+        return _fail(f"unknown arguments {extra}; {args.command} takes --configfile, "
+                     f"{'--cores' if args.command == 'plan' else '--output'}, --directory, -v")
     if args.verbose:
         os.environ[configuration.VERBOSE_ENV] = "1"
     root = Path(args.directory).resolve()
@@ -114,6 +153,9 @@ def main(argv=None):
         _, plan = configuration.load(root=root, user_files=args.configfile)
     except configuration.ConfigError as err:
         return _fail(err)
+    config_args = ["--configfile", *args.configfile] if args.configfile else []
+    if args.command == "report":
+        return write_report(root, config_args, args.output)
     print(plan.format(args.cores), file=sys.stderr if args.command == "run" else sys.stdout)
     if args.command == "plan":
         return 0
@@ -125,7 +167,6 @@ def main(argv=None):
         io.check_readable(root / "results")
     except io.CorruptFileError as err:
         return _fail(err, code=1)
-    config_args = ["--configfile", *args.configfile] if args.configfile else []
     code = _clear_stale_lock(root, config_args)
     if code:
         return code

@@ -14,7 +14,7 @@ draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits
 import re
 
 __all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item",
-           "figure_sources", "paper_target", "caption"]
+           "figure_sources", "paper_target", "caption", "rest_text"]
 
 FIGURES = {
     "fig03": dict(owner="study", reads=("trace",),
@@ -165,9 +165,21 @@ def _values_text(values):
     return f"{values:.4g}" if isinstance(values, float) else str(values)
 
 
+#: Characters with a meaning in reStructuredText inline markup (``|H|`` is a substitution,
+#: ``*x*`` emphasis, ``name_`` a reference ...); a backslash makes each one literal.
+_REST_SPECIAL = re.compile(r"([\\`*_|\[\]<>:])")
+
+
+def rest_text(text):
+    """``text`` as literal reStructuredText: every markup character backslash-escaped, so that
+    docutils prints it as written (``|H|^2 S_f`` is not a substitution reference)."""
+    return _REST_SPECIAL.sub(r"\\\1", str(text))
+
+
 def caption(kind, name, entry, target):
     """What figure ``target`` of config entry ``name`` shows and with which parameters: one
-    paragraph (the Snakemake report's caption, ``workflow/report/figure.rst``).
+    paragraph of reStructuredText, escaped (:func:`rest_text`), for the Snakemake report's
+    caption (``workflow/report/figure.rst``).
 
     ``kind`` is ``"study"`` or ``"orbits"``.
     """
@@ -191,5 +203,5 @@ def caption(kind, name, entry, target):
     sweep = entry.get("sweep")
     if sweep:
         parts.append(f"combination {sweep['index']} of sweep {sweep['name']}")
-    return (f"{title} ({'orbits entry' if kind == 'orbits' else 'study'} {name}): {what}. "
-            f"Parameters: {'; '.join(parts)}.")
+    return rest_text(f"{title} ({'orbits entry' if kind == 'orbits' else 'study'} {name}): "
+                     f"{what}. Parameters: {'; '.join(parts)}.")

@@ -1,8 +1,13 @@
-"""Helpers the report notebooks (``notebooks/*.ipynb``) call, so their cells stay one line.
+"""Helpers the report notebooks (``notebooks/*.ipynb``) call, so their cells stay one line,
+and the HTML rendering of an executed notebook (:func:`render_html`).
 
 The notebooks are executed by papermill from the workflow (``workflow/rules/reports.smk``),
 every input path passed as a parameter; a path given as ``""`` means "this study has no such
 dataset", and the cells that need it say so instead of failing.
+
+``python -m vibroimpact.reports.notebook REPORT.ipynb REPORT.html`` renders a report for
+reading offline: the maths turned into MathML at build time, no script or stylesheet loaded
+from the network (nbconvert's template would load require.js, MathJax and mermaid from a CDN).
 """
 from pathlib import Path
 import re
@@ -27,11 +32,14 @@ def paths(text):
     return str(text or "").split()
 
 
-def open_dataset(path):
-    """``xarray.load_dataset(path)``, or None for an empty path (no such dataset)."""
+def open_dataset(path, lazy=False):
+    """``xarray.load_dataset(path)``, or None for an empty path (no such dataset); with
+    ``lazy``, opened without reading the data (a noise record read for its attributes)."""
     import xarray as xr
 
-    return xr.load_dataset(path) if path else None
+    if not path:
+        return None
+    return xr.open_dataset(path) if lazy else xr.load_dataset(path)
 
 
 def show_figures(figures):
@@ -57,31 +65,67 @@ def show_table(found):
     return table
 
 
+#: The provenance attributes every dataset carries (``vibroimpact.pipeline.provenance``).
+_PROVENANCE = ("package_version", "git_commit", "git_dirty", "config_digest", "created", "seed",
+               "record_length", "t_end", "transient")
+
+
 def provenance(**datasets):
-    """One row per dataset: where it came from (package version, commit, config digest,
-    creation time, seed, record length) — the attributes every dataset carries."""
+    """Where each dataset came from (package version, commit, config digest, creation time,
+    seed, record length): one row per attribute, one column per dataset, the long hashes
+    wrapped in their cells, so that the table fits the page whatever the number of datasets."""
     import pandas as pd
 
-    keys = ("package_version", "git_commit", "git_dirty", "config_digest", "created", "seed",
-            "record_length", "t_end", "transient")
-    rows = {name: {k: ds.attrs.get(k, "") for k in keys}
-            for name, ds in datasets.items() if ds is not None}
-    return pd.DataFrame.from_dict(rows, orient="index")
+    columns = {name: {k: _text(ds.attrs.get(k, "")) for k in _PROVENANCE}
+               for name, ds in datasets.items() if ds is not None}
+    table = pd.DataFrame(columns, index=list(_PROVENANCE))
+    wrapped = [{"selector": "td", "props": "text-align: left; white-space: normal; "
+                                           "word-break: break-all"},
+               {"selector": "th.blank", "props": "width: 10em"}]     # the attributes' column
+    # class names of its own: a report's findings table is read by its "data" cells
+    names = {"data": "provenance", "row_heading": "provenance_attribute",
+             "col_heading": "provenance_dataset"}
+    return (table.style.set_table_styles(wrapped, css_class_names=names)
+            .set_table_attributes('style="width: 100%; table-layout: fixed"'))
+
+
+def _text(value):
+    """An attribute as table text: floats in up to 10 significant digits (``1000000``, not
+    ``1000000.0`` or ``1e+06``)."""
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):.10g}"
+    return str(value)
+
+
+#: The rows of a settings table, in order: the system, the forcing, the record and the
+#: statistics. Keys that only apply to a harmonic force are shown only with one.
+_SYSTEM = ("zeta", "eps", "amplitude")
+_NOISE = (("noise", "noise"), ("noise_kind", "kind"), ("noise_rms", "rms"),
+          ("noise_beta_c", "beta_c"), ("noise_zeta_f", "zeta_f"), ("noise_dt", "dt"),
+          ("seed", "seed"))
+_RECORD = ("transient", "t_end", "record_length", "n_batches", "motion_window", "rebound_floor",
+           "nperseg", "target_stderr", "max_periods")
+_HARMONIC_ONLY = ("motion_window", "inv_beta")
 
 
 def study_settings(ds, name=""):
     """The physical and statistical settings of a dataset (a study's or an orbits map's),
-    from its attributes and grids, as a small table."""
+    from its attributes and grids, as a small table: the system, the random force (its
+    record's name, kind, rms, cut-off, sample step and seed) and the record and statistics.
+    A study without a harmonic force (``amplitude`` 0) shows no 1/beta_f grid and no motion
+    window, which apply only to one."""
     import pandas as pd
 
-    keys = ("zeta", "eps", "amplitude", "transient", "t_end", "record_length", "n_batches",
-            "motion_window", "rebound_floor", "nperseg", "target_stderr", "max_periods")
+    skipped = () if float(ds.attrs.get("amplitude", 1.0)) != 0.0 else _HARMONIC_ONLY
     values = {"entry": name} if name else {}
-    values.update({k: ds.attrs[k] for k in keys if k in ds.attrs})
-    values.update({k: ds.attrs[k] for k in sorted(ds.attrs) if k.startswith("sweep")})
+    values.update({k: ds.attrs[k] for k in _SYSTEM if k in ds.attrs})
     values.update({f"{d} grid": _grid_text(ds[d].values) for d in ("inv_beta", "delta")
-                   if d in ds.dims})
-    return pd.Series(values, name="value").astype(str).to_frame()
+                   if d in ds.dims and d not in skipped})
+    values.update({"noise" if label == "noise" else f"noise {label}": ds.attrs[k]
+                   for k, label in _NOISE if k in ds.attrs})
+    values.update({k: ds.attrs[k] for k in _RECORD if k in ds.attrs and k not in skipped})
+    values.update({k: ds.attrs[k] for k in sorted(ds.attrs) if k.startswith("sweep")})
+    return pd.Series({k: _text(v) for k, v in values.items()}, name="value").to_frame()
 
 
 def map_agreement(motion_map, orbits):
@@ -211,3 +255,84 @@ def stress_summary(ds):
         "worst case": ds.worst_case.values}, index=ds.family.values)
     table.index.name = "family"
     return table
+
+
+# --- HTML rendering for reading offline ---------------------------------------------------
+
+#: nbconvert's JupyterLab template without what it loads from the network: require.js (no
+#: output here needs it), MathJax (the maths is MathML, rendered at build time), mermaid and
+#: the widget manager. Its stylesheets are inlined by nbconvert itself.
+_OFFLINE_TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
+{%- block html_head_js -%}{%- endblock html_head_js -%}
+{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
+{%- block html_head_js_mathjax -%}{%- endblock html_head_js_mathjax -%}
+{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+"""
+
+#: Code spans and fences (left alone), then display maths $$...$$, then inline maths $...$.
+_MATH = re.compile(r"(?P<code>(`+).*?\2)|\$\$(?P<display>.+?)\$\$|\$(?P<inline>[^$\n]+?)\$",
+                   re.S)
+
+
+def mathml(markdown):
+    """Markdown with its TeX maths (``$...$`` inline, ``$$...$$`` displayed) replaced by
+    MathML, which browsers render without a script; code spans are left as they are."""
+    from latex2mathml.converter import convert
+
+    def replace(match):
+        if match["code"] is not None:
+            return match["code"]
+        if match["display"] is not None:
+            return convert(match["display"].strip(), display="block")
+        return convert(match["inline"].strip())
+
+    return _MATH.sub(replace, markdown)
+
+
+def render_html(ipynb, html, figures=True):
+    """Render the executed notebook ``ipynb`` to the HTML file ``html``, readable offline:
+    figures embedded (they are in the notebook), the maths of markdown cells and outputs as
+    MathML, and no script or stylesheet from the network (:data:`_OFFLINE_TEMPLATE`).
+
+    Without ``figures``, the images are left out (each figure's path stays): the copy shown
+    in Snakemake's report, which holds every figure once, beside it.
+    """
+    import nbformat
+    from jinja2 import DictLoader
+    from nbconvert import HTMLExporter
+
+    nb = nbformat.read(ipynb, as_version=4)
+    for cell in nb.cells:
+        if cell.cell_type == "markdown":
+            cell.source = mathml(cell.source)
+        if cell.cell_type != "code":
+            continue
+        if not figures:
+            cell.outputs = [o for o in cell.get("outputs", [])
+                            if "image/png" not in o.get("data", {})]
+        for output in cell.get("outputs", []):
+            if "text/markdown" in output.get("data", {}):
+                output.data["text/markdown"] = mathml(output.data["text/markdown"])
+    exporter = HTMLExporter(template_name="lab", template_file="offline.html.j2",
+                            extra_loaders=[DictLoader({"offline.html.j2": _OFFLINE_TEMPLATE})])
+    body, _ = exporter.from_notebook_node(nb)
+    Path(html).write_text(body, encoding="utf-8")
+
+
+def main(argv=None):
+    """``python -m vibroimpact.reports.notebook [--no-figures] REPORT.ipynb REPORT.html``."""
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="python -m vibroimpact.reports.notebook",
+                                     description="Render an executed report notebook to HTML "
+                                                 "that reads offline.")
+    parser.add_argument("ipynb")
+    parser.add_argument("html")
+    parser.add_argument("--no-figures", dest="figures", action="store_false",
+                        help="leave the images out (Snakemake's report shows them once)")
+    args = parser.parse_args(argv)
+    render_html(args.ipynb, args.html, figures=args.figures)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,303 @@
+"""The reports as a referee reads them: offline, with captions docutils accepts, each figure
+once, and settings that are the study's.
+
+Fast: a notebook rendered by `vibroimpact.reports.notebook.render_html` loads nothing from the
+network (nbconvert's own template does: the check is shown to fail on it), and its maths is
+MathML; every figure caption of the paper's config passes through the report's template and
+docutils without a system message; the settings and provenance tables of datasets carrying
+the attributes the workflow writes; `python -m vibroimpact report` replaces the report whole
+or not at all. `workflow`: the same on the session's build of the test config, and Snakemake's
+report of it.
+"""
+import base64
+from html.parser import HTMLParser
+import json
+from pathlib import Path
+import re
+import subprocess
+import sys
+from types import SimpleNamespace
+
+import nbformat
+import numpy as np
+import pytest
+import xarray as xr
+
+from conftest import ROOT, make_workdir
+from vibroimpact.pipeline import cli, configuration, figures
+from vibroimpact.reports import notebook
+
+REPORTS = ["random/random_force", "harmonic/harmonic_random", "motion_map/harmonic_random",
+           "orbits/harmonic/periodic_motions", "validation/performance", "validation/stability"]
+
+
+class _Loads(HTMLParser):
+    """What a browser would fetch to show a page: the sources of scripts, stylesheets, images
+    and frames, the ``@import`` and ``url()`` of its styles, and the modules its scripts
+    import (nbconvert's mermaid loader does ``await import("https://...")``)."""
+
+    SOURCE = {"script": "src", "img": "src", "iframe": "src", "audio": "src", "video": "src",
+              "source": "src", "embed": "src", "object": "data", "link": "href"}
+    LINKED = ("stylesheet", "icon", "preload", "modulepreload")
+    IMPORT = re.compile(r"""(?:\bimport\s*\(|\bfrom\s+|importScripts\s*\()\s*["'`]([^"'`]+)""")
+    STYLE_URL = re.compile(r"""(?:@import\s+(?:url\()?|url\()\s*["']?([^"')\s;]+)""")
+
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.loads, self._inside = [], None
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        source = attrs.get(self.SOURCE.get(tag, ""))
+        if tag == "link" and not set((attrs.get("rel") or "").split()) & set(self.LINKED):
+            source = None
+        if source:
+            self.loads.append(source)
+        self._inside = tag if tag in ("script", "style") else None
+
+    def handle_endtag(self, tag):
+        self._inside = None
+
+    def handle_data(self, data):
+        if self._inside == "script":
+            self.loads += [u for u in self.IMPORT.findall(data) if "://" in u]
+        elif self._inside == "style":
+            self.loads += self.STYLE_URL.findall(re.sub(r"/\*.*?\*/", "", data, flags=re.S))
+
+
+def fetched(html):
+    """The resources an HTML page loads that it does not carry itself (not ``data:``)."""
+    parser = _Loads()
+    parser.feed(html)
+    return [url for url in parser.loads if not url.startswith("data:")]
+
+
+#: A PNG of one pixel, base64 (a figure output).
+_PIXEL = ("iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mNkYPhfDwAChwGA60e6kgAAAABJ"
+          "RU5ErkJggg==")
+
+
+def _notebook(tmp_path):
+    """An executed-looking notebook: maths in a markdown cell and a code span, a table."""
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [
+        nbformat.v4.new_markdown_cell("# Report\n\nDriven by $A \\sin(\\beta_f \\tau) + r(\\tau)$;"
+                                      " the wall-free response $$|H|^2 S_f$$ and `a $b$ c`."),
+        nbformat.v4.new_code_cell("table", outputs=[nbformat.v4.new_output(
+            "display_data", data={"text/html": "<table><tr><td>1</td></tr></table>",
+                                  "text/plain": "1"})]),
+        nbformat.v4.new_code_cell("figure", outputs=[
+            nbformat.v4.new_output("display_data", data={"text/markdown": "`fig.png`",
+                                                         "text/plain": "fig.png"}),
+            nbformat.v4.new_output("display_data", data={"image/png": _PIXEL,
+                                                         "text/plain": "<Image>"})]),
+    ]
+    path = tmp_path / "report.ipynb"
+    nbformat.write(nb, path)
+    return path
+
+
+def test_nbconverts_own_template_is_caught_loading_from_the_network(tmp_path):
+    """The check below fails on what the reports were before: MathJax, require.js, mermaid."""
+    from nbconvert import HTMLExporter
+
+    body, _ = HTMLExporter().from_filename(str(_notebook(tmp_path)))
+    loads = fetched(body)
+    assert any("mathjax" in url.lower() for url in loads)
+    assert any("require" in url for url in loads)
+
+
+def test_a_rendered_report_loads_nothing_and_its_maths_is_mathml(tmp_path):
+    html = tmp_path / "report.html"
+    notebook.render_html(_notebook(tmp_path), html)
+    text = html.read_text()
+    assert fetched(text) == []
+    assert text.count("<math ") == 2 and 'display="block"' in text
+    assert "\\beta_f" not in text                   # converted, not left for a script
+    assert "<code>a $b$ c</code>" in text           # a code span keeps its dollars
+    assert "<table>" in text and text.count(_PIXEL) == 1
+
+
+def test_the_summary_for_snakemakes_report_has_no_image_but_says_which(tmp_path):
+    html = tmp_path / "summary.html"
+    notebook.main([str(_notebook(tmp_path)), str(html), "--no-figures"])
+    text = html.read_text()
+    assert _PIXEL not in text and "<img" not in text
+    assert "fig.png" in text and "<table>" in text and fetched(text) == []
+
+
+def _paper_captions():
+    """``(target, caption rst)`` of every figure of every entry of the paper's config."""
+    config, _ = configuration.load(root=ROOT)
+    for kind, section in (("study", "studies"), ("orbits", "orbits")):
+        for name, entry in config[section].items():
+            for target in figures.figure_targets(entry):
+                yield target, figures.caption(kind, name, entry, target)
+
+
+def test_every_caption_passes_docutils_without_a_system_message():
+    """Through `workflow/report/figure.rst` as `snakemake --report` renders it (jinja, then
+    docutils' HTML writer): no error box, and the text reads as written (Fig. 6's |H|^2 S_f
+    is not a substitution reference)."""
+    import jinja2
+    from docutils.core import publish_parts
+
+    template = jinja2.Template((ROOT / "workflow" / "report" / "figure.rst").read_text())
+    captions = list(_paper_captions())
+    assert len(captions) >= 15
+    for target, caption in captions:
+        rst = template.render(snakemake=SimpleNamespace(
+            params=SimpleNamespace(caption=caption),
+            output=SimpleNamespace(png=f"results/figures/x/{target}.png")))
+        body = publish_parts(rst, writer="html",
+                             settings_overrides={"warning_stream": False})["body"]
+        assert "system-message" not in body and "System Message" not in body, (target, body)
+        assert "\\" not in body, (target, body)
+        if target == "fig06":
+            assert "|H|^2 S_f" in body
+
+
+def _study_dataset(amplitude, inv_beta):
+    """A dataset with the attributes and grids the workflow writes for a study
+    (``vibroimpact.pipeline.tasks``: the study's, its noise record's, the record's)."""
+    ds = xr.Dataset(coords={"inv_beta": np.asarray(inv_beta, dtype=float),
+                            "delta": np.arange(-1.0, 3.01, 0.5)})
+    ds.attrs.update(package_version="0.1.0", git_commit="2a54d9f2bded09952c6be3ea35153a49fba0687a",
+                    git_dirty=0, config_digest="9f612d59ee544ebb3fd4662dfbcc013cbe33c5fa50c9a1d7"
+                                               "3d24b3a877555b28",
+                    created="2026-11-24T10:13:53+00:00", seed=19740914, study="s", zeta=0.05,
+                    eps=0.5, amplitude=amplitude, noise="random_input", dt=0.1,
+                    noise_kind="band_limited", noise_rms=0.5, noise_dt=0.1, noise_beta_c=4.0,
+                    transient=200.0, t_end=1e6, record_length=999800.0, n_batches=20,
+                    motion_window=0.1, rebound_floor=0.01)
+    return ds
+
+
+def test_a_random_study_shows_its_noise_and_no_harmonic_keys():
+    rows = notebook.study_settings(_study_dataset(0.0, [1.0]), name="random")["value"]
+    assert {"noise": "random_input", "noise kind": "band_limited", "noise rms": "0.5",
+            "noise beta_c": "4", "noise dt": "0.1", "noise seed": "19740914",
+            "t_end": "1000000"}.items() <= rows.to_dict().items()
+    assert not {"inv_beta grid", "motion_window"} & set(rows.index)
+
+
+def test_a_harmonic_study_shows_its_noise_its_1_over_beta_grid_and_motion_window():
+    rows = notebook.study_settings(_study_dataset(1.0, [1 / 1.1, 1.1]))["value"]
+    assert rows["inv_beta grid"] == "0.9091, 1.1" and rows["motion_window"] == "0.1"
+    assert rows["noise rms"] == "0.5" and rows["noise seed"] == "19740914"
+
+
+def test_the_provenance_table_has_a_column_per_dataset_and_wraps_its_hashes():
+    ds = _study_dataset(0.0, [1.0])
+    styler = notebook.provenance(events=ds, spectra=ds, map=None, noise=ds)
+    table = styler.data
+    assert list(table.columns) == ["events", "spectra", "noise"]
+    assert table.loc["config_digest", "noise"] == ds.attrs["config_digest"]
+    assert table.loc["seed", "events"] == "19740914"
+    html = styler.to_html()
+    assert "word-break: break-all" in html and "table-layout: fixed" in html
+
+
+def _fake_snakemake(tmp_path, body, code):
+    """A `snakemake` that writes ``body`` to its ``--report`` file and exits with ``code``."""
+    script = tmp_path / "snakemake"
+    script.write_text(f"#!{sys.executable}\nimport sys\n"
+                      f"path = sys.argv[sys.argv.index('--report') + 1]\n"
+                      f"open(path, 'w').write({body!r})\nsys.exit({code})\n")
+    script.chmod(0o755)
+    return str(script)
+
+
+def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
+    workdir = make_workdir(tmp_path / "wd")
+    (workdir / "results").mkdir()
+    report = workdir / "results" / "report.html"
+    monkeypatch.setattr(cli, "_snakemake", lambda: _fake_snakemake(tmp_path, "<html>half", 1))
+    assert cli.main(["report", "--directory", str(workdir)]) == 1
+    assert not report.exists()
+    assert list((workdir / "results").iterdir()) == []     # no temporary either
+    monkeypatch.setattr(cli, "_snakemake",
+                        lambda: _fake_snakemake(tmp_path, "<html>whole</html>", 0))
+    assert cli.main(["report", "--directory", str(workdir)]) == 0
+    assert report.read_text() == "<html>whole</html>"
+    monkeypatch.setattr(cli, "_snakemake", lambda: _fake_snakemake(tmp_path, "<html>half", 1))
+    assert cli.main(["report", "--directory", str(workdir)]) == 1
+    assert report.read_text() == "<html>whole</html>"
+    assert [p.name for p in (workdir / "results").iterdir()] == ["report.html"]
+
+
+# --- the session's build of the test config ---------------------------------------------
+
+def _output_html(ipynb, call):
+    """The HTML output of the code cell of report ``ipynb`` whose source starts with
+    ``call``."""
+    nb = nbformat.read(ipynb, as_version=4)
+    cell = next(c for c in nb.cells if c.cell_type == "code" and c.source.startswith(call))
+    return next(o.data["text/html"] for o in cell.outputs if "text/html" in o.get("data", {}))
+
+
+#: A figure shown inline (not the template's icons, which are in its stylesheet).
+_IMAGE = re.compile(r"<img [^>]*src=\"data:image/png")
+
+
+def _row_labels(html):
+    """The row labels of a table: a styled one's (``level0 rowN`` headings) or a plain one's."""
+    return set(re.findall(r'<th id="[^"]*" class="[^"]* level0 row\d+"[^>]*>([^<]*)</th>', html)
+               or re.findall(r"<tr>\s*<th>([^<]*)</th>", html))
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("report", REPORTS)
+def test_every_report_of_the_build_reads_offline(built, report):
+    text = (built / "results" / "reports" / f"{report}.html").read_text()
+    assert fetched(text) == []
+    assert _IMAGE.search(text)
+    if report.endswith(("random_force", "harmonic_random", "periodic_motions")):
+        assert "<math " in text
+    summary = (built / "results" / "reports" / f"{report}.summary.html").read_text()
+    assert fetched(summary) == [] and not _IMAGE.search(summary)
+
+
+@pytest.mark.workflow
+def test_the_random_reports_settings_show_the_noise_and_no_harmonic_keys(built):
+    reports = built / "results" / "reports"
+    random = _row_labels(_output_html(reports / "random" / "random_force.ipynb",
+                                      "nb.study_settings"))
+    assert {"noise", "noise kind", "noise rms", "noise beta_c", "noise dt",
+            "noise seed"} <= random
+    assert not {"inv_beta grid", "motion_window"} & random
+    harmonic = _row_labels(_output_html(reports / "harmonic" / "harmonic_random.ipynb",
+                                        "nb.study_settings"))
+    assert {"inv_beta grid", "motion_window", "noise rms", "noise seed"} <= harmonic
+
+
+@pytest.mark.workflow
+def test_the_harmonic_reports_provenance_has_its_noise_record(built):
+    html = _output_html(built / "results" / "reports" / "harmonic" / "harmonic_random.ipynb",
+                        "nb.provenance")
+    columns = re.findall(r'<th [^>]*class="[^"]* level0 col\d+"[^>]*>([^<]*)</th>', html)
+    assert "noise" in columns and "events" in columns
+    assert {"git_commit", "config_digest", "seed"} <= _row_labels(html)
+
+
+@pytest.mark.workflow
+def test_snakemake_report_has_each_figure_once_and_no_docutils_error(built):
+    out = subprocess.run([sys.executable, "-m", "vibroimpact", "report", "--configfile",
+                          "config/test.yaml", "--output", "results/referee.html"],
+                         cwd=built, capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    text = (built / "results" / "referee.html").read_text()
+    assert "system-message" not in text and "System Message" not in text
+    assert fetched(text) == []
+    pngs = sorted((built / "results" / "figures").rglob("*.png"))
+    copies = [p for p in pngs if p.parent.name == "figures" and p.stem.startswith("fig")]
+    assert len(copies) >= 15
+    for png in pngs:
+        assert text.count(base64.b64encode(png.read_bytes()).decode()) == 1, png
+    categories = json.loads(re.search(r"var categories = (\{.*?\});\n", text)[1])
+    shown = [path for subs in categories.values() for paths in subs.values() for path in paths]
+    assert len(shown) == len(set(shown))
+    paper = [path for paths in categories["paper"].values() for path in paths]
+    assert len(paper) == len(copies) and all(p.startswith("results/figures/") for p in paper)
+    reports = [p for p in shown if p.startswith("results/reports/")]
+    assert len(reports) == len(REPORTS) and all(p.endswith(".summary.html") for p in reports)
