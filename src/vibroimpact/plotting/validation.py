@@ -57,7 +57,7 @@ FAR = 2.6
 #: Font size of the footnote, and its characters per inch of figure width (wrapped to fit;
 #: its mathtext has no spaces, so it is never broken inside).
 FOOTNOTE_SIZE = 7
-FOOTNOTE_CHARS_PER_INCH = 17
+FOOTNOTE_CHARS_PER_INCH = 19
 #: Font size of the setting labels, and their clearance (pixels) from every other mark.
 LABEL_SIZE = 6.5
 LABEL_PAD = 1.0
