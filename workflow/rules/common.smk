@@ -193,7 +193,7 @@ PYTHON = shlex.quote(sys.executable)
 REPORT_PARAMETERS = {
     "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
     "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
-                        "figures", "amplitude", "inv_beta"),
+                        "figures", "amplitude", "inv_beta", "density_delta"),
     "periodic_motions": ("name", "orbits", "map", "figures"),
     "performance": ("work_precision", "figures"),
     "stability": ("stress", "readme", "figures"),
@@ -291,7 +291,8 @@ def _nearest(values, target):
 def report_arguments(wildcards, input):
     """``-p name value`` for every parameter of the report's notebook: input paths (``""``
     when the study has no such dataset), the figures as one space-separated string, and the
-    study's name, forcing amplitude and the 1/beta_f its density findings read."""
+    study's name, forcing amplitude, the 1/beta_f its density findings read and the plays its
+    density figures draw (space-separated; "" = every play)."""
     notebook = _report_name(wildcards)
     given = {name: " ".join(value) if name == "figures" else str(value)
              for name, value in input.items()}
@@ -299,7 +300,9 @@ def report_arguments(wildcards, input):
         entry = config["studies"][wildcards.study]
         grid = [float(v) for v in STUDIES[wildcards.study].inv_beta]
         given.update(study=wildcards.study, amplitude=float(entry.get("amplitude", 0.0)),
-                     inv_beta=_nearest(grid, 1.1))      # Figs. 13, 14 of the paper: tau/1.1
+                     inv_beta=_nearest(grid, 1.1),      # Figs. 13, 14 of the paper: tau/1.1
+                     density_delta=" ".join(str(float(d))
+                                            for d in entry.get("density_delta") or ()))
     if "orbits" in wildcards.keys():
         given["name"] = wildcards.orbits
     given.setdefault("readme", "README.md")     # the stability report quotes its table
