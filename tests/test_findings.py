@@ -113,3 +113,20 @@ def test_the_table_has_one_row_per_finding_with_claim_measure_and_verdict():
     assert list(table.index) == [1, 2, 3, 4]
     assert list(table.columns) == ["claim", "measured", "holds"]
     assert "0.45" in table.loc[2, "measured"] or "0.7" in table.loc[2, "measured"]
+
+
+def test_finding4_tells_the_reach_of_a_record_from_a_threshold():
+    """Impacts that stop where Rice's rate expects < 3 in the record are its reach ("partly");
+    stopping where it expects many would be a threshold the Gaussian response does not have."""
+    events = random_events(rate=np.array([3.0, 2.9, 1.0, 0.3, 0.1, 0.01, 0.0]))
+    events["n_collisions"][0, -1] = 0                        # none at delta = 3
+    assert findings.finding4(events).holds == "yes"         # no theory attached: only the fall
+    sigma = 0.6
+    # Rice: nu+(3) = exp(-3^2 / 2 sigma^2) / 2 pi = 5.9e-7 for sigma_x = sigma_v = 0.6
+    nu = np.exp(-9.0 / (2 * sigma**2)) / (2 * np.pi)
+    reach = events.assign_attrs(linear_sigma_x=sigma, linear_sigma_v=sigma,
+                                record_length=1.0 / nu)     # one expected in the record
+    found = findings.finding4(reach)
+    assert found.holds == "partly" and "expects 1 " in found.measured
+    threshold = reach.assign_attrs(record_length=100.0 / nu)   # 100 expected, none seen
+    assert findings.finding4(threshold).holds == "yes"

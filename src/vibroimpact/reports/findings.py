@@ -15,6 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from vibroimpact.stats.theory import upcrossing_rate
+
 #: Fewest impacts a play needs before its means and densities take part in a finding
 #: (the batch-means error of a mean over 1000 impacts is a few percent).
 MIN_IMPACTS = 1000
@@ -176,7 +178,15 @@ def finding3(events):
 
 def finding4(events, orders=2.0):
     """Collision rate against delta (Fig. 9): for delta > 0 it never rises and falls by at least
-    ``orders`` orders of magnitude, towards the critical play past which no impact happens."""
+    ``orders`` orders of magnitude.
+
+    Whether "past a critical play no impact happens" is read against Rice's up-crossing rate
+    of the wall-free response (`vibroimpact.stats.upcrossing_rate`, from the dataset's
+    ``linear_sigma_x/_v``): where the record holds no collision and Rice's rate expects fewer
+    than 3 in its length, the impacts stop at the record's reach, not at a threshold of the
+    system ("partly": the rate falls, it does not vanish). Without those attributes only the
+    fall is read ("yes").
+    """
     ev = _row(events).sortby("delta")
     d, rate = ev.delta.values, ev.collision_rate.values
     positive = (d > 0) & (rate > 0)
@@ -191,7 +201,19 @@ def finding4(events, orders=2.0):
                 + (f"no impact from delta = {none.min():.3g} on" if none.size else
                    "every play of the grid still has impacts"))
     falling = bool(np.all(np.diff(rate[d > 0]) <= 0)) and fall >= orders
-    return _finding(4, measured, _yes(falling))
+    sigma = (ev.attrs.get("linear_sigma_x"), ev.attrs.get("linear_sigma_v"))
+    record = ev.attrs.get("record_length")
+    if not (falling and none.size and None not in sigma and record is not None):
+        return _finding(4, measured, _yes(falling))
+    expected = float(record) * upcrossing_rate(float(none.min()), *map(float, sigma))
+    rice = upcrossing_rate(at_low, *map(float, sigma))
+    measured += (f" in this record of length {float(record):.3g}, where Rice's up-crossing "
+                 f"rate expects {expected:.2g} (at delta = {at_low:.3g} it gives {rice:.3g}): ")
+    if expected < 3.0:
+        measured += "the impacts stop at the record's reach; the rate falls, never to zero"
+        return _finding(4, measured, "partly")
+    measured += "fewer impacts than the Gaussian response's excursions: a threshold"
+    return _finding(4, measured, "yes")
 
 
 def random_force(events=None, spectra=None):
