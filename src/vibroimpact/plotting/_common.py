@@ -176,13 +176,6 @@ def _headroom(ax):
     ax.set_ylim(low, high + LEGEND_HEADROOM * (high - low))
 
 
-def _bin_limits(ax, centres):
-    """x limits at the outer bin edges of evenly spaced bin centres."""
-    c = np.asarray(centres, dtype=float)
-    half = 0.5 * (c[1] - c[0]) if c.size > 1 else 0.5
-    ax.set_xlim(c[0] - half, c[-1] + half)
-
-
 #: Characters of a parameter line above which it is broken at its "; " separators.
 HEADER_WIDTH = 90
 
