@@ -82,9 +82,7 @@ def elastic_impact_rate(delta, sigma_x: float, sigma_v: float):
     up-crossing rate divided by ``Phi(delta / sigma_x)``. Computed with ``log_ndtr`` so it
     stays finite for large negative delta.
     """
-    d = np.asarray(delta, dtype=float) / sigma_x
-    rate = (sigma_v / sigma_x) / (2.0 * np.pi) * np.exp(-0.5 * d * d - special.log_ndtr(d))
-    return rate if rate.ndim else float(rate)
+    return _rice_rate(delta, sigma_x, sigma_v, elastic=True)
 
 
 def upcrossing_rate(delta, sigma_x: float, sigma_v: float):
@@ -112,8 +110,15 @@ def upcrossing_rate(delta, sigma_x: float, sigma_v: float):
     collisions of one excursion, and the wall's memory at smaller plays, make the measured
     interval shorter than ``1 / nu+``.
     """
+    return _rice_rate(delta, sigma_x, sigma_v, elastic=False)
+
+
+def _rice_rate(delta, sigma_x, sigma_v, elastic):
+    """Rice's up-crossing rate of delta, divided by Phi(delta / sigma_x) when ``elastic``
+    (in the exponent, so that it stays finite for large negative delta)."""
     d = np.asarray(delta, dtype=float) / sigma_x
-    rate = (sigma_v / sigma_x) / (2.0 * np.pi) * np.exp(-0.5 * d * d)
+    exponent = -0.5 * d * d - (special.log_ndtr(d) if elastic else 0.0)
+    rate = (sigma_v / sigma_x) / (2.0 * np.pi) * np.exp(exponent)
     return rate if rate.ndim else float(rate)
 
 
