@@ -94,7 +94,8 @@ def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estim
     nperseg : int
         Welch segment length of the PSD estimate.
     max_lag : float
-        Largest lag tau* of the autocorrelation (time units).
+        Largest lag tau* of the autocorrelation (time units); a record shorter than that
+        gives its lags up to its own length, (n_estimate - 1) dt at most.
     """
     from vibroimpact import noise as noise_mod   # scipy.signal: only the noise job needs it
 
@@ -112,7 +113,8 @@ def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estim
                     head.append(chunk[: n_estimate - k])
                 k += chunk.size
             head = np.concatenate(head)
-            lag, phi = noise_mod.estimate_autocorrelation(head, spec.dt, max_lag)
+            lag, phi = noise_mod.estimate_autocorrelation(
+                head, spec.dt, min(max_lag, (head.size - 1) * spec.dt))
             beta, S = noise_mod.estimate_psd(head, spec.dt, min(nperseg, head.size))
             nc.createDimension("lag", lag.size)
             nc.createDimension("beta", beta.size)
