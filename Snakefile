@@ -15,6 +15,8 @@ report: "workflow/report/workflow.rst"
 # into a paper entry of the same name; `configuration.load` adds, refuses collisions, and
 # checks and costs the whole config here, before any job (a problem: one or two lines each).
 try:
+    for _file in workflow.overwrite_configfiles:    # what Snakemake's loader lets through:
+        configuration.read_yaml(_file)              # a key given twice, nested aliases
     _config, PLAN = configuration.load(dict(config), root=workflow.basedir)
 except configuration.ConfigError as err:
     raise configuration.ConfigError(err.problems) from None

@@ -43,6 +43,8 @@ class Case:
     path: tuple = ()
     value: object = None
     text: str | None = None  # a user file of its own (layered on the paper's config)
+    snakemake: bool = True   # False: plain `snakemake` refuses it first, in words of its own
+
 
     def user(self):
         """The user's config as ``--configfile`` would give it (a fresh dict)."""
@@ -73,8 +75,39 @@ def _c(id, path, value, key, fragment):
     return Case(id=id, key=key, fragment=fragment, path=tuple(path), value=value)
 
 
-def _own(id, text, key, fragment):
-    return Case(id=id, key=key, fragment=fragment, text=textwrap.dedent(text))
+def _own(id, text, key, fragment, snakemake=True):
+    return Case(id=id, key=key, fragment=fragment, text=textwrap.dedent(text),
+                snakemake=snakemake)
+
+
+def _aliases(levels, width):
+    """A YAML file whose `delta` list nests ``levels`` aliases ``width`` wide: a "billion
+    laughs" of ``width ** levels`` values, a few lines of text."""
+    lines = [f"a0: &a0 [{', '.join(['0.5'] * width)}]"]
+    lines += [f"a{k}: &a{k} [{', '.join([f'*a{k - 1}'] * width)}]" for k in range(1, levels)]
+    return "\n".join(lines) + textwrap.dedent(f"""
+        paper: false
+        studies:
+          laughs:
+            noise: random_input
+            zeta: 0.05
+            eps: 0.5
+            delta: *a{levels - 1}
+            figures: [fig09]
+        """)
+
+
+#: A study of one's own, to write a file-level mistake into (line 1 is `paper: false`).
+OWN = textwrap.dedent("""\
+    paper: false
+    studies:
+      mine:
+        noise: random_input
+        zeta: 0.05
+        eps: 0.5
+        delta: [0.0, 1.0]
+        figures: [fig09]
+    """)
 
 
 R = ("studies", "random")
@@ -109,7 +142,7 @@ CASES = [
     _c("n_samples_huge", N + ("n_samples",), 10_000_000_000, "limits.max_disk_gb",
        "raise limits.max_disk_gb"),
     _c("n_samples_exponent_string", N + ("n_samples",), "4e5", "noises.random_input.n_samples",
-       "an integer >= 16"),
+       "write 400000; allowed: an integer >= 16"),
     _c("noise_kind_typo", N + ("kind",), "bandlimited", "noises.random_input.kind",
        "one of white, band_limited, lowpass2"),
     _c("noise_nperseg_beyond_record", N + ("nperseg",), 500_000, "noises.random_input.nperseg",
@@ -125,6 +158,17 @@ CASES = [
     _c("dt_zero", N + ("dt",), 0.0, "noises.random_input.dt", "> 0"),
     _c("rms_negative", N + ("rms",), -0.5, "noises.random_input.rms", ">= 0"),
     _c("seed_negative", N + ("seed",), -1, "noises.random_input.seed", ">= 0"),
+    _c("rms_beyond_float_range", N + ("rms",), 3e120, "noises.random_input.rms", "<= 1e+100"),
+    # --- the scale the arithmetic carries (squares summed over the record stay finite) -------
+    _c("amplitude_beyond_float_range", H + ("amplitude",), -5e150,
+       "studies.harmonic.amplitude", ">= -1e+100 and <= 1e+100"),
+    _c("delta_grid_beyond_float_range", R + ("delta",),
+       {"start": 0.0, "stop": 1e200, "step": 1e199}, "studies.random.delta.stop", "<= 1e+100"),
+    _c("trace_delta_beyond_float_range", R + ("trace", "delta"), 7e222,
+       "studies.random.trace.delta", "<= 1e+100"),
+    _c("sweep_rms_beyond_float_range", R + ("rms",), [0.5, 1e101],
+       "studies.random (noise of combination 1: rms=1e+101): rms",
+       "<= 1e+100"),
     # --- records: transient, t_end, spectra, trace ------------------------------------------
     _c("transient_beyond_record", R + ("transient",), 50_000.0, "studies.random.transient",
        "0 <= transient < 40000"),
@@ -156,6 +200,13 @@ CASES = [
        "harmonic_input, random_input"),
     _c("density_delta_off_grid", R + ("density_delta",), [1.0, 0.3],
        "studies.random.density_delta[1]", "-1, -0.5, ..., 3"),
+    _c("sweep_repeats_a_value", R + ("zeta",), [0.05, 0.1, 0.05], "studies.random.zeta",
+       "0.05 listed more than once"),
+    _c("sweep_repeats_a_seed", R + ("seed",), [4, 4], "studies.random.seed", "distinct values"),
+    _c("trace_inv_beta_without_harmonic_force", R + ("trace", "inv_beta"), 2.5,
+       "studies.random.trace.inv_beta", "amplitude != 0"),
+    _c("inv_beta_grid_without_harmonic_force", R + ("inv_beta",), [0.5, 2.0],
+       "studies.random.inv_beta", "amplitude != 0"),
     _c("entry_name_with_hyphen", ("studies", ("rename", "random", "random-fine")), None,
        "random-fine", "letters, digits and _"),
     # --- map ---------------------------------------------------------------------------------
@@ -213,6 +264,25 @@ CASES = [
        "raise limits.max_disk_gb"),
     _c("tiny_max_cells", ("limits",), {"max_cells": 10}, "limits.max_cells",
        "raise limits.max_cells"),
+    _c("tiny_max_cpu_hours", ("limits",), {"max_cpu_hours": 0.01}, "limits.max_cpu_hours",
+       "raise limits.max_cpu_hours"),
+    # --- the file itself: what YAML reads silently, or as text -----------------------------
+    _own("key_given_twice", OWN + "    eps: 0.7\n", "bad.yaml:9:5",
+         "the key 'eps' is given twice in one mapping (first on line 6)"),
+    _own("section_given_twice", OWN + "studies: {}\n", "bad.yaml:9:1",
+         "the key 'studies' is given twice"),
+    _own("exponent_without_sign", OWN.replace("zeta: 0.05", "zeta: 5e-2"),
+         "studies.mine.zeta", "read as the text '5e-2'"),
+    _own("exponent_without_dot_in_noise", OWN + textwrap.dedent("""\
+        noises:
+          my_noise: {kind: white, rms: 2.5e0, dt: 0.1, n_samples: 20001, seed: 3}
+        """).replace("random_input", "my_noise"), "noises.my_noise.rms", "write 2.5e+0"),
+    _own("quoted_number", OWN.replace("eps: 0.5", "eps: '0.5'"), "studies.mine.eps",
+         "write the number without quotes"),
+    _own("empty_file", "", "bad.yaml", "the config file is empty", snakemake=False),
+    _own("only_comments", "# my study, to be written\n", "bad.yaml", "the config file is empty",
+         snakemake=False),
+    _own("nested_aliases", _aliases(9, 9), "bad.yaml", "expand to more than 1,000,000 values"),
     _own("replace_as_a_string", """
         paper: false
         replace: studies.random
@@ -285,9 +355,15 @@ def _ids(cases):
 # --- fast suite: configuration.load ------------------------------------------------------------
 
 @pytest.mark.parametrize("case", CASES, ids=_ids(CASES))
-def test_load_refuses(case):
+def test_load_refuses(case, tmp_path):
+    """A case of its own file is read from it, as `make` and `plan` read a --configfile."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(case.yaml_text())
     with pytest.raises(configuration.ConfigError) as info:
-        configuration.load(case.user(), root=ROOT)
+        if case.text is None:
+            configuration.load(case.user(), root=ROOT)
+        else:
+            configuration.load(root=ROOT, user_files=[path])
     err = info.value
     text = "\n".join(err.problems)
     assert case.key in text, f"key path {case.key!r} not named:\n{text}"
@@ -362,8 +438,11 @@ def _no_job_ran(work):
 @pytest.mark.workflow
 @pytest.mark.parametrize("case", CASES, ids=_ids(CASES))
 def test_snakemake_refuses(copy_dir, case):
+    """Plain `snakemake`, or the entry point `make` calls where Snakemake's own loader
+    refuses the file first (an empty file: its message cannot name it)."""
     (copy_dir / "bad.yaml").write_text(case.yaml_text())
-    cmd = [SNAKEMAKE, "--cores", "1", "--configfile", "bad.yaml"]
+    cmd = ([SNAKEMAKE] if case.snakemake else [sys.executable, "-m", "vibroimpact", "run"]) + [
+        "--cores", "1", "--configfile", "bad.yaml"]
     out = subprocess.run(cmd, cwd=copy_dir, capture_output=True, text=True, timeout=120)
     text = out.stdout + out.stderr
     assert out.returncode != 0, text[-3000:]

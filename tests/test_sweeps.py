@@ -102,10 +102,11 @@ def test_derived_noises_are_shared_and_the_entrys_own_values_use_the_entry():
 
 
 def test_a_seed_list_gives_one_record_per_seed():
-    config, _ = configuration.load(_user(rms=None, eps=0.5, seed=[1, 2, 1]), root=ROOT)
-    noises = [config["studies"][f"eps_sweep_{k}"]["noise"] for k in range(3)]
-    assert noises == ["eps_sweep_noise0", "eps_sweep_noise1", "eps_sweep_noise0"]
-    assert [config["noises"][n]["seed"] for n in noises] == [1, 2, 1]
+    """Combinations of one seed share its record."""
+    config, _ = configuration.load(_user(rms=None, eps=[0.5, 0.7], seed=[1, 2]), root=ROOT)
+    noises = [config["studies"][f"eps_sweep_{k}"]["noise"] for k in range(4)]
+    assert noises == ["eps_sweep_noise0", "eps_sweep_noise1"] * 2
+    assert [config["noises"][n]["seed"] for n in noises] == [1, 2, 1, 2]
 
 
 def test_a_scalar_override_keeps_the_studys_name_and_is_no_sweep():
@@ -162,7 +163,8 @@ def test_a_sweep_of_a_study_without_events_figures_still_builds_its_events():
 
 
 def test_too_many_combinations_are_refused_before_expanding():
-    text = _problems(_user(eps=[0.5] * 50, rms=[0.1 * k for k in range(1, 51)]))
+    values = [0.01 * k for k in range(1, 51)]
+    text = _problems(_user(eps=values, rms=[10 * v for v in values]))
     assert "studies.eps_sweep: 50 eps x 50 rms = 2,500 combinations" in text
     assert "limits.max_jobs = 2,000" in text
 

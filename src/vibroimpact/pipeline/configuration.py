@@ -65,27 +65,98 @@ class ConfigError(ValueError):
 
 # --- reading and layering ---------------------------------------------------------------------
 
-def read_yaml(path):
-    """The mapping in a YAML config file; a syntax error names the file, line and column."""
+#: Values a config may hold once YAML aliases are expanded (the paper's config holds ~600);
+#: a file beyond it (nested aliases: a "billion laughs") is refused before anything walks it.
+MAX_VALUES = 1_000_000
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses a key given twice in one mapping (PyYAML keeps the
+    last silently), naming both lines."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = {}
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            key = self.construct_object(key_node, deep=True)
+            try:
+                first = seen.get(key)
+            except TypeError:
+                continue                    # an unhashable key: the base class says so
+            if first is not None:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key {key!r} is given twice in one mapping (first on "
+                    f"line {first + 1}); YAML keeps one silently: delete or rename the other",
+                    key_node.start_mark)
+            seen[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep=deep)
+
+
+def expanded_size(value, limit=MAX_VALUES):
+    """Number of values in ``value`` with every shared (aliased) part counted each time it
+    is used, as code that walks it meets them; counting stops above ``limit``."""
+    sizes = {}
+
+    def size(v):
+        if not isinstance(v, (dict, list)):
+            return 1
+        if id(v) not in sizes:
+            sizes[id(v)] = 0            # a self-referencing alias counts as one value
+            items = v.values() if isinstance(v, dict) else v
+            total = 1
+            for item in items:
+                total += size(item)
+                if total > limit:
+                    break
+            sizes[id(v)] = total
+        return sizes[id(v)]
+
+    return size(value)
+
+
+def check_size(value, where):
+    """Refuse ``value`` (a config read from ``where``) that expands beyond `MAX_VALUES`."""
+    n = expanded_size(value)
+    if n > MAX_VALUES:
+        raise ConfigError(f"{where}: its YAML aliases (*name) expand to more than "
+                          f"{MAX_VALUES:,} values (nested aliases repeat a part many times); "
+                          f"allowed: a config of up to {MAX_VALUES:,} values, written out or "
+                          f"with aliases used a few times")
+
+
+def read_yaml(path, *, user=True):
+    """The mapping in a YAML config file.
+
+    A syntax error or a key given twice names the file, line and column; an empty file, a
+    file that holds no mapping or whose aliases expand beyond `MAX_VALUES` names the file.
+    ``user=False`` (the project's own files) lets an empty file through as ``{}``.
+    """
     path = Path(path)
     try:
         text = path.read_text()
     except OSError as err:
         raise ConfigError(f"{path}: cannot read the config file ({err.strerror})") from None
     try:
-        data = yaml.safe_load(text)
+        data = yaml.load(text, Loader=_StrictLoader)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         context = getattr(err, "context", None)
-        raise ConfigError(f"{where}: YAML syntax error: {problem}"
+        kind = "YAML" if isinstance(err, yaml.constructor.ConstructorError) else "YAML syntax error"
+        raise ConfigError(f"{where}: {kind}: {problem}"
                           + (f" ({context})" if context else "")) from None
+    if data is None and user:
+        raise ConfigError(f"{path}: the config file is empty (or only comments); allowed: a "
+                          f"mapping of sections, e.g. studies: {{...}} (README, \"Your own "
+                          f"studies\")")
     if data is None:
         return {}
     if not isinstance(data, dict):
         raise ConfigError(f"{path}: a config file holds a mapping of keys (noises, studies, "
                           f"...), got a {type(data).__name__}")
+    check_size(data, path)
     return data
 
 
@@ -256,6 +327,11 @@ def _axes(name, entry, problems, max_studies):
                          allowed_)
             ok = False
         elif isinstance(value, list):
+            repeated = sorted({_short(v) for i, v in enumerate(value) if v in value[:i]})
+            if repeated:
+                problems.add(f"studies.{name}.{key}", value, f"{', '.join(repeated)} listed "
+                             f"more than once (identical studies)", "distinct values")
+                ok = False
             axes[key] = value
     n = math.prod(len(v) for v in axes.values())
     if ok and max_studies is not None and n > max_studies:
@@ -510,6 +586,39 @@ def _short(value):
     return text if len(text) <= 60 else text[:57] + "..."
 
 
+def _read_as_text(value, integer=False):
+    """Why a value that reads as a number is text (``1.0e6``: YAML 1.1 wants ``1.0e+6``),
+    with how to write it (``integer``: as the integer, ``4e5`` -> 400000); None for any other
+    value."""
+    if not isinstance(value, str):
+        return None
+    try:
+        number = float(value.replace("_", ""))
+    except ValueError:
+        return None
+    if not math.isfinite(number):
+        return None
+    exponent = re.fullmatch(r"\s*([-+]?[0-9_]*\.?[0-9_]*)[eE]([-+]?)([0-9]+)\s*", value)
+    if exponent is None:
+        return f"read as the text {value!r} (it is quoted); write the number without quotes"
+    mantissa, sign, digits = exponent.groups()
+    if integer and number.is_integer():
+        fix = f"{int(number)}"
+    else:
+        fix = f"{mantissa if '.' in mantissa else mantissa + '.0'}e{sign or '+'}{digits}"
+    return (f"read as the text {value!r}: YAML 1.1 reads a number with an exponent only "
+            f"with a dot and a signed exponent; write {fix}")
+
+
+def _not_allowed(parts, value, node=None):
+    """``<key path> = <value>: not allowed; allowed: ...`` (``node``: the schema node that
+    failed, else the one at ``parts``), saying when a number was read as text."""
+    node = node if node is not None else _schema_at(parts)
+    problem = _read_as_text(value, integer=node.get("type") == "integer")
+    return (f"{_path(parts)} = {_short(value)}: {problem or 'not allowed'}; "
+            f"allowed: {_describe(parts, node)}")
+
+
 def _schema_messages(error):
     """One or two lines for one jsonschema error (descending into oneOf branches)."""
     parts = list(error.absolute_path)
@@ -531,7 +640,9 @@ def _schema_messages(error):
                         and isinstance(error.instance, (int, float))))
             if same and not any(s.validator == "type" and not s.relative_path for s in subs):
                 return [m for s in subs for m in _schema_messages(s)]
-        return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts)}"]
+        node = _schema_at(parts)
+        return [_not_allowed(parts, error.instance,
+                             _scalar(node) if _read_as_text(error.instance) else node)]
     if kind == "required":
         missing = [k for k in error.validator_value if k not in error.instance]
         key = missing[0] if missing else error.message.split("'")[1]
@@ -548,7 +659,7 @@ def _schema_messages(error):
         return [f"{where}: empty; allowed: {_describe(parts)}"]
     # the failing node itself (a figure name's pattern, not the figure item's oneOf)
     node = error.schema if isinstance(error.schema, dict) and "oneOf" not in error.schema else None
-    return [f"{where} = {_short(error.instance)}: not allowed; allowed: {_describe(parts, node)}"]
+    return [_not_allowed(parts, error.instance, node)]
 
 
 def _validator(schema):
@@ -791,6 +902,16 @@ def _check_study(config, name, entry, problems, limits):
     grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_cells"], positive=True)
                          if harmonic else np.array([1.0]))
+    amplitude_swept = "amplitude" in entry.get("sweep", {}).get("values", {})
+    if not harmonic and not amplitude_swept:
+        # keys of the harmonic force a random study would silently ignore
+        trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
+        for key, value, default in (("inv_beta", entry["inv_beta"], [1.0]),
+                                    ("trace.inv_beta", trace_inv_beta, None)):
+            if value is not None and value != default:
+                problems.add(f"{where}.{key}", value, "1/beta_f of the harmonic force, and "
+                             "this study has none (amplitude = 0)", "leave it out, or give "
+                             "the study an amplitude != 0")
     transient = float(entry["transient"])
     t_end = entry.get("t_end")
     end = tau if t_end is None else float(t_end)
@@ -941,8 +1062,10 @@ def load(user=None, *, root=".", user_files=()):
         user = {}
         for path in user_files:
             user = _deep_merge(user, read_yaml(path))
-    schema = read_yaml(root / "config" / "schema.yaml")
-    paper = read_yaml(root / "config" / "config.yaml")
+    else:
+        check_size(user or {}, "the config given with --configfile")
+    schema = read_yaml(root / "config" / "schema.yaml", user=False)
+    paper = read_yaml(root / "config" / "config.yaml", user=False)
     config, own = compose(paper, user or {})
     if own is not None and "build" not in ((user or {}).get("validation") or {}):
         # paper: false builds the file's own entries; the validation runs are the paper's
@@ -1036,9 +1159,10 @@ class Plan:
         return sum(r.cpu_s for r in self.rows)
 
     def summary(self, cores=2):
-        return (f"{self.cells:,} simulation cells, {self.orbit_cells:,} orbit cells, "
-                f"{self.jobs} jobs, ~{_bytes(self.bytes)} of outputs, ~{_time(self.cpu_s)} of "
-                f"CPU (~{_time(self.cpu_s / max(cores, 1))} on {cores} cores)")
+        return (f"{_n(self.cells, 'simulation cell')}, {_n(self.orbit_cells, 'orbit cell')}, "
+                f"{_n(self.jobs, 'job')} (Snakemake counts {self.jobs + 1}, with its target "
+                f"`all`), ~{_bytes(self.bytes)} of outputs, ~{_time(self.cpu_s)} of CPU "
+                f"(~{_time(self.cpu_s / max(cores, 1))} on {_n(cores, 'core')})")
 
     def format(self, cores=2):
         lines = ["vibroimpact plan (every output of `rule all`, whether or not already built):"]
@@ -1055,7 +1179,9 @@ class Plan:
         lines.append(f"          {self.jobs} of {lim['max_jobs']} jobs (limits.max_jobs), "
                      f"{_bytes(self.bytes)} of {_num(lim['max_disk_gb'])} GB (limits.max_disk_gb)"
                      + (f"; {_bytes(self.free_bytes)} free under {self.results}"
-                        if self.free_bytes is not None else ""))
+                        if self.free_bytes is not None else "") + ",")
+        lines.append(f"          ~{_time(self.cpu_s)} of {_num(lim['max_cpu_hours'])} h of CPU "
+                     f"(limits.max_cpu_hours)")
         return "\n".join(lines)
 
     __str__ = format
@@ -1069,6 +1195,11 @@ class Plan:
                 problems.append(f"limits.{key} = {lim[key]:,}: this build has {value:,} "
                                 f"{what}; raise limits.{key} to build it, or shrink the grids"
                                 f"\n  ({self.summary()})")
+        if self.cpu_s > lim["max_cpu_hours"] * 3600:
+            problems.append(f"limits.max_cpu_hours = {_num(lim['max_cpu_hours'])}: this build "
+                            f"needs ~{_time(self.cpu_s)} of CPU; raise limits.max_cpu_hours to "
+                            f"build it (a cluster: README, \"On a SLURM cluster\"), or shrink the grids or "
+                            f"records\n  ({self.summary()})")
         gb = self.bytes / 1e9
         if gb > lim["max_disk_gb"]:
             problems.append(f"limits.max_disk_gb = {_num(lim['max_disk_gb'])}: this build "
@@ -1080,6 +1211,13 @@ class Plan:
                             f"some space or shorten the records")
         if problems:
             raise ConfigError(problems)
+
+
+def _n(count, word):
+    """``"1 figure"``, ``"3 figures"``, ``"2 studies"``."""
+    if count == 1:
+        return f"1 {word}"
+    return f"{count:,} " + (word[:-1] + "ies" if word.endswith(("dy", "py")) else word + "s")
 
 
 def _bytes(n):
@@ -1152,14 +1290,14 @@ def make_plan(config, own=None, *, results="results"):
             per_cell = 12 * (bins + 100)
             _add(row, cells, study.n_tiles("events") + 1, 2 * cells * per_cell,
                  cells * steps * NS_PER_STEP * 1e-9)
-            parts.append(f"events {cells} cells")
+            parts.append(f"events {_n(cells, 'cell')}")
         if "map" in needs:
             cells = len(study.cells("events"))
             cap = sum(len(study.delta) * min(n - 1, (float(entry["transient"]) + int(
                 entry["map"]["max_periods"]) * 2 * math.pi * ib) / dt) for ib in study.inv_beta)
             _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200, cap * NS_PER_STEP
                  * 1e-9)
-            parts.append(f"map {cells} cells (CPU at the caps)")
+            parts.append(f"map {_n(cells, 'cell')} (CPU at the caps)")
         if "spectra" in needs:
             cells = len(study.cells("spectra"))
             spec = entry["spectra"]
@@ -1167,7 +1305,7 @@ def make_plan(config, own=None, *, results="results"):
             _add(row, cells, study.n_tiles("spectra") + 1,
                  2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1),
                  cells * steps * NS_PER_STEP * 1e-9)
-            parts.append(f"spectra {cells} cells")
+            parts.append(f"spectra {_n(cells, 'cell')}")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / dt
             _add(row, 0, 1, 40 * steps, 0.0)
@@ -1176,26 +1314,26 @@ def make_plan(config, own=None, *, results="results"):
         row.jobs += targets
         row.bytes += targets * FIGURE_BYTES
         row.cpu_s += targets * FIGURE_S + row.jobs * JOB_START_S
-        row.detail = ", ".join(parts) + f", {targets} figures"
+        row.detail = ", ".join(parts) + f", {_n(targets, 'figure')}"
         plan.rows.append(row)
     for name in sorted(build["orbits"]):
         entry = config["orbits"][name]
         rows, n_tiles = orbit_rows(entry)
         cells = len(rows) * grid_size(entry["delta"])
         targets = len(figures.figure_targets(entry)) if name in drawn["orbits"] else 0
-        row = Row(f"orbits.{name}", f"{cells:,} cells x {len(entry['types'])} types, "
-                  f"{targets} figures", orbit_cells=cells, jobs=n_tiles + 1 + targets,
+        row = Row(f"orbits.{name}", f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}, "
+                  f"{_n(targets, 'figure')}", orbit_cells=cells, jobs=n_tiles + 1 + targets,
                   bytes=2 * cells * len(entry["types"]) * 34 + targets * FIGURE_BYTES)
         row.cpu_s = (cells * len(entry["types"]) * US_PER_ORBIT * 1e-6
                      + row.jobs * JOB_START_S + targets * FIGURE_S)
         plan.rows.append(row)
     for name in drawn_sweeps(config, drawn):
         n = len(config["sweeps"][name]["studies"])
-        plan.rows.append(Row(f"sweeps.{name}", f"{n} studies side by side, 1 figure", jobs=1,
+        plan.rows.append(Row(f"sweeps.{name}", f"{_n(n, 'study')} side by side, 1 figure", jobs=1,
                              bytes=FIGURE_BYTES, cpu_s=FIGURE_S + JOB_START_S))
     reports = len(drawn["studies"]) + len(drawn["orbits"])
     if reports:
-        plan.rows.append(Row("reports", f"{reports} notebooks executed, with HTML",
+        plan.rows.append(Row("reports", f"{_n(reports, 'notebook')} executed, with HTML",
                              jobs=reports, bytes=reports * REPORT_BYTES,
                              cpu_s=reports * (REPORT_S + JOB_START_S)))
     if config["validation"]["build"]:
@@ -1204,7 +1342,7 @@ def make_plan(config, own=None, *, results="results"):
                              cpu_s=VALIDATION_S + 2 * (FIGURE_S + REPORT_S) + 6 * JOB_START_S))
     copies = drawn["paper_figures"]
     if copies:
-        plan.rows.append(Row("paper_figures", f"{len(copies)} copies", jobs=len(copies),
+        plan.rows.append(Row("paper_figures", _n(len(copies), "copy"), jobs=len(copies),
                              bytes=len(copies) * FIGURE_BYTES))
     try:
         probe = Path(results)
