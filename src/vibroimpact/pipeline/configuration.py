@@ -654,7 +654,7 @@ def _schema_messages(error):
                 for k in extra]
     if "propertyNames" in error.schema_path:
         return [f"{where}: the name {error.instance!r} is not allowed; allowed: letters, "
-                f"digits and _, starting with a letter"]
+                f"digits and _, starting with a letter, at most 120 characters (a file name)"]
     if kind in ("minProperties", "minItems") and not error.instance:
         return [f"{where}: empty; allowed: {_describe(parts)}"]
     # the failing node itself (a figure name's pattern, not the figure item's oneOf)
@@ -740,6 +740,22 @@ class _Problems(list):
         self.append(f"{where}{shown}: {problem}; allowed: {allowed_}")
 
 
+def _repeated(values):
+    """The values of a list given more than once (equal within `GRID_RTOL`), ascending."""
+    v = np.sort(np.asarray(values, dtype=float))
+    close = np.diff(v) <= GRID_RTOL * np.maximum(1.0, np.abs(v[1:]))
+    return sorted(set(v[1:][close].tolist()))
+
+
+def _distinct(problems, where, values):
+    """Record a list of values that repeats one; True when it does not."""
+    repeated = _repeated(values) if values else []
+    if repeated:
+        problems.add(where, values, f"{', '.join(map(_num, repeated))} listed more than once",
+                     "distinct values")
+    return not repeated
+
+
 def _grid(problems, where, spec, limit, positive=False):
     """Values of a grid, or None after recording why it is unusable."""
     try:
@@ -754,6 +770,11 @@ def _grid(problems, where, spec, limit, positive=False):
                      f"at most {limit:,} values (limits.max_cells), e.g. a larger step")
         return None
     values = grid_values(spec)
+    repeated = _repeated(values)
+    if repeated:
+        problems.add(where, spec, f"{', '.join(map(_num, repeated))} listed more than once "
+                     f"(one cell each)", "distinct values")
+        return None
     if positive and np.any(values <= 0.0):
         bad = float(values[values <= 0.0][0])
         key = f"{where}.start" if isinstance(spec, dict) else where
@@ -840,10 +861,12 @@ def _check_figures(config, section, name, entry, problems, grids):
                 problems.add(f"{at}.{key}", item[key], f"not an option of {fig}",
                              _figure_keys(fig))
         if spec.get("per") == "inv_beta" and "inv_beta" in item:
+            _distinct(problems, f"{at}.inv_beta", item["inv_beta"])
             for j, v in enumerate(item["inv_beta"]):
                 if not _on_grid(v, grids["inv_beta"]):
                     problems.add(f"{at}.inv_beta[{j}]", v, "not on the study's inv_beta grid",
                                  _grid_text(grids["inv_beta"]))
+        _distinct(problems, f"{at}.density_delta", item.get("density_delta"))
         for j, v in enumerate(item.get("density_delta", [])):
             if not _on_grid(v, grids["delta"]):
                 problems.add(f"{at}.density_delta[{j}]", v, "not on the study's delta grid",
@@ -902,6 +925,17 @@ def _check_study(config, name, entry, problems, limits):
     grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_cells"], positive=True)
                          if harmonic else np.array([1.0]))
+    if harmonic:
+        shortest = dt / (2 * math.pi)       # a forcing period of one sample step
+        trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
+        for key, values in (("inv_beta", grids["inv_beta"]),
+                            ("trace.inv_beta", [] if trace_inv_beta is None else [trace_inv_beta])):
+            fast = [float(v) for v in (values if values is not None else []) if v < shortest]
+            if fast:
+                problems.add(f"{where}.{key}", fast[0], f"a forcing period 2 pi/beta_f shorter "
+                             f"than the sample step dt = {_num(dt)} of noises.{entry['noise']} "
+                             f"(the pressed mass would stick and release many times a step)",
+                             f"1/beta_f >= dt/(2 pi) = {shortest:.6g}")
     amplitude_swept = "amplitude" in entry.get("sweep", {}).get("values", {})
     if not harmonic and not amplitude_swept:
         # keys of the harmonic force a random study would silently ignore
@@ -954,6 +988,7 @@ def _check_study(config, name, entry, problems, limits):
     if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
         problems.add(f"{where}.trace.t_end", trace["t_end"],
                      f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
+    _distinct(problems, f"{where}.density_delta", entry["density_delta"])
     if grids["delta"] is not None:
         for j, v in enumerate(entry["density_delta"]):
             if not _on_grid(v, grids["delta"]):
@@ -974,18 +1009,31 @@ def _check_study(config, name, entry, problems, limits):
             problems.add(f"{where}.map.min_time", spec["min_time"],
                          f"transient + min_time is beyond the record ({record})",
                          f"0 < min_time <= {tau - transient:.6g}")
+    if "map" in uses and harmonic:
+        _plane(problems, where, grids, "fig15")
     if all(g is not None for g in grids.values()):
         _check_figures(config, "studies", name, entry, problems, grids)
     return grids
+
+
+def _plane(problems, where, grids, fig):
+    """Record a (1/beta_f, delta) plane too small for `fig`'s contours (2 values an axis)."""
+    for key in ("inv_beta", "delta"):
+        if grids[key] is not None and grids[key].size < 2:
+            problems.add(f"{where}.{key}", float(grids[key][0]), f"{fig} draws contours "
+                         f"over the (1/beta_f, delta) plane", "at least 2 values")
 
 
 def _check_orbits(config, name, entry, problems, limits):
     from vibroimpact.orbits.api import MAX_M
 
     where = f"orbits.{name}"
-    _grid(problems, f"{where}.inv_beta", entry["inv_beta"], limits["max_orbit_cells"],
-          positive=True)
-    _grid(problems, f"{where}.delta", entry["delta"], limits["max_orbit_cells"])
+    grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
+                               limits["max_orbit_cells"], positive=True),
+             "delta": _grid(problems, f"{where}.delta", entry["delta"],
+                            limits["max_orbit_cells"])}
+    if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
+        _plane(problems, where, grids, "fig16")
     for j, (m, n) in enumerate(entry["types"]):
         if m > MAX_M:
             problems.add(f"{where}.types[{j}]", [m, n], f"the orbit solver finds (m/n) motions "
