@@ -438,6 +438,16 @@ def test_yaml_syntax_error_names_file_line_column(tmp_path):
     assert len(text.splitlines()) <= 2
 
 
+def test_a_file_not_in_utf8_is_named_with_its_line(tmp_path):
+    """A file saved in Latin-1 (an accented study name): its file and line, not a traceback."""
+    path = tmp_path / "latin1.yaml"
+    path.write_bytes(OWN.replace("mine:", "mïne:").encode("latin-1"))
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.load(root=ROOT, user_files=[path])
+    assert str(info.value) == (f"{path}:3: not UTF-8 text (byte 0xef); allowed: a YAML file "
+                               f"saved as UTF-8")
+
+
 # --- workflow suite: the real snakemake command in a copy of the project ----------------------
 
 @pytest.fixture(scope="module")

@@ -137,6 +137,10 @@ def read_yaml(path, *, user=True):
         text = path.read_text()
     except OSError as err:
         raise ConfigError(f"{path}: cannot read the config file ({err.strerror})") from None
+    except UnicodeDecodeError as err:
+        line = err.object[:err.start].count(b"\n") + 1
+        raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{err.object[err.start]:02x}); "
+                          f"allowed: a YAML file saved as UTF-8") from None
     try:
         data = yaml.load(text, Loader=_StrictLoader)
     except yaml.YAMLError as err:
@@ -144,7 +148,8 @@ def read_yaml(path, *, user=True):
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
         problem = getattr(err, "problem", None) or str(err).splitlines()[0]
         context = getattr(err, "context", None)
-        kind = "YAML" if isinstance(err, yaml.constructor.ConstructorError) else "YAML syntax error"
+        duplicate = isinstance(err, yaml.constructor.ConstructorError)
+        kind = "YAML" if duplicate else "YAML syntax error"
         raise ConfigError(f"{where}: {kind}: {problem}"
                           + (f" ({context})" if context else "")) from None
     if data is None and user:
@@ -927,9 +932,9 @@ def _check_study(config, name, entry, problems, limits):
                          if harmonic else np.array([1.0]))
     if harmonic:
         shortest = dt / (2 * math.pi)       # a forcing period of one sample step
-        trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
+        trace = (entry.get("trace") or {}).get("inv_beta")
         for key, values in (("inv_beta", grids["inv_beta"]),
-                            ("trace.inv_beta", [] if trace_inv_beta is None else [trace_inv_beta])):
+                            ("trace.inv_beta", None if trace is None else [trace])):
             fast = [float(v) for v in (values if values is not None else []) if v < shortest]
             if fast:
                 problems.add(f"{where}.{key}", fast[0], f"a forcing period 2 pi/beta_f shorter "
@@ -1246,8 +1251,8 @@ class Plan:
         if self.cpu_s > lim["max_cpu_hours"] * 3600:
             problems.append(f"limits.max_cpu_hours = {_num(lim['max_cpu_hours'])}: this build "
                             f"needs ~{_time(self.cpu_s)} of CPU; raise limits.max_cpu_hours to "
-                            f"build it (a cluster: README, \"On a SLURM cluster\"), or shrink the grids or "
-                            f"records\n  ({self.summary()})")
+                            f"build it (a cluster: README, \"On a SLURM cluster\"), or shrink "
+                            f"the grids or records\n  ({self.summary()})")
         gb = self.bytes / 1e9
         if gb > lim["max_disk_gb"]:
             problems.append(f"limits.max_disk_gb = {_num(lim['max_disk_gb'])}: this build "
