@@ -18,6 +18,7 @@ from matplotlib.figure import Figure
 from vibroimpact._files import atomic_path
 from vibroimpact.stats.events import t_quantile
 from vibroimpact.stats.spectra import line_power
+from vibroimpact.stats.theory import upcrossing_rate
 
 #: The house style sheet (the only place rcParams are set).
 STYLE_FILE = Path(__file__).with_name("vibroimpact.mplstyle")
@@ -196,6 +197,66 @@ def _panel_tag(ax, tag):
             fontweight="bold")
 
 
+def _padded(values, fraction=0.05):
+    """``(low, high)`` of `values` widened by `fraction` of their range (by 0.5 when flat)."""
+    low, high = float(np.min(values)), float(np.max(values))
+    pad = fraction * (high - low) if high > low else 0.5
+    return low - pad, high + pad
+
+
+def note_on_axes(ax, text):
+    """Write `text` at the centre of an axes that has nothing to draw (gid ``"note"``)."""
+    ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.25",
+            gid="note", bbox=dict(facecolor="white", edgecolor="0.7", pad=4))
+
+
+def input_is_zero(ds):
+    """Whether the force of a dataset is zero: no random part (``noise_rms`` 0) and no harmonic."""
+    return float(ds.attrs.get("noise_rms", 1.0)) == 0.0 and float(_attr(ds, "amplitude")) == 0.0
+
+
+def no_collision_text(ds, where="in this record at any $\\delta$"):
+    """Why a figure of collision statistics has nothing to draw, in words for its axes.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Events or map dataset with ``delta``, global attributes ``noise_rms``, ``amplitude``
+        and, from an events dataset, ``linear_sigma_x``, ``linear_sigma_v`` (the wall-free
+        response's stds) and ``record_length``.
+    where : str, optional
+        Where no collision happened (``"in any cell of this map"``).
+
+    Returns
+    -------
+    str
+        ``"no collision in this record at any delta"`` and the reason: the force is zero
+        (the mass stays at rest), there is no random part (rms_r = 0), or the smallest play
+        in units of the wall-free std sigma_x with the up-crossings of it that Rice's rate
+        (`vibroimpact.stats.upcrossing_rate`) expects in the record's length: a property of
+        this record, the rate falls with delta but never to zero.
+    """
+    text = f"no collision {where}"
+    rms = float(ds.attrs.get("noise_rms", np.nan))
+    sigma_x = float(ds.attrs.get("linear_sigma_x", 0.0))
+    sigma_v = float(ds.attrs.get("linear_sigma_v", 0.0))
+    if input_is_zero(ds):
+        return text + "\nthe force is zero (rms$_r$ = 0, no harmonic): the mass stays at rest"
+    if rms == 0.0:
+        return text + " (rms$_r$ = 0)"
+    if sigma_x > 0.0 and sigma_v > 0.0:
+        smallest = float(np.min(np.asarray(ds["delta"], dtype=float)))
+        text += ("\n" + rf"its smallest $\delta$ = {_num(smallest)} is "
+                 rf"{_num(smallest / sigma_x)} $\sigma_x$ of the wall-free response "
+                 rf"($\sigma_x$ = {_num(sigma_x)})")
+        if "record_length" in ds.attrs:
+            record = float(ds.attrs["record_length"])
+            expected = record * upcrossing_rate(smallest, sigma_x, sigma_v)
+            text += ("\n" + rf"where Rice's rate expects {expected:.2g} up-crossings in the "
+                     f"record's length {record:.4g}")
+    return text
+
+
 # --------------------------------------------------------------------------------------------
 # The parameter line every figure prints
 # --------------------------------------------------------------------------------------------
@@ -308,9 +369,15 @@ def _trace_figure(trace, title, harmonic):
         label = f"collision: first impact ({int(shown.sum())})"
     else:
         label = f"impact ({int(shown.sum())})"
+    if not shown.any():
+        label = "no collision in this stretch"
     ax_a.plot(t_imp[shown], np.zeros(int(shown.sum())), ls="none", marker="v", color="C3",
               markersize=5, label=label)
-    ax_a.set_ylim(bottom=min(-0.06 * float(trace["a"].max()), float(trace["a"].min())))
+    a = np.asarray(trace["a"], dtype=float)
+    if np.ptp(np.append(a, 0.0)) > 0.0:
+        ax_a.set_ylim(bottom=min(-0.06 * a.max(), a.min()))
+    else:
+        ax_a.set_ylim(-0.06, 1.0)           # a = 0 throughout: the mass rests at the wall
     _headroom(ax_a)
     ax_a.set_ylabel(axis_label(trace["a"]))
     ax_a.set_xlabel(axis_label(tau))
@@ -344,7 +411,13 @@ def _response_spectra(spectra, i_beta, title, params, beta_max, lin_label):
     ax.plot(ds["beta"], ds["S_lin"], color="k", ls=(0, (1.5, 1.5)), lw=1.1, label=lin_label)
     if harmonic:
         _mark_forcing(ax, float(spectra["inv_beta"][i_beta]))
-    ax.set_yscale("log")
+    if input_is_zero(spectra):
+        # what the record holds is round-off: a log axis would show it as a spectrum
+        ax.set_ylim(-0.05, 1.0)
+        note_on_axes(ax, "the force is zero (rms$_r$ = 0, no harmonic):\n"
+                         r"the mass stays at rest, $a(\tau)$ has no power")
+    else:
+        ax.set_yscale("log")
     ax.set_xlim(0.0, float(ds["beta"].max()))
     ax.set_xlabel(axis_label(ds["beta"]))
     ax.set_ylabel(_psd_label(ds["S_a"]))
@@ -581,11 +654,18 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
             top = max(top, float(np.nanmax(y)))
             low = min(low, float(np.nanmin(y)))
     ax_log = axes[0]
+    ax_log.set_yscale("log")
     if top > 0.0:
-        ax_log.set_yscale("log")
         ax_log.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
     else:
-        ax_log.set_ylim(bottom=0.0)
+        ax_log.set_ylim(DENSITY_DECADES, 1.0)
+        drawn = ds.isel(delta=index)
+        empty = (no_collision_text(drawn, where=r"in this record at any $\delta$ drawn")
+                 if int(drawn["n_collisions"].sum()) == 0 else
+                 f"no bin run holds {MIN_BIN_COUNT} values at any $\\delta$ drawn:\n"
+                 "too few collisions for a density")
+        for ax in axes:
+            note_on_axes(ax, empty)
     for ax in axes[1:]:
         ax.set_ylim(0.0, 1.08 * top if top > 0.0 else 1.0)
     for ax in axes:

@@ -19,7 +19,8 @@ from scipy.spatial import cKDTree
 
 from vibroimpact import stats
 from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _styled,
-                                          _system_text, axis_label)
+                                          _system_text, axis_label, no_collision_text,
+                                          note_on_axes)
 
 #: Probability contours (%) of Fig. 15 (the paper draws 10 % steps).
 PROBABILITY_LEVELS = (10, 20, 30, 40, 50, 60, 70, 80, 90)
@@ -316,17 +317,26 @@ def _cliff_handle(lw):
 
 def _finish_figure(fig, motion_map, handles, title):
     """Legend below the panels and the header: system, forcing, the map's statistics."""
-    fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
     _header(fig, title, f"{_system_text(motion_map)};  {_map_forcing_text(motion_map)}\n"
                         f"{_map_text(motion_map)}")
     return fig
 
 
 def _finish_axes(axes, ds):
+    """Labels, the grid's extent (from centre to centre, as the filled contours) and, on a
+    map without a collision, the words."""
+    x, y = _grid(ds)
+    empty = "n_collisions" in ds and int(ds["n_collisions"].sum()) == 0
     for ax in axes:
+        ax.set_xlim(*(x if x.size > 1 else cell_edges(x))[[0, -1]])
+        ax.set_ylim(*(y if y.size > 1 else cell_edges(y))[[0, -1]])
         ax.set_xlabel(axis_label(ds["inv_beta"]))
         ax.set_ylabel(axis_label(ds["delta"]))
         ax.label_outer()
+        if empty:
+            note_on_axes(ax, no_collision_text(ds, where="in any cell\nof this map"))
 
 
 @_styled

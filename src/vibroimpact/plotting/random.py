@@ -7,8 +7,9 @@ from matplotlib.patches import Patch
 
 from vibroimpact.plotting._common import (
     CONFIDENCE, FEW_IMPACTS, SPECTRUM_BETA_MAX, STOP_BAND_LEVEL, _attr, _density_figure,
-    _events_params, _figure, _header, _headroom, _num, _panel_tag, _psd_label, _require,
-    _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label, t_quantile)
+    _events_params, _figure, _header, _headroom, _num, _padded, _panel_tag, _psd_label, _require,
+    _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label, no_collision_text,
+    note_on_axes, t_quantile)
 from vibroimpact.stats.theory import upcrossing_rate
 
 #: fig05 draws the PSD of the piecewise-linear force as its own line when it differs from the
@@ -246,9 +247,12 @@ def fig09(events):
     d_c = critical_delta(events)
     record = ds.attrs.get("record_length")
     sigma = (ds.attrs.get("linear_sigma_x"), ds.attrs.get("linear_sigma_v"))
-    rice = sigma[0] is not None and sigma[1] is not None
+    # a zero force (rms 0) has a wall-free response without excursions: no asymptote
+    rice = None not in sigma and min(float(v) for v in sigma) > 0.0
     if rice:
         sigma_x, sigma_v = (float(v) for v in sigma)
+        rice = RICE_FROM_SIGMA * sigma_x < delta.max()      # the asymptotes reach the sweep
+    if rice:
         d_rice = np.linspace(max(RICE_FROM_SIGMA * sigma_x, delta.min()), delta.max(), 200)
         eps = float(_attr(ds, "eps"))
         asymptotes = (np.full_like(d_rice, eps * sigma_v * np.sqrt(np.pi / 2.0)),
@@ -278,6 +282,11 @@ def fig09(events):
     if np.isfinite(measured).any():
         axes[1].set_ylim(0.5 * np.nanmin(measured),
                          20.0 * max(np.nanmax(measured), float(record or 0.0)))
+    if not n.any():
+        axes[0].set_xlim(*_padded(delta))
+        axes[1].set_ylim(1.0, 20.0 * float(record or 1.0))
+        for ax in axes:
+            note_on_axes(ax, no_collision_text(ds))
     if record is not None:
         axes[1].axhline(float(record), color="0.45", ls=":", lw=1.0)
     # one legend for both panels, below them, so it never hides a point

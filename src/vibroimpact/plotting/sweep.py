@@ -5,8 +5,8 @@ import numpy as np
 from matplotlib.lines import Line2D
 
 from vibroimpact.plotting._common import (
-    CONFIDENCE, FEW_IMPACTS, _attr, _colors, _figure, _filter_parts, _header, _num, _panel_tag,
-    _require, _styled, axis_label, t_quantile)
+    CONFIDENCE, FEW_IMPACTS, _attr, _colors, _figure, _filter_parts, _header, _num, _padded,
+    _panel_tag, _require, _styled, axis_label, note_on_axes, t_quantile)
 
 #: Height (inches): two panels and the legend below them.
 SWEEP_HEIGHT = 7.0
@@ -100,11 +100,12 @@ def sweep_means(datasets, labels):
         mean velocity after impact, (b) the mean interval on a log scale. Bars are +-t
         batch-means standard errors (t the Student quantile of B - 1 dof at `CONFIDENCE`);
         means resting on fewer than `FEW_IMPACTS` collisions are open squares without bars;
-        deltas without impacts are left out. With two or more swept keys the first one's
-        value gives the colour and the others' the line style, else each combination has
-        its colour; each combination's points are shifted by a fixed small offset in delta
-        (`DODGE`, stated in the legend). The parameter line gives the values the studies
-        share and names those that vary.
+        deltas without impacts are left out, a combination without any is named so in the
+        legend, and when no combination has one the axes say so in words. With two or more
+        swept keys the first one's value gives the colour and the others' the line style,
+        else each combination has its colour; each combination's points are shifted by a
+        fixed small offset in delta (`DODGE`, stated in the legend). The parameter line
+        gives the values the studies share and names those that vary.
 
     Raises
     ------
@@ -136,12 +137,21 @@ def sweep_means(datasets, labels):
                         markersize=4.5)
         any_few |= bool(few.any())
         handles.append(Line2D([], [], color=color, ls=ls, marker="o", markersize=3.5,
-                              label=label))
+                              label=label if impacts.any() else f"{label}  (no collision)"))
     reference = datasets[0].isel(inv_beta=0)
     for ax, name in zip(axes, ("v_after", "interval")):
         ax.set_ylabel(axis_label(reference[f"{name}_mean"]))
     axes[0].set_ylim(bottom=0.0)
     axes[1].set_yscale("log")       # the mean interval spans orders of magnitude over delta
+    intervals = np.concatenate([np.ravel(ds["interval_mean"]) for ds in datasets])
+    if not np.isfinite(intervals).any():     # nothing on the log axis to scale it by
+        axes[1].set_ylim(1.0, 20.0 * float(reference.attrs.get("record_length", 1.0)))
+    if not any(int(ds["n_collisions"].sum()) for ds in datasets):
+        delta = np.concatenate([np.asarray(ds["delta"], dtype=float) for ds in datasets])
+        axes[0].set_xlim(*_padded(delta))
+        for ax in axes:
+            note_on_axes(ax, "no collision in the record of any combination at any "
+                             r"$\delta$")
     axes[1].set_xlabel(axis_label(reference["delta"]))
     _panel_tag(axes[0], "(a)")
     _panel_tag(axes[1], "(b)")

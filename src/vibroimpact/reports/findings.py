@@ -3,9 +3,10 @@
 Every function takes the datasets a finding is about (as written by the workflow,
 ``docs/datasets.md``) and returns a :class:`Finding`: the paper's claim, what this run
 measured, and whether the claim holds on it (``"yes"``, ``"partly"``, ``"no"``, or ``"n/a"`` when
-the datasets cannot decide it). The report notebooks show them as a table
-(:func:`findings_table`); the workflow tests assert them on the test config. Nothing here is
-typed in from a previous run: change a dataset and the verdict changes with it.
+the datasets cannot decide it: missing, or, for the findings on collisions (2-4, 6, 7), a record
+with no collision at any play, which ``measured`` then says). The report notebooks show them
+as a table (:func:`findings_table`); the workflow tests assert them on the test config.
+Nothing here is typed in from a previous run: change a dataset and the verdict changes with it.
 
 The thresholds are the ones stated with each claim below; "within the resolution" means one
 bin of the density or the frequency grid.
@@ -83,6 +84,19 @@ def _fmt(values, spec=".3g"):
     return ", ".join(format(float(v), spec) for v in values)
 
 
+def _without_collision(events):
+    """Why ``events`` (one 1/beta row or all) cannot decide a finding on collisions: the
+    record has none at any play (and, with no force at all, that the mass stays at rest);
+    None when some play has one."""
+    if int(events.n_collisions.sum()) > 0:
+        return None
+    why = f"no collision in this record at any play (delta = {_fmt(np.unique(events.delta))})"
+    zero = (float(events.attrs.get("noise_rms", 1.0)) == 0.0
+            and float(events.attrs.get("amplitude", 1.0)) == 0.0)
+    return why + ("; the force is zero (rms 0, no harmonic): the mass stays at rest" if zero
+                  else "")
+
+
 def _impacting(events, minimum=MIN_IMPACTS):
     """The plays with at least ``minimum`` collisions (one 1/beta row), in increasing delta."""
     keep = events.delta[events.n_collisions >= minimum]
@@ -109,9 +123,18 @@ def finding1(spectra, band=(0.2, 3.0), flat=3.0):
     Over ``band`` of beta, for the plays delta > 0 in decreasing order, the peak frequency must
     rise (never fall by a bin of the spectrum, and end higher than it starts: plays too large
     to be hit share the linear peak's bin) and the peak level fall; at delta = 0 the peak must
-    be below ``flat`` times the median (no marked peak).
+    be below ``flat`` times the median (no marked peak). A zero random force (the linear
+    reference ``S_lin`` zero) or fewer than two frequencies in ``band`` leave nothing to
+    judge: ``n/a``.
     """
     s = _row(spectra).sel(beta=slice(*band))
+    if s.sizes["beta"] < 2:
+        step = float(spectra.beta[1] - spectra.beta[0])
+        return not_available(1, f"the spectrum's resolution (beta step {step:.3g}) leaves "
+                                f"{s.sizes['beta']} frequencies in {band[0]:g} <= beta <= "
+                                f"{band[1]:g}; a finer one needs a longer spectra.nperseg")
+    if "S_lin" in s and not float(s.S_lin.max()) > 0.0:
+        return not_available(1, "the random force is zero (rms 0): a(tau) has no spectrum")
     positive = s.sel(delta=s.delta[s.delta > 0]).sortby("delta", ascending=False)
     if positive.sizes["delta"] < 2 or 0.0 not in s.delta.values:
         return not_available(1, f"needs spectra at two plays > 0 and at delta = 0; this study "
@@ -134,6 +157,8 @@ def finding2(events):
     impacts, and "markedly so for negative delta": it falls faster, relative to its value,
     over the negative plays than over as wide a range of positive ones (the mean slope of
     ln v against delta on [delta_min, 0] exceeds that on [0, -delta_min])."""
+    if (why := _without_collision(_row(events))) is not None:
+        return not_available(2, why)
     ev = _impacting(_row(events))
     if ev.sizes["delta"] < 3:
         return not_available(2, f"needs three plays with >= {MIN_IMPACTS} impacts")
@@ -158,6 +183,8 @@ def finding3(events):
     interval may grow again at the lowest plays: ``yes`` when it increases over every play,
     ``partly`` when it increases from some play <= 0 upwards (the table says where it turns
     and the contact fraction below), ``no`` otherwise."""
+    if (why := _without_collision(_row(events))) is not None:
+        return not_available(3, why)
     ev = _impacting(_row(events))
     if ev.sizes["delta"] < 3:
         return not_available(3, f"needs three plays with >= {MIN_IMPACTS} collisions")
@@ -188,6 +215,8 @@ def finding4(events, orders=2.0):
     fall is read ("yes").
     """
     ev = _row(events).sortby("delta")
+    if (why := _without_collision(ev)) is not None:
+        return not_available(4, why)
     d, rate = ev.delta.values, ev.collision_rate.values
     positive = (d > 0) & (rate > 0)
     if positive.sum() < 3:
@@ -235,7 +264,13 @@ def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0):
     integral of its one-sided PSD); concentrated means > 80 %. The response, per 1/beta_f:
     its share of power within ``halfwidth`` of beta_f must fall as delta decreases (spreads
     wider), and its centroid over ``0 < beta <= band`` fall (moves to lower frequency).
+    Fewer than two frequencies in that band (a Welch segment too short) leave it ``n/a``.
     """
+    beta = spectra.beta.values
+    if np.count_nonzero((beta > 0) & (beta <= band)) < 2:
+        return not_available(5, f"the spectrum's resolution (beta step {beta[1] - beta[0]:.3g}) "
+                                f"leaves fewer than two frequencies in 0 < beta <= {band:g}; a "
+                                f"finer one needs a longer spectra.nperseg")
     lines, shares, centroids = [], [], []
     spread_all, lower_all = True, True
     for inv_beta in np.atleast_1d(spectra.inv_beta.values):
@@ -286,6 +321,8 @@ def finding6(events, inv_beta=1.1, symmetric=0.1):
     of 1 and P(1/1) > 0.5. Small play: at the smaller play where (2/1) is most
     probable, the two peaks below 1 add up to 1 within ``symmetric`` and P(2/1) > 0.5.
     """
+    if (why := _without_collision(_row(events, inv_beta))) is not None:
+        return not_available(6, why)
     ev = _impacting(_row(events, inv_beta))
     motions = [str(m) for m in ev.motion.values] if "motion" in ev.dims else []
     if "ratio_density" not in ev or not {"1/1", "2/1"} <= set(motions) or ev.sizes["delta"] < 2:
@@ -334,6 +371,8 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     larger is narrow; "partly": the spread falls with P(1/1) but such a play is wide; "no":
     it does not fall with P(1/1).
     """
+    if (why := _without_collision(_row(events, inv_beta))) is not None:
+        return not_available(7, why)
     ev = _impacting(_row(events, inv_beta))
     if "motion_probability" not in ev or "1/1" not in [str(m) for m in ev.motion.values]:
         return not_available(7, "needs the velocity densities and P(1/1) of a harmonic study")
@@ -343,6 +382,8 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     p11 = _motion(ev, "1/1").values
     d = ev.delta.values
     dominant = p11 >= 0.5
+    if not d.size:
+        return not_available(7, f"no play has >= {MIN_IMPACTS} collisions")
     if not dominant.any():
         return not_available(7, f"(1/1) dominates at no play drawn (delta = {_fmt(d)})")
     small = (d < d[dominant].min()) & ~dominant

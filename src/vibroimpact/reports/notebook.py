@@ -42,6 +42,13 @@ def open_dataset(path, lazy=False):
     return xr.open_dataset(path) if lazy else xr.load_dataset(path)
 
 
+def first(*datasets):
+    """The first of `datasets` that is not None (None when every one is): the dataset a
+    report reads a study's settings from, whichever of events, spectra, map or trace the
+    study has."""
+    return next((ds for ds in datasets if ds is not None), None)
+
+
 def show_figures(figures):
     """Display each figure file inline (PNG embedded, so the HTML stands alone), under its
     path."""
@@ -105,22 +112,30 @@ _NOISE = (("noise", "noise"), ("noise_kind", "kind"), ("noise_rms", "rms"),
           ("seed", "seed"))
 _RECORD = ("transient", "t_end", "record_length", "n_batches", "motion_window", "rebound_floor",
            "nperseg", "target_stderr", "max_periods")
-_HARMONIC_ONLY = ("motion_window", "inv_beta")
+_HARMONIC_ONLY = ("motion_window", "inv_beta", "beta_f")
+#: The single play and forcing frequency of a trace (``results/traces/<study>.nc``).
+_TRACE = (("delta", "trace delta"), ("beta_f", "trace beta_f"))
 
 
 def study_settings(ds, name=""):
-    """The physical and statistical settings of a dataset (a study's or an orbits map's),
-    from its attributes and grids, as a small table: the system, the random force (its
+    """The physical and statistical settings of a dataset (a study's, a trace's or an orbits
+    map's), from its attributes and grids, as a small table: the system, the random force (its
     record's name, kind, rms, cut-off, sample step and seed) and the record and statistics.
-    A study without a harmonic force (``amplitude`` 0) shows no 1/beta_f grid and no motion
-    window, which apply only to one."""
+    A study without a harmonic force (``amplitude`` 0) shows no 1/beta_f grid, forcing
+    frequency or motion window, which apply only to one. ``None`` (a study with no dataset
+    to read them from) gives a note saying so."""
     import pandas as pd
+    from IPython.display import Markdown
 
+    if ds is None:
+        return Markdown("*This study has no dataset to read its settings from.*")
     skipped = () if float(ds.attrs.get("amplitude", 1.0)) != 0.0 else _HARMONIC_ONLY
     values = {"entry": name} if name else {}
     values.update({k: ds.attrs[k] for k in _SYSTEM if k in ds.attrs})
     values.update({f"{d} grid": _grid_text(ds[d].values) for d in ("inv_beta", "delta")
                    if d in ds.dims and d not in skipped})
+    values.update({label: ds.attrs[k] for k, label in _TRACE
+                   if k in ds.attrs and k not in ds.dims and k not in skipped})
     values.update({"noise" if label == "noise" else f"noise {label}": ds.attrs[k]
                    for k, label in _NOISE if k in ds.attrs})
     values.update({k: ds.attrs[k] for k in _RECORD if k in ds.attrs and k not in skipped})
