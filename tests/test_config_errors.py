@@ -120,8 +120,9 @@ CASES = [
     # --- non-finite, out of range, wrong type, unknown keys -----------------------------------
     _c("zeta_nan", R + ("zeta",), math.nan, "studies.random.zeta", "> 0"),
     _c("eps_inf", R + ("eps",), math.inf, "studies.random.eps", "<= 1"),
-    _c("zeta_negative", R + ("zeta",), -0.05, "studies.random.zeta", "> 0 and < 1"),
-    _c("zeta_percent", H + ("zeta",), 5.0, "studies.harmonic.zeta", "< 1"),
+    _c("zeta_negative", R + ("zeta",), -0.05, "studies.random.zeta", "> 0 and <= 0.9999"),
+    _c("zeta_percent", H + ("zeta",), 5.0, "studies.harmonic.zeta", "<= 0.9999"),
+    _c("zeta_critical", R + ("zeta",), 0.99999999, "studies.random.zeta", "<= 0.9999"),
     _c("eps_above_one", R + ("eps",), 1.5, "studies.random.eps", ">= 0 and <= 1"),
     _c("unknown_study_key", R + ("colour",), "red", "studies.random.colour",
        "allowed keys here: noise, zeta, eps"),
@@ -179,7 +180,7 @@ CASES = [
     _c("spectra_t_end_beyond_record", R + ("spectra", "t_end"), 50_000.0,
        "studies.random.spectra.t_end", "<= 40000"),
     _c("spectra_nperseg_beyond_spectra_record", R + ("spectra", "nperseg"), 500_000,
-       "studies.random.spectra.nperseg", "16 <= nperseg <= 199000"),
+       "studies.random.spectra.nperseg", "16 <= nperseg <= 199001"),
     _c("spectra_delta_off_grid", R + ("spectra", "delta"), [3.0, 1.0, 0.3],
        "studies.random.spectra.delta[2]", "-1, -0.5, ..., 3"),
     _c("trace_t_end_beyond_record", R + ("trace", "t_end"), 50_000.0,
@@ -302,6 +303,20 @@ CASES = [
         """).replace("random_input", "my_noise"), "noises.my_noise.rms", "write 2.5e+0"),
     _own("quoted_number", OWN.replace("eps: 0.5", "eps: '0.5'"), "studies.mine.eps",
          "write the number without quotes"),
+    _own("spectra_record_shorter_than_a_segment", """
+        paper: false
+        noises:
+          short: {kind: white, rms: 0.5, dt: 0.1, n_samples: 16, nperseg: 16, seed: 2}
+        studies:
+          mine:
+            noise: short
+            zeta: 0.05
+            eps: 0.5
+            delta: [0.0, 1.0]
+            transient: 0.5
+            spectra: {delta: [0.0], nperseg: 16}
+            figures: [fig06]
+        """, "studies.mine.spectra: its record holds 11 samples", "n_samples >= 21"),
     _own("empty_file", "", "bad.yaml", "the config file is empty", snakemake=False),
     _own("only_comments", "# my study, to be written\n", "bad.yaml", "the config file is empty",
          snakemake=False),

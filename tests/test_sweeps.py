@@ -236,7 +236,7 @@ def test_the_error_of_a_plain_study_is_as_before():
                                                  "eps": 0.5, "delta": [0.0],
                                                  "figures": ["fig09"]}}}
     assert _problems(user) == ("studies.mine.zeta = nan: not a finite number; allowed: a finite "
-                               "number > 0 and < 1 (damping ratio, 0 < zeta < 1)")
+                               "number > 0 and <= 0.9999 (damping ratio, 0 < zeta <= 0.9999)")
 
 
 # --- attributes and the figure, through the workflow's tasks -----------------------------------

@@ -975,12 +975,19 @@ def _check_study(config, name, entry, problems, limits):
                              f"leaves no record after the transient ({_num(transient)})",
                              f"{_num(transient)} < t_end <= {tau:.6g}, or null")
         else:
-            samples = int((s_end - transient) / dt)
-            if samples < int(spectra["nperseg"]):
+            # the samples k dt with transient <= k dt <= t_end (cells.spectra_cell)
+            samples = (math.floor(s_end / dt + 1e-9) - math.ceil(transient / dt - 1e-9) + 1)
+            if samples < 16:
+                problems.add(f"{where}.spectra", None, f"its record holds {samples} samples "
+                             f"(transient to t_end, at dt = {_num(dt)}), fewer than a Welch "
+                             f"segment's 16", f"a record of 16 samples or more: n_samples >= "
+                             f"{16 + math.ceil(transient / dt - 1e-9)} in noises."
+                             f"{entry['noise']}, or a longer spectra.t_end")
+            elif samples < int(spectra["nperseg"]):
                 problems.add(f"{where}.spectra.nperseg", spectra["nperseg"],
-                             f"longer than the spectra record ((t_end - transient)/dt = "
-                             f"{max(samples, 0)} samples)",
-                             f"16 <= nperseg <= {max(samples, 0)}, or a longer spectra.t_end")
+                             f"longer than the spectra record ({samples} samples from the "
+                             f"transient to t_end)",
+                             f"16 <= nperseg <= {samples}, or a longer spectra.t_end")
         sgrid = _grid(problems, f"{where}.spectra.delta", spectra["delta"], limits["max_cells"])
         if sgrid is not None and grids["delta"] is not None:
             for j, v in enumerate(sgrid):
