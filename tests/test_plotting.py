@@ -526,3 +526,12 @@ def test_density_figure_draws_no_point_below_the_sparse_bin_count(data):
     x = np.asarray(line.get_xdata(), dtype=float)
     assert np.nanmax(x) < float(events["v_after"][-1]) - 0.5 * width   # the lone bin is not drawn
     assert ax.get_xlim()[1] < float(events["v_after"][-1])              # nor the axis taken to it
+
+
+def test_a_single_bin_spans_zero_to_max():
+    """``bins: {max: 1000, n: 1}``: one bin [0, 1000] holding every interval (it was given a
+    width of 1 and failed as "not a count")."""
+    cell = xr.Dataset({"interval_density": ("interval", [1.0 / 1000.0]), "n_collisions": 369},
+                      coords={"interval": [500.0]})
+    edges, counts, n = plotting.bin_counts(cell, "interval_density")
+    assert edges.tolist() == [0.0, 1000.0] and counts.tolist() == [368] and n == 368

@@ -434,7 +434,8 @@ def _welch_text(ds, lines):
     segments = np.asarray(ds["n_segments"]) if "n_segments" in ds else np.array([])
     text = rf"Welch, Hann window: resolution $\Delta\beta$ = {step:.3g}"
     if segments.size:
-        text += f", {int(segments.min()):,} segments"
+        n = int(segments.min())
+        text += f", {n:,} segment{'' if n == 1 else 's'}"
     if lines:
         text += ("\n" r"a line's peak height grows as 1/$\Delta\beta$; its power "
                  r"$\frac{1}{\pi}\int (S - S_{\rm background})\,d\beta$ does not")
@@ -572,9 +573,9 @@ def bin_counts(cell, var):
 
 
 def _bin_edges(centres):
-    """Edges of evenly spaced bins from their centres."""
+    """Edges of evenly spaced bins from their centres (the first edge at 0 for one bin)."""
     c = np.asarray(centres, dtype=float)
-    half = 0.5 * (c[1] - c[0]) if c.size > 1 else 0.5
+    half = 0.5 * (c[1] - c[0]) if c.size > 1 else c[0]     # one bin: [0, max] (datasets.bin_edges)
     return np.concatenate([c - half, [c[-1] + half]])
 
 
