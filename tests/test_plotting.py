@@ -193,7 +193,7 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
 def test_density_delta_without_impacts_keeps_its_line(data):
     ax = plotting.fig07(data["events"], density_delta=[6.0, 0.0]).axes[0]
     assert len(_data_lines(ax)) == 2
-    assert "no impacts" in _legend_texts(ax)[0]
+    assert "no collision" in _legend_texts(ax)[0]
 
 
 def test_fig09_bars_scale_and_markers(data):

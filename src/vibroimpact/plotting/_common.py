@@ -639,7 +639,7 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
         cell = ds.isel(delta=k)
         n = int(cell["n_collisions"])
         xs, y, se = _drawn_density(cell, var, band)
-        impacts = f"{n:,} collisions" if n else "no impacts"
+        impacts = f"{n:,} collision{'' if n == 1 else 's'}" if n else "no collision"
         label = rf"$\delta$ = {_num(cell['delta'])}  ({impacts}{_beyond_text(beyond[k])})"
         for ax in axes:
             ax.plot(xs, y, color=style["color"], ls=style["ls"], marker=style["marker"],
