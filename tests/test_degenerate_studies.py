@@ -66,6 +66,8 @@ def data(tmp_path_factory):
            "partial": _events(tmp, "partial", PARTIAL, band),
            "coarse": _events(tmp, "coarse", COARSE, band, "spectra"),
            "weak": _events(tmp, "weak", WEAK, zero),
+           "weak_spectra": _events(tmp, "weak", dict(WEAK, spectra=dict(
+               delta=[20.0, 30.0], nperseg=256)), zero, "spectra"),
            "map": _events(tmp, "weak_map", WEAK_MAP, zero, "map")}
     out["orbits"] = datasets.orbit_map_dataset(
         orbit_map(np.array([0.5, 1.0]), np.array([20.0, 30.0]), types=[(1, 1), (2, 1), (1, 2)],
@@ -167,8 +169,10 @@ def test_findings_that_need_collisions_are_na_with_the_reason(data):
     assert all(NO_COLLISION.replace("any", "any play") in f.measured for f in found[1:])
     far = findings.random_force(events=data["far"])
     assert all("(delta = 50, 60)" in f.measured for f in far[1:])
-    weak = findings.harmonic_random(events=data["weak"], inv_beta=1.1)
+    weak = findings.harmonic_random(events=data["weak"], spectra=data["weak_spectra"],
+                                    inv_beta=1.1)
     assert [f.holds for f in weak] == ["n/a"] * 4
+    assert "no collision in this record at the plays of the spectra" in weak[0].measured
     assert all(NO_COLLISION.replace("any", "any play") in f.measured for f in weak[1:3])
 
 

@@ -257,15 +257,24 @@ def random_force(events=None, spectra=None):
 
 # --- harmonic plus random force (Figs. 11-15) --------------------------------------------------
 
-def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0):
+def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0, events=None):
     """Input and response spectra under ``amplitude sin(beta_f tau) + r(tau)`` (Figs. 11, 12).
 
     The input: the line carries ``amplitude^2/2`` against the random part's power (the
     integral of its one-sided PSD); concentrated means > 80 %. The response, per 1/beta_f:
     its share of power within ``halfwidth`` of beta_f must fall as delta decreases (spreads
     wider), and its centroid over ``0 < beta <= band`` fall (moves to lower frequency).
-    Fewer than two frequencies in that band (a Welch segment too short) leave it ``n/a``.
+    Fewer than two frequencies in that band (a Welch segment too short) leave it ``n/a``, and
+    so do ``events`` (the study's impact statistics) without a collision at the spectra's
+    plays: a response that never meets the wall cannot show what impacts do to it.
     """
+    if events is not None:
+        at = events.sel(delta=spectra.delta.values, method="nearest")
+        if "inv_beta" in at.dims and "inv_beta" in spectra.dims:
+            at = at.sel(inv_beta=np.atleast_1d(spectra.inv_beta.values), method="nearest")
+        why = _without_collision(at)
+        if why is not None:
+            return not_available(5, why.replace("at any play", "at the plays of the spectra"))
     beta = spectra.beta.values
     if np.count_nonzero((beta > 0) & (beta <= band)) < 2:
         return not_available(5, f"the spectrum's resolution (beta step {beta[1] - beta[0]:.3g}) "
@@ -431,7 +440,7 @@ def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, in
     ``n/a``. ``agreement`` is :func:`vibroimpact.plotting.maps.map_agreement` of its map with
     an orbits map; ``density_delta``, the plays Fig. 14 draws, are those finding 7 reads
     (default: every play with impacts)."""
-    found = [finding5(spectra, amplitude) if spectra is not None else
+    found = [finding5(spectra, amplitude, events=events) if spectra is not None else
              not_available(5, "this study draws no spectrum of a(tau) (Fig. 12)")]
     missing = "this study has no impact densities (Figs. 13, 14)"
     found.append(finding6(events, inv_beta) if events is not None else not_available(6, missing))
