@@ -185,6 +185,8 @@ CASES = [
        "studies.random.spectra.delta[2]", "-1, -0.5, ..., 3"),
     _c("trace_t_end_beyond_record", R + ("trace", "t_end"), 50_000.0,
        "studies.random.trace.t_end", "0 < t_end <= 40000"),
+    _c("trace_shorter_than_a_sample_step", R + ("trace", "t_end"), 0.05,
+       "studies.random.trace.t_end", "0.1 <= t_end <= 40000"),
     # --- study settings ------------------------------------------------------------------------
     _c("tile_size_zero", R + ("tile_size",), 0, "studies.random.tile_size", ">= 1"),
     _c("n_batches_one", R + ("n_batches",), 1, "studies.random.n_batches", ">= 2"),

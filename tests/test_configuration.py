@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from vibroimpact import _files
-from vibroimpact.pipeline import configuration
+from vibroimpact.pipeline import configuration, figures
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -171,3 +171,16 @@ def test_progress_is_logged_at_a_bounded_rate_and_at_the_end(caplog):
     assert "~80 s left" in lines[0]
     assert lines[-1].startswith("progress tile 0: 1000 of 1000 cells, 3000 collisions")
     assert "~0 s left" in lines[-1]
+
+
+def test_a_per_figure_listed_by_name_alone_is_drawn_at_every_grid_value():
+    """``fig14`` alone in a study with ``inv_beta: [0.5, 1.1]``: ``fig14-0`` at 0.5 and
+    ``fig14-1`` at 1.1 (it crashed in the figure job, missing inv_beta); with one grid value
+    the plain name."""
+    entry = {"inv_beta": [0.5, 1.1], "figures": ["fig14", {"name": "fig13", "inv_beta": [1.1]}]}
+    assert figures.figure_targets(entry) == ["fig14-0", "fig14-1", "fig13"]
+    assert [figures.figure_options(entry, t)["inv_beta"] for t in ("fig14-0", "fig14-1")] == [
+        0.5, 1.1]
+    one = {"inv_beta": {"start": 1.1, "stop": 1.1, "step": 0.1}, "figures": ["fig12"]}
+    assert figures.figure_targets(one) == ["fig12"]
+    assert figures.figure_options(one, "fig12")["inv_beta"] == 1.1

@@ -1000,6 +1000,10 @@ def _check_study(config, name, entry, problems, limits):
     if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
         problems.add(f"{where}.trace.t_end", trace["t_end"],
                      f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
+    elif trace and float(trace["t_end"]) < dt * (1 - 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"], f"shorter than one sample step "
+                     f"(dt = {_num(dt)} of noises.{entry['noise']}): a trace of one point",
+                     f"{_num(dt)} <= t_end <= {tau:.6g}")
     _distinct(problems, f"{where}.density_delta", entry["density_delta"])
     if grids["delta"] is not None:
         for j, v in enumerate(entry["density_delta"]):

@@ -6,15 +6,18 @@ under ``reads``, its drawing options come from its owner's config entry (keys li
 in the entry's ``figures`` list. A figure that names a ``per`` parameter is drawn once per
 listed value: the item ``{name: fig13, inv_beta: [0.8, 1.25]}`` gives the targets
 ``fig13-0`` and ``fig13-1`` (an index, never a float in a file name); a list of one value
-keeps the plain name ``fig13``. ``harmonic`` figures
+keeps the plain name ``fig13``; a ``per`` figure listed by its name alone is drawn once per
+value of its entry's grid of that parameter (:func:`per_values`). ``harmonic`` figures
 (Figs. 10-15) need a study with a harmonic force (``amplitude != 0``). A figure that lists
 ``sources`` reads those datasets from the config entry its item names (``fig15_vs_fig16``
 draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits: harmonic}``).
 """
 import re
 
+from vibroimpact.pipeline.study import grid_values
+
 __all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item",
-           "figure_sources", "paper_target", "caption", "rest_text"]
+           "figure_sources", "paper_target", "caption", "rest_text", "per_values"]
 
 FIGURES = {
     "fig03": dict(owner="study", reads=("trace",),
@@ -93,16 +96,28 @@ def figure_item(entry, name):
                      f"{[_item_name(i) for i in entry.get('figures', [])]}")
 
 
+def per_values(entry, item):
+    """The values of a ``per`` figure's parameter: the item's list, or, for a figure listed
+    by its name alone, every value of the entry's grid of that parameter (``fig14`` alone in
+    a study with ``inv_beta: [0.5, 1.1]`` draws ``fig14-0`` and ``fig14-1``); None for a
+    figure drawn once."""
+    per = FIGURES[_item_name(item)].get("per")
+    if per is None:
+        return None
+    if not isinstance(item, str) and per in item:
+        return list(item[per])
+    return [float(v) for v in grid_values(entry[per])] if per in entry else None
+
+
 def figure_targets(entry):
     """Target names (``fig07``, ``fig13-0`` ...) of every figure an entry lists."""
     targets = []
     for item in entry.get("figures", []):
-        name = _item_name(item)
-        per = FIGURES[name].get("per")
-        if per is None or isinstance(item, str) or per not in item or len(item[per]) == 1:
+        name, values = _item_name(item), per_values(entry, item)
+        if values is None or len(values) == 1:
             targets.append(name)
         else:
-            targets += [f"{name}-{k}" for k in range(len(item[per]))]
+            targets += [f"{name}-{k}" for k in range(len(values))]
     return targets
 
 
@@ -118,9 +133,8 @@ def figure_options(entry, target):
     item = figure_item(entry, name)
     options.update({k: v for k, v in item.items()
                     if k != "name" and k not in spec.get("sources", ())})
-    per = spec.get("per")
-    if per is not None and per in item:
-        values = item[per]
+    per, values = spec.get("per"), per_values(entry, item)
+    if values is not None:
         if index is None and len(values) == 1:
             index = 0       # one value: the plain name (fig11), no variant suffix
         if index is None or not 0 <= index < len(values):
