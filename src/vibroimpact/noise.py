@@ -125,7 +125,7 @@ class NoiseSpec:
             numtaps = _fir_order(self.beta_c * self.dt)[0]
             if numtaps > FIR_MAX_TAPS:
                 raise ValueError(
-                    f"beta_c = {self.beta_c!r} needs a {numtaps}-tap FIR (more than "
+                    f"beta_c = {self.beta_c!r} needs a {numtaps:.3g}-tap FIR (more than "
                     f"{FIR_MAX_TAPS}): beta_c*dt = {self.beta_c * self.dt!r} must be neither "
                     f"tiny nor this close to pi; use a larger dt, or beta_c = pi/dt (white)")
 
