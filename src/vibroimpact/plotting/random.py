@@ -205,6 +205,9 @@ def critical_delta(events, inv_beta_index=0):
 #: Rice's asymptotes are drawn from this many wall-free stds sigma_x of play upwards (where
 #: the wall's memory is short against the mean interval, `stats.upcrossing_rate`).
 RICE_FROM_SIGMA = 1.5
+#: ... up to this many: beyond, Rice's mean interval exceeds exp(30^2 / 2) ~ 1e195, off every
+#: axis (and, past ~37 stds, beyond float64).
+RICE_TO_SIGMA = 30.0
 
 
 @_styled
@@ -251,9 +254,11 @@ def fig09(events):
     rice = None not in sigma and min(float(v) for v in sigma) > 0.0
     if rice:
         sigma_x, sigma_v = (float(v) for v in sigma)
-        rice = RICE_FROM_SIGMA * sigma_x < delta.max()      # the asymptotes reach the sweep
+        d_lo = max(RICE_FROM_SIGMA * sigma_x, delta.min())
+        d_hi = min(RICE_TO_SIGMA * sigma_x, delta.max())
+        rice = d_lo < d_hi      # the asymptotes reach the sweep, on a finite axis
     if rice:
-        d_rice = np.linspace(max(RICE_FROM_SIGMA * sigma_x, delta.min()), delta.max(), 200)
+        d_rice = np.linspace(d_lo, d_hi, 200)
         eps = float(_attr(ds, "eps"))
         asymptotes = (np.full_like(d_rice, eps * sigma_v * np.sqrt(np.pi / 2.0)),
                       1.0 / upcrossing_rate(d_rice, sigma_x, sigma_v))
