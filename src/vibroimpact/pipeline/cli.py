@@ -3,10 +3,14 @@
 ``plan``  reads and checks the config (the paper's, with ``--configfile`` files layered on
           it) and prints what a build would make: cells, jobs, disk and a rough time.
 ``run``   does the same checks, then prepares the directory and hands over to Snakemake:
-          removes the temporaries of writers that are gone, refuses an unreadable result
-          file (naming it), clears a lock left by a killed run when no run is alive in this
-          directory, and replaces itself with ``snakemake`` (the default profile,
-          ``profiles/default``, reruns the jobs a crash interrupted).
+          refuses a folder of ``results`` or ``.snakemake`` the user may not write (naming
+          it, before anything changes), removes the temporaries of writers that are gone,
+          refuses an unreadable result file (naming it), clears a lock left by a killed run
+          when no run is alive in this directory, asks Snakemake which outputs of the
+          requested build are missing and adds them to ``--forcerun`` (Snakemake alone never
+          rebuilds a deleted file whose consumers are up to date), and replaces itself with
+          ``snakemake`` (the default profile, ``profiles/default``, reruns the jobs a crash
+          interrupted).
 ``report`` writes Snakemake's own report of the build (``snakemake --report``: every figure
           once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
           all: it is rendered elsewhere and moved into place only when complete (``make``
@@ -93,6 +97,59 @@ def live_snakemake_runs(root):
     return found
 
 
+#: What a build writes in the project directory: the results and Snakemake's own state.
+WRITTEN = ("results", ".snakemake")
+
+
+def unwritable_folders(root):
+    """The folders a build in ``root`` writes into that this user may not write.
+
+    Every folder under ``results`` and ``.snakemake`` (:data:`WRITTEN`), and ``root`` itself
+    when one of them is still to be made. Writing a file into a folder takes write and
+    search permission on it, asked of the kernel for the real user by ``os.access`` (so
+    ``root`` may write anywhere, as the build would).
+
+    Returns
+    -------
+    list of pathlib.Path
+        Outermost first; empty when the build can write everything it needs.
+    """
+    root = Path(root)
+    folders = {}
+    for name in WRITTEN:
+        top = root / name
+        walk = os.walk(top) if top.is_dir() else [(root, (), ())]
+        folders.update((Path(parent), None) for parent, _, _ in walk)
+    return [f for f in folders if not os.access(f, os.W_OK | os.X_OK)]
+
+
+def _unwritable_message(root, folders):
+    """One line: the first folder ``root``'s build may not write, how many more, the remedy
+    (``chmod`` of the outermost ones when they are the user's, else whose they are)."""
+    def shown(folder):
+        return str(folder) if folder == root else os.path.relpath(folder)
+
+    more = f", nor are {len(folders) - 1} more folders" if len(folders) > 1 else ""
+    others = sorted({f.stat().st_uid for f in folders} - {os.getuid()})
+    if others:
+        import pwd
+
+        names = []
+        for uid in others:
+            try:
+                names.append(pwd.getpwuid(uid).pw_name)
+            except KeyError:
+                names.append(f"uid {uid}")
+        fix = f"owned by {', '.join(names)}: ask them to make it writable"
+    elif more:
+        outermost = [f for f in folders if not set(f.parents) & set(folders)]
+        fix = f"chmod -R u+w {' '.join(shown(f) for f in outermost)}"
+    else:
+        fix = f"chmod u+w {shown(folders[0])}"
+    return (f"{shown(folders[0])} is not writable by you{more} ({fix}, or build in a copy of "
+            f"the project); nothing was changed")
+
+
 def _snakemake():
     exe = Path(sys.executable).with_name("snakemake")
     return str(exe) if exe.exists() else (shutil.which("snakemake") or "snakemake")
@@ -115,6 +172,48 @@ def _clear_stale_lock(root, config_args):
     if out.returncode != 0:
         return _fail(f"snakemake --unlock failed:\n{out.stderr[-2000:]}", code=1)
     return 0
+
+
+def missing_outputs(summary):
+    """Outputs that a build would leave missing, from ``snakemake --summary``'s table.
+
+    Snakemake runs a job whose output is missing only when that output is a target or a job
+    that needs it runs: a deleted intermediate whose consumers are up to date is never
+    rebuilt (its status ``missing``, its plan ``no update``). These are the files to give
+    ``--forcerun``: their jobs run, and then, their outputs being newer, what uses them.
+
+    Parameters
+    ----------
+    summary : str
+        The standard output of ``snakemake ... --summary``.
+
+    Returns
+    -------
+    list of str or None
+        The missing outputs; ``None`` when ``summary`` is not that table (another mode of
+        Snakemake asked for by the user took precedence over ``--summary``).
+    """
+    lines = summary.splitlines()
+    try:
+        start = next(i for i, line in enumerate(lines) if line.startswith("output_file\t"))
+    except StopIteration:
+        return None
+    rows = (line.split("\t") for line in lines[start + 1:])
+    return [row[0] for row in rows if len(row) >= 6 and row[-2:] == ["missing", "no update"]]
+
+
+def with_forcerun(cmd, files):
+    """``cmd`` with ``files`` added to its ``--forcerun``: Snakemake keeps only the last
+    ``--forcerun``/``-R`` list given, so the user's own list is extended, not replaced (one
+    value glued to its option, ``--forcerun=X`` or ``-RX``, moves to the end of ``cmd``)."""
+    for i in reversed(range(len(cmd))):
+        word = cmd[i]
+        if word in ("-R", "--forcerun"):
+            return [*cmd[:i + 1], *files, *cmd[i + 1:]]
+        if word.startswith(("--forcerun=", "-R")):
+            value = word.partition("=")[2] if word.startswith("--") else word[2:]
+            return [*cmd[:i], *cmd[i + 1:], "--forcerun", value, *files]
+    return [*cmd, "--forcerun", *files]
 
 
 def write_report(root, config_args, output=REPORT):
@@ -159,6 +258,9 @@ def main(argv=None):
     print(plan.format(args.cores), file=sys.stderr if args.command == "run" else sys.stdout)
     if args.command == "plan":
         return 0
+    unwritable = unwritable_folders(root)
+    if unwritable:
+        return _fail(_unwritable_message(root, unwritable), code=1)
     removed = _files.sweep_stale_temporaries(root / "results")
     if removed:
         print(f"vibroimpact: removed {len(removed)} temporary file(s) of interrupted writes",
@@ -174,5 +276,19 @@ def main(argv=None):
     cmd = [_snakemake(), "--cores", str(args.cores), *extra, *config_args]
     sys.stdout.flush()
     sys.stderr.flush()
+    query = subprocess.run([*cmd, "--summary"], cwd=root, capture_output=True, text=True)
+    missing = missing_outputs(query.stdout)
+    if query.returncode != 0 or missing is None:
+        # Snakemake refused the arguments, or this was the user's own mode (--unlock, --dag
+        # ..., which take precedence over --summary): it has run; its output, once
+        sys.stdout.write(query.stdout)
+        sys.stderr.write(query.stderr)
+        return query.returncode
+    if missing:
+        names = ", ".join(missing[:5]) + (f" ... ({len(missing)} files)" if missing[5:] else "")
+        print(f"vibroimpact: missing, so rebuilt with what uses them (--forcerun): {names}",
+              file=sys.stderr)
+        cmd = with_forcerun(cmd, missing)
+        sys.stderr.flush()
     os.chdir(root)
     os.execv(cmd[0], cmd)

@@ -24,7 +24,9 @@ class CorruptFileError(OSError):
     def __init__(self, path, reason):
         reason = str(reason).strip().splitlines()[-1] if str(reason).strip() else type(reason).__name__
         super().__init__(f"{path}: cannot be read as netCDF ({reason}): the file is truncated "
-                         f"or corrupt; delete it and run again, it will be rebuilt")
+                         f"or corrupt; delete it and run make (python -m vibroimpact run) "
+                         f"again, which rebuilds it (plain snakemake does not: add "
+                         f"--forcerun {path})")
         self.path = Path(path)
 
 
@@ -56,14 +58,15 @@ def load_dataset(path):
 
 def check_readable(root):
     """Open every netCDF file under ``root`` (not the temporaries); the unreadable ones
-    raise :class:`CorruptFileError` (the first one found) before any job would use them."""
+    raise :class:`CorruptFileError` (the first one found) before any job would use them,
+    naming the file relative to the working directory (the path ``--forcerun`` takes)."""
     root = Path(root)
     if not root.is_dir():
         return
     for path in sorted(root.rglob("*.nc")):
         if path.name.startswith("."):
             continue
-        _open(path).close()
+        _open(os.path.relpath(path)).close()
 
 
 def write_dataset(ds, path):
