@@ -276,7 +276,11 @@ def main(argv=None):
     cmd = [_snakemake(), "--cores", str(args.cores), *extra, *config_args]
     sys.stdout.flush()
     sys.stderr.flush()
-    query = subprocess.run([*cmd, "--summary"], cwd=root, capture_output=True, text=True)
+    try:
+        query = subprocess.run([*cmd, "--summary"], cwd=root, capture_output=True, text=True)
+    except KeyboardInterrupt:
+        return _fail("interrupted while asking Snakemake what is missing; nothing was built",
+                     code=130)
     missing = missing_outputs(query.stdout)
     if query.returncode != 0 or missing is None:
         # Snakemake refused the arguments, or this was the user's own mode (--unlock, --dag
