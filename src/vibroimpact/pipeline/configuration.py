@@ -753,7 +753,8 @@ def _repeated(values):
 
 
 def _distinct(problems, where, values):
-    """Record a list of values that repeats one; True when it does not."""
+    """Record a list of values that repeats one (one cell, study or figure twice); True when
+    it does not."""
     repeated = _repeated(values) if values else []
     if repeated:
         problems.add(where, values, f"{', '.join(map(_num, repeated))} listed more than once",
@@ -774,12 +775,9 @@ def _grid(problems, where, spec, limit, positive=False):
         problems.add(where, spec, f"{n:,} values (more than the limit of cells)",
                      f"at most {limit:,} values (limits.max_cells), e.g. a larger step")
         return None
-    values = grid_values(spec)
-    repeated = _repeated(values)
-    if repeated:
-        problems.add(where, spec, f"{', '.join(map(_num, repeated))} listed more than once "
-                     f"(one cell each)", "distinct values")
+    if isinstance(spec, list) and not _distinct(problems, where, spec):
         return None
+    values = grid_values(spec)
     if positive and np.any(values <= 0.0):
         bad = float(values[values <= 0.0][0])
         key = f"{where}.start" if isinstance(spec, dict) else where
@@ -930,11 +928,11 @@ def _check_study(config, name, entry, problems, limits):
     grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_cells"], positive=True)
                          if harmonic else np.array([1.0]))
+    trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
     if harmonic:
         shortest = dt / (2 * math.pi)       # a forcing period of one sample step
-        trace = (entry.get("trace") or {}).get("inv_beta")
         for key, values in (("inv_beta", grids["inv_beta"]),
-                            ("trace.inv_beta", None if trace is None else [trace])):
+                            ("trace.inv_beta", [trace_inv_beta] if trace_inv_beta else None)):
             fast = [float(v) for v in (values if values is not None else []) if v < shortest]
             if fast:
                 problems.add(f"{where}.{key}", fast[0], f"a forcing period 2 pi/beta_f shorter "
@@ -944,7 +942,6 @@ def _check_study(config, name, entry, problems, limits):
     amplitude_swept = "amplitude" in entry.get("sweep", {}).get("values", {})
     if not harmonic and not amplitude_swept:
         # keys of the harmonic force a random study would silently ignore
-        trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
         for key, value, default in (("inv_beta", entry["inv_beta"], [1.0]),
                                     ("trace.inv_beta", trace_inv_beta, None)):
             if value is not None and value != default:
