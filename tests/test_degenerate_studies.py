@@ -82,7 +82,7 @@ def _drawn(fig):
 
 
 def _notes(fig):
-    """The words written on each axes that has nothing to draw (`plotting._common.note_on_axes`)."""
+    """The words on each axes that has nothing to draw (`plotting._common.note_on_axes`)."""
     return [t.get_text() for ax in fig.axes for t in ax.texts if t.get_gid() == "note"]
 
 
