@@ -138,9 +138,12 @@ def test_sweep_removes_only_the_temporaries_of_dead_writers(tmp_path):
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGINT])
 def test_a_signal_while_writing_removes_the_temporary(tmp_path, sig):
     target = tmp_path / "out.nc"
+    # Ctrl-C as at a terminal: a shell without job control starts background commands with
+    # SIGINT ignored, which Python then keeps (the writer would never see the signal)
     code = textwrap.dedent(f"""
-        import sys, time
+        import signal, sys, time
         from vibroimpact._files import atomic_path
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         with atomic_path({str(target)!r}) as tmp:
             open(tmp, "w").write("half")
             print(tmp, flush=True)
