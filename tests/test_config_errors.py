@@ -422,16 +422,8 @@ def test_huge_record_is_refused_without_writing(tmp_path):
     assert sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*")) == before
 
 
-BROKEN = """\
-paper: false
-studies:
-  mine:
-    noise: random_input
-    zeta: 0.05
-     eps: 0.5
-    delta: [0.0, 1.0]
-    figures: [fig09]
-"""
+#: OWN with its `eps` line indented one space too far.
+BROKEN = OWN.replace("\n    eps:", "\n     eps:")
 
 
 def _broken_mark():
