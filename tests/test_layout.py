@@ -44,3 +44,21 @@ def test_validators_name_the_argument_and_its_range():
         _checks.real("dt", float("nan"), low=0.0, low_open=True)
     with pytest.raises(ValueError, match="got True"):
         _checks.real("delta", True)
+
+
+def test_the_configs_fir_length_is_the_generators():
+    # the config refuses a band_limited record by the FIR length the generator designs,
+    # counted without scipy (vibroimpact._limits); scipy's kaiserord is the reference
+    import math
+
+    import numpy as np
+    import scipy.signal
+
+    from vibroimpact import _limits
+
+    thetas = np.concatenate([np.geomspace(1e-9, 3.0, 3000),
+                             math.pi - np.geomspace(1e-12, 0.1, 1000)])
+    for theta in map(float, thetas):
+        width = min(_limits.FIR_TRANSITION_FRACTION * theta, 2.0 * (math.pi - theta))
+        numtaps, _ = scipy.signal.kaiserord(_limits.FIR_ATTENUATION_DB, width / math.pi)
+        assert _limits.fir_taps(theta) == numtaps | 1, theta

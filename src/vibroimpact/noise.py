@@ -34,23 +34,17 @@ import scipy.fft
 import scipy.signal
 
 from vibroimpact import _checks
+# the FIR and band limits, shared with the config checks (which load no scipy)
+from vibroimpact._limits import (  # noqa: F401 (the FIR constants: the generator's too)
+    FIR_ATTENUATION_DB, FIR_MAX_TAPS, FIR_TRANSITION_FRACTION, FULL_BAND_RTOL, cutoff, fir_taps)
 from vibroimpact.stats import spectra
 
 KINDS = ("white", "band_limited", "lowpass2")
 
 # --- numerical constants of the generators ----------------------------------------------
-#: Stop-band attenuation (dB) of the Kaiser-window FIR of ``kind="band_limited"``; the pass
-#: band ripple of the amplitude is the same 10**(-80/20) = 1e-4.
-FIR_ATTENUATION_DB = 80.0
-#: Width of the FIR transition band as a fraction of the cut-off beta_c.
-FIR_TRANSITION_FRACTION = 0.02
-#: Longest FIR accepted (a band_limited spec needing more taps is rejected).
-FIR_MAX_TAPS = 2**18 + 1
 #: Innovations drawn per internal block. Blocks are fixed, so the arithmetic (and therefore
 #: every bit of the output) does not depend on the chunk size the caller asks for.
 BLOCK = 2**16
-#: beta_c * dt within this relative distance of pi counts as the full band (white).
-FULL_BAND_RTOL = 1e-12
 #: |phi_c| bound below which the correlation of lowpass2 is truncated in sinc series.
 LOWPASS2_TAIL = 1e-18
 
@@ -114,20 +108,10 @@ class NoiseSpec:
                 raise ValueError(f"{name} {state} for kind={self.kind!r}")
         if self.beta_c is not None:
             beta_c = _checks.real("beta_c", self.beta_c, low=0.0, low_open=True)
-            if beta_c > self.nyquist * (1.0 + FULL_BAND_RTOL):
-                raise ValueError(
-                    f"beta_c must be in (0, pi/dt] = (0, {self.nyquist!r}], got {beta_c!r}")
-            object.__setattr__(self, "beta_c", min(beta_c, self.nyquist))
+            object.__setattr__(self, "beta_c", cutoff(self.kind, beta_c, self.dt))
         if self.zeta_f is not None:
             object.__setattr__(self, "zeta_f",
                                _checks.real("zeta_f", self.zeta_f, low=0.0, low_open=True))
-        if self.kind == "band_limited" and not self._full_band:
-            numtaps = _fir_order(self.beta_c * self.dt)[0]
-            if numtaps > FIR_MAX_TAPS:
-                raise ValueError(
-                    f"beta_c = {self.beta_c!r} needs a {numtaps:.3g}-tap FIR (more than "
-                    f"{FIR_MAX_TAPS}): beta_c*dt = {self.beta_c * self.dt!r} must be neither "
-                    f"tiny nor this close to pi; use a larger dt, or beta_c = pi/dt (white)")
 
     @property
     def nyquist(self) -> float:
@@ -483,9 +467,7 @@ def _rechunk(blocks, n_samples, chunk_size):
 
 def _fir_order(theta_c):
     """Kaiser FIR length (odd) and window beta for cut-off theta_c (rad/sample)."""
-    width = min(FIR_TRANSITION_FRACTION * theta_c, 2.0 * (math.pi - theta_c))
-    numtaps, kaiser_beta = scipy.signal.kaiserord(FIR_ATTENUATION_DB, width / math.pi)
-    return numtaps | 1, kaiser_beta
+    return fir_taps(theta_c), scipy.signal.kaiser_beta(FIR_ATTENUATION_DB)
 
 
 def _band_limited_taps(spec):

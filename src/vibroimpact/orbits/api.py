@@ -60,6 +60,7 @@ import numba
 import numpy as np
 
 from vibroimpact import _checks
+from vibroimpact._limits import MAX_M
 from vibroimpact.orbits import kernels as ok
 
 __all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
@@ -89,7 +90,6 @@ _REASON_TEXT = {
 }
 #: ``{code: description}`` of `Reason` (kept for the datasets' attributes and old callers).
 REASON_CODES = {int(r): r.description for r in Reason}
-MAX_M = 3
 
 
 @dataclass(frozen=True, eq=False)
