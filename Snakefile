@@ -2,7 +2,7 @@
 # `snakemake results/figures/fig07.png` builds one figure and only what it needs.
 from snakemake.utils import min_version
 
-from vibroimpact.pipeline import configuration
+from vibroimpact.pipeline import config as configuration  # `config`: Snakemake's dict
 
 min_version("9.0")
 

@@ -23,7 +23,7 @@ import textwrap
 import pytest
 import yaml
 
-from vibroimpact.pipeline import configuration
+from vibroimpact.pipeline import config as configuration
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))

@@ -12,7 +12,7 @@ import pytest
 import yaml
 
 from vibroimpact import _files
-from vibroimpact.pipeline import configuration, figures
+from vibroimpact.pipeline import config as configuration, figures
 
 ROOT = Path(__file__).resolve().parents[1]
 PAPER = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

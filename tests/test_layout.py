@@ -46,6 +46,18 @@ def test_validators_name_the_argument_and_its_range():
         _checks.real("delta", True)
 
 
+def test_loading_a_config_loads_no_numba_scipy_or_kernel():
+    # what the Snakefile does at every parse (a dry run, --lint, each job of a cluster run)
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    loaded = _modules_after("from vibroimpact.pipeline import config as configuration\n"
+                            f"configuration.load({{}}, root={str(root)!r})")
+    assert not {m for m in loaded if m.split(".")[0] in ("numba", "scipy", "llvmlite")}
+    assert not {m for m in loaded if m.startswith(("vibroimpact.impact", "vibroimpact.orbits",
+                                                   "vibroimpact.noise"))}
+
+
 def test_the_configs_fir_length_is_the_generators():
     # the config refuses a band_limited record by the FIR length the generator designs,
     # counted without scipy (vibroimpact._limits); scipy's kaiserord is the reference

@@ -24,7 +24,7 @@ import pytest
 import xarray as xr
 
 from conftest import ROOT, make_workdir
-from vibroimpact.pipeline import cli, configuration, figures
+from vibroimpact.pipeline import cli, config as configuration, figures
 from vibroimpact.reports import notebook
 
 REPORTS = ["random/random_force", "harmonic/harmonic_random", "motion_map/harmonic_random",

@@ -16,8 +16,8 @@ import xarray as xr
 import yaml
 from matplotlib.figure import Figure
 
-from vibroimpact.pipeline import configuration, provenance, tasks
-from vibroimpact.pipeline.configuration import ConfigError
+from vibroimpact.pipeline import config as configuration, provenance, tasks
+from vibroimpact.pipeline.config import ConfigError
 from vibroimpact.plotting.sweep import sweep_means
 from vibroimpact.stats.events import t_quantile
 

@@ -57,7 +57,7 @@ def test_fig15_vs_fig16_runs_the_map_and_the_orbits(workdir):
 
 
 def test_the_plan_counts_the_jobs_of_a_dry_run(workdir):
-    from vibroimpact.pipeline import configuration
+    from vibroimpact.pipeline import config as configuration
 
     _, plan = configuration.load(root=workdir, user_files=[workdir / "config" / "test.yaml"])
     out = run(workdir, "-n", "--quiet", "rules")

@@ -322,39 +322,31 @@ def report_targets():
     return targets
 
 
-# Resources, from measured needs (README, "Job costs"): a job's resident memory is ~550 MB of
-# interpreter, numba and scipy, plus the noise record held in memory (8 bytes a sample) and
-# the simulator's chunk buffers (~100 MB at the default chunk of 2**20 samples).
-BASE_MEM_MB = 600
+# Resources: the cost model of vibroimpact.pipeline.config.costs (README, "Job costs"), the one
+# the plan uses too.
+from vibroimpact.pipeline.config import costs
+
+BASE_MEM_MB = costs.BASE_MEM_MB
+NOISE_MEM_MB = costs.NOISE_MEM_MB
 
 
-def _noise_samples(name):
-    return int(config["noises"][name]["n_samples"])
-
-
-# chunked generation: one chunk (8 MB) plus the 2**22-sample head kept for the estimates
-NOISE_MEM_MB = BASE_MEM_MB + 200
+def _study_noise_entry(study):
+    return config["noises"][config["studies"][study]["noise"]]
 
 
 def simulate_mem_mb(wildcards):
-    n = _noise_samples(config["studies"][wildcards.study]["noise"])
-    return BASE_MEM_MB + 150 + -(-8 * n // 2**20)
+    return costs.simulate_mem_mb(int(_study_noise_entry(wildcards.study)["n_samples"]))
 
 
 def simulate_runtime(kind):
-    """Minutes: cells of a tile x steps x ~60 ns a step (the measured cost with many impacts
-    is ~20 ns a step on one core; x3 for a slower or shared node), plus start-up."""
+    """Minutes of a ``kind`` tile: its cells at the steps of one cell (a map cell: to the cap
+    of the longest forcing period), plus start-up."""
     def runtime(wildcards):
-        study = STUDIES[wildcards.study]
+        if kind == "trace":
+            return costs.simulate_runtime_min(0, 0)
         entry = config["studies"][wildcards.study]
-        noise = config["noises"][entry["noise"]]
-        steps = _noise_samples(entry["noise"])
-        if kind == "spectra" and entry["spectra"].get("t_end"):
-            steps = min(steps, entry["spectra"]["t_end"] / noise["dt"])
-        if kind == "map":   # a cell runs at most to its cap, the longest forcing period's
-            steps = min(steps, (entry["transient"] + entry["map"]["max_periods"] * 2 * 3.141592653589793
-                                * float(study.inv_beta.max())) / noise["dt"])
+        steps = costs.study_steps(kind, entry, _study_noise_entry(wildcards.study))
         grid = "events" if kind == "map" else kind
-        cells = len(study.tile(int(wildcards.tile), grid)) if kind != "trace" else 0
-        return 5 + int(cells * steps * 60e-9 / 60)
+        cells = len(STUDIES[wildcards.study].tile(int(wildcards.tile), grid))
+        return costs.simulate_runtime_min(cells, steps)
     return runtime

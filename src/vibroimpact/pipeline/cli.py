@@ -27,7 +27,7 @@ import subprocess
 import sys
 
 from vibroimpact import _files
-from vibroimpact.pipeline import configuration, io
+from vibroimpact.pipeline import config, io
 
 __all__ = ["main"]
 
@@ -246,11 +246,11 @@ def main(argv=None):
         return _fail(f"unknown arguments {extra}; {args.command} takes --configfile, "
                      f"{'--cores' if args.command == 'plan' else '--output'}, --directory, -v")
     if args.verbose:
-        os.environ[configuration.VERBOSE_ENV] = "1"
+        os.environ[config.VERBOSE_ENV] = "1"
     root = Path(args.directory).resolve()
     try:
-        _, plan = configuration.load(root=root, user_files=args.configfile)
-    except configuration.ConfigError as err:
+        _, plan = config.load(root=root, user_files=args.configfile)
+    except config.ConfigError as err:
         return _fail(err)
     config_args = ["--configfile", *args.configfile] if args.configfile else []
     if args.command == "report":

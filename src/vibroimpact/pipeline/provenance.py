@@ -83,7 +83,7 @@ def config_text(obj):
 def sweep_attrs(config_block):
     """``sweep``, ``sweep_index`` and ``sweep_<key>`` (e.g. ``sweep_eps``, ``sweep_rms``) of a
     study expanded from a sweep (its block's ``sweep`` key,
-    `vibroimpact.pipeline.configuration.expand_sweeps`); empty for any other block."""
+    `vibroimpact.pipeline.config.sweeps.expand_sweeps`); empty for any other block."""
     sweep = config_block.get("sweep") if isinstance(config_block, dict) else None
     if not sweep:
         return {}

@@ -116,6 +116,12 @@ class Study:
         return self.cells(kind)[t::n]
 
 
+def noise_record(entry):
+    """``(n_samples, dt, tau_end)`` of a ``noises`` entry: its samples, step and last time."""
+    n, dt = int(entry["n_samples"]), float(entry["dt"])
+    return n, dt, (n - 1) * dt
+
+
 def orbit_rows(entry):
     """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
     rows = grid_values(entry["inv_beta"])

@@ -1,0 +1,388 @@
+"""The cross-field checks of a config that has passed the schema.
+
+What JSON Schema cannot say: a study's records, grids and figures against each other and
+against its noise record (a ``t_end`` beyond the record, a figure value off the study's
+grid, a figure that needs a block the study lacks, an orbit type the solver does not find),
+and the noise records against the generator's limits. :func:`check` finds every problem
+before it raises, one or two lines each.
+
+Loads no kernel, numba or scipy: the solver's and the generator's limits come from
+`vibroimpact._limits`.
+"""
+import math
+
+import numpy as np
+
+from vibroimpact._limits import MAX_M, cutoff
+from vibroimpact.pipeline import figures
+from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
+from vibroimpact.pipeline.study import grid_size, grid_values, map_cap_steps, noise_record
+
+__all__ = ["GRID_RTOL", "check"]
+
+#: Relative tolerance for "on the grid" (a value written as 1/1.1 matches 0.9090909091).
+GRID_RTOL = 1e-6
+
+
+def _on_grid(value, grid):
+    return bool(np.any(np.abs(grid - value) <= GRID_RTOL * max(1.0, abs(value))))
+
+
+def _grid_text(grid):
+    if grid.size <= 8:
+        return ", ".join(_num(float(v)) for v in grid)
+    return f"{_num(float(grid[0]))}, {_num(float(grid[1]))}, ..., {_num(float(grid[-1]))}"
+
+
+def _repeated(values):
+    """The values of a list given more than once (equal within `GRID_RTOL`), ascending."""
+    v = np.sort(np.asarray(values, dtype=float))
+    close = np.diff(v) <= GRID_RTOL * np.maximum(1.0, np.abs(v[1:]))
+    return sorted(set(v[1:][close].tolist()))
+
+
+def _distinct(problems, where, values):
+    """Record a list of values that repeats one (one cell, study or figure twice); True when
+    it does not."""
+    repeated = _repeated(values) if values else []
+    if repeated:
+        problems.add(where, values, f"{', '.join(map(_num, repeated))} listed more than once",
+                     "distinct values")
+    return not repeated
+
+
+def _grid(problems, where, spec, limit, positive=False):
+    """Values of a grid, or None after recording why it is unusable."""
+    try:
+        n = grid_size(spec)
+    except ValueError as err:
+        key = "stop" if "stop" in str(err) else "step"
+        problems.add(f"{where}.{key}", spec.get(key), str(err).split(",")[0].removeprefix("grid "),
+                     f"stop >= start = {_num(spec['start'])}" if key == "stop" else "> 0")
+        return None
+    if n > limit:
+        problems.add(where, spec, f"{n:,} values (more than the limit of cells)",
+                     f"at most {limit:,} values (limits.max_cells), e.g. a larger step")
+        return None
+    if isinstance(spec, list) and not _distinct(problems, where, spec):
+        return None
+    values = grid_values(spec)
+    if positive and np.any(values <= 0.0):
+        bad = float(values[values <= 0.0][0])
+        key = f"{where}.start" if isinstance(spec, dict) else where
+        problems.add(key, spec["start"] if isinstance(spec, dict) else spec,
+                     f"1/beta_f = {_num(bad)} is not a forcing period ratio",
+                     "values > 0")
+        return None
+    return values
+
+
+def _check_noises(config, problems):
+    for name, entry in config["noises"].items():
+        where = f"noises.{name}"
+        kind, dt = entry["kind"], float(entry["dt"])
+        needs = {"white": (), "band_limited": ("beta_c",), "lowpass2": ("beta_c", "zeta_f")}[kind]
+        ok = True
+        for key in ("beta_c", "zeta_f"):
+            given = entry.get(key) is not None
+            if given != (key in needs):
+                ok = False
+                problems.add(f"{where}.{key}", entry.get(key),
+                             f"{'required' if not given else 'not used'} for kind {kind}",
+                             "a number > 0" if not given else "null (or leave it out)")
+        nyquist = math.pi / dt
+        beta_c = entry.get("beta_c")
+        if beta_c is not None and beta_c > nyquist * (1 + 1e-9):
+            ok = False
+            problems.add(f"{where}.beta_c", beta_c,
+                         f"above the Nyquist frequency pi/dt of dt = {_num(dt)}",
+                         f"0 < beta_c <= {nyquist:.6g}")
+        if int(entry["nperseg"]) > int(entry["n_samples"]):
+            problems.add(f"{where}.nperseg", entry["nperseg"], "longer than the record",
+                         f"16 <= nperseg <= n_samples = {entry['n_samples']}")
+        if ok and beta_c is not None:
+            try:        # the generator's own limits (the FIR length), without loading it
+                cutoff(kind, float(beta_c), dt)
+            except ValueError as err:
+                problems.add(where, None, str(err), "see config/schema.yaml, noises")
+
+
+def _check_figures(config, section, name, entry, problems, grids):
+    where = f"{section}.{name}.figures"
+    kind = "study" if section == "studies" else "orbits"
+    if not entry["figures"]:
+        allowed_ = sorted(f for f, s in figures.FIGURES.items() if s["owner"] == kind)
+        problems.add(where, [], "no figure listed: this entry would build nothing",
+                     f"a list of figures from {', '.join(allowed_)}")
+        return
+    seen = set()
+    for i, item in enumerate(entry["figures"]):
+        fig = item if isinstance(item, str) else item["name"]
+        spec = figures.FIGURES[fig]
+        at = f"{where}[{i}]"
+        if spec["owner"] != kind:
+            allowed_ = sorted(f for f, s in figures.FIGURES.items() if s["owner"] == kind)
+            source = "a study" if kind == "study" else "an orbits map"
+            problems.add(at, fig, f"not drawn from {source}",
+                         ", ".join(allowed_))
+            continue
+        if fig in seen:
+            problems.add(at, fig, "listed twice", "each figure once (a list of values under "
+                         "its `inv_beta` draws it several times)")
+        seen.add(fig)
+        if kind != "study":
+            continue
+        if spec.get("harmonic") and not entry.get("amplitude"):
+            problems.add(f"studies.{name}.amplitude", entry.get("amplitude", 0.0),
+                         f"{fig} shows the harmonic force", "amplitude != 0 for this figure")
+        for block in ("trace", "spectra"):
+            if block in spec["reads"] and not entry.get(block):
+                problems.add(f"studies.{name}.{block}", None,
+                             f"missing, and {fig} draws it",
+                             f"a `{block}:` block (config/schema.yaml), or drop {fig}")
+        item = {} if isinstance(item, str) else item
+        for key in item:
+            if key == "name":
+                continue
+            usable = (key == spec.get("per") or key in spec.get("options", ())
+                      or key in spec.get("sources", ())
+                      or (key == "beta_max" and "spectra" in spec["reads"]))
+            if not usable:
+                problems.add(f"{at}.{key}", item[key], f"not an option of {fig}",
+                             _figure_keys(fig))
+        if spec.get("per") == "inv_beta" and "inv_beta" in item:
+            _distinct(problems, f"{at}.inv_beta", item["inv_beta"])
+            for j, v in enumerate(item["inv_beta"]):
+                if not _on_grid(v, grids["inv_beta"]):
+                    problems.add(f"{at}.inv_beta[{j}]", v, "not on the study's inv_beta grid",
+                                 _grid_text(grids["inv_beta"]))
+        _distinct(problems, f"{at}.density_delta", item.get("density_delta"))
+        for j, v in enumerate(item.get("density_delta", [])):
+            if not _on_grid(v, grids["delta"]):
+                problems.add(f"{at}.density_delta[{j}]", v, "not on the study's delta grid",
+                             _grid_text(grids["delta"]))
+        if "orbits" in spec.get("sources", ()):
+            _check_orbits_item(config, name, entry, at, fig, item, problems)
+
+
+def _figure_keys(fig):
+    spec = figures.FIGURES[fig]
+    keys = [*([spec["per"]] if spec.get("per") else []), *spec.get("options", ()),
+            *spec.get("sources", ()), *(["beta_max"] if "spectra" in spec["reads"] else [])]
+    return f"name, {', '.join(keys)}" if keys else f"only name ({fig} has no options)"
+
+
+def _check_orbits_item(config, name, entry, at, fig, item, problems):
+    orbits = item.get("orbits")
+    names = sorted(config.get("orbits", {}))
+    if orbits not in config.get("orbits", {}):
+        problems.add(f"{at}.orbits", orbits, f"{fig} is drawn over an orbit map; give its "
+                     f"entry as {{name: {fig}, orbits: <name>}}", ", ".join(names) or
+                     "an `orbits` entry (none defined)")
+        return
+    other = config["orbits"][orbits]
+    for key in ("zeta", "eps"):
+        if float(other[key]) != float(entry[key]):
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = "
+                         f"{_num(other[key])}, the study {key} = {_num(entry[key])}",
+                         "an `orbits` entry of the same zeta and eps")
+    types = {tuple(t) for t in other["types"]}
+    missing = [m for m in entry["motions"] if tuple(m) not in types]
+    if missing:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
+                     f"which studies.{name}.motions lists", "an `orbits` entry whose types "
+                     "include every motion of the study")
+
+
+def _check_study(config, name, entry, problems, limits, unforced):
+    where = f"studies.{name}"
+    siblings = {name}           # itself, or every study of its sweep
+    if "sweep" in entry:
+        siblings = set(config.get("sweeps", {}).get(entry["sweep"]["name"], {}).get(
+            "studies", [name]))
+    for other in entry.get("report_with", []):
+        if other in siblings or other not in config["studies"]:
+            problems.add(f"{where}.report_with", other, "no other study of this name",
+                         ", ".join(sorted(set(config["studies"]) - siblings)) or "none")
+    if entry["noise"] not in config["noises"]:
+        problems.add(f"{where}.noise", entry["noise"], "no such noise record",
+                     ", ".join(sorted(config["noises"])))
+        return None
+    n, dt, tau = noise_record(config["noises"][entry["noise"]])
+    record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
+    grids = {"delta": _grid(problems, f"{where}.delta", entry["delta"], limits["max_cells"])}
+    harmonic = float(entry["amplitude"]) != 0.0
+    grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
+                               limits["max_cells"], positive=True)
+                         if harmonic else np.array([1.0]))
+    trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
+    if harmonic:
+        shortest = dt / (2 * math.pi)       # a forcing period of one sample step
+        for key, values in (("inv_beta", grids["inv_beta"]),
+                            ("trace.inv_beta", [trace_inv_beta] if trace_inv_beta else None)):
+            fast = [float(v) for v in (values if values is not None else []) if v < shortest]
+            if fast:
+                problems.add(f"{where}.{key}", fast[0], f"a forcing period 2 pi/beta_f shorter "
+                             f"than the sample step dt = {_num(dt)} of noises.{entry['noise']} "
+                             f"(the pressed mass would stick and release many times a step)",
+                             f"1/beta_f >= dt/(2 pi) = {shortest:.6g}")
+    amplitude_swept = "amplitude" in entry.get("sweep", {}).get("values", {})
+    if not harmonic and not amplitude_swept:
+        # keys of the harmonic force a random study would silently ignore
+        for key, value, default in (("inv_beta", entry["inv_beta"], unforced),
+                                    ("trace.inv_beta", trace_inv_beta, None)):
+            if value is not None and value != default:
+                problems.add(f"{where}.{key}", value, "1/beta_f of the harmonic force, and "
+                             "this study has none (amplitude = 0)", "leave it out, or give "
+                             "the study an amplitude != 0")
+    transient = float(entry["transient"])
+    t_end = entry.get("t_end")
+    end = tau if t_end is None else float(t_end)
+    if t_end is not None and t_end > tau * (1 + 1e-9):
+        problems.add(f"{where}.t_end", t_end, f"longer than the noise record ({record})",
+                     f"transient < t_end <= {tau:.6g}, or null for the whole record")
+    elif transient >= end:
+        problems.add(f"{where}.transient", transient, "leaves no record for the statistics "
+                     f"(t_end = {end:.6g})", f"0 <= transient < {end:.6g}")
+    uses = {r for f in entry["figures"] for r in figures.FIGURES[
+        f if isinstance(f, str) else f["name"]]["reads"]}
+    spectra = entry.get("spectra")
+    if spectra:
+        s_end = tau if spectra.get("t_end") is None else float(spectra["t_end"])
+        if s_end > tau * (1 + 1e-9):
+            problems.add(f"{where}.spectra.t_end", spectra["t_end"],
+                         f"longer than the noise record ({record})",
+                         f"transient < t_end <= {tau:.6g}, or null")
+        elif s_end <= transient:
+            if transient < end:
+                problems.add(f"{where}.spectra.t_end", spectra["t_end"],
+                             f"leaves no record after the transient ({_num(transient)})",
+                             f"{_num(transient)} < t_end <= {tau:.6g}, or null")
+        else:
+            # the samples k dt with transient <= k dt <= t_end (cells.spectra_cell)
+            samples = (math.floor(s_end / dt + 1e-9) - math.ceil(transient / dt - 1e-9) + 1)
+            if samples < 16:
+                problems.add(f"{where}.spectra", None, f"its record holds {samples} samples "
+                             f"(transient to t_end, at dt = {_num(dt)}), fewer than a Welch "
+                             f"segment's 16", f"a record of 16 samples or more: n_samples >= "
+                             f"{16 + math.ceil(transient / dt - 1e-9)} in noises."
+                             f"{entry['noise']}, or a longer spectra.t_end")
+            elif samples < int(spectra["nperseg"]):
+                problems.add(f"{where}.spectra.nperseg", spectra["nperseg"],
+                             f"longer than the spectra record ({samples} samples from the "
+                             f"transient to t_end)",
+                             f"16 <= nperseg <= {samples}, or a longer spectra.t_end")
+        sgrid = _grid(problems, f"{where}.spectra.delta", spectra["delta"], limits["max_cells"])
+        if sgrid is not None and grids["delta"] is not None:
+            for j, v in enumerate(sgrid):
+                if not _on_grid(v, grids["delta"]):
+                    problems.add(f"{where}.spectra.delta" + (f"[{j}]" if isinstance(
+                        spectra["delta"], list) else ""), float(v),
+                        "not on the study's delta grid (a spectrum's cell has its impact "
+                        "statistics too)", _grid_text(grids["delta"]))
+    trace = entry.get("trace")
+    if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"],
+                     f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
+    elif trace and float(trace["t_end"]) < dt * (1 - 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"], f"shorter than one sample step "
+                     f"(dt = {_num(dt)} of noises.{entry['noise']}): a trace of one point",
+                     f"{_num(dt)} <= t_end <= {tau:.6g}")
+    _distinct(problems, f"{where}.density_delta", entry["density_delta"])
+    if grids["delta"] is not None:
+        for j, v in enumerate(entry["density_delta"]):
+            if not _on_grid(v, grids["delta"]):
+                problems.add(f"{where}.density_delta[{j}]", v, "not on the delta grid",
+                             _grid_text(grids["delta"]))
+    motions = [tuple(m) for m in entry["motions"]]
+    if len(set(motions)) != len(motions):
+        problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
+                     "distinct [m, n] pairs")
+    if "map" in uses and harmonic and grids["inv_beta"] is not None:
+        spec = entry["map"]
+        try:        # the cap of the longest forcing period (the job's own check, at parse time)
+            map_cap_steps(n, dt, transient, int(spec["max_periods"]),
+                          1.0 / float(grids["inv_beta"].max()), where=f"{where}.map.max_periods")
+        except ValueError as err:
+            problems.append(f"{err} in noises.{entry['noise']}")
+        if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
+            problems.add(f"{where}.map.min_time", spec["min_time"],
+                         f"transient + min_time is beyond the record ({record})",
+                         f"0 < min_time <= {tau - transient:.6g}")
+    if "map" in uses and harmonic:
+        _plane(problems, where, grids, "fig15")
+    if all(g is not None for g in grids.values()):
+        _check_figures(config, "studies", name, entry, problems, grids)
+    return grids
+
+
+def _plane(problems, where, grids, fig):
+    """Record a (1/beta_f, delta) plane too small for `fig`'s contours (2 values an axis)."""
+    for key in ("inv_beta", "delta"):
+        if grids[key] is not None and grids[key].size < 2:
+            problems.add(f"{where}.{key}", float(grids[key][0]), f"{fig} draws contours "
+                         f"over the (1/beta_f, delta) plane", "at least 2 values")
+
+
+def _check_orbits(config, name, entry, problems, limits):
+    where = f"orbits.{name}"
+    grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
+                               limits["max_orbit_cells"], positive=True),
+             "delta": _grid(problems, f"{where}.delta", entry["delta"],
+                            limits["max_orbit_cells"])}
+    if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
+        _plane(problems, where, grids, "fig16")
+    for j, (m, n) in enumerate(entry["types"]):
+        if m > MAX_M:
+            problems.add(f"{where}.types[{j}]", [m, n], f"the orbit solver finds (m/n) motions "
+                         f"with m <= {MAX_M} impacts a period only", f"[m, n] with 1 <= m <= "
+                         f"{MAX_M} and 1 <= n <= 12")
+    types = [tuple(t) for t in entry["types"]]
+    if len(set(types)) != len(types):
+        problems.add(f"{where}.types", entry["types"], "a type is listed twice",
+                     "distinct [m, n] pairs")
+    _check_figures(config, "orbits", name, entry, problems, None)
+
+
+def _check_paper_figures(config, problems, only=None):
+    for fig, name in config["paper_figures"].items():
+        if only is not None and fig not in only:
+            continue    # the paper's, not built (paper: false): a replaced entry may differ
+        section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
+        where = f"paper_figures.{fig}"
+        if name not in config[section]:
+            problems.add(where, name, f"{fig} is drawn from {section} entries; no such entry",
+                         ", ".join(sorted(config[section])))
+            continue
+        names = [f if isinstance(f, str) else f["name"] for f in config[section][name]["figures"]]
+        if names and fig not in names:      # (an empty list is reported with its entry)
+            problems.add(where, name, f"{section}.{name} does not list {fig} in its figures",
+                         f"an entry listing {fig}, or add {fig} to {section}.{name}.figures")
+
+
+def check(config, schema, own=None):
+    """Check every cross-field relation of ``config``.
+
+    ``config`` has passed `~vibroimpact.pipeline.config.messages.validate` against
+    ``schema``; ``own`` is from `~vibroimpact.pipeline.config.layering.compose`.
+
+    Raises
+    ------
+    ConfigError
+        Listing every problem found, one or two lines each.
+    """
+    limits = config["limits"]
+    problems = _Problems()
+    _check_noises(config, problems)
+    # a random study's inv_beta left out (the schema's default) is not one it ignores
+    unforced = schema["$defs"]["study"]["properties"]["inv_beta"]["default"]
+    for name, entry in config["studies"].items():
+        _check_study(config, name, entry, problems, limits, unforced)
+    for name, entry in config["orbits"].items():
+        _check_orbits(config, name, entry, problems, limits)
+    _check_paper_figures(config, problems, None if own is None else own["paper_figures"])
+    if own is not None and not any(own[s] for s in ("studies", "orbits", "paper_figures")):
+        problems.add("paper", False, "your file builds nothing of its own",
+                     "paper: false with at least one study or orbits entry that lists figures")
+    if problems:
+        raise ConfigError(problems)

@@ -1,0 +1,91 @@
+"""The cost model of the workflow's jobs: CPU time, output bytes, memory, scheduler time.
+
+One model, in functions of plain numbers, for the plan (`vibroimpact.pipeline.config.plan`:
+what a build costs, printed and checked against ``limits`` before it runs) and for the
+resources each rule asks of a scheduler (``workflow/rules/common.smk``). The costs were
+measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job costs").
+"""
+from vibroimpact.pipeline.study import Study, map_cap_steps
+
+__all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simulate_runtime_min",
+           "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s"]
+
+# --- CPU seconds -----------------------------------------------------------------------------
+JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
+NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
+NS_PER_SAMPLE = 50.0       # noise generation
+US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
+FIGURE_S = 1.5             # one figure, start-up included
+REPORT_S = 4.0             # one report notebook executed and rendered (papermill, nbconvert)
+VALIDATION_S = 85.0        # the work-precision run and the stress sample together
+
+# --- bytes of the outputs (measured file sizes of the default build) -------------------------
+FILE_OVERHEAD = 20_000
+FIGURE_BYTES = 400_000     # png + pdf
+REPORT_BYTES = 4_000_000   # executed notebook + HTML, figures embedded
+
+# --- what a job asks of a scheduler ----------------------------------------------------------
+#: The simulate job's time asked over the estimate: 2.4 x 25 ns = 60 ns a step, for a slower
+#: or shared node (x3 the ~20 ns measured on one core).
+RUNTIME_MARGIN = 2.4
+#: Minutes every simulate job asks besides its steps: start-up, reading, writing.
+RUNTIME_FLOOR_MIN = 5
+#: Resident memory of a job (MB): ~550 MB of interpreter, numba and scipy.
+BASE_MEM_MB = 600
+#: A noise job: chunked generation, one chunk (8 MB) plus the 2**22-sample head kept for the
+#: estimates.
+NOISE_MEM_MB = BASE_MEM_MB + 200
+#: A simulate job: the simulator's chunk buffers (~100 MB at the default chunk of 2**20
+#: samples), besides the noise record held in memory (8 bytes a sample).
+SIMULATE_BUFFERS_MB = 150
+
+
+def record_steps(n_samples, dt, t_end=None):
+    """Sample steps of a record of ``n_samples`` at ``dt`` up to ``t_end`` (None: to its end)."""
+    end = (n_samples - 1) * dt if t_end is None else float(t_end)
+    return end / dt
+
+
+def map_steps(n_samples, dt, transient, max_periods, inv_beta):
+    """Sample steps of a map cell at ``1/beta_f = inv_beta`` run to its cap (the most it
+    runs: `~vibroimpact.pipeline.study.map_cap_steps`)."""
+    return map_cap_steps(n_samples, dt, transient, max_periods, 1.0 / inv_beta)
+
+
+def study_steps(kind, entry, noise, inv_beta=None):
+    """Sample steps of one cell of a ``kind`` job (``events``, ``map``, ``spectra``) of the
+    study ``entry`` driven by the ``noises`` entry ``noise``; a map cell at ``inv_beta``
+    (None: the study's longest forcing period, the dearest cell)."""
+    n, dt = int(noise["n_samples"]), float(noise["dt"])
+    if kind == "map":
+        if inv_beta is None:
+            inv_beta = float(Study.from_config("", entry).inv_beta.max())
+        return map_steps(n, dt, float(entry["transient"]), int(entry["map"]["max_periods"]),
+                         inv_beta)
+    block = entry["spectra"] if kind == "spectra" else entry
+    return record_steps(n, dt, block.get("t_end"))
+
+
+def simulate_cpu_s(cells, steps):
+    """CPU seconds of ``cells`` cells of ``steps`` sample steps each."""
+    return cells * steps * NS_PER_STEP * 1e-9
+
+
+def simulate_runtime_min(cells, steps):
+    """Minutes a simulate job of ``cells`` cells of ``steps`` steps asks of a scheduler."""
+    return RUNTIME_FLOOR_MIN + int(simulate_cpu_s(cells, steps) * RUNTIME_MARGIN / 60)
+
+
+def simulate_mem_mb(n_samples):
+    """Memory (MB) of a simulate job over a noise record of ``n_samples`` samples."""
+    return BASE_MEM_MB + SIMULATE_BUFFERS_MB + -(-8 * n_samples // 2**20)
+
+
+def noise_cpu_s(n_samples):
+    """CPU seconds of a noise job of ``n_samples`` samples, start-up included."""
+    return JOB_START_S + n_samples * NS_PER_SAMPLE * 1e-9
+
+
+def orbit_cpu_s(cells, types):
+    """CPU seconds of the orbit solves of ``cells`` (1/beta, delta) cells of ``types`` types."""
+    return cells * types * US_PER_ORBIT * 1e-6

@@ -1,0 +1,196 @@
+"""Reading a config file strictly, and layering a user's config on the paper's.
+
+- :func:`read_yaml` reads a config file; a syntax error, a key given twice or aliases that
+  expand beyond `MAX_VALUES` name the file, line and column.
+- :func:`compose` layers a user's file on the paper's config (``config/config.yaml``): its
+  entries are added; an entry named like a paper entry but different is refused unless the
+  file lists it under ``replace`` (it would overwrite the paper's results); with
+  ``paper: false`` only the file's own entries are built (the paper's stay available by
+  name, e.g. a noise record or an orbits map).
+"""
+import copy
+from pathlib import Path
+
+import yaml
+
+from vibroimpact.pipeline.config.messages import ConfigError, _short
+
+__all__ = ["SECTIONS", "MAX_VALUES", "read_yaml", "check_size", "expanded_size", "compose",
+           "deep_merge"]
+
+#: Sections whose entries are named; a user's entry replaces a paper entry whole.
+SECTIONS = ("noises", "studies", "orbits", "paper_figures")
+
+#: Values a config may hold once YAML aliases are expanded (the paper's config holds ~600);
+#: a file beyond it (nested aliases: a "billion laughs") is refused before anything walks it.
+MAX_VALUES = 1_000_000
+
+
+class _StrictLoader(yaml.SafeLoader):
+    """``yaml.SafeLoader`` that refuses a key given twice in one mapping (PyYAML keeps the
+    last silently), naming both lines."""
+
+    def construct_mapping(self, node, deep=False):
+        seen = {}
+        for key_node, _ in node.value:
+            if key_node.tag == "tag:yaml.org,2002:merge":
+                continue
+            key = self.construct_object(key_node, deep=True)
+            try:
+                first = seen.get(key)
+            except TypeError:
+                continue                    # an unhashable key: the base class says so
+            if first is not None:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key {key!r} is given twice in one mapping (first on "
+                    f"line {first + 1}); YAML keeps one silently: delete or rename the other",
+                    key_node.start_mark)
+            seen[key] = key_node.start_mark.line
+        return super().construct_mapping(node, deep=deep)
+
+
+def expanded_size(value, limit=MAX_VALUES):
+    """Number of values in ``value`` with every shared (aliased) part counted each time it
+    is used, as code that walks it meets them; counting stops above ``limit``."""
+    sizes = {}
+
+    def size(v):
+        if not isinstance(v, (dict, list)):
+            return 1
+        if id(v) not in sizes:
+            sizes[id(v)] = 0            # a self-referencing alias counts as one value
+            items = v.values() if isinstance(v, dict) else v
+            total = 1
+            for item in items:
+                total += size(item)
+                if total > limit:
+                    break
+            sizes[id(v)] = total
+        return sizes[id(v)]
+
+    return size(value)
+
+
+def check_size(value, where):
+    """Refuse ``value`` (a config read from ``where``) that expands beyond `MAX_VALUES`."""
+    n = expanded_size(value)
+    if n > MAX_VALUES:
+        raise ConfigError(f"{where}: its YAML aliases (*name) expand to more than "
+                          f"{MAX_VALUES:,} values (nested aliases repeat a part many times); "
+                          f"allowed: a config of up to {MAX_VALUES:,} values, written out or "
+                          f"with aliases used a few times")
+
+
+def read_yaml(path, *, user=True):
+    """The mapping in a YAML config file.
+
+    A syntax error or a key given twice names the file, line and column; an empty file, a
+    file that holds no mapping or whose aliases expand beyond `MAX_VALUES` names the file.
+    ``user=False`` (the project's own files) lets an empty file through as ``{}``.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as err:
+        raise ConfigError(f"{path}: cannot read the config file ({err.strerror})") from None
+    except UnicodeDecodeError as err:
+        line = err.object[:err.start].count(b"\n") + 1
+        raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{err.object[err.start]:02x}); "
+                          f"allowed: a YAML file saved as UTF-8") from None
+    try:
+        data = yaml.load(text, Loader=_StrictLoader)
+    except yaml.YAMLError as err:
+        mark = getattr(err, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+        problem = getattr(err, "problem", None) or str(err).splitlines()[0]
+        context = getattr(err, "context", None)
+        duplicate = isinstance(err, yaml.constructor.ConstructorError)
+        kind = "YAML" if duplicate else "YAML syntax error"
+        raise ConfigError(f"{where}: {kind}: {problem}"
+                          + (f" ({context})" if context else "")) from None
+    if data is None and user:
+        raise ConfigError(f"{path}: the config file is empty (or only comments); allowed: a "
+                          f"mapping of sections, e.g. studies: {{...}} (README, \"Your own "
+                          f"studies\")")
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise ConfigError(f"{path}: a config file holds a mapping of keys (noises, studies, "
+                          f"...), got a {type(data).__name__}")
+    check_size(data, path)
+    return data
+
+
+def _replaced(user, section, name):
+    replace = user.get("replace", False)
+    if replace is True:
+        return True
+    return isinstance(replace, list) and f"{section}.{name}" in replace
+
+
+def compose(paper, user):
+    """``(config, own)``: the paper's config with a user's layered on, and what is built.
+
+    ``own`` is ``None`` when everything is built (no user file, or ``paper: true``), else
+    ``{section: names}`` of the user's own entries (``paper: false``).
+
+    Raises
+    ------
+    ConfigError
+        If a user entry would overwrite a different paper entry without being listed under
+        ``replace``, or ``replace`` names no user entry.
+    """
+    if not user:
+        return copy.deepcopy(paper), None
+    replace = user.get("replace", False)
+    if not isinstance(replace, (bool, list)):
+        raise ConfigError(f"replace = {_short(replace)}: not allowed; allowed: true, or a list "
+                          f"of section.name, e.g. replace: [studies.random]")
+    config = copy.deepcopy(paper)
+    problems = []
+    for key, value in user.items():
+        if key not in SECTIONS:
+            config[key] = copy.deepcopy(value)      # paper, replace, limits: the user's
+    config.setdefault("paper", True)
+    for section in SECTIONS:
+        mine = user.get(section)
+        if mine is None:
+            continue
+        if not isinstance(mine, dict) or not isinstance(config.get(section, {}), dict):
+            config[section] = copy.deepcopy(mine)     # the schema check names the problem
+            continue
+        merged = config.setdefault(section, {})
+        for name, entry in mine.items():
+            if name in merged and merged[name] != entry and not _replaced(user, section, name):
+                problems.append(
+                    f"{section}.{name}: the paper's config (config/config.yaml) has an entry "
+                    f"of this name; yours differs and would overwrite its results.\n"
+                    f"  Rename yours, or list it to replace the paper's: "
+                    f"replace: [{section}.{name}] (or replace: true)")
+            merged[name] = copy.deepcopy(entry)
+    replace = user.get("replace")
+    if isinstance(replace, list):
+        for item in replace:
+            section, _, name = str(item).partition(".")
+            if section not in SECTIONS or name not in (user.get(section) or {}):
+                problems.append(f"replace: {item!r} names no entry of your file; allowed: "
+                                f"<section>.<name> with section in {list(SECTIONS)}")
+    if problems:
+        raise ConfigError(problems)
+    own = None
+    if user.get("paper", True) is False:
+        own = {s: set(user.get(s) or {}) if isinstance(user.get(s), dict) else set()
+               for s in SECTIONS}
+    return config, own
+
+
+def deep_merge(base, extra):
+    """``base`` with ``extra`` merged in key by key (mappings recursively), as Snakemake
+    merges several ``--configfile`` files; neither is changed."""
+    out = dict(base)
+    for key, value in extra.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = deep_merge(out[key], value)
+        else:
+            out[key] = value
+    return out

@@ -1,0 +1,266 @@
+"""The plan of a build: cells, jobs, output bytes and CPU time per config entry.
+
+:func:`make_plan` costs every output of ``rule all`` with the one cost model
+(`vibroimpact.pipeline.config.costs`) before anything runs; :meth:`Plan.format` is what
+``python -m vibroimpact plan`` prints and :meth:`Plan.refuse_beyond_limits` refuses a build
+beyond the config's ``limits``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+import shutil
+
+from vibroimpact.pipeline import figures
+from vibroimpact.pipeline.config import costs
+from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVERHEAD,
+                                               JOB_START_S, REPORT_BYTES, REPORT_S,
+                                               VALIDATION_S)
+from vibroimpact.pipeline.config.messages import ConfigError, _num
+from vibroimpact.pipeline.config.sweeps import drawn_sweeps
+from vibroimpact.pipeline.study import Study, grid_size, orbit_rows
+
+__all__ = ["Plan", "Row", "make_plan", "built_entries"]
+
+
+@dataclass
+class Row:
+    """One line of the plan: a config entry and what building it costs."""
+
+    key: str
+    detail: str
+    cells: int = 0
+    orbit_cells: int = 0
+    jobs: int = 0
+    bytes: float = 0.0
+    cpu_s: float = 0.0
+
+
+@dataclass
+class Plan:
+    """What a build will make, before anything runs (``str()`` is the printed plan)."""
+
+    rows: list = field(default_factory=list)
+    limits: dict = field(default_factory=dict)
+    free_bytes: float | None = None
+    results: str = "results"
+    drawn: dict = field(default_factory=dict)    # built_entries(...)[0]: what `rule all` draws
+
+    @property
+    def cells(self):
+        return sum(r.cells for r in self.rows)
+
+    @property
+    def orbit_cells(self):
+        return sum(r.orbit_cells for r in self.rows)
+
+    @property
+    def jobs(self):
+        return sum(r.jobs for r in self.rows)
+
+    @property
+    def bytes(self):
+        return sum(r.bytes for r in self.rows)
+
+    @property
+    def cpu_s(self):
+        return sum(r.cpu_s for r in self.rows)
+
+    def summary(self, cores=2):
+        return (f"{_n(self.cells, 'simulation cell')}, {_n(self.orbit_cells, 'orbit cell')}, "
+                f"{_n(self.jobs, 'job')} (Snakemake counts {self.jobs + 1}, with its target "
+                f"`all`), ~{_bytes(self.bytes)} of outputs, ~{_time(self.cpu_s)} of CPU "
+                f"(~{_time(self.cpu_s / max(cores, 1))} on {_n(cores, 'core')})")
+
+    def format(self, cores=2):
+        lines = ["vibroimpact plan (every output of `rule all`, whether or not already built):"]
+        width = max([len(r.key) for r in self.rows] + [10])
+        lines.append(f"  {'entry':<{width}}  {'jobs':>4}  {'outputs':>8}  {'CPU':>8}  what")
+        for r in self.rows:
+            lines.append(f"  {r.key:<{width}}  {r.jobs:>4}  {_bytes(r.bytes):>8}  "
+                         f"~{_time(r.cpu_s):>7}  {r.detail}")
+        lines.append(f"  total: {self.summary(cores)}")
+        lim = self.limits
+        lines.append(f"  limits: {self.cells:,} of {lim['max_cells']:,} cells (limits.max_cells), "
+                     f"{self.orbit_cells:,} of {lim['max_orbit_cells']:,} orbit cells "
+                     f"(limits.max_orbit_cells),")
+        lines.append(f"          {self.jobs} of {lim['max_jobs']} jobs (limits.max_jobs), "
+                     f"{_bytes(self.bytes)} of {_num(lim['max_disk_gb'])} GB (limits.max_disk_gb)"
+                     + (f"; {_bytes(self.free_bytes)} free under {self.results}"
+                        if self.free_bytes is not None else "") + ",")
+        lines.append(f"          ~{_time(self.cpu_s)} of {_num(lim['max_cpu_hours'])} h of CPU "
+                     f"(limits.max_cpu_hours)")
+        return "\n".join(lines)
+
+    __str__ = format
+
+    def refuse_beyond_limits(self):
+        lim, problems = self.limits, []
+        for value, key, what in ((self.cells, "max_cells", "simulation cells"),
+                                 (self.orbit_cells, "max_orbit_cells", "orbit cells"),
+                                 (self.jobs, "max_jobs", "jobs")):
+            if value > lim[key]:
+                problems.append(f"limits.{key} = {lim[key]:,}: this build has {value:,} "
+                                f"{what}; raise limits.{key} to build it, or shrink the grids"
+                                f"\n  ({self.summary()})")
+        if self.cpu_s > lim["max_cpu_hours"] * 3600:
+            problems.append(f"limits.max_cpu_hours = {_num(lim['max_cpu_hours'])}: this build "
+                            f"needs ~{_time(self.cpu_s)} of CPU; raise limits.max_cpu_hours to "
+                            f"build it (a cluster: README, \"On a SLURM cluster\"), or shrink "
+                            f"the grids or records\n  ({self.summary()})")
+        gb = self.bytes / 1e9
+        if gb > lim["max_disk_gb"]:
+            problems.append(f"limits.max_disk_gb = {_num(lim['max_disk_gb'])}: this build "
+                            f"writes ~{_bytes(self.bytes)}; raise limits.max_disk_gb to build "
+                            f"it, or shorten the records\n  ({self.summary()})")
+        elif self.free_bytes is not None and self.bytes > self.free_bytes:
+            problems.append(f"disk: this build writes ~{_bytes(self.bytes)}, only "
+                            f"{_bytes(self.free_bytes)} free under {self.results}; free "
+                            f"some space or shorten the records")
+        if problems:
+            raise ConfigError(problems)
+
+
+def _n(count, word):
+    """``"1 figure"``, ``"3 figures"``, ``"2 studies"``."""
+    if count == 1:
+        return f"1 {word}"
+    return f"{count:,} " + (word[:-1] + "ies" if word.endswith(("dy", "py")) else word + "s")
+
+
+def _bytes(n):
+    for unit, scale in (("GB", 1e9), ("MB", 1e6), ("kB", 1e3)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{int(n)} B"
+
+
+def _time(s):
+    if s >= 3600:
+        return f"{s / 3600:.2g} h"
+    if s >= 60:
+        return f"{s / 60:.2g} min"
+    return f"{s:.2g} s"
+
+
+def _study_needs(entry):
+    needs = {r for f in entry["figures"] for r in figures.FIGURES[
+        f if isinstance(f, str) else f["name"]]["reads"]}
+    if "sweep" in entry:
+        needs.add("events")         # the sweep's side-by-side figure reads them
+    return needs
+
+
+def built_entries(config, own=None):
+    """``(drawn, reads)`` of ``rule all``: ``drawn`` the entries whose figures it draws
+    (``{section: names}``, paper figures included), ``reads`` every entry whose datasets
+    those figures read (``{"studies", "orbits", "noises": names}``)."""
+    sections = ("studies", "orbits", "paper_figures")
+    drawn = {s: set(config.get(s, {})) if own is None else set(own[s]) for s in sections}
+    for fig in drawn["paper_figures"]:
+        section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
+        drawn[section].add(config["paper_figures"][fig])
+    reads = {"studies": set(drawn["studies"]), "orbits": set(drawn["orbits"]), "noises": set()}
+    for name in drawn["studies"]:
+        entry = config["studies"][name]
+        for item in entry["figures"]:
+            fig = item if isinstance(item, str) else item["name"]
+            for kind, other in figures.figure_sources(entry, fig).items():
+                reads[kind].add(other)
+        if _study_needs(entry) - {"orbits"}:
+            reads["noises"].add(entry["noise"])
+    return drawn, reads
+
+
+def make_plan(config, own=None, *, results="results"):
+    """The :class:`Plan` of ``rule all``: cells, jobs, bytes and CPU seconds per entry."""
+    drawn, build = built_entries(config, own)
+    plan = Plan(limits=dict(config["limits"]), results=str(results), drawn=drawn)
+    for name in sorted(build["noises"]):
+        entry = config["noises"][name]
+        n = int(entry["n_samples"])
+        plan.rows.append(Row(f"noises.{name}", f"{n:,} samples", jobs=1,
+                             bytes=8 * n + FILE_OVERHEAD, cpu_s=costs.noise_cpu_s(n)))
+    for name in sorted(build["studies"]):
+        entry = config["studies"][name]
+        study = Study.from_config(name, entry)
+        noise = config["noises"][entry["noise"]]
+        needs = _study_needs(entry)
+        row = Row(f"studies.{name}", "")
+        parts = []
+        if "events" in needs:
+            cells = len(study.cells("events"))
+            steps = costs.study_steps("events", entry, noise)
+            bins = sum(int(b["n"]) for b in entry["bins"].values())
+            per_cell = 12 * (bins + 100)
+            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * per_cell,
+                 costs.simulate_cpu_s(cells, steps))
+            parts.append(f"events {_n(cells, 'cell')}")
+        if "map" in needs:
+            cells = len(study.cells("events"))
+            cap = sum(len(study.delta) * costs.study_steps("map", entry, noise, float(ib))
+                      for ib in study.inv_beta)
+            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200,
+                 costs.simulate_cpu_s(1, cap))
+            parts.append(f"map {_n(cells, 'cell')} (CPU at the caps)")
+        if "spectra" in needs:
+            cells = len(study.cells("spectra"))
+            spec = entry["spectra"]
+            steps = costs.study_steps("spectra", entry, noise)
+            _add(row, cells, study.n_tiles("spectra") + 1,
+                 2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1),
+                 costs.simulate_cpu_s(cells, steps))
+            parts.append(f"spectra {_n(cells, 'cell')}")
+        if "trace" in needs:
+            steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
+            _add(row, 0, 1, 40 * steps, 0.0)
+            parts.append("trace")
+        targets = len(figures.figure_targets(entry))
+        row.jobs += targets
+        row.bytes += targets * FIGURE_BYTES
+        row.cpu_s += targets * FIGURE_S + row.jobs * JOB_START_S
+        row.detail = ", ".join(parts) + f", {_n(targets, 'figure')}"
+        plan.rows.append(row)
+    for name in sorted(build["orbits"]):
+        entry = config["orbits"][name]
+        rows, n_tiles = orbit_rows(entry)
+        cells = len(rows) * grid_size(entry["delta"])
+        targets = len(figures.figure_targets(entry)) if name in drawn["orbits"] else 0
+        row = Row(f"orbits.{name}", f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}, "
+                  f"{_n(targets, 'figure')}", orbit_cells=cells, jobs=n_tiles + 1 + targets,
+                  bytes=2 * cells * len(entry["types"]) * 34 + targets * FIGURE_BYTES)
+        row.cpu_s = (costs.orbit_cpu_s(cells, len(entry["types"])) + row.jobs * JOB_START_S
+                     + targets * FIGURE_S)
+        plan.rows.append(row)
+    for name in drawn_sweeps(config, drawn):
+        n = len(config["sweeps"][name]["studies"])
+        plan.rows.append(Row(f"sweeps.{name}", f"{_n(n, 'study')} side by side, 1 figure", jobs=1,
+                             bytes=FIGURE_BYTES, cpu_s=FIGURE_S + JOB_START_S))
+    reports = len(drawn["studies"]) + len(drawn["orbits"])
+    if reports:
+        plan.rows.append(Row("reports", f"{_n(reports, 'notebook')} executed, with HTML",
+                             jobs=reports, bytes=reports * REPORT_BYTES,
+                             cpu_s=reports * (REPORT_S + JOB_START_S)))
+    if config["validation"]["build"]:
+        plan.rows.append(Row("validation", "work-precision and stress-sample runs, 2 figures, "
+                             "2 reports", jobs=6, bytes=2 * FIGURE_BYTES + 2 * REPORT_BYTES,
+                             cpu_s=VALIDATION_S + 2 * (FIGURE_S + REPORT_S) + 6 * JOB_START_S))
+    copies = drawn["paper_figures"]
+    if copies:
+        plan.rows.append(Row("paper_figures", _n(len(copies), "copy"), jobs=len(copies),
+                             bytes=len(copies) * FIGURE_BYTES))
+    try:
+        probe = Path(results)
+        while not probe.exists():
+            probe = probe.parent
+        plan.free_bytes = shutil.disk_usage(probe).free
+    except OSError:
+        plan.free_bytes = None
+    return plan
+
+
+def _add(row, cells, jobs, nbytes, cpu_s):
+    row.cells += cells
+    row.jobs += jobs
+    row.bytes += nbytes + jobs * FILE_OVERHEAD
+    row.cpu_s += cpu_s
