@@ -69,7 +69,7 @@ def test_ratio_statistics_only_with_a_harmonic_force(record):
     assert not harmonic_only & set(plain) and harmonic_only <= set(forced)
     for name, study in (("plain", dict(amplitude=0.0)),
                         ("forced", dict(amplitude=1.0, inv_beta=[1.1]))):
-        cell_list = Study.from_config(name, dict(zeta=0.05, eps=0.5, delta=[0.0],
+        cell_list = Study.from_config(name, dict(zeta=0.05, eps=0.5, delta=[0.0], tile_size=16,
                                                  **study)).cells()
         tile = datasets.events_tile(cell_list, [plain if name == "plain" else forced], BINS,
                                     dict(zeta=0.05))

@@ -25,8 +25,8 @@ NOISE = dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=60_001,
              seed=19740914, nperseg=1024)
 BINS = dict(v_after=dict(max=2.5, n=50), interval=dict(max=10.0, n=50), ratio=dict(max=4.0, n=80))
 COMMON = dict(noise="band", zeta=0.05, eps=0.5, transient=100.0, tile_size=100, n_batches=20,
-              motion_window=0.1, bins=BINS, spectra=dict(delta=[3.0, 1.0, 0.0, -0.5],
-                                                         nperseg=512, t_end=6000.0))
+              motion_window=0.1, motions=[[1, 1], [2, 1], [1, 2]], bins=BINS,
+              spectra=dict(delta=[3.0, 1.0, 0.0, -0.5], nperseg=512, t_end=6000.0))
 #: Random study: impacts stop between 3 and 4.5 on this record; 3 has only a handful.
 RANDOM = dict(COMMON, amplitude=0.0, delta=[-1.0, -0.5, 0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0],
               trace=dict(delta=0.0, t_end=60.0))

@@ -75,14 +75,15 @@ class Study:
     delta: np.ndarray
     spectra_delta: np.ndarray
     tile_size: int
-    motions: tuple = ((1, 1), (2, 1), (1, 2))
+    motions: tuple = ()
 
     @classmethod
     def from_config(cls, name, entry):
-        """Build from a validated config entry ``studies[name]``, or the part of it a job
-        reads (an entry without ``delta`` has an empty events grid)."""
-        amplitude = float(entry.get("amplitude", 0.0))
-        inv_beta = grid_values(entry.get("inv_beta", [1.0])) if amplitude != 0.0 else np.array([1.0])
+        """Build from a validated config entry ``studies[name]`` (the schema's defaults
+        filled in), or the part of it a job reads: an entry without ``delta`` has an empty
+        events grid, one without ``motions`` classifies none (a spectra or trace job)."""
+        amplitude = float(entry["amplitude"])
+        inv_beta = grid_values(entry["inv_beta"]) if amplitude != 0.0 else np.array([1.0])
         if np.any(inv_beta <= 0.0):
             raise ValueError(f"studies.{name}.inv_beta must hold values > 0, got {inv_beta!r}")
         spectra = entry.get("spectra") or {}
@@ -90,8 +91,8 @@ class Study:
                    amplitude=amplitude, inv_beta=inv_beta,
                    delta=grid_values(entry["delta"]) if "delta" in entry else np.empty(0),
                    spectra_delta=grid_values(spectra["delta"]) if spectra.get("delta") else np.empty(0),
-                   tile_size=int(entry.get("tile_size", 16)),
-                   motions=tuple((int(m), int(n)) for m, n in entry.get("motions", cls.motions)))
+                   tile_size=int(entry["tile_size"]),
+                   motions=tuple((int(m), int(n)) for m, n in entry.get("motions", ())))
 
     def cells(self, kind="events"):
         """All cells of the events grid (``inv_beta x delta``; also the map's) or of the

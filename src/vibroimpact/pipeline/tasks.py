@@ -87,7 +87,7 @@ def make_noise(entry, out):
     spec = noise_spec(entry)
     log.info("generating %d samples of %s", entry["n_samples"], spec)
     io.write_noise(out, spec, int(entry["n_samples"]), int(entry["seed"]),
-                   attrs=provenance(entry, entry["seed"]), nperseg=int(entry.get("nperseg", 2048)))
+                   attrs=provenance(entry, entry["seed"]), nperseg=int(entry["nperseg"]))
 
 
 def _study_attrs(study, block, noise_attrs):
