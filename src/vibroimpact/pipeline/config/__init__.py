@@ -24,7 +24,8 @@ from pathlib import Path
 from vibroimpact.pipeline.config.checks import check
 from vibroimpact.pipeline.config.layering import (SECTIONS, check_size, compose, deep_merge,
                                                   read_yaml)
-from vibroimpact.pipeline.config.messages import VERBOSE_ENV, ConfigError, _short, validate
+from vibroimpact.pipeline.config.messages import VERBOSE_ENV, ConfigError, validate
+from vibroimpact.pipeline.config.messages import _short  # noqa: F401 (how a value is shown)
 from vibroimpact.pipeline.config.plan import Plan, make_plan
 from vibroimpact.pipeline.config.sweeps import (SWEEP_KEYS, Sweeps, drawn_sweeps,
                                                 expand_sweeps, sweep_figures, sweep_label,
@@ -32,7 +33,7 @@ from vibroimpact.pipeline.config.sweeps import (SWEEP_KEYS, Sweeps, drawn_sweeps
 
 __all__ = ["ConfigError", "Plan", "Sweeps", "read_yaml", "compose", "expand_sweeps", "validate",
            "check", "make_plan", "load", "drawn_sweeps", "sweep_figures", "sweep_label",
-           "sweep_labels", "SECTIONS", "SWEEP_KEYS", "VERBOSE_ENV", "_short"]
+           "sweep_labels", "SECTIONS", "SWEEP_KEYS", "VERBOSE_ENV"]
 
 
 def load(user=None, *, root=".", user_files=()):

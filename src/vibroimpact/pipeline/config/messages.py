@@ -15,7 +15,7 @@ import re
 
 import yaml
 
-__all__ = ["ConfigError", "VERBOSE_ENV", "validate", "allowed"]
+__all__ = ["ConfigError", "VERBOSE_ENV", "validate"]
 
 #: Environment variable asking for the full schema validator output after the short one.
 VERBOSE_ENV = "VIBROIMPACT_VERBOSE"
@@ -242,11 +242,6 @@ class _Words:
         node = self.resolve(error.schema)
         return [self.not_allowed(parts, error.instance,
                                  _scalar(node) if _read_as_text(error.instance) else node)]
-
-
-def allowed(schema, root=None):
-    """The allowed values of the node ``schema`` of the schema ``root``, in words."""
-    return _Words(root if root is not None else schema).allowed(schema)
 
 
 def _filling_validator(schema):
