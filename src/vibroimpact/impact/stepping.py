@@ -144,8 +144,8 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         s = min(s + sig, H)
         x = delta
         at_wall = True
-        vscale = abs(b) + abs(P[P_AQ]) * P[P_BETA] + c[C_R] + abs(v)
-        if code == ROOT and u <= TOUCH_ULPS * EPS64 * vscale:
+        if code == ROOT and u <= TOUCH_ULPS * EPS64 * (abs(b) + abs(P[P_AQ]) * P[P_BETA]
+                                                       + c[C_R] + abs(v)):
             code = TOUCH          # arrives with zero velocity within round-off: grazing touch
         if code == TOUCH:
             v = min(u, 0.0)

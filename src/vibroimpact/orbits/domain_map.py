@@ -8,7 +8,8 @@ from numba import prange
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants, lam_of, monodromy, orbit_margin
-from vibroimpact.orbits.newton import newton, uncertainty
+from vibroimpact.orbits.newton import (N_WORK, WORK_DY, WORK_RES, WORK_TRY, newton,
+                                        uncertainty)
 from vibroimpact.orbits.solutions import _accept, _valid
 from vibroimpact.orbits.solve import solve_type
 from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, MAP_SCAN_EVERY,
@@ -31,8 +32,8 @@ def _follow_back(y0, m, n, beta, deltas, d_from, d_stop, zeta, eps, sols, counts
     for dd in range(d_from - 1, d_stop - 1, -1):
         delta = deltas[dd]
         scale = 1.0 + abs(delta) + q * (1.0 + beta)
-        conv, _ = newton(y, m, z, beta, delta, zeta, eps, scale, work[0], jac, work[1],
-                         work[2])
+        conv, _ = newton(y, m, z, beta, delta, zeta, eps, scale, work[WORK_RES], jac,
+                         work[WORK_DY], work[WORK_TRY])
         if not conv or not _valid(y, m, z):
             return
         rho = uncertainty(y, m, z, beta, delta, zeta, eps, scale, tf, scale)
@@ -62,7 +63,7 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
         z = 2.0 * pi * n / beta
         sols = np.empty((nd, MAX_SOLUTIONS, nn + 1))   # rows (tau.., u.., uncertainty)
         counts = np.zeros(nd, dtype=np.int64)
-        work = np.empty((3, nn))
+        work = np.empty((N_WORK, nn))
         jac = np.empty((nn, nn))
         scan_step = MAP_SCAN_STEP_M2 if m == 2 else MAP_SCAN_STEP_M3
         last_scan = 0

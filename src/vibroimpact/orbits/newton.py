@@ -14,6 +14,11 @@ from vibroimpact.orbits.tolerances import (NEWTON_GIVE_UP_IT, NEWTON_GIVE_UP_RTO
                                            RESIDUAL_NOISE_RTOL, UNCERTAINTY_CAP,
                                            UNCERTAINTY_SAFETY)
 
+#: Rows of the solvers' scratch ``work`` (shape ``(N_WORK, 2m)``): the residual, the Newton
+#: step and the trial point of :func:`newton`.
+WORK_RES, WORK_DY, WORK_TRY = range(3)
+N_WORK = 3
+
 
 @kernel
 def _residual_jacobian(y, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac):

@@ -8,10 +8,10 @@ import numpy as np
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants
-from vibroimpact.orbits.linalg import _cofactors, _norm
-from vibroimpact.orbits.newton import _residual_jacobian, uncertainty
-from vibroimpact.orbits.solutions import _accept, _try_start, _valid
 from vibroimpact.orbits.intervals import _circle_factors, _fill_interval_system, _guess_from_null
+from vibroimpact.orbits.linalg import _cofactors, _norm
+from vibroimpact.orbits.newton import WORK_RES, _residual_jacobian, uncertainty
+from vibroimpact.orbits.solutions import _accept, _try_start, _valid
 from vibroimpact.orbits.tolerances import (BRENT_ROOT_REL, EDGE_LEVELS, GOLDEN_SECTION,
                                            M2_MIN_NODES, NEWTON_RTOL, ROOT_MAXIT, TANGENCY_MARGIN,
                                            TANGENCY_XTOL, TINY)
@@ -275,7 +275,7 @@ def _m2_solution(x, f, n, beta, delta, zeta, eps, scale, zs, kmat, sub, nvec, y,
     zs[1] = z - x
     if not _guess_from_null(nvec, 2, zs, q, phi, beta, 1.0 if f == 0 else -1.0, y):
         return count
-    res = work[0]
+    res = work[WORK_RES]
     _residual_jacobian(y, 2, z, beta, delta, zeta, eps, wd, q, phi, res, jac)
     if _norm(res, 4) <= NEWTON_RTOL * scale:
         if _valid(y, 2, z):

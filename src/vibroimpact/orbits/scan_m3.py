@@ -7,9 +7,9 @@ import numpy as np
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants
-from vibroimpact.orbits.linalg import _cofactors
 from vibroimpact.orbits.intervals import (_circle_factors, _fill_interval_system,
                                           _start_from_intervals)
+from vibroimpact.orbits.linalg import _cofactors
 from vibroimpact.orbits.tolerances import (BILINEAR_ACCEPT, BILINEAR_DIVERGED, BILINEAR_MAXIT,
                                            BILINEAR_XTOL, M3_CIRCLE_NEAR, M3_MIN_NODES,
                                            M3_NODE_OFFSET)

@@ -2,7 +2,7 @@
 their uncertainty) and shorter orbits traversed repeatedly left out.
 """
 from vibroimpact.orbits._jit import kernel
-from vibroimpact.orbits.newton import newton, uncertainty
+from vibroimpact.orbits.newton import WORK_DY, WORK_RES, WORK_TRY, newton, uncertainty
 from vibroimpact.orbits.tolerances import SAME_ORBIT_RTOL
 
 
@@ -76,9 +76,9 @@ def _accept(y, rho, rep_rho, m, z, tf, uscale, sols, count):
 @kernel
 def _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, uscale, sols, count, work, jac):
     """Newton from ``y``; a converged, valid solution goes to ``_accept``."""
-    res = work[0]
-    dy = work[1]
-    ytry = work[2]
+    res = work[WORK_RES]
+    dy = work[WORK_DY]
+    ytry = work[WORK_TRY]
     conv, _ = newton(y, m, z, beta, delta, zeta, eps, scale, res, jac, dy, ytry)
     if conv and _valid(y, m, z):
         rho = uncertainty(y, m, z, beta, delta, zeta, eps, scale, tf, uscale)

@@ -7,10 +7,11 @@ import numpy as np
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants
-from vibroimpact.orbits.solutions import _try_start
 from vibroimpact.orbits.m1 import solve_m1
+from vibroimpact.orbits.newton import N_WORK
 from vibroimpact.orbits.scan_m2 import _scan_m2
 from vibroimpact.orbits.scan_m3 import _scan_m3
+from vibroimpact.orbits.solutions import _try_start
 
 
 @kernel
@@ -47,7 +48,7 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     nn = 2 * m
     scale = 1.0 + abs(delta) + q * (1.0 + beta)
     count = 0
-    work = np.empty((3, nn))
+    work = np.empty((N_WORK, nn))
     jac = np.empty((nn, nn))
     y = np.empty(nn)
     for i in range(nseed):
