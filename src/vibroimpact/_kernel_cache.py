@@ -36,6 +36,8 @@ def kernel_decorator(njit, anchor, modules, **defaults):
 
     def stamped(fn, options):
         dispatcher = njit(cache=True, **{**defaults, **options})(fn)
+        if dispatcher is fn:            # NUMBA_DISABLE_JIT: plain Python, nothing cached
+            return fn
         cache_file = dispatcher._cache._cache_file
         cache_file._source_stamp = (cache_file._source_stamp, stamp)
         return dispatcher
