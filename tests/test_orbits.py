@@ -11,8 +11,10 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, root
 
-from vibroimpact.orbits import kernels as orbit_kernels
 from vibroimpact.orbits import PeriodicOrbit, orbit_map, periodic_orbits
+from vibroimpact.orbits.flight import harmonic_constants
+from vibroimpact.orbits.newton import _residual_jacobian
+from vibroimpact.orbits.scan_m2 import _m2_null
 
 ZETA, EPS = 0.05, 0.5
 
@@ -473,8 +475,8 @@ def test_repeated_shorter_orbit_is_not_a_22_motion():
     y = np.array([o11.tau0, o11.tau0 + o11.period, o11.velocities[0], o11.velocities[0]])
     res = np.empty(4)
     jac = np.empty((4, 4))
-    wd, q, phi = orbit_kernels.harmonic_constants(beta, ZETA)
-    orbit_kernels._residual_jacobian(y, 2, z, beta, delta, ZETA, EPS, wd, q, phi, res, jac)
+    wd, q, phi = harmonic_constants(beta, ZETA)
+    _residual_jacobian(y, 2, z, beta, delta, ZETA, EPS, wd, q, phi, res, jac)
     assert np.abs(res).max() < 1e-12
     orbits22 = periodic_orbits(2, 2, beta, delta, ZETA, EPS, include_inadmissible=True)
     for o in orbits22:
@@ -488,21 +490,18 @@ def test_symmetric_22_system_has_the_same_null_space():
     plain system where that is well conditioned, and a regular one at o = 0, where the plain
     system has rank 3 (the doubled (1/(n/2)) motion)."""
     beta, delta = 1 / 1.3, 0.7
-    wd, q, _ = orbit_kernels.harmonic_constants(beta, ZETA)
+    wd, q, _ = harmonic_constants(beta, ZETA)
     kmat, sub, zs = np.empty((4, 5)), np.empty((4, 5)), np.empty(2)
     for n in (2, 4):
         z = 2 * math.pi * n / beta
         for o in (-1.1, -0.3, 0.05, 0.9):
             plain, sym = np.empty(5), np.empty(5)
-            orbit_kernels._m2_null(z / 2 + o, z, False, beta, delta, ZETA, EPS, wd, zs, kmat,
-                                   sub, plain)
-            orbit_kernels._m2_null(z / 2 + o, z, True, beta, delta, ZETA, EPS, wd, zs, kmat,
-                                   sub, sym)
+            _m2_null(z / 2 + o, z, False, beta, delta, ZETA, EPS, wd, zs, kmat, sub, plain)
+            _m2_null(z / 2 + o, z, True, beta, delta, ZETA, EPS, wd, zs, kmat, sub, sym)
             a, b = plain / np.linalg.norm(plain), sym / np.linalg.norm(sym)
             assert min(np.abs(a - b).max(), np.abs(a + b).max()) < 1e-12, (n, o)
         at_half = np.empty(5)
-        orbit_kernels._m2_null(z / 2, z, True, beta, delta, ZETA, EPS, wd, zs, kmat, sub,
-                               at_half)
+        _m2_null(z / 2, z, True, beta, delta, ZETA, EPS, wd, zs, kmat, sub, at_half)
         assert np.all(np.isfinite(at_half)) and np.linalg.norm(at_half) > 1e-6
 
 

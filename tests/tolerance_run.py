@@ -10,11 +10,17 @@ import sys
 
 import numpy as np
 
-from vibroimpact.impact import kernels
+from vibroimpact.impact import kernels, tolerances
 
 FACTORS = json.loads(sys.argv[1])
+# every kernel module binds the thresholds it reads (``from ...tolerances import``): numba
+# reads each function's own module globals, so the scaled value goes into each of them
+MODULES = [m for n, m in sorted(sys.modules.items()) if n.startswith("vibroimpact.impact.")]
 for name, factor in FACTORS.items():
-    setattr(kernels, name, type(getattr(kernels, name))(getattr(kernels, name) * factor))
+    value = type(getattr(tolerances, name))(getattr(tolerances, name) * factor)
+    for module in MODULES:
+        if hasattr(module, name):
+            setattr(module, name, value)
 
 from vibroimpact import simulate                       # noqa: E402  (after the patch)
 from vibroimpact.noise import NoiseSpec, generate_array  # noqa: E402

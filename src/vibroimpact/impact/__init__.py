@@ -1,7 +1,9 @@
-"""The exact simulator: numba kernels (`kernels`) and the driver (`simulate`).
+"""The exact simulator: numba kernels (gathered in `kernels`) and the driver (`simulate`).
 
-Between samples the flight is closed form; impacts are roots, found and polished in the
-kernels; chatter and sticking are handled there too (docs/model.md). Importing this package
+Between samples the flight is closed form (`motion`); impacts are roots, found and polished
+in `events`, which also handles chatter and sticking; `stepping` walks the force samples
+(docs/model.md). Thresholds live in `tolerances`, the named slots of the arrays the kernels
+share in `layout`. Importing this package
 compiles nothing until a simulation runs (numba caches the kernels on disk).
 """
 from vibroimpact.impact.simulate import (SimulationResult, concatenate_results, simulate,

@@ -194,21 +194,21 @@ class _Buffers:
         self.stk_step = np.empty(_BUFFER, np.int64)
         self.stk_off = np.empty(_BUFFER)
         self.stk_kind = np.empty(_BUFFER)
-        self.cnt = np.zeros(3, np.int64)
-        self.ftot = np.zeros(7)       # [time in contact, what a step that gave up saw (6)]
+        self.cnt = np.zeros(kernels.N_COUNTERS, np.int64)
+        self.ftot = np.zeros(kernels.N_FTOT)      # the time in contact; a step that gave up
         self.grid = np.empty(max(n_grid, 1))
         self.grid_v = np.empty(max(n_grid, 1))
         self.grid_n = np.zeros(1, np.int64)
 
     def drain(self, parts):
-        n, m = int(self.cnt[0]), int(self.cnt[1])
+        n, m = int(self.cnt[kernels.CNT_IMPACTS]), int(self.cnt[kernels.CNT_STICK_EVENTS])
         parts["imp_step"].append(self.imp_step[:n].copy())
         parts["imp_off"].append(self.imp_off[:n].copy())
         parts["imp_u"].append(self.imp_u[:n].copy())
         parts["stk_step"].append(self.stk_step[:m].copy())
         parts["stk_off"].append(self.stk_off[:m].copy())
         parts["stk_kind"].append(self.stk_kind[:m].copy())
-        parts["n_chatter"] += int(self.cnt[2])
+        parts["n_chatter"] += int(self.cnt[kernels.CNT_CHATTER])
         self.cnt[:] = 0
 
 
@@ -217,7 +217,7 @@ def _raise_status(status, k, dt, r, k0, diag, P):
         bad = k + 1 if np.isfinite(r[k - k0]) else k
         raise ValueError(f"noise must be finite: noise[{bad}] = {float(r[bad - k0])!r}")
     if status == kernels.TOO_MANY_EVENTS:
-        s, gap, v, mode, n_imp, n_stk = (float(d) for d in diag)
+        s, gap, v, mode, n_imp, n_stk = (float(d) for d in diag)    # layout.FT_FIELDS[1:]
         delta, A, beta = (float(p) for p in (P[kernels.P_DELTA], P[kernels.P_A], P[kernels.P_BETA]))
         r0, r1 = float(r[k - k0]), float(r[k - k0 + 1])
         f0 = r0 + A * math.sin(beta * k * dt)
@@ -253,8 +253,10 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
                   x0=x0, v0=v0, rebound_floor=rebound_floor)
     Aq, phi = P[kernels.P_AQ], P[kernels.P_PHI]
-    state = np.array([x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE,
-                      -math.sin(phi), math.cos(phi)])
+    state = np.empty(kernels.N_STATE)
+    state[[kernels.S_W, kernels.S_WV, kernels.S_MODE, kernels.S_SIN_PSI, kernels.S_COS_PSI]] = (
+        x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE,
+        -math.sin(phi), math.cos(phi))
     n_full, rem = _split_steps(t_end, dt)
     stride = int(record_every)
     zeros = None if noise is not None else np.zeros(min(chunk_size, n_full + 1) + 1)
@@ -270,7 +272,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             r = np.ascontiguousarray(noise[k0 : k1 + 1], dtype=np.float64)
         final = k1 == n_full
         buf.grid_n[0] = 0
-        buf.ftot[0] = 0.0
+        buf.ftot[kernels.FT_CONTACT_TIME] = 0.0
         parts = dict(imp_step=[], imp_off=[], imp_u=[], stk_step=[], stk_off=[], stk_kind=[], n_chatter=0)
         k = k0
         while k < k1:
@@ -281,7 +283,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             if status == kernels.BUFFER_FULL:
                 buf.drain(parts)
             else:
-                _raise_status(status, k, dt, r, k0, buf.ftot[1:], P)
+                _raise_status(status, k, dt, r, k0, buf.ftot[kernels.FT_DIAGNOSTICS], P)
         t_chunk = k1 * dt
         x, v, mode = _state_at(state, P, k1)
         if final and stride and n_full % stride == 0:
@@ -301,7 +303,8 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             x, v, mode, status = kernels.slow_step(
                 n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
                 buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
-            _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[1:], P)
+            _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[kernels.FT_DIAGNOSTICS],
+                          P)
             t_chunk = t_end
         buf.drain(parts)
         requested = yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode,
@@ -317,14 +320,15 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
 def _state_at(state, P, k):
     """Displacement, velocity and mode at sample ``k`` from the kernel's state vector."""
     delta, beta, Aq = P[kernels.P_DELTA], P[kernels.P_BETA], P[kernels.P_AQ]
-    mode = int(state[2])
+    mode = int(state[kernels.S_MODE])
     if mode == kernels.STUCK:
         return delta, 0.0, kernels.STUCK
     if Aq == 0.0:
-        x, v = state[0], state[1]
+        x, v = state[kernels.S_W], state[kernels.S_WV]
     else:
         psi = kernels.phase(k, 0.0, P[kernels.P_BH_HI], P[kernels.P_BH_LO], beta) - P[kernels.P_PHI]
-        x, v = state[0] + Aq * math.sin(psi), state[1] + Aq * beta * math.cos(psi)
+        x = state[kernels.S_W] + Aq * math.sin(psi)
+        v = state[kernels.S_WV] + Aq * beta * math.cos(psi)
     if mode == kernels.WALL:
         x = delta       # exactly on the wall, not through the round-off of w + p_h
     return x, v, mode
@@ -381,7 +385,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         n_steps=k1 - k0 + (1 if t_chunk > k1 * dt else 0),
         n_impacts=len(imp_step),
         n_chatter=parts["n_chatter"],
-        contact_time=float(buf.ftot[0]),
+        contact_time=float(buf.ftot[kernels.FT_CONTACT_TIME]),
         t_end=t_chunk,
         x_end=float(x),
         v_end=float(v),

@@ -1,8 +1,11 @@
 """Periodic (m/n) impact motions under the harmonic force alone, their stability, domain maps.
 
 `api` is the public face (`periodic_orbits`, `PeriodicOrbit`, `orbit_map`, `Reason`); `kernels`
-holds the numba kernels: flights and admissibility, the (1/n) closed form, the (m/n) scan and
-Newton solver, the impact-map Jacobian and the row-parallel map (docs/model.md, section 8).
+gathers the numba kernels, one module per concept: flights, the impact-map Jacobian and
+admissibility (`flight`), linear algebra (`linalg`), Newton (`newton`), one orbit once
+(`solutions`), the (1/n) closed form (`m1`), the (m/n) scans (`intervals`, `scan_m2`,
+`scan_m3`, `solve`) and the row-parallel map (`domain_map`); thresholds in `tolerances`
+(docs/model.md, section 8).
 """
 from vibroimpact.orbits.api import REASON_CODES, PeriodicOrbit, Reason, orbit_map, periodic_orbits
 

@@ -219,7 +219,8 @@ def _make_orbit(y, m, n, beta, delta, zeta, eps):
     mult = np.linalg.eigvals(tmat).astype(complex)
     mult = mult[np.argsort(-np.abs(mult), kind="stable")]
     lam = float(np.abs(mult[0]) ** (1.0 / m))
-    margin = float(ok.orbit_margin(y_c, m, z, beta, delta, zeta, eps, np.empty((64, 2))))
+    stack = np.empty((ok.FLIGHT_STACK, 2))
+    margin = float(ok.orbit_margin(y_c, m, z, beta, delta, zeta, eps, stack))
     return PeriodicOrbit(
         m=m, n=n, beta=beta, delta=delta, zeta=zeta, eps=eps, tau0=tau0,
         intervals=intervals, velocities=np.roll(u_c, -1), multipliers=mult, jacobian=tmat,

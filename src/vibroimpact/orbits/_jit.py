@@ -1,0 +1,12 @@
+"""The orbit solver's numba decorator: ``njit(cache=True)``, with the cache of every kernel
+invalidated by an edit of any module below (:mod:`vibroimpact._kernel_cache`)."""
+from numba import njit
+
+from vibroimpact._kernel_cache import kernel_decorator
+
+#: The modules the compiled kernels are made of (constants included).
+KERNEL_MODULES = ("tolerances.py", "flight.py", "linalg.py", "newton.py", "solutions.py",
+                  "m1.py", "intervals.py", "scan_m2.py", "scan_m3.py", "solve.py",
+                  "domain_map.py")
+
+kernel = kernel_decorator(njit, __file__, KERNEL_MODULES)
