@@ -12,7 +12,7 @@ import sys
 
 from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
-from vibroimpact.pipeline.figures import figure_variant
+from vibroimpact.pipeline.figures import drawing_function, figure_variant
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import Study, grid_values, map_cap_steps, orbit_rows
 
@@ -264,18 +264,18 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
 
 
 def figure(target, inputs, out_png, options):
-    """Rule ``draw_figure``: ``plotting.<fig>(*datasets, **options)`` saved to ``out_png``.
+    """Rule ``draw_figure``: the figure's function (its ``draw`` in the figure table) of
+    ``*datasets, **options``, saved to ``out_png``.
 
     ``target`` is ``fig07`` or ``fig13-1`` (`vibroimpact.pipeline.figures`); ``options``
     come from the owner's config entry through the figure table (`figure_options`).
     """
     from vibroimpact import plotting
 
-    name, _ = figure_variant(target)
+    draw = drawing_function(figure_variant(target)[0])
     log.info("drawing %s from %s with %s", target, inputs, options)
     with plotting.style():
-        fig = getattr(plotting, name)(*[io.load_dataset(p) for p in inputs], **options)
-        plotting.save(fig, out_png)
+        plotting.save(draw(*[io.load_dataset(p) for p in inputs], **options), out_png)
 
 
 def orbit_tile(entry, tile, out, threads=None):
