@@ -6,15 +6,10 @@ system to random force", Bull. Fac. Eng. Hokkaido Univ. 72, 13-24.
 The public API is re-exported lazily: ``import vibroimpact`` loads neither numba nor the
 simulator; ``vibroimpact.simulate`` does, on first use. Subpackages (docs/api.md):
 ``impact`` (the simulator), ``orbits`` (periodic motions), ``stats``, ``noise``,
-``plotting``, ``pipeline`` (the workflow-facing layer), ``validation``.
+``plotting``, ``pipeline`` (the workflow-facing layer), ``validation``. ``__version__`` is
+lazy too: reading it loads ``importlib.metadata``, which a figure job does not otherwise need.
 """
 import importlib
-from importlib.metadata import PackageNotFoundError, version
-
-try:
-    __version__ = version("vibroimpact")
-except PackageNotFoundError:  # running from a source tree without installation
-    __version__ = "0+unknown"
 
 PAPER_REFERENCE = (
     "T. Irie, G. Yamada, H. Matsuzaki (1974), On the Dynamic Response of a Vibro-Impact "
@@ -34,7 +29,19 @@ _LAZY = {
 __all__ = [*_LAZY, "PAPER_REFERENCE", "__version__"]
 
 
+def _version():
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("vibroimpact")
+    except PackageNotFoundError:  # running from a source tree without installation
+        return "0+unknown"
+
+
 def __getattr__(name):
+    if name == "__version__":
+        globals()[name] = _version()
+        return globals()[name]
     if name not in _LAZY:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     value = getattr(importlib.import_module(_LAZY[name]), name)
@@ -43,4 +50,4 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(list(globals()) + list(_LAZY))
+    return sorted({*globals(), *_LAZY, "__version__"})

@@ -11,65 +11,105 @@ value of its entry's grid of that parameter (:func:`per_values`). ``harmonic`` f
 (Figs. 10-15) need a study with a harmonic force (``amplitude != 0``). A figure that lists
 ``sources`` reads those datasets from the config entry its item names (``fig15_vs_fig16``
 draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits: harmonic}``).
+
+``draw`` names the function that draws the figure, ``"module:function"`` with the module
+under `vibroimpact.plotting` (``"random:fig07"``), resolved by :func:`drawing_function` when
+a job draws: the table is read at every workflow parse, which must not import matplotlib.
 """
+import importlib
 import re
 
 from vibroimpact.pipeline.study import grid_values
 
-__all__ = ["FIGURES", "figure_targets", "figure_variant", "figure_options", "figure_item",
-           "figure_sources", "paper_target", "caption", "rest_text", "per_values"]
+__all__ = ["FIGURES", "VALIDATION_FIGURES", "drawing_function", "figure_targets",
+           "figure_variant", "figure_options", "figure_item", "figure_sources", "paper_target",
+           "caption", "rest_text", "per_values"]
 
 FIGURES = {
-    "fig03": dict(owner="study", reads=("trace",),
+    "fig03": dict(draw="random:fig03",
+                  owner="study", reads=("trace",),
                   shows="a stretch of the random input r(tau) and the motion x(tau) of the mass "
                         "from rest, with the wall at delta"),
-    "fig04": dict(owner="study", reads=("noise",),
+    "fig04": dict(draw="random:fig04",
+                  owner="study", reads=("noise",),
                   shows="the autocorrelation of the random input, estimated from its record "
                         "against the target (paper eq. 8)"),
-    "fig05": dict(owner="study", reads=("noise",),
+    "fig05": dict(draw="random:fig05",
+                  owner="study", reads=("noise",),
                   shows="the power spectral density of the random input, estimated against "
                         "the target (paper eq. 9)"),
-    "fig06": dict(owner="study", reads=("spectra",),
+    "fig06": dict(draw="random:fig06",
+                  owner="study", reads=("spectra",),
                   shows="the PSD of the acceleration a(tau) for several plays delta, with the "
                         "wall-free response |H|^2 S_f"),
-    "fig07": dict(owner="study", reads=("events",), options=("density_delta",),
+    "fig07": dict(draw="random:fig07",
+                  owner="study", reads=("events",), options=("density_delta",),
                   shows="the probability density of the velocity after impact for several "
                         "plays delta"),
-    "fig08": dict(owner="study", reads=("events",), options=("density_delta",),
+    "fig08": dict(draw="random:fig08",
+                  owner="study", reads=("events",), options=("density_delta",),
                   shows="the probability density of the interval between impacts for several "
                         "plays delta"),
-    "fig09": dict(owner="study", reads=("events",),
+    "fig09": dict(draw="random:fig09",
+                  owner="study", reads=("events",),
                   shows="the mean velocity after impact and the mean interval against delta, "
                         "with batch-means confidence bars, down to the play beyond which no "
                         "impact occurs"),
-    "fig10": dict(owner="study", reads=("trace",), harmonic=True,
+    "fig10": dict(draw="harmonic:fig10",
+                  owner="study", reads=("trace",), harmonic=True,
                   shows="the input sin(beta_f tau) + r(tau) and the motion of the mass from rest"),
-    "fig11": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True,
+    "fig11": dict(draw="harmonic:fig11",
+                  owner="study", reads=("spectra",), per="inv_beta", harmonic=True,
                   shows="the PSD of the input sin(beta_f tau) + r(tau): the random part and "
                         "the line of the harmonic force"),
-    "fig12": dict(owner="study", reads=("spectra",), per="inv_beta", harmonic=True,
+    "fig12": dict(draw="harmonic:fig12",
+                  owner="study", reads=("spectra",), per="inv_beta", harmonic=True,
                   shows="the PSD of the acceleration a(tau) under sin(beta_f tau) + r(tau) for "
                         "several plays delta"),
-    "fig13": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta",
+    "fig13": dict(draw="harmonic:fig13",
+                  owner="study", reads=("events",), options=("density_delta",), per="inv_beta",
                   harmonic=True,
                   shows="the probability density of z_j/z (interval over forcing period) for "
                         "several plays delta: (1/1) at 1, (2/1) about 1/2, (1/2) at 2"),
-    "fig14": dict(owner="study", reads=("events",), options=("density_delta",), per="inv_beta",
+    "fig14": dict(draw="harmonic:fig14",
+                  owner="study", reads=("events",), options=("density_delta",), per="inv_beta",
                   harmonic=True,
                   shows="the probability density of the velocity after impact under "
                         "sin(beta_f tau) + r(tau) for several plays delta"),
-    "fig15": dict(owner="study", reads=("map",), harmonic=True,
+    "fig15": dict(draw="maps:fig15",
+                  owner="study", reads=("map",), harmonic=True,
                   shows="maps over the (1/beta_f, delta) plane of the probability (%) of the "
                         "(1/1), (2/1) and (1/2) impact motions under sin(beta_f tau) + r(tau)"),
-    "fig15_vs_fig16": dict(owner="study", reads=("map", "orbits"), sources=("orbits",),
+    "fig15_vs_fig16": dict(draw="maps:fig15_vs_fig16",
+                           owner="study", reads=("map", "orbits"), sources=("orbits",),
                            harmonic=True,
                            shows="the probability contours of Fig. 15 over the stable domains "
                                  "of Fig. 16, with the agreement measures of each motion"),
-    "fig16": dict(owner="orbits", reads=("orbits",),
+    "fig16": dict(draw="orbits:fig16",
+                  owner="orbits", reads=("orbits",),
                   shows="the domains over the (1/beta_f, delta) plane of stable periodic "
                         "(m/n) impact motions under sin(beta_f tau) alone, with contours of "
                         "the degree of stability S"),
 }
+
+#: The figures of the validation targets (rule ``draw_validation_figure``), each drawn from
+#: its one dataset.
+VALIDATION_FIGURES = {
+    "work_precision": dict(draw="validation:work_precision"),
+    "stress": dict(draw="validation:stress"),
+}
+
+
+def drawing_function(name):
+    """The function of `vibroimpact.plotting` that draws figure ``name`` (``fig07``, not
+    ``fig13-1``; or a validation figure), from its ``draw`` in the tables above."""
+    spec = FIGURES.get(name) or VALIDATION_FIGURES.get(name)
+    if spec is None:
+        raise ValueError(f"no figure {name!r}; the figures: "
+                         f"{sorted(FIGURES) + sorted(VALIDATION_FIGURES)}")
+    module, function = spec["draw"].split(":")
+    return getattr(importlib.import_module(f"vibroimpact.plotting.{module}"), function)
+
 
 _VARIANT = re.compile(r"^(?P<name>[a-z][a-z0-9_]*?)(-(?P<index>[0-9]+))?$")
 

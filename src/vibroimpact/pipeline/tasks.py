@@ -12,7 +12,7 @@ import sys
 
 from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
-from vibroimpact.pipeline.figures import figure_variant
+from vibroimpact.pipeline.figures import drawing_function, figure_variant
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import Study, grid_values, map_cap_steps, orbit_rows
 
@@ -118,6 +118,23 @@ def _physics(study, cell):
                 beta_f=1.0 / cell.inv_beta)
 
 
+def _tile_job(study, tile, grid, what, run_cell, to_dataset, out):
+    """The skeleton of every ``simulate_*`` tile job.
+
+    ``run_cell(cell)`` on each cell of tile ``tile`` of the study's ``grid`` (``"events"``,
+    also the map's, or ``"spectra"``) with the progress in the log, then
+    ``to_dataset(cells, results)`` written to ``out`` (its provenance collected then).
+    """
+    tile_cells = study.tile(tile, grid)
+    progress = Progress(f"studies.{study.name} {what} tile {tile}", len(tile_cells))
+    results = []
+    for cell in tile_cells:
+        log.debug("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
+        results.append(run_cell(cell))
+        progress.cell_done(results[-1])
+    io.write_dataset(to_dataset(tile_cells, results), out)
+
+
 def events_tile(name, block, tile, noise_path, out):
     """Rule ``simulate_events``: impact statistics of the cells of one tile."""
     from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
@@ -125,24 +142,23 @@ def events_tile(name, block, tile, noise_path, out):
     study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     edges = datasets.bin_edges(block["bins"])
-    results = []
-    progress = Progress(f"studies.{name} events tile {tile}", len(study.tile(tile, "events")))
-    for cell in study.tile(tile, "events"):
-        log.debug("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
-        results.append(cells.event_statistics(
+
+    def run_cell(cell):
+        return cells.event_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
             t_end=block.get("t_end"), bins=edges, n_batches=int(block["n_batches"]),
             motion_window=float(block["motion_window"]), motions=study.motions,
-            rebound_floor=_rebound_floor(block)))
-        progress.cell_done(results[-1])
-    ds = datasets.events_tile(study.tile(tile, "events"), results, edges,
-                              dict(_study_attrs(study, block, noise_attrs),
-                                   **_record_attrs(block, block.get("t_end"), len(samples), dt),
-                                   n_batches=int(block["n_batches"]), bins=config_text(block["bins"]),
-                                   motion_window=float(block["motion_window"]),
-                                   rebound_floor=_rebound_floor(block)),
-                              motions=study.motions)
-    io.write_dataset(ds, out)
+            rebound_floor=_rebound_floor(block))
+
+    def to_dataset(tile_cells, results):
+        attrs = dict(_study_attrs(study, block, noise_attrs),
+                     **_record_attrs(block, block.get("t_end"), len(samples), dt),
+                     n_batches=int(block["n_batches"]), bins=config_text(block["bins"]),
+                     motion_window=float(block["motion_window"]),
+                     rebound_floor=_rebound_floor(block))
+        return datasets.events_tile(tile_cells, results, edges, attrs, motions=study.motions)
+
+    _tile_job(study, tile, "events", "events", run_cell, to_dataset, out)
 
 
 def map_tile(name, block, tile, noise_path, out):
@@ -161,9 +177,8 @@ def map_tile(name, block, tile, noise_path, out):
     # the longest forcing period of the whole study: every tile fails alike, before simulating
     map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
                   1.0 / study.inv_beta.max(), where=f"studies.{name}.map.max_periods")
-    results = []
-    progress = Progress(f"studies.{name} map tile {tile}", len(study.tile(tile, "events")))
-    for cell in study.tile(tile, "events"):
+
+    def run_cell(cell):
         start = time.process_time()
         result = cells.motion_map_cell(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
@@ -172,18 +187,21 @@ def map_tile(name, block, tile, noise_path, out):
             min_time=float(spec["min_time"]), max_periods=int(spec["max_periods"]),
             min_switches=int(spec["min_switches"]))
         result["cpu_time"] = time.process_time() - start
-        log.debug("cell %d: inv_beta=%g delta=%g: %.0f time units, %d collisions, %.3f s%s",
-                  cell.index, cell.inv_beta, cell.delta, result["simulated_time"],
-                  result["n_collisions"], result["cpu_time"],
+        log.debug("cell %d: %.0f time units, %d collisions, %.3f s%s", cell.index,
+                  result["simulated_time"], result["n_collisions"], result["cpu_time"],
                   "" if result["reached"] else ", target precision not reached")
-        results.append(result)
-        progress.cell_done(result)
-    attrs = dict(_study_attrs(study, block, noise_attrs), motion_window=float(block["motion_window"]),
-                 n_batches=int(block["n_batches"]),
-                 **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods", "min_switches")},
-                 transient=float(block["transient"]))
-    io.write_dataset(datasets.map_tile(study.tile(tile, "events"), results, study.motions, attrs),
-                     out)
+        return result
+
+    def to_dataset(tile_cells, results):
+        attrs = dict(_study_attrs(study, block, noise_attrs),
+                     motion_window=float(block["motion_window"]),
+                     n_batches=int(block["n_batches"]),
+                     **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods",
+                                             "min_switches")},
+                     transient=float(block["transient"]))
+        return datasets.map_tile(tile_cells, results, study.motions, attrs)
+
+    _tile_job(study, tile, "events", "map", run_cell, to_dataset, out)
 
 
 def spectra_tile(name, block, tile, noise_path, out):
@@ -193,19 +211,19 @@ def spectra_tile(name, block, tile, noise_path, out):
     study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spectra = block["spectra"]
-    results = []
-    progress = Progress(f"studies.{name} spectra tile {tile}", len(study.tile(tile, "spectra")))
-    for cell in study.tile(tile, "spectra"):
-        log.debug("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
-        results.append(cells.spectra_statistics(
+
+    def run_cell(cell):
+        return cells.spectra_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
-            t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"])))
-        progress.cell_done(results[-1])
-    ds = datasets.spectra_tile(study.tile(tile, "spectra"), results,
-                               dict(_study_attrs(study, block, noise_attrs),
-                                    **_record_attrs(block, spectra.get("t_end"), len(samples), dt),
-                                    nperseg=int(spectra["nperseg"])))
-    io.write_dataset(ds, out)
+            t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"]))
+
+    def to_dataset(tile_cells, results):
+        attrs = dict(_study_attrs(study, block, noise_attrs),
+                     **_record_attrs(block, spectra.get("t_end"), len(samples), dt),
+                     nperseg=int(spectra["nperseg"]))
+        return datasets.spectra_tile(tile_cells, results, attrs)
+
+    _tile_job(study, tile, "spectra", "spectra", run_cell, to_dataset, out)
 
 
 def trace(name, block, noise_path, out):
@@ -224,7 +242,7 @@ def trace(name, block, noise_path, out):
 
 
 def aggregate(name, block, kind, tiles, out, noise_path=None):
-    """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: one dataset per study."""
+    """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: a study's dataset."""
     study = Study.from_config(name, block)
     parts = [io.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)
@@ -246,18 +264,18 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
 
 
 def figure(target, inputs, out_png, options):
-    """Rule ``draw_figure``: ``plotting.<fig>(*datasets, **options)`` saved to ``out_png``.
+    """Rule ``draw_figure``: the figure's function (its ``draw`` in the figure table) of
+    ``*datasets, **options``, saved to ``out_png``.
 
     ``target`` is ``fig07`` or ``fig13-1`` (`vibroimpact.pipeline.figures`); ``options``
     come from the owner's config entry through the figure table (`figure_options`).
     """
     from vibroimpact import plotting
 
-    name, _ = figure_variant(target)
+    draw = drawing_function(figure_variant(target)[0])
     log.info("drawing %s from %s with %s", target, inputs, options)
     with plotting.style():
-        fig = getattr(plotting, name)(*[io.load_dataset(p) for p in inputs], **options)
-        plotting.save(fig, out_png)
+        plotting.save(draw(*[io.load_dataset(p) for p in inputs], **options), out_png)
 
 
 def orbit_tile(entry, tile, out, threads=None):

@@ -15,7 +15,6 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 from matplotlib.path import Path
-from scipy.spatial import cKDTree
 
 from vibroimpact import stats
 from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _styled,
@@ -144,6 +143,8 @@ def label_contours(ax, cs, fmt, avoid=()):
     first, a level's second label only after every level had its chance at a first one.
     Returns the label texts (none when `cs` is None).
     """
+    from scipy.spatial import cKDTree   # scipy in the map figures' jobs only
+
     if cs is None:
         return []
     to_axes = ax.transData + ax.transAxes.inverted()

@@ -8,7 +8,6 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
-from scipy import ndimage
 
 from vibroimpact.plotting._common import _attr, _header, _styled, _system_text, axis_label
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
@@ -92,6 +91,8 @@ def _name_regions(ax, x, y, reason, stable):
     stable domain, no other word) within `LEADER_LENGTH`, with a line to the region's
     deepest point that crosses no stable domain. The texts have gid ``reason-<code>``.
     """
+    from scipy import ndimage   # scipy in fig16's job only, not in every job importing plotting
+
     taken = stable.copy()
     scale = np.array([1.0 / x.size, 1.0 / y.size])        # a cell, as a share of the panel
     for code in (3, 2, 1):       # the thin unstable regions first: they need space near them
@@ -145,6 +146,8 @@ def _leader_spot(free, target, stable, scale):
 
 def _fits(allowed, bw, bh):
     """Cells on which a box of bw x bh cells, centred, covers only `allowed` cells."""
+    from scipy import ndimage
+
     return ndimage.minimum_filter(allowed.astype(np.uint8), size=(bw, bh), mode="constant",
                                   cval=0) > 0
 
@@ -177,6 +180,8 @@ def fig16(orbits):
     (11) and (13), and U the domain where eq. (22) (stability) fails, without saying which
     letter is which region on its figure: the legend maps causes to letters, not regions.
     """
+    from scipy import ndimage
+
     types = [str(t) for t in orbits["type"].values]
     ncols = 3
     nrows = -(-(len(types) + 1) // ncols)

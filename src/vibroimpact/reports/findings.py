@@ -14,7 +14,6 @@ bin of the density or the frequency grid.
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from vibroimpact.stats.theory import upcrossing_rate
 
@@ -380,6 +379,8 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     larger is narrow; "partly": the spread falls with P(1/1) but such a play is wide; "no":
     it does not fall with P(1/1).
     """
+    from scipy import stats   # scipy.stats for this finding alone
+
     if (why := _without_collision(_row(events, inv_beta))) is not None:
         return not_available(7, why)
     ev = _impacting(_row(events, inv_beta))

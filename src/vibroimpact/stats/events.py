@@ -4,7 +4,6 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from scipy import stats as _sps
 
 from vibroimpact import _checks
 
@@ -155,9 +154,13 @@ def t_quantile(n_batches, level: float = 0.95):
     float or ndarray
         The factor (2.093 for B = 20 at 95 %); NaN where B < 2.
     """
+    # stdtrit is what scipy.stats.t.ppf computes (t._ppf), without the 1 s import of
+    # scipy.stats in every figure job that draws a confidence band
+    from scipy.special import stdtrit
+
     _checks.real("level", level, low=0.0, high=1.0, low_open=True, high_open=True)
     b = np.asarray(n_batches, dtype=float)
-    q = np.where(b >= 2, _sps.t.ppf(0.5 + 0.5 * level, np.maximum(b - 1.0, 1.0)), np.nan)
+    q = np.where(b >= 2, stdtrit(np.maximum(b - 1.0, 1.0), 0.5 + 0.5 * level), np.nan)
     return float(q) if q.ndim == 0 else q
 
 

@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
-from scipy import integrate, signal
 
 from vibroimpact import _checks
 
@@ -74,6 +73,8 @@ class WelchAccumulator:
     """
 
     def __init__(self, dt: float, nperseg: int, detrend: str | bool = PSD_DETREND):
+        from scipy import signal   # here, not at import: a figure job never estimates a PSD
+
         dt = _checks.real("dt", dt, low=0.0, low_open=True)
         nperseg = _checks.integer("nperseg", nperseg, low=2)
         if detrend not in _DETRENDS:
@@ -156,6 +157,8 @@ class WelchAccumulator:
 
     def _periodogram_sum(self, segments: np.ndarray) -> np.ndarray:
         if self.detrend in ("constant", "linear"):
+            from scipy import signal
+
             segments = signal.detrend(segments, type=self.detrend, axis=-1)
         spectrum = np.fft.rfft(segments * self.window, axis=-1)
         if self.detrend == "mean":
@@ -256,6 +259,8 @@ def variance_from_psd(beta, S) -> float:
     (trapezoid rule). On the Welch grid with even nperseg this is exactly scipy's
     ``sum(P) df`` (the end bins carry half weight on both sides).
     """
+    from scipy import integrate
+
     return float(integrate.trapezoid(np.asarray(S, float), np.asarray(beta, float)) / np.pi)
 
 

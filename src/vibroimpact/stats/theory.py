@@ -4,7 +4,6 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-from scipy import integrate, special
 
 from vibroimpact import _checks
 
@@ -42,6 +41,8 @@ def linear_response_std(S_f: float | Callable[[float], float], zeta: float) -> t
             raise ValueError(f"S_f must be a non-negative number or a callable, got {S_f!r}")
         s = np.sqrt(S0 / (4.0 * zeta))
         return float(s), float(s)
+
+    from scipy import integrate   # only the white-noise-free case integrates
 
     def response(b, power):
         return b**power * float(S_f(b)) / ((1.0 - b * b) ** 2 + (2.0 * zeta * b) ** 2)
@@ -117,9 +118,17 @@ def _rice_rate(delta, sigma_x, sigma_v, elastic):
     """Rice's up-crossing rate of delta, divided by Phi(delta / sigma_x) when ``elastic``
     (in the exponent, so that it stays finite for large negative delta)."""
     d = np.asarray(delta, dtype=float) / sigma_x
-    exponent = -0.5 * d * d - (special.log_ndtr(d) if elastic else 0.0)
+    exponent = -0.5 * d * d - (_log_ndtr(d) if elastic else 0.0)
     rate = (sigma_v / sigma_x) / (2.0 * np.pi) * np.exp(exponent)
     return rate if rate.ndim else float(rate)
+
+
+def _log_ndtr(x):
+    """``log Phi(x)``: scipy.special, imported here so that `upcrossing_rate` (figures,
+    reports) does not load it."""
+    from scipy.special import log_ndtr
+
+    return log_ndtr(x)
 
 
 def rayleigh_pdf(u, sigma_v: float):
@@ -143,7 +152,7 @@ def truncated_gaussian_pdf(x, sigma_x: float, delta: float):
     """
     x = np.asarray(x, dtype=float)
     z = x / sigma_x
-    log_p = -0.5 * z * z - 0.5 * np.log(2.0 * np.pi) - np.log(sigma_x) - special.log_ndtr(
+    log_p = -0.5 * z * z - 0.5 * np.log(2.0 * np.pi) - np.log(sigma_x) - _log_ndtr(
         delta / sigma_x)
     p = np.where(x <= delta, np.exp(log_p), 0.0)
     return p if p.ndim else float(p)
