@@ -14,8 +14,6 @@ fragment of the allowed range or of the remedy.
 import copy
 from dataclasses import dataclass
 import math
-from pathlib import Path
-import shutil
 import subprocess
 import sys
 import textwrap
@@ -25,8 +23,8 @@ import yaml
 
 from vibroimpact.pipeline import configuration
 
-ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+from helpers import ROOT, SNAKEMAKE, make_workdir
+
 TEST_CONFIG = yaml.safe_load((ROOT / "config" / "test.yaml").read_text())
 
 DELETE = object()       # a value that removes the key instead
@@ -414,7 +412,7 @@ def test_load_refuses(case, tmp_path):
 
 def test_huge_record_is_refused_without_writing(tmp_path):
     """n_samples = 1e10 is costed, not generated: refused at once, nothing written."""
-    shutil.copytree(ROOT / "config", tmp_path / "config")
+    make_workdir(tmp_path)
     case = next(c for c in CASES if c.id == "n_samples_huge")
     before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
     with pytest.raises(configuration.ConfigError, match="limits.max_disk_gb"):
@@ -461,11 +459,7 @@ def test_a_file_not_in_utf8_is_named_with_its_line(tmp_path):
 
 @pytest.fixture(scope="module")
 def copy_dir(tmp_path_factory):
-    work = tmp_path_factory.mktemp("badconfig")
-    for item in ("Snakefile", "config", "workflow", "profiles"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
-    return work
+    return make_workdir(tmp_path_factory.mktemp("badconfig"))
 
 
 def _no_job_ran(work):

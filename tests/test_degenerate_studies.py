@@ -16,6 +16,7 @@ import xarray as xr
 import yaml
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
+from helpers import make_workdir, snakemake
 from vibroimpact import plotting
 from vibroimpact.orbits import orbit_map
 from vibroimpact.pipeline import datasets, tasks
@@ -211,8 +212,6 @@ STUDIES = {
 
 @pytest.mark.workflow
 def test_degenerate_studies_build_every_figure_and_report(tmp_path):
-    from conftest import make_workdir, snakemake
-
     workdir = make_workdir(tmp_path / "wf")
     config = dict(paper=False, noises=dict(
         zero=dict(kind="band_limited", rms=0.0, dt=0.1, beta_c=4.0, n_samples=3001, seed=1),

@@ -354,7 +354,7 @@ WORKFLOW = textwrap.dedent("""\
 
 @pytest.mark.workflow
 def test_a_plain_study_and_a_sweep_end_to_end(tmp_path):
-    from conftest import make_workdir, snakemake
+    from helpers import make_workdir, snakemake
 
     workdir = make_workdir(tmp_path / "w")
     (workdir / "mine.yaml").write_text(WORKFLOW)

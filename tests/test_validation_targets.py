@@ -16,7 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
-from conftest import make_workdir, scheduled_rules
+from helpers import make_workdir, scheduled_rules
 from vibroimpact import plotting
 from vibroimpact.validation import peers
 from vibroimpact.validation.campaign import COUNTS, campaign_dataset
