@@ -110,3 +110,17 @@ def assert_same_data(a, b):
     for name in files:
         xr.testing.assert_identical(data(a / name), data(b / name))
 
+
+def assert_figure(path):
+    """``path`` is a whole figure file with something drawn on it: a PNG that decodes to an
+    image of more than one colour, or a PDF with its header and end-of-file marker."""
+    path = Path(path)
+    if path.suffix == ".pdf":
+        content = path.read_bytes()
+        assert content.startswith(b"%PDF-") and b"%%EOF" in content[-64:], path
+        return
+    from matplotlib import image
+
+    pixels = image.imread(path)
+    assert pixels.ndim == 3 and min(pixels.shape[:2]) >= 100, (path, pixels.shape)
+    assert (pixels != pixels[0, 0]).any(), f"{path}: a blank image"
