@@ -9,10 +9,12 @@ its path itself.
   repository.
 - :func:`copy_tree`: every tracked and new file, the package's sources included, for runs
   that import the package from the copy (``PYTHONPATH=<copy>/src``).
-- :func:`snakemake`, :func:`scheduled_rules`: the real ``snakemake`` command in a copy.
+- :func:`snakemake`, :func:`scheduled_rules`, :func:`scheduled_jobs`: the real ``snakemake``
+  command in a copy.
 - :func:`data_files`, :func:`data`, :func:`assert_same_data`: the datasets of two builds.
 """
 from pathlib import Path
+import re
 import shutil
 import subprocess
 import sys
@@ -86,6 +88,21 @@ def scheduled_rules(workdir, target, config="config/test.yaml"):
     """Rules a dry run would execute for ``target`` (from the job stats table)."""
     return set(job_table(snakemake(workdir, target, "-n", "--quiet", "rules",
                                    config=config).stdout))
+
+
+def scheduled_jobs(workdir, *targets, config="config/test.yaml"):
+    """The jobs one dry run for ``targets`` would execute: ``[{"rule", "input",
+    "output"}]``, inputs and outputs as sets of paths."""
+    jobs = []
+    for line in snakemake(workdir, *targets, "-n", config=config).stdout.splitlines():
+        line = line.strip()
+        match = re.fullmatch(r"(?:local)?rule (\w+):", line)
+        if match:
+            jobs.append({"rule": match[1], "input": set(), "output": set()})
+        elif jobs and line.startswith(("input:", "output:")):
+            key, paths = line.split(":", 1)
+            jobs[-1][key].update(p.strip() for p in paths.split(","))
+    return jobs
 
 
 def data_files(root):

@@ -16,7 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
-from helpers import assert_figure, make_workdir, scheduled_rules
+from helpers import assert_figure, make_workdir, scheduled_jobs
 from vibroimpact import plotting
 from vibroimpact.validation import peers
 from vibroimpact.validation.campaign import COUNTS, campaign_dataset
@@ -317,8 +317,12 @@ def workdir(tmp_path_factory):
     ("stress", {"sample_stress_families", "draw_validation_figure"}),
 ])
 def test_a_validation_figure_schedules_only_its_rules(workdir, figure, rules):
-    assert scheduled_rules(workdir, f"results/figures/{figure}.png") == rules
-    assert scheduled_rules(workdir, f"results/figures/{figure}.pdf") == rules
+    """The PNG and the PDF in one dry run: the jobs of both are these rules."""
+    jobs = scheduled_jobs(workdir, f"results/figures/{figure}.png",
+                          f"results/figures/{figure}.pdf")
+    assert {j["rule"] for j in jobs} == rules
+    drawn = next(j for j in jobs if j["rule"] == "draw_validation_figure")["output"]
+    assert {f"results/figures/{figure}.png", f"results/figures/{figure}.pdf"} <= drawn
 
 
 @pytest.mark.workflow
