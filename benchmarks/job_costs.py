@@ -9,7 +9,6 @@ its own copy and imported from there (PYTHONPATH), so both run on the same machi
 """
 import argparse
 import os
-import shutil
 from pathlib import Path
 import statistics
 import subprocess
@@ -18,7 +17,9 @@ import tempfile
 import time
 
 ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+# the tests' copy of the working tree (one function for both); a script, so not on the path
+sys.path.insert(0, str(ROOT / "tests"))
+from helpers import SNAKEMAKE, copy_tree  # noqa: E402
 
 # kind -> target (fig16's path depends on the revision)
 JOBS = {
@@ -32,16 +33,6 @@ JOBS = {
 def _checkout(rev, where):
     subprocess.run(["git", "worktree", "add", "-f", "--detach", str(where), rev], cwd=ROOT,
                    check=True, capture_output=True)
-
-
-def _copy_tree(where):
-    """The working tree (tracked and new files), so results never land in the repository."""
-    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT,
-                           capture_output=True, text=True, check=True).stdout.split()
-    for name in files:
-        if (ROOT / name).is_file():
-            (where / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(ROOT / name, where / name)
 
 
 def _run(workdir, *args):
@@ -68,7 +59,7 @@ def main():
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         sides = {"this tree": Path(tmp) / "now", f"peer {args.peer}": Path(tmp) / "peer"}
-        _copy_tree(sides["this tree"])
+        copy_tree(sides["this tree"])     # results never land in the repository
         _checkout(args.peer, sides[f"peer {args.peer}"])
         try:
             for workdir in sides.values():

@@ -7,15 +7,16 @@ fragment of the allowed range or of the remedy.
 
 - The fast suite calls :func:`configuration.load` on each case: it must raise
   :class:`ConfigError` with that key path and fragment, one or two lines per problem.
-- The ``workflow`` suite runs the real ``snakemake --cores 1 --configfile bad.yaml`` (no dry
-  run) on each case in one copy of the project: it must fail at parse time with the same
-  message, and no job may have run (nothing under ``results``, no incomplete markers).
+- The ``workflow`` suite gives each case to Snakemake in one copy of the project: its own
+  config loader and the Snakefile, in this process through Snakemake's API (what ``snakemake
+  --configfile bad.yaml`` runs before any job): it must refuse the file at parse time with the
+  same message. One case per kind of check (``COMMAND_CASES``) also runs as the real command
+  ``snakemake --cores 1 --configfile bad.yaml`` (no dry run): the message reaches the user's
+  terminal, and no job may have run (nothing under ``results``, no incomplete markers).
 """
 import copy
 from dataclasses import dataclass
 import math
-from pathlib import Path
-import shutil
 import subprocess
 import sys
 import textwrap
@@ -25,8 +26,8 @@ import yaml
 
 from vibroimpact.pipeline import config as configuration
 
-ROOT = Path(__file__).resolve().parents[1]
-SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
+from helpers import ROOT, SNAKEMAKE, make_workdir
+
 TEST_CONFIG = yaml.safe_load((ROOT / "config" / "test.yaml").read_text())
 
 DELETE = object()       # a value that removes the key instead
@@ -414,7 +415,7 @@ def test_load_refuses(case, tmp_path):
 
 def test_huge_record_is_refused_without_writing(tmp_path):
     """n_samples = 1e10 is costed, not generated: refused at once, nothing written."""
-    shutil.copytree(ROOT / "config", tmp_path / "config")
+    make_workdir(tmp_path)
     case = next(c for c in CASES if c.id == "n_samples_huge")
     before = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*"))
     with pytest.raises(configuration.ConfigError, match="limits.max_disk_gb"):
@@ -461,11 +462,7 @@ def test_a_file_not_in_utf8_is_named_with_its_line(tmp_path):
 
 @pytest.fixture(scope="module")
 def copy_dir(tmp_path_factory):
-    work = tmp_path_factory.mktemp("badconfig")
-    for item in ("Snakefile", "config", "workflow", "profiles"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
-    return work
+    return make_workdir(tmp_path_factory.mktemp("badconfig"))
 
 
 def _no_job_ran(work):
@@ -477,9 +474,54 @@ def _no_job_ran(work):
     assert not markers, f"incomplete markers: {markers[:5]}"
 
 
+#: One case per kind of check, by the code that refuses it and writes its message, through the
+#: real `snakemake` command (each ~3-5 s of start-up; every case goes through Snakemake's API
+#: in this process): the schema (a non-finite number, an unknown key, a number YAML reads as
+#: text), a cross-field check, a figure's block, a sweep's combination, the plan's limits,
+#: the strict reading of the file (a key given twice, nested aliases), the layering on the
+#: paper's config, and the cases Snakemake's own loader refuses first (the entry point).
+COMMAND_CASES = ("zeta_nan", "unknown_study_key", "n_samples_exponent_string",
+                 "transient_beyond_record", "fig03_without_trace",
+                 "sweep_rms_beyond_float_range", "tiny_max_cells", "key_given_twice",
+                 "nested_aliases", "collision_without_replace", "empty_file", "only_comments")
+assert {c.id for c in CASES} >= set(COMMAND_CASES)
+assert {c.id for c in CASES if not c.snakemake} <= set(COMMAND_CASES)
+
+
+def _snakemake_parse(work, configfile):
+    """What ``snakemake --cores 1 --configfile CONFIGFILE`` does before its first job, in this
+    process: Snakemake loads the file and reads the Snakefile (which checks the config)."""
+    from snakemake.api import SnakemakeApi
+    from snakemake.settings.enums import Quietness
+    from snakemake.settings.types import ConfigSettings, OutputSettings, ResourceSettings
+
+    with SnakemakeApi(OutputSettings(quiet={Quietness.ALL})) as api:
+        api.workflow(resource_settings=ResourceSettings(cores=1),
+                     config_settings=ConfigSettings(configfiles=[configfile]),
+                     snakefile=work / "Snakefile", workdir=work).dag()
+
+
 @pytest.mark.workflow
 @pytest.mark.parametrize("case", CASES, ids=_ids(CASES))
 def test_snakemake_refuses(copy_dir, case):
+    """Snakemake's loader and the Snakefile refuse the file with the message; where
+    Snakemake's own loader refuses it first (an empty file), in words of its own."""
+    (copy_dir / "bad.yaml").write_text(case.yaml_text())
+    with pytest.raises(Exception) as info:
+        _snakemake_parse(copy_dir, copy_dir / "bad.yaml")
+    text = str(info.value)
+    if case.snakemake:
+        assert case.key in text, f"key path {case.key!r} not named:\n{text[-3000:]}"
+        assert case.fragment in text, f"allowed range {case.fragment!r} not given:\n{text}"
+    else:
+        assert "Config file must be given as JSON or YAML" in text, text
+    _no_job_ran(copy_dir)
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("case", [c for c in CASES if c.id in COMMAND_CASES],
+                         ids=_ids(c for c in CASES if c.id in COMMAND_CASES))
+def test_the_command_refuses(copy_dir, case):
     """Plain `snakemake`, or the entry point `make` calls where Snakemake's own loader
     refuses the file first (an empty file: its message cannot name it)."""
     (copy_dir / "bad.yaml").write_text(case.yaml_text())

@@ -16,6 +16,7 @@ import xarray as xr
 import yaml
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
+from helpers import assert_figure, make_workdir, snakemake
 from vibroimpact import plotting
 from vibroimpact.orbits import orbit_map
 from vibroimpact.pipeline import datasets, tasks
@@ -211,8 +212,6 @@ STUDIES = {
 
 @pytest.mark.workflow
 def test_degenerate_studies_build_every_figure_and_report(tmp_path):
-    from conftest import make_workdir, snakemake
-
     workdir = make_workdir(tmp_path / "wf")
     config = dict(paper=False, noises=dict(
         zero=dict(kind="band_limited", rms=0.0, dt=0.1, beta_c=4.0, n_samples=3001, seed=1),
@@ -223,7 +222,7 @@ def test_degenerate_studies_build_every_figure_and_report(tmp_path):
     results = Path(workdir) / "results"
     for name, study in STUDIES.items():
         for fig in study["figures"]:
-            assert (results / "figures" / name / f"{fig}.png").stat().st_size > 0, (name, fig)
+            assert_figure(results / "figures" / name / f"{fig}.png")
         html = (results / "reports" / name / "random_force.html").read_text()
         assert "n/a" in html and "Traceback" not in html, name
     silent = (results / "reports" / "silent" / "random_force.html").read_text()

@@ -7,7 +7,6 @@ anything.
 """
 import os
 from pathlib import Path
-import shutil
 import stat
 import subprocess
 import sys
@@ -15,7 +14,7 @@ import sys
 import pytest
 import xarray as xr
 
-from conftest import _data, assert_same_data, make_workdir
+from helpers import assert_same_data, data, make_workdir
 from vibroimpact.pipeline import cli
 
 RUN = [sys.executable, "-m", "vibroimpact", "run", "--cores", "2", "--configfile",
@@ -34,15 +33,12 @@ def test_a_deleted_dataset_and_tile_are_rebuilt_by_the_run_command(built, tmp_pa
     """The events dataset of study `random` and one of its simulation tiles deleted from a
     finished build: a dry run plans them, the README's command rebuilds them (and what uses
     them), with the same data, and then nothing is left to do."""
-    copy = make_workdir(tmp_path)
-    shutil.copytree(built / "results", copy / "results")
-    shutil.copytree(built / ".snakemake", copy / ".snakemake",
-                    ignore=shutil.ignore_patterns("locks", "log"))
+    copy = make_workdir(tmp_path, build=built)
     found = sorted(str(p.relative_to(copy)) for p in (copy / "results").rglob("*.nc"))
     events = [name for name in found if "random" in name and "events" in name]
     tiled = [name for name in events if {"cells", "tiles"} & set(Path(name).parts)]
     names = [next(name for name in events if name not in tiled), tiled[0]]
-    originals = {name: _data(copy / name) for name in names}
+    originals = {name: data(copy / name) for name in names}
     for name in names:
         (copy / name).unlink()
 
@@ -53,8 +49,8 @@ def test_a_deleted_dataset_and_tile_are_rebuilt_by_the_run_command(built, tmp_pa
     rebuilt = _run(copy)
     line = next(l for l in rebuilt.stderr.splitlines() if "--forcerun" in l)
     assert all(name in line for name in names), line
-    for name, data in originals.items():
-        xr.testing.assert_identical(_data(copy / name), data)
+    for name, kept in originals.items():
+        xr.testing.assert_identical(data(copy / name), kept)
     assert_same_data(built, copy)
     assert "Nothing to be done" in _run(copy, "-n").stdout
 

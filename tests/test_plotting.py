@@ -14,6 +14,7 @@ import pytest
 import xarray as xr
 from matplotlib.figure import Figure
 
+from helpers import assert_figure
 from vibroimpact import plotting, stats
 from vibroimpact.orbits import orbit_map, periodic_orbits
 from vibroimpact.pipeline import datasets, tasks
@@ -431,7 +432,8 @@ def test_save_writes_png_and_pdf_atomically(data, tmp_path):
     fig = plotting.fig04(data["noise"])
     png, pdf = plotting.save(fig, tmp_path / "figs" / "fig04.png")
     assert sorted(os.listdir(tmp_path / "figs")) == ["fig04.pdf", "fig04.png"]
-    assert png.stat().st_size > 0 and pdf.stat().st_size > 0
+    assert_figure(png)
+    assert_figure(pdf)
     with pytest.raises(ValueError, match="path_png"):
         plotting.save(fig, tmp_path / "fig04.svg")
 

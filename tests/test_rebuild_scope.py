@@ -7,12 +7,13 @@ that copy (PYTHONPATH), so an edit of its sources is an edit of the code the wor
 import os
 from pathlib import Path
 import re
-import shutil
 import subprocess
 import sys
 
 import pytest
 import yaml
+
+from helpers import copy_tree
 
 pytestmark = pytest.mark.workflow
 
@@ -62,13 +63,7 @@ def scheduled(repo):
 @pytest.fixture(scope="module")
 def repo(tmp_path_factory):
     """A git repository holding the working tree, with the test config built."""
-    repo = tmp_path_factory.mktemp("rebuild")
-    files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=ROOT,
-                           capture_output=True, text=True, check=True).stdout.split()
-    for name in files:
-        if (ROOT / name).is_file():
-            (repo / name).parent.mkdir(parents=True, exist_ok=True)
-            shutil.copy2(ROOT / name, repo / name)
+    repo = copy_tree(tmp_path_factory.mktemp("rebuild"))
     _git(repo, "init", "-q")
     _git(repo, "add", "-A")
     _git(repo, "commit", "-qm", "base")

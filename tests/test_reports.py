@@ -7,14 +7,13 @@ self-contained HTML of every figure, captioned, by study.
 """
 from pathlib import Path
 import re
-import shutil
 
 import nbformat
 import numpy as np
 import pytest
 import xarray as xr
 
-from conftest import make_workdir, snakemake
+from helpers import make_workdir, snakemake
 from vibroimpact.reports import findings
 
 pytestmark = pytest.mark.workflow
@@ -61,10 +60,7 @@ def test_the_tables_are_the_findings_of_the_datasets(built):
 def test_a_changed_dataset_changes_the_table(built, tmp_path):
     """Finding 2 on the test config holds; with the mean velocities reversed the rebuilt
     report says it does not (only the report and the figures of that dataset rerun)."""
-    copy = make_workdir(tmp_path / "copy")
-    shutil.copytree(built / "results", copy / "results")
-    shutil.copytree(built / ".snakemake", copy / ".snakemake", symlinks=True,
-                    ignore=shutil.ignore_patterns("locks", "incomplete", "log"))
+    copy = make_workdir(tmp_path / "copy", build=built)
     report = copy / "results" / "reports" / "random" / "random_force.html"
     assert _verdicts(report)[2] == "yes"
     path = copy / "results" / "datasets" / "random_events.nc"

@@ -23,7 +23,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from conftest import ROOT, make_workdir
+from helpers import ROOT, make_workdir
 from vibroimpact.pipeline import cli, config as configuration, figures
 from vibroimpact.reports import notebook
 

@@ -13,7 +13,7 @@ import subprocess
 
 import pytest
 
-from conftest import ROOT, SNAKEMAKE, _data_files, assert_same_data, make_workdir
+from helpers import ROOT, SNAKEMAKE, assert_same_data, data_files, make_workdir
 
 pytestmark = pytest.mark.slurm
 
@@ -75,7 +75,7 @@ def slurm_states(run_id):
 
 def test_the_datasets_through_slurm_equal_the_local_build(cluster, built, tmp_path):
     workdir = make_workdir(tmp_path / "slurm")
-    targets = [str(p) for p in _data_files(built)]
+    targets = [str(p) for p in data_files(built)]
     cmd = [SNAKEMAKE, *targets, "--workflow-profile", "workflow/profiles/slurm",
            "--configfile", "config/test.yaml"]
     code, out = run_bounded(cmd, cwd=workdir)

@@ -354,7 +354,7 @@ WORKFLOW = textwrap.dedent("""\
 
 @pytest.mark.workflow
 def test_a_plain_study_and_a_sweep_end_to_end(tmp_path):
-    from conftest import make_workdir, snakemake
+    from helpers import assert_figure, make_workdir, snakemake
 
     workdir = make_workdir(tmp_path / "w")
     (workdir / "mine.yaml").write_text(WORKFLOW)
@@ -363,11 +363,11 @@ def test_a_plain_study_and_a_sweep_end_to_end(tmp_path):
     sweep = [f"small_sweep_{k}" for k in range(4)]
     for name, figs in [("stiff", ["fig07", "fig09"])] + [(s, ["fig09"]) for s in sweep]:
         for fig in figs:
-            assert (results / "figures" / name / f"{fig}.png").stat().st_size > 0
-            assert (results / "figures" / name / f"{fig}.pdf").stat().st_size > 0
+            assert_figure(results / "figures" / name / f"{fig}.png")
+            assert_figure(results / "figures" / name / f"{fig}.pdf")
         assert list((results / "reports" / name).glob("*.html")), f"no report of {name}"
-    assert (results / "figures" / "small_sweep" / "sweep.png").stat().st_size > 0
-    assert (results / "figures" / "small_sweep" / "sweep.pdf").stat().st_size > 0
+    assert_figure(results / "figures" / "small_sweep" / "sweep.png")
+    assert_figure(results / "figures" / "small_sweep" / "sweep.pdf")
     assert not (results / "figures" / "random").exists()       # paper: false
     plain = xr.open_dataset(results / "datasets" / "stiff_events.nc")
     assert (plain.attrs["eps"], plain.attrs["zeta"]) == (0.8, 0.02)

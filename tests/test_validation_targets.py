@@ -16,7 +16,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
-from conftest import make_workdir, scheduled_rules
+from helpers import assert_figure, make_workdir, scheduled_jobs
 from vibroimpact import plotting
 from vibroimpact.validation import peers
 from vibroimpact.validation.campaign import COUNTS, campaign_dataset
@@ -73,10 +73,12 @@ def test_work_precision_layout(wp):
 def test_work_precision_values(wp):
     assert np.all(wp["n_compared"] >= 3)
     assert np.all(wp["cost"] > 0) and np.all(np.isfinite(wp["cost"]))
-    # ratios are to the simulator of the same play: 1 on its own row (to rounding)
+    # every run's ratios are to the simulator's run (run 0) of the same play
     sim = wp.isel(run=0)
-    np.testing.assert_allclose(sim["cost_ratio"], 1.0, rtol=0, atol=0)
-    np.testing.assert_allclose(sim["error_ratio"], 1.0, rtol=0, atol=0)
+    assert wp["method"].values[0] == SIMULATOR
+    np.testing.assert_allclose(wp["cost_ratio"], wp["cost"] / sim["cost"], rtol=1e-15, atol=0)
+    np.testing.assert_allclose(wp["error_ratio"], wp["error"] / sim["error"], rtol=1e-15,
+                               atol=0)
     np.testing.assert_allclose(wp["error"], np.maximum(wp["err_time"], wp["err_velocity"]))
     np.testing.assert_allclose(wp["cost"], wp["seconds"] / wp["timed_span"], rtol=1e-12)
     # the compiled methods are timed on the long record, solve_ivp on the first `stretch`
@@ -299,7 +301,8 @@ def test_stress_figure(stress_ds):
 def test_figures_save_png_and_pdf(wp, stress_ds, tmp_path):
     for name, ds in (("work_precision", wp), ("stress", stress_ds)):
         png, pdf = plotting.save(getattr(plotting, name)(ds), tmp_path / f"{name}.png")
-        assert png.stat().st_size > 0 and pdf.stat().st_size > 0
+        assert_figure(png)
+        assert_figure(pdf)
 
 
 # --- the rules -----------------------------------------------------------------------------------
@@ -314,8 +317,12 @@ def workdir(tmp_path_factory):
     ("stress", {"sample_stress_families", "draw_validation_figure"}),
 ])
 def test_a_validation_figure_schedules_only_its_rules(workdir, figure, rules):
-    assert scheduled_rules(workdir, f"results/figures/{figure}.png") == rules
-    assert scheduled_rules(workdir, f"results/figures/{figure}.pdf") == rules
+    """The PNG and the PDF in one dry run: the jobs of both are these rules."""
+    jobs = scheduled_jobs(workdir, f"results/figures/{figure}.png",
+                          f"results/figures/{figure}.pdf")
+    assert {j["rule"] for j in jobs} == rules
+    drawn = next(j for j in jobs if j["rule"] == "draw_validation_figure")["output"]
+    assert {f"results/figures/{figure}.png", f"results/figures/{figure}.pdf"} <= drawn
 
 
 @pytest.mark.workflow
@@ -324,7 +331,7 @@ def test_the_validation_targets_are_built(built):
     results = Path(built) / "results"
     for name in ("work_precision", "stress"):
         for ext in ("png", "pdf"):
-            assert (results / "figures" / f"{name}.{ext}").stat().st_size > 0
+            assert_figure(results / "figures" / f"{name}.{ext}")
     for name in ("work_precision", "stress_sample"):
         ds = xr.load_dataset(results / "validation" / f"{name}.nc")
         assert {"config", "config_digest", "git_commit", "seed"} <= set(ds.attrs)

@@ -13,9 +13,9 @@ from vibroimpact.validation.families import FAMILIES, FULL_CASES as FULL, run_fa
 SEED = 20261122
 
 
-def _check(report):
+def _check(report, n_cases):
     print(report.summary())
-    assert report.cases > 0 and report.compared > 0, report.summary()
+    assert report.cases == n_cases and report.compared > 0, report.summary()
     assert report.exceptions == 0 and report.missed == 0 and report.spurious == 0, report.details()
     assert report.worst_error <= report.tolerance, report.details()
     assert report.ok, report.details()
@@ -27,13 +27,13 @@ def test_every_family_has_a_full_size():
 
 @pytest.mark.parametrize("name", sorted(FAMILIES))
 def test_family_quick_sample(name):
-    _check(run_family(name, 4, SEED))
+    _check(run_family(name, 4, SEED), 4)
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(FAMILIES))
 def test_family_full_size(name):
-    _check(run_family(name, FULL[name], SEED))
+    _check(run_family(name, FULL[name], SEED), FULL[name])
 
 
 def test_same_seed_same_cases():
