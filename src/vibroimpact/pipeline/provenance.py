@@ -8,14 +8,15 @@ from a sweep, its combination (`sweep_attrs`). `source_digest` is what the workf
 params instead: a digest of the package sources an output depends on, so editing them
 (committed or not) reruns exactly the jobs they feed.
 """
+import ast
 import functools
 import hashlib
 import json
 from pathlib import Path
 import subprocess
 
-__all__ = ["config_digest", "config_text", "source_digest", "git_state", "provenance",
-           "sweep_attrs"]
+__all__ = ["code_closure", "code_digest", "config_digest", "config_text", "git_state",
+           "provenance", "source_digest", "sweep_attrs"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -120,3 +121,230 @@ def provenance(config_block, seed=None):
         attrs["seed"] = int(seed)
     attrs.update(sweep_attrs(config_block))
     return attrs
+
+
+# --- code digests: the import closure of what a rule runs, blind to docstrings and comments --
+
+
+def _is_docstring(stmt):
+    return isinstance(stmt, ast.Expr) and isinstance(stmt.value, ast.Constant) \
+        and isinstance(stmt.value.value, str)
+
+
+def _runs_code(node):
+    """Whether evaluating ``node`` (a top-level assignment's value) may call anything."""
+    return any(isinstance(n, (ast.Call, ast.Lambda, ast.comprehension)) for n in ast.walk(node))
+
+
+_BODIES = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+
+
+class _Module:
+    """One module of the package: its code digest and its parts (``units``).
+
+    A unit is a top-level function, class or literal assignment (run only when something
+    reaches its name), or ``None``: every other top-level statement, run on import.
+    ``bindings`` maps each name an import statement binds, anywhere in the module, to
+    ``(module, None)`` or ``(module, attribute)``; ``defined``: every name it assigns.
+    """
+
+    def __init__(self, name, tree, is_package):
+        self.name, self.is_package = name, is_package
+        self.bindings, self.defined = {}, set()
+        for node in ast.walk(tree):     # one pass: docstrings out, bound names in
+            if isinstance(node, _BODIES) and node.body and _is_docstring(node.body[0]):
+                node.body = node.body[1:] or [ast.Pass()]
+            elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
+                self.defined.add(node.id)
+            for target in _imported(node, self.package):
+                self.bindings.setdefault(target[0], []).append(target[1:])
+        self.digest = hashlib.sha256(ast.dump(tree).encode()).hexdigest()
+        self.units = {None: []}
+        for stmt in tree.body:
+            key = None
+            if isinstance(stmt, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                key = stmt.name
+            elif isinstance(stmt, (ast.Assign, ast.AnnAssign)) and not _runs_code(stmt.value):
+                targets = stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target]
+                if len(targets) == 1 and isinstance(targets[0], ast.Name):
+                    key = targets[0].id
+            self.units.setdefault(key, []).append(stmt)
+
+    @property
+    def package(self):
+        return self.name if self.is_package else self.name.rpartition(".")[0]
+
+
+def _imported(node, package):
+    """``(bound name, module, attribute or None)`` of each name an import statement binds."""
+    if isinstance(node, ast.Import):
+        for alias in node.names:
+            if alias.asname:
+                yield alias.asname, alias.name, None
+            else:       # `import a.b` binds a
+                yield alias.name.split(".")[0], alias.name.split(".")[0], None
+    elif isinstance(node, ast.ImportFrom):
+        base = node.module or ""
+        if node.level:
+            parts = package.split(".")[:len(package.split(".")) - node.level + 1]
+            base = ".".join(parts + ([base] if base else []))
+        for alias in node.names:
+            yield alias.asname or alias.name, base, alias.name
+
+
+class _Graph:
+    """The modules of package ``vibroimpact`` and what each part of each one reaches."""
+
+    def __init__(self, package_dir):
+        self._reaches = {}
+        self.modules = {}
+        for path in sorted(package_dir.rglob("*.py")):
+            parts = path.relative_to(package_dir.parent).with_suffix("").parts
+            is_package = parts[-1] == "__init__"
+            name = ".".join(parts[:-1] if is_package else parts)
+            self.modules[name] = _Module(name, ast.parse(path.read_text(), str(path)),
+                                         is_package)
+
+    def closure(self, tree):
+        """The modules of the package that code ``tree`` (a script) reaches, sorted."""
+        entry = _Module("__main__", tree, False)
+        seen, todo = set(), [(entry, None)]
+        while todo:
+            module, unit = todo.pop()
+            if (module.name, unit) in seen or unit not in module.units:
+                continue
+            seen.add((module.name, unit))
+            todo += self._unit_reaches(module, unit)
+        return sorted({name for name, _ in seen} - {"__main__"})
+
+    def _unit_reaches(self, module, unit):
+        """What part ``unit`` of ``module`` reaches (once per part of the package)."""
+        key = (module.name, unit)
+        if key not in self._reaches or module.name == "__main__":
+            self._reaches[key] = [part for stmt in module.units[unit]
+                                  for part in self._reached(module, stmt)]
+        return self._reaches[key]
+
+    def _top(self, name):
+        """The top-level parts of module ``name`` and of the packages above it."""
+        parts = name.split(".")
+        return [(self.modules[m], None) for m in (".".join(parts[:k + 1])
+                                                   for k in range(len(parts)))
+                if m in self.modules]
+
+    def _attribute(self, module_name, attr):
+        """What ``module.attr`` reaches: a submodule, a unit, or the module's ``__getattr__``."""
+        module = self.modules.get(module_name)
+        if module is None:
+            return []
+        if f"{module_name}.{attr}" in self.modules:
+            return self._top(f"{module_name}.{attr}")
+        if attr in module.units:
+            return [(module, attr)]
+        if attr in module.defined:
+            return [(module, None)]
+        for target, name in module.bindings.get(attr, []):  # a name the module imports
+            if target in self.modules and target != module_name:
+                return self._top(target) + (self._attribute(target, name) if name else [])
+        return [(module, "__getattr__")]
+
+    def _resolve(self, module, expr):
+        """The package module an expression names (``stats``, ``stats.events``), or None."""
+        if isinstance(expr, ast.Name):
+            targets = [(t, n) for t, n in module.bindings.get(expr.id, []) if t in self.modules]
+            for target, name in targets:
+                full = f"{target}.{name}" if name else target
+                if full in self.modules:
+                    return full
+        elif isinstance(expr, ast.Attribute):
+            base = self._resolve(module, expr.value)
+            if base and f"{base}.{expr.attr}" in self.modules:
+                return f"{base}.{expr.attr}"
+        return None
+
+    def _reached(self, module, stmt):
+        """The parts of the package that statement ``stmt`` of ``module`` reaches."""
+        out = []
+        strings = []
+        for node in ast.walk(stmt):
+            for _, target, name in _imported(node, module.package):
+                if target in self.modules:
+                    out += self._top(target)
+                    if name:
+                        out += self._attribute(target, name)
+            if isinstance(node, ast.Name) and node.id in module.units:
+                out.append((module, node.id))
+            elif isinstance(node, ast.Attribute):
+                base = self._resolve(module, node.value)
+                if base:
+                    out += self._attribute(base, node.attr)
+            elif isinstance(node, ast.Constant) and isinstance(node.value, str):
+                strings.append(node.value)
+            elif isinstance(node, ast.Call) and _dynamic(node):
+                out += self._dynamic_import(module, node, stmt)
+        out += [part for s in strings if s in self.modules for part in self._top(s)]
+        return out
+
+    def _dynamic_import(self, module, call, stmt):
+        """``importlib.import_module(<not a constant>)`` or ``getattr(<module>, <not a
+        constant>)``: the modules named by the strings of the tables ``stmt`` reads (a
+        lazy ``__getattr__``), else every module of the package."""
+        if isinstance(call.func, ast.Name) and call.func.id == "getattr":
+            base = self._resolve(module, call.args[0])
+            if base is None:
+                return []
+            return [(self.modules[base], unit) for unit in self.modules[base].units]
+        tables = {n.id for n in ast.walk(stmt) if isinstance(n, ast.Name)} & set(module.units)
+        names = [c.value for t in tables for s in module.units[t] for c in ast.walk(s)
+                 if isinstance(c, ast.Constant) and isinstance(c.value, str)]
+        found = [m for s in names for m in (s, f"{module.package}.{s}") if m in self.modules]
+        if not found:
+            found = [m for m in self.modules if m.startswith(f"{module.package}.")]
+        return [part for m in found for part in self._top(m)]
+
+
+def _dynamic(call):
+    """Whether ``call`` imports or looks up by a name computed at run time."""
+    func = call.func
+    name = func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", None)
+    if name == "getattr" and len(call.args) >= 2:
+        return not isinstance(call.args[1], ast.Constant)
+    return name == "import_module" and bool(call.args) \
+        and not isinstance(call.args[0], ast.Constant)
+
+
+@functools.cache
+def _graph():
+    return _Graph(PACKAGE_DIR)
+
+
+def _script_tree(path):
+    """The code of a script, or of a notebook's code cells (IPython magics left out)."""
+    path = Path(path)
+    text = path.read_text()
+    if path.suffix == ".ipynb":
+        cells = json.loads(text)["cells"]
+        text = "\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "code")
+        text = "\n".join(line for line in text.splitlines()
+                         if not line.lstrip().startswith(("%", "!")))
+    return ast.parse(text, str(path))
+
+
+def code_closure(script):
+    """The modules of vibroimpact that ``script`` (a ``.py`` file or an ``.ipynb`` notebook)
+    imports, transitively, found statically: every import statement, at the top of a module
+    or inside a function, of the functions and classes the script's code reaches."""
+    return _graph().closure(_script_tree(script))
+
+
+@functools.cache
+def code_digest(script):
+    """Digest of the code ``script`` runs: each module of :func:`code_closure` by name and
+    abstract syntax tree, docstrings removed (comments are not in the tree), so editing a
+    docstring or a comment changes no digest and editing code changes the digests of
+    exactly the scripts that reach it. Computed once per script and process."""
+    modules = _graph().modules
+    digest = hashlib.sha256()
+    for name in code_closure(script):
+        digest.update(f"{name}\0{modules[name].digest}\0".encode())
+    return digest.hexdigest()[:16]
