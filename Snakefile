@@ -23,15 +23,13 @@ except configuration.ConfigError as err:
 config.clear()
 config.update(_config)
 
+# The plan, printed only: the recovery after a crash (stale temporaries removed, damaged
+# results refused) is `python -m vibroimpact run`'s, so a plain `snakemake -n` or `--lint`
+# changes nothing on disk.
 if workflow.is_main_process:    # not again in each job of a cluster run
     from snakemake.logging import logger
 
-    from vibroimpact._files import sweep_stale_temporaries
-    from vibroimpact.pipeline.io import check_readable
-
     logger.info(f"vibroimpact plan: {PLAN.summary(workflow.resource_settings.cores or 1)}")
-    sweep_stale_temporaries("results")      # of writers killed outright (SIGKILL)
-    check_readable("results")               # a damaged result: one line, before any job
 
 
 include: "workflow/rules/common.smk"
@@ -46,6 +44,7 @@ include: "workflow/rules/reports.smk"
 
 
 rule all:
+    """Every figure and report of the config's built entries."""
     input:
         all_targets(),
     default_target: True

@@ -5,7 +5,14 @@ localrules:
     copy_paper_figure,
 
 
+# What each figure shows, with its parameters, for the report's caption (figure.rst reads it
+# from the config, which the report hands to a caption template; not a param: rewording a
+# caption redraws nothing).
+config["figure_captions"] = figure_captions()
+
+
 rule draw_figure:
+    """Figure {fig} of study or orbits entry {owner}, as PNG and PDF."""
     input:
         figure_inputs,
     output:
@@ -26,13 +33,13 @@ rule draw_figure:
         runtime=5,
     params:
         options=figure_options,
-        caption=figure_caption,     # what it shows, with which parameters (report caption)
-        code=CODE["figure"],
+        code=script_code("draw_figure"),
     script:
         "../scripts/draw_figure.py"
 
 
 rule copy_paper_figure:
+    """The paper figure {paper_fig}: a copy of the study figure it names."""
     input:
         unpack(paper_figure_source),
     output:

@@ -33,6 +33,7 @@ REPORT_SHELL = (
 
 
 rule study_report:
+    """The executed report notebook {report} of study {study}, and its HTML."""
     input:
         unpack(study_report_inputs),
     output:
@@ -55,12 +56,13 @@ rule study_report:
     params:
         arguments=report_arguments,
         python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
-        code=CODE["report"],
+        code=report_code,
     shell:
         REPORT_SHELL
 
 
 rule orbits_report:
+    """The executed periodic-motions report of orbits entry {orbits}, and its HTML."""
     input:
         unpack(orbits_report_inputs),
     output:
@@ -82,12 +84,13 @@ rule orbits_report:
     params:
         arguments=report_arguments,
         python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
-        code=CODE["report"],
+        code=report_code,
     shell:
         REPORT_SHELL
 
 
 rule validation_report:
+    """The executed validation report {vreport}, and its HTML."""
     input:
         unpack(validation_report_inputs),
     output:
@@ -109,7 +112,6 @@ rule validation_report:
     params:
         arguments=report_arguments,
         python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
-        quoted=quoted_campaign,     # README's campaign table (stability report)
-        code=CODE["report"],
+        code=report_code,
     shell:
         REPORT_SHELL
