@@ -15,8 +15,8 @@ report: "workflow/report/workflow.rst"
 # into a paper entry of the same name; `configuration.load` adds, refuses collisions, and
 # checks and costs the whole config here, before any job (a problem: one or two lines each).
 try:
-    for _file in workflow.overwrite_configfiles:    # what Snakemake's loader lets through:
-        configuration.read_yaml(_file)              # a key given twice, nested aliases
+    for _file in workflow.overwrite_configfiles:  # what Snakemake's loader lets through:
+        configuration.read_yaml(_file)  # a key given twice, nested aliases
     _config, PLAN = configuration.load(dict(config), root=workflow.basedir)
 except configuration.ConfigError as err:
     raise configuration.ConfigError(err.problems) from None
@@ -26,7 +26,7 @@ config.update(_config)
 # The plan, printed only: the recovery after a crash (stale temporaries removed, damaged
 # results refused) is `python -m vibroimpact run`'s, so a plain `snakemake -n` or `--lint`
 # changes nothing on disk.
-if workflow.is_main_process:    # not again in each job of a cluster run
+if workflow.is_main_process:  # not again in each job of a cluster run
     from snakemake.logging import logger
 
     logger.info(f"vibroimpact plan: {PLAN.summary(workflow.resource_settings.cores or 1)}")

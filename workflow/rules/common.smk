@@ -54,9 +54,11 @@ _READS = {
 
 def study_block(kind):
     """The part of ``studies[{study}]`` that a ``kind`` job reads."""
+
     def block(wildcards):
         entry = config["studies"][wildcards.study]
         return {key: entry[key] for key in _READS[kind] if key in entry}
+
     return block
 
 
@@ -72,6 +74,7 @@ def orbits_entry(wildcards):
 
 # --- inputs of the simulations and aggregations ----------------------------------------------
 
+
 def study_noise(wildcards):
     """The noise record that drives study ``{study}``."""
     return f"results/noise/{config['studies'][wildcards.study]['noise']}.nc"
@@ -79,9 +82,11 @@ def study_noise(wildcards):
 
 def tiles(kind):
     """The ``kind`` tiles of study ``{study}``."""
+
     def files(wildcards):
         n = STUDIES[wildcards.study].n_tiles(kind)
         return [f"results/cells/{wildcards.study}/{kind}/{t}.nc" for t in range(n)]
+
     return files
 
 
@@ -92,6 +97,7 @@ def orbit_tiles(wildcards):
 
 
 # --- figures ----------------------------------------------------------------------------------
+
 
 def _owner(wildcards):
     """``("orbits", name, entry)`` or ``("study", name, entry)`` of a figure's owner."""
@@ -119,8 +125,10 @@ def figure_inputs(wildcards):
     if figures.FIGURES.get(fig, {}).get("owner") != kind:
         raise ValueError(f"{wildcards.owner}: no figure {fig!r} for a {kind} entry")
     names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
-    return [_DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
-            for d in figures.FIGURES[fig]["reads"]]
+    return [
+        _DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
+        for d in figures.FIGURES[fig]["reads"]
+    ]
 
 
 def figure_options(wildcards):
@@ -146,8 +154,10 @@ def figure_captions():
 def paper_figure_source(wildcards):
     """The PNG and PDF of the figure that ``paper_figures[{paper_fig}]`` names."""
     if wildcards.paper_fig not in config.get("paper_figures", {}):
-        raise ValueError(f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
-                         f"{sorted(config.get('paper_figures', {}))}")
+        raise ValueError(
+            f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
+            f"{sorted(config.get('paper_figures', {}))}"
+        )
     name = config["paper_figures"][wildcards.paper_fig]
     section = "orbits" if figures.FIGURES[wildcards.paper_fig]["owner"] == "orbits" else "studies"
     owner = f"orbits/{name}" if section == "orbits" else name
@@ -179,11 +189,13 @@ def figure_report_labels(wildcards):
 
 # --- sweeps (sweeps.smk) ----------------------------------------------------------------------
 
+
 def _sweep(wildcards):
     """The record ``config["sweeps"][{sweep}]``: its studies, keys and values."""
     if wildcards.sweep not in config["sweeps"]:
-        raise ValueError(f"{wildcards.sweep} is not a sweep; sweeps: "
-                         f"{sorted(config['sweeps']) or 'none'}")
+        raise ValueError(
+            f"{wildcards.sweep} is not a sweep; sweeps: " f"{sorted(config['sweeps']) or 'none'}"
+        )
     return config["sweeps"][wildcards.sweep]
 
 
@@ -219,8 +231,9 @@ def _study_datasets(name):
     for fig in {f if isinstance(f, str) else f["name"] for f in entry["figures"]}:
         names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
         for kind in figures.FIGURES[fig]["reads"]:
-            out.setdefault(kind, _DATASETS[kind].format(name=names.get(kind, name),
-                                                        noise=names["noise"]))
+            out.setdefault(
+                kind, _DATASETS[kind].format(name=names.get(kind, name), noise=names["noise"])
+            )
     return out
 
 
@@ -231,14 +244,18 @@ def study_report_inputs(wildcards):
     kind = arguments.study_report_kind(entry)
     if wildcards.report != kind:
         raise ValueError(f"study {wildcards.study}: its report is {kind}, not {wildcards.report}")
-    inputs = {"notebook": f"notebooks/{kind}.ipynb",
-              "noise": _DATASETS["noise"].format(noise=entry["noise"])}
+    inputs = {
+        "notebook": f"notebooks/{kind}.ipynb",
+        "noise": _DATASETS["noise"].format(noise=entry["noise"]),
+    }
     shown = []
     for name in [wildcards.study, *entry.get("report_with", [])]:
         for dataset, path in _study_datasets(name).items():
             inputs.setdefault(dataset, path)
-        shown += [f"results/figures/{name}/{f}.png"
-                  for f in figures.figure_targets(config["studies"][name])]
+        shown += [
+            f"results/figures/{name}/{f}.png"
+            for f in figures.figure_targets(config["studies"][name])
+        ]
     return {**inputs, "figures": shown}
 
 
@@ -256,10 +273,14 @@ def orbits_report_inputs(wildcards):
     """The notebook, the dataset and the figures of orbits entry ``{orbits}``, and the map
     drawn over it (Fig. 15 against Fig. 16), if a built study draws one."""
     entry = config["orbits"][wildcards.orbits]
-    inputs = {"notebook": "notebooks/periodic_motions.ipynb",
-              "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
-              "figures": [f"results/figures/orbits/{wildcards.orbits}/{f}.png"
-                          for f in figures.figure_targets(entry)]}
+    inputs = {
+        "notebook": "notebooks/periodic_motions.ipynb",
+        "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
+        "figures": [
+            f"results/figures/orbits/{wildcards.orbits}/{f}.png"
+            for f in figures.figure_targets(entry)
+        ],
+    }
     inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
     return inputs
 
@@ -268,13 +289,17 @@ def validation_report_inputs(wildcards):
     """The notebook, the dataset and the figure of validation report ``{vreport}``; the
     stability report also quotes the full stress campaign (docs/stress_campaign.csv)."""
     if wildcards.vreport == "performance":
-        return {"notebook": "notebooks/performance.ipynb",
-                "work_precision": "results/validation/work_precision.nc",
-                "figures": ["results/figures/work_precision.png"]}
-    return {"notebook": "notebooks/stability.ipynb",
-            "stress": "results/validation/stress_sample.nc",
-            "campaign": "docs/stress_campaign.csv",
-            "figures": ["results/figures/stress.png"]}
+        return {
+            "notebook": "notebooks/performance.ipynb",
+            "work_precision": "results/validation/work_precision.nc",
+            "figures": ["results/figures/work_precision.png"],
+        }
+    return {
+        "notebook": "notebooks/stability.ipynb",
+        "stress": "results/validation/stress_sample.nc",
+        "campaign": "docs/stress_campaign.csv",
+        "figures": ["results/figures/stress.png"],
+    }
 
 
 def _report_notebook(wildcards):
@@ -295,13 +320,18 @@ def report_arguments(wildcards, input):
     (`vibroimpact.reports.arguments`)."""
     study = wildcards.get("study")
     parameters = arguments.notebook_parameters(
-        _report_notebook(wildcards), dict(input.items()), study=study,
+        _report_notebook(wildcards),
+        dict(input.items()),
+        study=study,
         entry=config["studies"][study] if study else None,
-        inv_beta=STUDIES[study].inv_beta if study else (), orbits=wildcards.get("orbits"))
+        inv_beta=STUDIES[study].inv_beta if study else (),
+        orbits=wildcards.get("orbits"),
+    )
     return arguments.papermill_arguments(parameters)
 
 
 # --- targets of `rule all` ------------------------------------------------------------------
+
 
 def sweep_targets():
     """The side-by-side figure of every sweep whose studies the config builds."""
@@ -316,11 +346,13 @@ def validation_targets():
 def report_targets():
     """The HTML report of every built study and orbits entry, and the validation reports."""
     drawn = PLAN.drawn
-    targets = [f"results/reports/{name}/"
-               f"{arguments.study_report_kind(config['studies'][name])}.html"
-               for name in sorted(drawn["studies"])]
-    targets += [f"results/reports/orbits/{name}/periodic_motions.html"
-                for name in sorted(drawn["orbits"])]
+    targets = [
+        f"results/reports/{name}/" f"{arguments.study_report_kind(config['studies'][name])}.html"
+        for name in sorted(drawn["studies"])
+    ]
+    targets += [
+        f"results/reports/orbits/{name}/periodic_motions.html" for name in sorted(drawn["orbits"])
+    ]
     if config["validation"]["build"]:
         targets += [f"results/reports/validation/{r}.html" for r in ("performance", "stability")]
     return targets
@@ -336,7 +368,9 @@ def all_targets():
         targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
     for name in sorted(drawn["orbits"]):
         entry = config["orbits"][name]
-        targets += [f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)]
+        targets += [
+            f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)
+        ]
     targets += sweep_targets()
     if config["validation"]["build"]:
         targets += validation_targets()
@@ -365,6 +399,7 @@ def simulate_mem_mb(wildcards):
 def simulate_runtime(kind):
     """Minutes: cells of a tile x steps x ~60 ns a step (the measured cost with many impacts
     is ~20 ns a step on one core; x3 for a slower or shared node), plus start-up."""
+
     def runtime(wildcards):
         study = STUDIES[wildcards.study]
         entry = config["studies"][wildcards.study]
@@ -372,10 +407,20 @@ def simulate_runtime(kind):
         steps = _noise_samples(entry["noise"])
         if kind == "spectra" and entry["spectra"].get("t_end"):
             steps = min(steps, entry["spectra"]["t_end"] / noise["dt"])
-        if kind == "map":   # a cell runs at most to its cap, the longest forcing period's
-            steps = min(steps, (entry["transient"] + entry["map"]["max_periods"] * 2 * 3.141592653589793
-                                * float(study.inv_beta.max())) / noise["dt"])
+        if kind == "map":  # a cell runs at most to its cap, the longest forcing period's
+            steps = min(
+                steps,
+                (
+                    entry["transient"]
+                    + entry["map"]["max_periods"]
+                    * 2
+                    * 3.141592653589793
+                    * float(study.inv_beta.max())
+                )
+                / noise["dt"],
+            )
         grid = "events" if kind == "map" else kind
         cells = len(study.tile(int(wildcards.tile), grid)) if kind != "trace" else 0
         return 5 + int(cells * steps * 60e-9 / 60)
+
     return runtime

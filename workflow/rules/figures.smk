@@ -18,8 +18,12 @@ rule draw_figure:
     output:
         # in `snakemake --report`, once: under `paper` when it is a paper figure (its copy
         # results/figures/figNN.png is not marked), else in its study's or orbits entry's
-        png=report("results/figures/{owner}/{fig}.png", caption="../report/figure.rst",
-                   category=figure_report_category, labels=figure_report_labels),
+        png=report(
+            "results/figures/{owner}/{fig}.png",
+            caption="../report/figure.rst",
+            category=figure_report_category,
+            labels=figure_report_labels,
+        ),
         pdf="results/figures/{owner}/{fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"
@@ -43,7 +47,7 @@ rule copy_paper_figure:
     input:
         unpack(paper_figure_source),
     output:
-        png="results/figures/{paper_fig}.png",      # in the report as its source (draw_figure)
+        png="results/figures/{paper_fig}.png",  # in the report as its source (draw_figure)
         pdf="results/figures/{paper_fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"

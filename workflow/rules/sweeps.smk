@@ -13,8 +13,12 @@ rule draw_sweep:
     input:
         sweep_inputs,
     output:
-        png=report("results/figures/{sweep}/sweep.png", caption="../report/sweep.rst",
-                   category="{sweep}", labels={"figure": "sweep"}),
+        png=report(
+            "results/figures/{sweep}/sweep.png",
+            caption="../report/sweep.rst",
+            category="{sweep}",
+            labels={"figure": "sweep"},
+        ),
         pdf="results/figures/{sweep}/sweep.pdf",
     conda:
         "../envs/vibroimpact.yaml"

@@ -54,9 +54,12 @@ rule draw_validation_figure:
     input:
         lookup(dpath="{validation_fig}", within=VALIDATION_FIGURES),
     output:
-        png=report("results/figures/{validation_fig}.png",
-                   caption="../report/validation_figure.rst", category="validation",
-                   labels={"figure": "{validation_fig}"}),
+        png=report(
+            "results/figures/{validation_fig}.png",
+            caption="../report/validation_figure.rst",
+            category="validation",
+            labels={"figure": "{validation_fig}"},
+        ),
         pdf="results/figures/{validation_fig}.pdf",
     wildcard_constraints:
         validation_fig="|".join(VALIDATION_FIGURES),

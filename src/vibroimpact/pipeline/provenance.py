@@ -4,9 +4,9 @@
 so a commit alone reruns nothing) and records the package version, the git commit of the
 package's source tree with a dirty flag, the config block the job read (YAML text and
 digest), the creation time, the seed and the paper's reference, and, for a study expanded
-from a sweep, its combination (`sweep_attrs`). `source_digest` is what the workflow puts in
-params instead: a digest of the package sources an output depends on, so editing them
-(committed or not) reruns exactly the jobs they feed.
+from a sweep, its combination (`sweep_attrs`). `code_digest` is what the workflow puts in
+params instead: a digest of the code a job runs (the import closure of its script, docstrings
+and comments left out), so editing it (committed or not) reruns exactly the jobs it feeds.
 """
 import ast
 import functools
@@ -16,7 +16,7 @@ from pathlib import Path
 import subprocess
 
 __all__ = ["code_closure", "code_digest", "config_digest", "config_text", "git_state",
-           "provenance", "source_digest", "sweep_attrs"]
+           "provenance", "sweep_attrs"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -25,32 +25,6 @@ def config_digest(obj):
     """SHA-256 of the canonical JSON form of a config fragment."""
     text = json.dumps(obj, sort_keys=True, separators=(",", ":"), default=str)
     return hashlib.sha256(text.encode()).hexdigest()
-
-
-def source_digest(*modules):
-    """SHA-256 over the source files of package modules, given as paths inside the package.
-
-    ``"impact"`` is the subpackage (every ``.py`` file under it), ``"pipeline/io"`` one
-    module. Files are hashed by relative path and content, so a rename counts too.
-
-    Raises
-    ------
-    ValueError
-        If a name is neither a module nor a subpackage of vibroimpact.
-    """
-    digest = hashlib.sha256()
-    for name in sorted(modules):
-        package, module = PACKAGE_DIR / name, PACKAGE_DIR / f"{name}.py"
-        if package.is_dir():
-            files = sorted(package.rglob("*.py"))
-        elif module.is_file():
-            files = [module]
-        else:
-            raise ValueError(f"source_digest: no module or subpackage {name!r} in {PACKAGE_DIR}")
-        for path in files:
-            digest.update(str(path.relative_to(PACKAGE_DIR)).encode() + b"\0")
-            digest.update(path.read_bytes() + b"\0")
-    return digest.hexdigest()[:16]
 
 
 @functools.cache
@@ -314,8 +288,8 @@ def _dynamic(call):
 
 
 @functools.cache
-def _graph():
-    return _Graph(PACKAGE_DIR)
+def _graph(package_dir):
+    return _Graph(Path(package_dir))
 
 
 def _script_tree(path):
@@ -330,21 +304,23 @@ def _script_tree(path):
     return ast.parse(text, str(path))
 
 
-def code_closure(script):
+def code_closure(script, package_dir=PACKAGE_DIR):
     """The modules of vibroimpact that ``script`` (a ``.py`` file or an ``.ipynb`` notebook)
-    imports, transitively, found statically: every import statement, at the top of a module
-    or inside a function, of the functions and classes the script's code reaches."""
-    return _graph().closure(_script_tree(script))
+    imports, transitively, found statically from the sources in ``package_dir``: every
+    import statement, at the top of a module or inside a function, of the functions and
+    classes the script's code reaches (a name looked up at run time, as in a lazy
+    ``__getattr__``, reaches the modules its table names, or else the whole package)."""
+    return _graph(package_dir).closure(_script_tree(script))
 
 
 @functools.cache
-def code_digest(script):
+def code_digest(script, package_dir=PACKAGE_DIR):
     """Digest of the code ``script`` runs: each module of :func:`code_closure` by name and
     abstract syntax tree, docstrings removed (comments are not in the tree), so editing a
     docstring or a comment changes no digest and editing code changes the digests of
     exactly the scripts that reach it. Computed once per script and process."""
-    modules = _graph().modules
+    modules = _graph(package_dir).modules
     digest = hashlib.sha256()
-    for name in code_closure(script):
+    for name in code_closure(script, package_dir):
         digest.update(f"{name}\0{modules[name].digest}\0".encode())
     return digest.hexdigest()[:16]
