@@ -110,7 +110,18 @@ def _runs_code(node):
     return any(isinstance(n, (ast.Call, ast.Lambda, ast.comprehension)) for n in ast.walk(node))
 
 
-_BODIES = (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+_BODIES = (ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)
+
+
+def _unit_name(stmt):
+    """The name of the part a top-level statement belongs to (None: run on import)."""
+    if isinstance(stmt, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+        return stmt.name
+    if isinstance(stmt, (ast.Assign, ast.AnnAssign)) and not _runs_code(stmt.value):
+        targets = stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target]
+        if len(targets) == 1 and isinstance(targets[0], ast.Name):
+            return targets[0].id
+    return None
 
 
 class _Module:
@@ -124,25 +135,37 @@ class _Module:
 
     def __init__(self, name, tree, is_package):
         self.name, self.is_package = name, is_package
-        self.bindings, self.defined = {}, set()
-        for node in ast.walk(tree):     # one pass: docstrings out, bound names in
-            if isinstance(node, _BODIES) and node.body and _is_docstring(node.body[0]):
-                node.body = node.body[1:] or [ast.Pass()]
-            elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Store):
-                self.defined.add(node.id)
-            for target in _imported(node, self.package):
-                self.bindings.setdefault(target[0], []).append(target[1:])
-        self.digest = hashlib.sha256(ast.dump(tree).encode()).hexdigest()
-        self.units = {None: []}
+        self.bindings, self.defined, self.units, self.facts = {}, set(), {None: []}, {}
+        if tree.body and _is_docstring(tree.body[0]):
+            tree.body = tree.body[1:]
         for stmt in tree.body:
-            key = None
-            if isinstance(stmt, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-                key = stmt.name
-            elif isinstance(stmt, (ast.Assign, ast.AnnAssign)) and not _runs_code(stmt.value):
-                targets = stmt.targets if isinstance(stmt, ast.Assign) else [stmt.target]
-                if len(targets) == 1 and isinstance(targets[0], ast.Name):
-                    key = targets[0].id
-            self.units.setdefault(key, []).append(stmt)
+            self.units.setdefault(_unit_name(stmt), []).append(stmt)
+            self.facts[id(stmt)] = self._scan(stmt)
+        self.digest = hashlib.sha256(ast.dump(tree).encode()).hexdigest()
+
+    def _scan(self, stmt):
+        """Take the docstrings out of ``stmt`` and list what it names: one pass over it."""
+        facts = []
+        for node in ast.walk(stmt):
+            if isinstance(node, _BODIES):
+                if node.body and _is_docstring(node.body[0]):
+                    node.body = node.body[1:] or [ast.Pass()]
+            elif isinstance(node, ast.Name):
+                if isinstance(node.ctx, ast.Store):
+                    self.defined.add(node.id)
+                else:
+                    facts.append(("name", node.id))
+            elif isinstance(node, ast.Attribute):
+                facts.append(("attribute", node))
+            elif isinstance(node, (ast.Import, ast.ImportFrom)):
+                for bound, target, attr in _imported(node, self.package):
+                    self.bindings.setdefault(bound, []).append((target, attr))
+                    facts.append(("import", target, attr))
+            elif isinstance(node, ast.Constant) and isinstance(node.value, str):
+                facts.append(("string", node.value))
+            elif isinstance(node, ast.Call) and _dynamic(node):
+                facts.append(("dynamic", node))
+        return facts
 
     @property
     def package(self):
@@ -239,24 +262,19 @@ class _Graph:
     def _reached(self, module, stmt):
         """The parts of the package that statement ``stmt`` of ``module`` reaches."""
         out = []
-        strings = []
-        for node in ast.walk(stmt):
-            for _, target, name in _imported(node, module.package):
-                if target in self.modules:
-                    out += self._top(target)
-                    if name:
-                        out += self._attribute(target, name)
-            if isinstance(node, ast.Name) and node.id in module.units:
-                out.append((module, node.id))
-            elif isinstance(node, ast.Attribute):
-                base = self._resolve(module, node.value)
+        for kind, *fact in module.facts[id(stmt)]:
+            if kind == "import" and fact[0] in self.modules:
+                out += self._top(fact[0]) + (self._attribute(*fact) if fact[1] else [])
+            elif kind == "name" and fact[0] in module.units:
+                out.append((module, fact[0]))
+            elif kind == "attribute":
+                base = self._resolve(module, fact[0].value)
                 if base:
-                    out += self._attribute(base, node.attr)
-            elif isinstance(node, ast.Constant) and isinstance(node.value, str):
-                strings.append(node.value)
-            elif isinstance(node, ast.Call) and _dynamic(node):
-                out += self._dynamic_import(module, node, stmt)
-        out += [part for s in strings if s in self.modules for part in self._top(s)]
+                    out += self._attribute(base, fact[0].attr)
+            elif kind == "string" and fact[0] in self.modules:
+                out += self._top(fact[0])
+            elif kind == "dynamic":
+                out += self._dynamic_import(module, fact[0], stmt)
         return out
 
     def _dynamic_import(self, module, call, stmt):
