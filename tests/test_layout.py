@@ -44,3 +44,20 @@ def test_validators_name_the_argument_and_its_range():
         _checks.real("dt", float("nan"), low=0.0, low_open=True)
     with pytest.raises(ValueError, match="got True"):
         _checks.real("delta", True)
+
+
+def test_every_rule_has_a_one_line_docstring():
+    from pathlib import Path
+    import re
+
+    root = Path(__file__).resolve().parents[1]
+    missing = []
+    for path in [root / "Snakefile", *sorted((root / "workflow" / "rules").glob("*.smk"))]:
+        lines = path.read_text().splitlines()
+        for k, line in enumerate(lines):
+            rule = re.match(r"^\s*rule (\w+):", line)
+            if rule and not re.fullmatch(r'\s+""".+"""', lines[k + 1]):
+                missing.append(f"{path.name}: rule {rule[1]}")
+    assert not missing
+    assert sum(1 for p in (root / "workflow" / "rules").glob("*.smk")
+               for line in p.read_text().splitlines() if re.match(r"^\s*rule \w+:", line)) >= 18
