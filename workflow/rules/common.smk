@@ -287,7 +287,7 @@ def orbits_report_inputs(wildcards):
 
 def validation_report_inputs(wildcards):
     """The notebook, the dataset and the figure of validation report ``{vreport}``; the
-    stability report also quotes the full stress campaign (docs/stress_campaign.csv)."""
+    stability report also quotes the full stress campaign (notebooks/stress_campaign.csv)."""
     if wildcards.vreport == "performance":
         return {
             "notebook": "notebooks/performance.ipynb",
@@ -297,7 +297,7 @@ def validation_report_inputs(wildcards):
     return {
         "notebook": "notebooks/stability.ipynb",
         "stress": "results/validation/stress_sample.nc",
-        "campaign": "docs/stress_campaign.csv",
+        "campaign": "notebooks/stress_campaign.csv",
         "figures": ["results/figures/stress.png"],
     }
 

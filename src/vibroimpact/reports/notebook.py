@@ -227,7 +227,7 @@ def markdown_table(path, header):
 
 
 def csv_table(path):
-    """A CSV table (e.g. ``docs/stress_campaign.csv``, the full stress campaign) as a
+    """A CSV table (e.g. ``notebooks/stress_campaign.csv``, the full stress campaign) as a
     DataFrame of strings, empty cells as ``""``."""
     import pandas as pd
 
