@@ -243,7 +243,25 @@ class _Graph:
         for target, name in module.bindings.get(attr, []):  # a name the module imports
             if target in self.modules and target != module_name:
                 return self._top(target) + (self._attribute(target, name) if name else [])
-        return [(module, "__getattr__")]
+        return self._lazy(module, attr) or [(module, "__getattr__")]
+
+    def _lazy(self, module, attr):
+        """Where a lazy ``__getattr__`` of ``module`` loads ``attr`` from, by the entry for it
+        in a dict literal it reads (``{"simulate": "vibroimpact.impact.simulate"}``,
+        ``{"density": "events"}``); empty if none names it."""
+        getter = module.units.get("__getattr__", [])
+        tables = {fact[1] for stmt in getter for fact in module.facts[id(stmt)]
+                  if fact[0] == "name"} & set(module.units)
+        for stmt in (s for table in sorted(tables) for s in module.units[table]):
+            if not isinstance(stmt.value, ast.Dict):
+                continue
+            for key, value in zip(stmt.value.keys, stmt.value.values):
+                if isinstance(key, ast.Constant) and key.value == attr \
+                        and isinstance(value, ast.Constant) and isinstance(value.value, str):
+                    for name in (value.value, f"{module.package}.{value.value}"):
+                        if name in self.modules:
+                            return self._top(name) + self._attribute(name, attr)
+        return []
 
     def _resolve(self, module, expr):
         """The package module an expression names (``stats``, ``stats.events``), or None."""
