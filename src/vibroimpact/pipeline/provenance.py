@@ -10,6 +10,7 @@ and comments left out), so editing it (committed or not) reruns exactly the jobs
 """
 import ast
 import functools
+import gc
 import hashlib
 import json
 from pathlib import Path
@@ -325,7 +326,13 @@ def _dynamic(call):
 
 @functools.cache
 def _graph(package_dir):
-    return _Graph(Path(package_dir))
+    enabled = gc.isenabled()
+    gc.disable()        # some 10^5 tree nodes, none cyclic garbage: no collections meanwhile
+    try:
+        return _Graph(Path(package_dir))
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def _script_tree(path):
