@@ -2,7 +2,8 @@
 # Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the fast suite, the slow (stress/convergence) suite, the
 # end-to-end workflow and SLURM suites (one session: the test config is built once; the
-# SLURM suite installs and starts a one-node cluster, as root), and the import-layer contract.
+# SLURM suite installs and starts a one-node cluster, as root), the import-layer contract and
+# the format of the Snakemake files (snakefmt).
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -36,12 +37,14 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q -m slow
 	$(BIN)/python -m pytest -q -m "workflow or slurm"
 	$(BIN)/lint-imports
+	$(BIN)/snakefmt --check Snakefile workflow/
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 
 lint: $(STAMP)
 	$(BIN)/snakemake --lint
+	$(BIN)/snakefmt --check Snakefile workflow/
 
 clean:
 	rm -rf results

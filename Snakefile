@@ -15,23 +15,21 @@ report: "workflow/report/workflow.rst"
 # into a paper entry of the same name; `configuration.load` adds, refuses collisions, and
 # checks and costs the whole config here, before any job (a problem: one or two lines each).
 try:
-    for _file in workflow.overwrite_configfiles:    # what Snakemake's loader lets through:
-        configuration.read_yaml(_file)              # a key given twice, nested aliases
+    for _file in workflow.overwrite_configfiles:  # what Snakemake's loader lets through:
+        configuration.read_yaml(_file)  # a key given twice, nested aliases
     _config, PLAN = configuration.load(dict(config), root=workflow.basedir)
 except configuration.ConfigError as err:
     raise configuration.ConfigError(err.problems) from None
 config.clear()
 config.update(_config)
 
-if workflow.is_main_process:    # not again in each job of a cluster run
+# The plan, printed only: the recovery after a crash (stale temporaries removed, damaged
+# results refused) is `python -m vibroimpact run`'s, so a plain `snakemake -n` or `--lint`
+# changes nothing on disk.
+if workflow.is_main_process:  # not again in each job of a cluster run
     from snakemake.logging import logger
 
-    from vibroimpact._files import sweep_stale_temporaries
-    from vibroimpact.pipeline.io import check_readable
-
     logger.info(f"vibroimpact plan: {PLAN.summary(workflow.resource_settings.cores or 1)}")
-    sweep_stale_temporaries("results")      # of writers killed outright (SIGKILL)
-    check_readable("results")               # a damaged result: one line, before any job
 
 
 include: "workflow/rules/common.smk"
@@ -46,6 +44,7 @@ include: "workflow/rules/reports.smk"
 
 
 rule all:
+    """Every figure and report of the config's built entries."""
     input:
         all_targets(),
     default_target: True

@@ -74,3 +74,20 @@ def test_the_configs_fir_length_is_the_generators():
         width = min(_limits.FIR_TRANSITION_FRACTION * theta, 2.0 * (math.pi - theta))
         numtaps, _ = scipy.signal.kaiserord(_limits.FIR_ATTENUATION_DB, width / math.pi)
         assert _limits.fir_taps(theta) == numtaps | 1, theta
+
+
+def test_every_rule_has_a_one_line_docstring():
+    from pathlib import Path
+    import re
+
+    root = Path(__file__).resolve().parents[1]
+    missing = []
+    for path in [root / "Snakefile", *sorted((root / "workflow" / "rules").glob("*.smk"))]:
+        lines = path.read_text().splitlines()
+        for k, line in enumerate(lines):
+            rule = re.match(r"^\s*rule (\w+):", line)
+            if rule and not re.fullmatch(r'\s+""".+"""', lines[k + 1]):
+                missing.append(f"{path.name}: rule {rule[1]}")
+    assert not missing
+    assert sum(1 for p in (root / "workflow" / "rules").glob("*.smk")
+               for line in p.read_text().splitlines() if re.match(r"^\s*rule \w+:", line)) >= 18

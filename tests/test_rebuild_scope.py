@@ -2,11 +2,13 @@
 
 The test config is built once in a temporary git repository holding the working tree; each case
 edits one thing there and reads the job list of ``snakemake -n``. The package is imported from
-that copy (PYTHONPATH), so an edit of its sources is an edit of the code the workflow runs.
+that copy (PYTHONPATH), so an edit of its sources is an edit of the code the workflow runs. A
+code edit is a statement appended to a module: comments and docstrings rerun nothing.
 """
 import os
 from pathlib import Path
 import re
+import socket
 import subprocess
 import sys
 
@@ -80,13 +82,17 @@ def edit(repo):
     saved = {}
 
     def change(path, func):
+        """Write ``func(text)`` to ``path``; a new file when ``path`` does not exist."""
         path = repo / path
-        saved.setdefault(path, path.read_text())
-        path.write_text(func(path.read_text()))
+        saved.setdefault(path, path.read_text() if path.exists() else None)
+        path.write_text(func(path.read_text() if path.exists() else ""))
 
     yield change
     for path, text in saved.items():
-        path.write_text(text)
+        if text is None:
+            path.unlink()
+        else:
+            path.write_text(text)
     _git(repo, "reset", "-q", "--hard", head)
 
 
@@ -105,6 +111,15 @@ def _append_comment(text):
     return text + "\n# an edit\n"
 
 
+def _append_code(text):
+    return text + "\n_EDITED = True\n"
+
+
+def _reword_docstring(text):
+    assert text.lstrip().startswith('"""')
+    return text.replace('"""', '"""Reworded. ', 1)
+
+
 def test_commits_of_nothing_docs_readme_tests_rerun_nothing(repo, edit):
     _git(repo, "commit", "-q", "--allow-empty", "-m", "empty")
     assert scheduled(repo) == {}
@@ -114,8 +129,48 @@ def test_commits_of_nothing_docs_readme_tests_rerun_nothing(repo, edit):
     assert scheduled(repo) == {}
 
 
+def test_plan_and_lint_change_nothing_on_disk(repo):
+    """A plain dry run leaves a stale temporary of a killed writer (`python -m vibroimpact
+    run` removes it before it hands over), and `--lint` passes."""
+    name = f".x.nc.999999999.0123456789ab@{socket.gethostname()}.tmp"    # pid: none alive
+    stale = repo / "results" / "datasets" / name
+    stale.write_bytes(b"x")
+    try:
+        assert scheduled(repo) == {}
+        assert stale.exists()
+        _snakemake(repo, "--lint")
+        assert stale.exists()
+    finally:
+        stale.unlink()
+
+
+def test_docstring_or_comment_edits_rerun_nothing(repo, edit):
+    for module in ("pipeline/tasks.py", "stats/events.py", "_checks.py"):
+        edit(f"src/vibroimpact/{module}", _reword_docstring)
+    edit("src/vibroimpact/impact/kernels.py", _append_comment)
+    assert scheduled(repo) == {}
+
+
+def test_a_new_module_reruns_exactly_the_jobs_that_import_it(repo, edit):
+    edit("src/vibroimpact/validation/_timing.py", lambda text: "REPEATS = 3\n")
+    edit("src/vibroimpact/validation/work_precision.py",
+         lambda text: text + "\nfrom vibroimpact.validation import _timing  # noqa: E402\n")
+    jobs = scheduled(repo)
+    assert jobs == {"measure_work_precision": {"results/validation/work_precision.nc"},
+                    "draw_validation_figure": {"results/figures/work_precision.png",
+                                               "results/figures/work_precision.pdf"},
+                    "validation_report": {f"results/reports/validation/performance.{ext}"
+                                          for ext in ("ipynb", "html", "summary.html")},
+                    "all": set()}
+    edit("src/vibroimpact/validation/_timing.py", _append_comment)
+    assert scheduled(repo) == jobs
+    # a module no job imports reruns nothing
+    edit("src/vibroimpact/validation/work_precision.py", lambda text: text.rsplit("from", 1)[0])
+    assert scheduled(repo) == {}
+
+
 def test_plotting_edit_reruns_only_figures(repo, edit):
-    edit("src/vibroimpact/plotting/_common.py", _append_comment)
+    edit("src/vibroimpact/plotting/_common.py", _append_code)
     jobs = scheduled(repo)
     drawn = FIGURE_RULES | REPORT_RULES | {"draw_validation_figure"}
     assert set(jobs) == drawn
@@ -136,15 +191,18 @@ def test_figure_only_key_reruns_only_that_figure(repo, edit):
 
 
 def test_simulator_edit_reruns_the_studies_and_downstream(repo, edit):
-    edit("src/vibroimpact/impact/kernels.py", _append_comment)    # uncommitted
+    edit("src/vibroimpact/impact/kernels.py", _append_code)    # uncommitted
     jobs = scheduled(repo)
     assert set(jobs) == STUDY_RULES | MAP_RULES | FIGURE_RULES | REPORT_RULES | VALIDATION_RULES
     assert "fig16.png" not in {Path(p).name for p in jobs["draw_figure"]}
 
 
-def test_statistics_edit_reruns_the_studies(repo, edit):
-    edit("src/vibroimpact/stats/events.py", _append_comment)
-    assert STUDY_RULES <= set(scheduled(repo))
+def test_statistics_edit_reruns_the_studies_that_use_it(repo, edit):
+    edit("src/vibroimpact/stats/events.py", _append_code)
+    jobs = scheduled(repo)
+    assert {"simulate_events", "aggregate_events", "simulate_map", "aggregate_map"} <= set(jobs)
+    # no event statistics in a trace, a spectrum or a noise record
+    assert not {"simulate_trace", "simulate_spectra", "generate_noise"} & set(jobs)
 
 
 def test_physical_value_reruns_that_study(repo, edit):
@@ -167,7 +225,7 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
         "fig16.png", "fig15_vs_fig16.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
-    edit("src/vibroimpact/orbits/kernels.py", _append_comment)     # the stress sample too
+    edit("src/vibroimpact/orbits/kernels.py", _append_code)     # the stress sample too
     assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES | {"orbits_report"} | STRESS_RULES
 
 

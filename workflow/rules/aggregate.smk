@@ -6,6 +6,7 @@ localrules:
 
 
 rule aggregate_events:
+    """The events dataset of study {study}, from its tiles."""
     input:
         tiles("events"),
     output:
@@ -22,12 +23,13 @@ rule aggregate_events:
         runtime=5,
     params:
         block=study_block("events"),
-        code=CODE["aggregate"],
+        code=script_code("aggregate_events"),
     script:
         "../scripts/aggregate_events.py"
 
 
 rule aggregate_spectra:
+    """The spectra dataset of study {study}, from its tiles and noise record."""
     input:
         tiles=tiles("spectra"),
         noise=study_noise,
@@ -45,12 +47,13 @@ rule aggregate_spectra:
         runtime=5,
     params:
         block=study_block("spectra"),
-        code=CODE["aggregate"],
+        code=script_code("aggregate_spectra"),
     script:
         "../scripts/aggregate_spectra.py"
 
 
 rule aggregate_map:
+    """The motion-map dataset of study {study}, from its tiles."""
     input:
         tiles("map"),
     output:
@@ -67,6 +70,6 @@ rule aggregate_map:
         runtime=5,
     params:
         block=study_block("map"),
-        code=CODE["aggregate"],
+        code=script_code("aggregate_map"),
     script:
         "../scripts/aggregate_map.py"

@@ -1,26 +1,29 @@
-# Named helpers: config blocks, code digests, tile lists, the figure table. No numerics here.
+# Named helpers the rules use, each defined before its first use: config blocks, code
+# digests, tile lists, the inputs of each rule, the targets of `rule all`. No numerics here.
 #
 # Rebuild scope (README, "What reruns"): each rule's params carry only the config block it
-# reads and a digest of the package sources its output depends on, so Snakemake's params
-# trigger reruns exactly the jobs an edit touches, committed or not. Provenance (version,
-# commit, dirty flag, config digest, seed) is written by the jobs at run time, never passed
-# through params (a commit alone must not rerun anything).
-import hashlib
+# reads and the digest of the code its script runs (`provenance.code_digest`: the import
+# closure of the script, docstrings and comments left out), so Snakemake's params trigger
+# reruns exactly the jobs an edit touches, committed or not. Provenance (version, commit,
+# dirty flag, config digest, seed) is written by the jobs at run time, never passed through
+# params (a commit alone must not rerun anything).
 from pathlib import Path
 import shlex
 import sys
 from types import SimpleNamespace
 
 from vibroimpact.pipeline import figures
-from vibroimpact.pipeline.provenance import source_digest
+from vibroimpact.pipeline.config import costs
+from vibroimpact.pipeline.provenance import code_digest
 from vibroimpact.pipeline.study import Study, orbit_rows
-from vibroimpact.reports.notebook import markdown_table
+from vibroimpact.reports import arguments
 
 
 wildcard_constraints:
     study="[A-Za-z][A-Za-z0-9_]*",
     orbits="[A-Za-z][A-Za-z0-9_]*",
     noise="[A-Za-z][A-Za-z0-9_]*",
+    sweep="[A-Za-z][A-Za-z0-9_]*",
     tile="[0-9]+",
     # a study name, or orbits/<name> for an `orbits` entry (their figures never collide)
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
@@ -32,23 +35,13 @@ wildcard_constraints:
 
 STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}
 
-# Package sources each kind of output depends on (modules or subpackages of vibroimpact).
-CODE = {
-    "noise": source_digest("noise", "stats/spectra", "pipeline/io", "pipeline/tasks",
-                           "_checks", "_files"),
-    "simulate": source_digest("impact", "stats", "noise", "pipeline/cells", "pipeline/study",
-                              "pipeline/datasets", "pipeline/io", "pipeline/tasks",
-                              "_checks", "_files"),
-    "aggregate": source_digest("pipeline/datasets", "pipeline/study", "pipeline/io",
-                               "pipeline/tasks", "stats/spectra", "noise", "_files"),
-    "orbits": source_digest("orbits", "pipeline/datasets", "pipeline/study",
-                            "pipeline/io", "pipeline/tasks", "_checks", "_files"),
-    "figure": source_digest("plotting", "pipeline/figures", "pipeline/tasks", "stats",
-                            "_files"),
-    # a report runs its notebook, which calls vibroimpact.reports (and plotting for Fig. 15
-    # against Fig. 16); the notebooks themselves are inputs
-    "report": source_digest("reports", "plotting", "stats"),
-}
+
+def script_code(rule):
+    """The code digest of ``workflow/scripts/<rule>.py``: what its job runs."""
+    return code_digest(Path(workflow.basedir, "workflow", "scripts", f"{rule}.py"))
+
+
+# --- config blocks --------------------------------------------------------------------------
 
 # Config keys each job reads from a study entry (nothing else of the entry reaches its params).
 _PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size", "sweep")
@@ -62,34 +55,49 @@ _READS = {
 
 def study_block(kind):
     """The part of ``studies[{study}]`` that a ``kind`` job reads."""
+
     def block(wildcards):
         entry = config["studies"][wildcards.study]
         return {key: entry[key] for key in _READS[kind] if key in entry}
+
     return block
 
 
 def noise_entry(wildcards):
+    """The config entry ``noises[{noise}]``."""
     return config["noises"][wildcards.noise]
 
 
 def orbits_entry(wildcards):
+    """The config entry ``orbits[{orbits}]``."""
     return config["orbits"][wildcards.orbits]
 
 
+# --- inputs of the simulations and aggregations ----------------------------------------------
+
+
 def study_noise(wildcards):
+    """The noise record that drives study ``{study}``."""
     return f"results/noise/{config['studies'][wildcards.study]['noise']}.nc"
 
 
 def tiles(kind):
+    """The ``kind`` tiles of study ``{study}``."""
+
     def files(wildcards):
         n = STUDIES[wildcards.study].n_tiles(kind)
         return [f"results/cells/{wildcards.study}/{kind}/{t}.nc" for t in range(n)]
+
     return files
 
 
 def orbit_tiles(wildcards):
+    """The tiles of orbits entry ``{orbits}``."""
     _, n = orbit_rows(config["orbits"][wildcards.orbits])
     return [f"results/orbits/{wildcards.orbits}/tiles/{t}.nc" for t in range(n)]
+
+
+# --- figures ----------------------------------------------------------------------------------
 
 
 def _owner(wildcards):
@@ -118,8 +126,10 @@ def figure_inputs(wildcards):
     if figures.FIGURES.get(fig, {}).get("owner") != kind:
         raise ValueError(f"{wildcards.owner}: no figure {fig!r} for a {kind} entry")
     names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
-    return [_DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
-            for d in figures.FIGURES[fig]["reads"]]
+    return [
+        _DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
+        for d in figures.FIGURES[fig]["reads"]
+    ]
 
 
 def figure_options(wildcards):
@@ -128,10 +138,32 @@ def figure_options(wildcards):
     return figures.figure_options(entry, wildcards.fig)
 
 
-def figure_caption(wildcards):
-    """What ``{fig}`` of ``{owner}`` shows, with its parameters (the report's caption)."""
-    kind, name, entry = _owner(wildcards)
-    return figures.caption(kind, name, entry, wildcards.fig)
+def figure_captions():
+    """``{png: caption}`` of every figure of every study and orbits entry: what it shows,
+    with its parameters. The report's caption template (workflow/report/figure.rst) reads it
+    from ``config["figure_captions"]``: a caption is no param, so rewording one redraws
+    nothing."""
+    captions = {}
+    for kind, section, prefix in (("study", "studies", ""), ("orbits", "orbits", "orbits/")):
+        for name, entry in config[section].items():
+            for fig in figures.figure_targets(entry):
+                png = f"results/figures/{prefix}{name}/{fig}.png"
+                captions[png] = figures.caption(kind, name, entry, fig)
+    return captions
+
+
+def paper_figure_source(wildcards):
+    """The PNG and PDF of the figure that ``paper_figures[{paper_fig}]`` names."""
+    if wildcards.paper_fig not in config.get("paper_figures", {}):
+        raise ValueError(
+            f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
+            f"{sorted(config.get('paper_figures', {}))}"
+        )
+    name = config["paper_figures"][wildcards.paper_fig]
+    section = "orbits" if figures.FIGURES[wildcards.paper_fig]["owner"] == "orbits" else "studies"
+    owner = f"orbits/{name}" if section == "orbits" else name
+    target = figures.paper_target(config[section][name], wildcards.paper_fig)
+    return {ext: f"results/figures/{owner}/{target}.{ext}" for ext in ("png", "pdf")}
 
 
 def _paper_figure_of(wildcards):
@@ -156,53 +188,41 @@ def figure_report_labels(wildcards):
     return {"figure": _paper_figure_of(wildcards) or wildcards.fig}
 
 
-def paper_figure_source(wildcards):
-    if wildcards.paper_fig not in config.get("paper_figures", {}):
-        raise ValueError(f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
-                         f"{sorted(config.get('paper_figures', {}))}")
-    name = config["paper_figures"][wildcards.paper_fig]
-    section = "orbits" if figures.FIGURES[wildcards.paper_fig]["owner"] == "orbits" else "studies"
-    owner = f"orbits/{name}" if section == "orbits" else name
-    target = figures.paper_target(config[section][name], wildcards.paper_fig)
-    return {ext: f"results/figures/{owner}/{target}.{ext}" for ext in ("png", "pdf")}
+# --- sweeps (sweeps.smk) ----------------------------------------------------------------------
 
 
-def all_targets():
-    """The figures of the entries the config builds (``PLAN.drawn``: with ``paper: false``,
-    only the user's file's own entries)."""
-    drawn = PLAN.drawn
-    targets = [f"results/figures/{fig}.png" for fig in sorted(drawn["paper_figures"])]
-    for name in sorted(drawn["studies"]):
-        entry = config["studies"][name]
-        targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
-    for name in sorted(drawn["orbits"]):
-        entry = config["orbits"][name]
-        targets += [f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)]
-    targets += sweep_targets()              # sweeps.smk: the side-by-side figure of each sweep
-    if config["validation"]["build"]:
-        targets += validation_targets()     # validation.smk: work_precision.png, stress.png
-    return targets + report_targets()
+def _sweep(wildcards):
+    """The record ``config["sweeps"][{sweep}]``: its studies, keys and values."""
+    if wildcards.sweep not in config["sweeps"]:
+        raise ValueError(
+            f"{wildcards.sweep} is not a sweep; sweeps: " f"{sorted(config['sweeps']) or 'none'}"
+        )
+    return config["sweeps"][wildcards.sweep]
+
+
+def sweep_inputs(wildcards):
+    """The events datasets of the studies of sweep ``{sweep}``, in its order."""
+    return [_DATASETS["events"].format(name=study) for study in _sweep(wildcards)["studies"]]
+
+
+def sweep_labels(wildcards):
+    """The label of each combination of sweep ``{sweep}`` (the figure's legend)."""
+    return configuration.sweep_labels(_sweep(wildcards))
+
+
+# --- validation (validation.smk) ------------------------------------------------------------
+
+# Each validation figure and the dataset it draws.
+VALIDATION_FIGURES = {
+    "work_precision": "results/validation/work_precision.nc",
+    "stress": "results/validation/stress_sample.nc",
+}
 
 
 # --- reports (reports.smk): one notebook per study, per orbits entry, two for validation -----
 
 #: The interpreter running Snakemake (the .venv's): reports call its papermill and nbconvert.
 PYTHON = shlex.quote(sys.executable)
-
-#: The parameters of each notebook, in its `parameters` cell; each is passed with -p.
-REPORT_PARAMETERS = {
-    "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
-    "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
-                        "figures", "amplitude", "inv_beta", "density_delta"),
-    "periodic_motions": ("name", "orbits", "map", "figures"),
-    "performance": ("work_precision", "figures"),
-    "stability": ("stress", "readme", "figures"),
-}
-
-
-def study_report_kind(entry):
-    """The notebook of a study's report: random force alone, or harmonic plus random."""
-    return "harmonic_random" if float(entry.get("amplitude", 0.0)) != 0.0 else "random_force"
 
 
 def _study_datasets(name):
@@ -212,8 +232,9 @@ def _study_datasets(name):
     for fig in {f if isinstance(f, str) else f["name"] for f in entry["figures"]}:
         names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
         for kind in figures.FIGURES[fig]["reads"]:
-            out.setdefault(kind, _DATASETS[kind].format(name=names.get(kind, name),
-                                                        noise=names["noise"]))
+            out.setdefault(
+                kind, _DATASETS[kind].format(name=names.get(kind, name), noise=names["noise"])
+            )
     return out
 
 
@@ -221,17 +242,21 @@ def study_report_inputs(wildcards):
     """The notebook, the datasets and the figures of a study and of its ``report_with``, and
     the study's noise record (its provenance row, whether or not a figure draws it)."""
     entry = config["studies"][wildcards.study]
-    kind = study_report_kind(entry)
+    kind = arguments.study_report_kind(entry)
     if wildcards.report != kind:
         raise ValueError(f"study {wildcards.study}: its report is {kind}, not {wildcards.report}")
-    inputs = {"notebook": f"notebooks/{kind}.ipynb",
-              "noise": _DATASETS["noise"].format(noise=entry["noise"])}
+    inputs = {
+        "notebook": f"notebooks/{kind}.ipynb",
+        "noise": _DATASETS["noise"].format(noise=entry["noise"]),
+    }
     shown = []
     for name in [wildcards.study, *entry.get("report_with", [])]:
         for dataset, path in _study_datasets(name).items():
             inputs.setdefault(dataset, path)
-        shown += [f"results/figures/{name}/{f}.png"
-                  for f in figures.figure_targets(config["studies"][name])]
+        shown += [
+            f"results/figures/{name}/{f}.png"
+            for f in figures.figure_targets(config["studies"][name])
+        ]
     return {**inputs, "figures": shown}
 
 
@@ -246,86 +271,115 @@ def _maps_over(orbits_name):
 
 
 def orbits_report_inputs(wildcards):
+    """The notebook, the dataset and the figures of orbits entry ``{orbits}``, and the map
+    drawn over it (Fig. 15 against Fig. 16), if a built study draws one."""
     entry = config["orbits"][wildcards.orbits]
-    inputs = {"notebook": "notebooks/periodic_motions.ipynb",
-              "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
-              "figures": [f"results/figures/orbits/{wildcards.orbits}/{f}.png"
-                          for f in figures.figure_targets(entry)]}
+    inputs = {
+        "notebook": "notebooks/periodic_motions.ipynb",
+        "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
+        "figures": [
+            f"results/figures/orbits/{wildcards.orbits}/{f}.png"
+            for f in figures.figure_targets(entry)
+        ],
+    }
     inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
     return inputs
 
 
 def validation_report_inputs(wildcards):
+    """The notebook, the dataset and the figure of validation report ``{vreport}``; the
+    stability report also quotes the full stress campaign (notebooks/stress_campaign.csv)."""
     if wildcards.vreport == "performance":
-        return {"notebook": "notebooks/performance.ipynb",
-                "work_precision": "results/validation/work_precision.nc",
-                "figures": ["results/figures/work_precision.png"]}
-    return {"notebook": "notebooks/stability.ipynb",
-            "stress": "results/validation/stress_sample.nc",
-            "figures": ["results/figures/stress.png"]}
+        return {
+            "notebook": "notebooks/performance.ipynb",
+            "work_precision": "results/validation/work_precision.nc",
+            "figures": ["results/figures/work_precision.png"],
+        }
+    return {
+        "notebook": "notebooks/stability.ipynb",
+        "stress": "results/validation/stress_sample.nc",
+        "campaign": "notebooks/stress_campaign.csv",
+        "figures": ["results/figures/stress.png"],
+    }
 
 
-def quoted_campaign(wildcards):
-    """The README's table of the full stress campaign, which the stability report quotes: a
-    param, so that editing that table reruns the report and editing the rest of the README
-    does not (the README is passed by path, not as an input)."""
-    if wildcards.get("vreport") != "stability":
-        return ""
-    try:
-        table = markdown_table(Path(workflow.basedir, "README.md"), "| family |")
-    except ValueError:
-        return ""       # no table to quote: the report says so when it runs
-    return hashlib.sha256(table.to_csv().encode()).hexdigest()[:16]
-
-
-def _report_name(wildcards):
+def _report_notebook(wildcards):
+    """The name of the notebook a report rule runs."""
     if "vreport" in wildcards.keys():
         return wildcards.vreport
     return wildcards.report if "report" in wildcards.keys() else "periodic_motions"
 
 
-def _nearest(values, target):
-    return min(values, key=lambda v: abs(v - target))
+def report_code(wildcards):
+    """The code digest of the report's notebook: what its import lines reach."""
+    notebook = Path(workflow.basedir, "notebooks", f"{_report_notebook(wildcards)}.ipynb")
+    return code_digest(notebook)
 
 
 def report_arguments(wildcards, input):
-    """``-p name value`` for every parameter of the report's notebook: input paths (``""``
-    when the study has no such dataset), the figures as one space-separated string, and the
-    study's name, forcing amplitude, the 1/beta_f its density findings read and the plays its
-    density figures draw (space-separated; "" = every play)."""
-    notebook = _report_name(wildcards)
-    given = {name: " ".join(value) if name == "figures" else str(value)
-             for name, value in input.items()}
-    if "study" in wildcards.keys():
-        entry = config["studies"][wildcards.study]
-        grid = [float(v) for v in STUDIES[wildcards.study].inv_beta]
-        given.update(study=wildcards.study, amplitude=float(entry.get("amplitude", 0.0)),
-                     inv_beta=_nearest(grid, 1.1),      # Figs. 13, 14 of the paper: tau/1.1
-                     density_delta=" ".join(str(float(d))
-                                            for d in entry.get("density_delta") or ()))
-    if "orbits" in wildcards.keys():
-        given["name"] = wildcards.orbits
-    given.setdefault("readme", "README.md")     # the stability report quotes its table
-    values = {name: given.get(name, "") for name in REPORT_PARAMETERS[notebook]}
-    return " ".join(f"-p {name} {shlex.quote(str(value))}" for name, value in values.items())
+    """``-p name value`` for every parameter of the report's notebook
+    (`vibroimpact.reports.arguments`)."""
+    study = wildcards.get("study")
+    parameters = arguments.notebook_parameters(
+        _report_notebook(wildcards),
+        dict(input.items()),
+        study=study,
+        entry=config["studies"][study] if study else None,
+        inv_beta=STUDIES[study].inv_beta if study else (),
+        orbits=wildcards.get("orbits"),
+    )
+    return arguments.papermill_arguments(parameters)
+
+
+# --- targets of `rule all` ------------------------------------------------------------------
+
+
+def sweep_targets():
+    """The side-by-side figure of every sweep whose studies the config builds."""
+    return configuration.sweep_figures(config, PLAN.drawn)
+
+
+def validation_targets():
+    """``results/figures/work_precision.png`` and ``stress.png``."""
+    return [f"results/figures/{name}.png" for name in VALIDATION_FIGURES]
 
 
 def report_targets():
     """The HTML report of every built study and orbits entry, and the validation reports."""
     drawn = PLAN.drawn
-    targets = [f"results/reports/{name}/{study_report_kind(config['studies'][name])}.html"
-               for name in sorted(drawn["studies"])]
-    targets += [f"results/reports/orbits/{name}/periodic_motions.html"
-                for name in sorted(drawn["orbits"])]
+    targets = [
+        f"results/reports/{name}/" f"{arguments.study_report_kind(config['studies'][name])}.html"
+        for name in sorted(drawn["studies"])
+    ]
+    targets += [
+        f"results/reports/orbits/{name}/periodic_motions.html" for name in sorted(drawn["orbits"])
+    ]
     if config["validation"]["build"]:
         targets += [f"results/reports/validation/{r}.html" for r in ("performance", "stability")]
     return targets
 
 
+def all_targets():
+    """The figures and reports of the entries the config builds (``PLAN.drawn``: with
+    ``paper: false``, only the user's file's own entries)."""
+    drawn = PLAN.drawn
+    targets = [f"results/figures/{fig}.png" for fig in sorted(drawn["paper_figures"])]
+    for name in sorted(drawn["studies"]):
+        entry = config["studies"][name]
+        targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
+    for name in sorted(drawn["orbits"]):
+        entry = config["orbits"][name]
+        targets += [
+            f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)
+        ]
+    targets += sweep_targets()
+    if config["validation"]["build"]:
+        targets += validation_targets()
+    return targets + report_targets()
+
+
 # Resources: the cost model of vibroimpact.pipeline.config.costs (README, "Job costs"), the one
 # the plan uses too.
-from vibroimpact.pipeline.config import costs
-
 BASE_MEM_MB = costs.BASE_MEM_MB
 NOISE_MEM_MB = costs.NOISE_MEM_MB
 
@@ -341,6 +395,7 @@ def simulate_mem_mb(wildcards):
 def simulate_runtime(kind):
     """Minutes of a ``kind`` tile: its cells at the steps of one cell (a map cell: to the cap
     of the longest forcing period), plus start-up."""
+
     def runtime(wildcards):
         if kind == "trace":
             return costs.simulate_runtime_min(0, 0)

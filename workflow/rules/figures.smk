@@ -5,14 +5,25 @@ localrules:
     copy_paper_figure,
 
 
+# What each figure shows, with its parameters, for the report's caption (figure.rst reads it
+# from the config, which the report hands to a caption template; not a param: rewording a
+# caption redraws nothing).
+config["figure_captions"] = figure_captions()
+
+
 rule draw_figure:
+    """Figure {fig} of study or orbits entry {owner}, as PNG and PDF."""
     input:
         figure_inputs,
     output:
         # in `snakemake --report`, once: under `paper` when it is a paper figure (its copy
         # results/figures/figNN.png is not marked), else in its study's or orbits entry's
-        png=report("results/figures/{owner}/{fig}.png", caption="../report/figure.rst",
-                   category=figure_report_category, labels=figure_report_labels),
+        png=report(
+            "results/figures/{owner}/{fig}.png",
+            caption="../report/figure.rst",
+            category=figure_report_category,
+            labels=figure_report_labels,
+        ),
         pdf="results/figures/{owner}/{fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"
@@ -26,17 +37,17 @@ rule draw_figure:
         runtime=5,
     params:
         options=figure_options,
-        caption=figure_caption,     # what it shows, with which parameters (report caption)
-        code=CODE["figure"],
+        code=script_code("draw_figure"),
     script:
         "../scripts/draw_figure.py"
 
 
 rule copy_paper_figure:
+    """The paper figure {paper_fig}: a copy of the study figure it names."""
     input:
         unpack(paper_figure_source),
     output:
-        png="results/figures/{paper_fig}.png",      # in the report as its source (draw_figure)
+        png="results/figures/{paper_fig}.png",  # in the report as its source (draw_figure)
         pdf="results/figures/{paper_fig}.pdf",
     conda:
         "../envs/vibroimpact.yaml"

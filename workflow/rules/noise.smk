@@ -1,4 +1,5 @@
 rule generate_noise:
+    """The seeded noise record of `noises[{noise}]`: force samples and their spectrum."""
     output:
         "results/noise/{noise}.nc",
     conda:
@@ -13,6 +14,6 @@ rule generate_noise:
         runtime=20,
     params:
         entry=noise_entry,
-        code=CODE["noise"],
+        code=script_code("generate_noise"),
     script:
         "../scripts/generate_noise.py"

@@ -5,6 +5,7 @@ localrules:
 
 
 rule solve_orbit_tile:
+    """The periodic (m/n) motions of one tile of orbits entry {orbits}."""
     output:
         "results/orbits/{orbits}/tiles/{tile}.nc",
     conda:
@@ -20,12 +21,13 @@ rule solve_orbit_tile:
         runtime=30,
     params:
         entry=orbits_entry,
-        code=CODE["orbits"],
+        code=script_code("solve_orbit_tile"),
     script:
         "../scripts/solve_orbit_tile.py"
 
 
 rule aggregate_orbits:
+    """The orbits dataset of entry {orbits}, from its tiles."""
     input:
         orbit_tiles,
     output:
@@ -42,6 +44,6 @@ rule aggregate_orbits:
         runtime=5,
     params:
         entry=orbits_entry,
-        code=CODE["aggregate"],
+        code=script_code("aggregate_orbits"),
     script:
         "../scripts/aggregate_orbits.py"

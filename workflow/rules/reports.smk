@@ -20,7 +20,7 @@ wildcard_constraints:
 
 REPORT_SHELL = (
     'tmp=$(mktemp -d "$(dirname {output.ipynb})/.report.XXXXXX"); '
-    'trap \'rm -rf "$tmp"\' EXIT; '
+    "trap 'rm -rf \"$tmp\"' EXIT; "
     "{params.python} -m papermill {input.notebook} $tmp/report.ipynb --kernel python3 --log-output "
     "--no-progress-bar {params.arguments} > {log} 2>&1; "
     "{params.python} -m vibroimpact.reports.notebook $tmp/report.ipynb $tmp/report.html "
@@ -33,15 +33,19 @@ REPORT_SHELL = (
 
 
 rule study_report:
+    """The executed report notebook {report} of study {study}, and its HTML."""
     input:
         unpack(study_report_inputs),
     output:
         ipynb="results/reports/{study}/{report}.ipynb",
         html="results/reports/{study}/{report}.html",
         # in `snakemake --report` without its images: the report holds each figure once
-        summary=report("results/reports/{study}/{report}.summary.html",
-                       caption="../report/report.rst", category="{study}",
-                       labels={"figure": "report: {report}"}),
+        summary=report(
+            "results/reports/{study}/{report}.summary.html",
+            caption="../report/report.rst",
+            category="{study}",
+            labels={"figure": "report: {report}"},
+        ),
     log:
         "results/logs/report/{study}/{report}.log",
     benchmark:
@@ -54,21 +58,25 @@ rule study_report:
         "../envs/vibroimpact.yaml"
     params:
         arguments=report_arguments,
-        python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
-        code=CODE["report"],
+        python=PYTHON,  # papermill and nbconvert of the .venv, whether or not on PATH
+        code=report_code,
     shell:
         REPORT_SHELL
 
 
 rule orbits_report:
+    """The executed periodic-motions report of orbits entry {orbits}, and its HTML."""
     input:
         unpack(orbits_report_inputs),
     output:
         ipynb="results/reports/orbits/{orbits}/periodic_motions.ipynb",
         html="results/reports/orbits/{orbits}/periodic_motions.html",
-        summary=report("results/reports/orbits/{orbits}/periodic_motions.summary.html",
-                       caption="../report/report.rst", category="orbits/{orbits}",
-                       labels={"figure": "report: periodic motions"}),
+        summary=report(
+            "results/reports/orbits/{orbits}/periodic_motions.summary.html",
+            caption="../report/report.rst",
+            category="orbits/{orbits}",
+            labels={"figure": "report: periodic motions"},
+        ),
     log:
         "results/logs/report/orbits/{orbits}.log",
     benchmark:
@@ -81,21 +89,25 @@ rule orbits_report:
         "../envs/vibroimpact.yaml"
     params:
         arguments=report_arguments,
-        python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
-        code=CODE["report"],
+        python=PYTHON,  # papermill and nbconvert of the .venv, whether or not on PATH
+        code=report_code,
     shell:
         REPORT_SHELL
 
 
 rule validation_report:
+    """The executed validation report {vreport}, and its HTML."""
     input:
         unpack(validation_report_inputs),
     output:
         ipynb="results/reports/validation/{vreport}.ipynb",
         html="results/reports/validation/{vreport}.html",
-        summary=report("results/reports/validation/{vreport}.summary.html",
-                       caption="../report/report.rst", category="validation",
-                       labels={"figure": "report: {vreport}"}),
+        summary=report(
+            "results/reports/validation/{vreport}.summary.html",
+            caption="../report/report.rst",
+            category="validation",
+            labels={"figure": "report: {vreport}"},
+        ),
     log:
         "results/logs/report/validation/{vreport}.log",
     benchmark:
@@ -108,8 +120,7 @@ rule validation_report:
         "../envs/vibroimpact.yaml"
     params:
         arguments=report_arguments,
-        python=PYTHON,      # papermill and nbconvert of the .venv, whether or not on PATH
-        quoted=quoted_campaign,     # README's campaign table (stability report)
-        code=CODE["report"],
+        python=PYTHON,  # papermill and nbconvert of the .venv, whether or not on PATH
+        code=report_code,
     shell:
         REPORT_SHELL

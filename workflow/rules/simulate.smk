@@ -1,4 +1,5 @@
 rule simulate_events:
+    """Impact statistics of the cells of one tile of study {study}."""
     input:
         noise=study_noise,
     output:
@@ -15,12 +16,13 @@ rule simulate_events:
         runtime=simulate_runtime("events"),
     params:
         block=study_block("events"),
-        code=CODE["simulate"],
+        code=script_code("simulate_events"),
     script:
         "../scripts/simulate_events.py"
 
 
 rule simulate_spectra:
+    """Response spectra of the cells of one tile of study {study}."""
     input:
         noise=study_noise,
     output:
@@ -37,12 +39,13 @@ rule simulate_spectra:
         runtime=simulate_runtime("spectra"),
     params:
         block=study_block("spectra"),
-        code=CODE["simulate"],
+        code=script_code("simulate_spectra"),
     script:
         "../scripts/simulate_spectra.py"
 
 
 rule simulate_trace:
+    """A stretch of the motion of study {study} (Figs. 3, 10)."""
     input:
         noise=study_noise,
     output:
@@ -59,12 +62,13 @@ rule simulate_trace:
         runtime=simulate_runtime("trace"),
     params:
         block=study_block("trace"),
-        code=CODE["simulate"],
+        code=script_code("simulate_trace"),
     script:
         "../scripts/simulate_trace.py"
 
 
 rule simulate_map:
+    """The motion map of one tile of study {study} (Fig. 15)."""
     input:
         noise=study_noise,
     output:
@@ -81,6 +85,6 @@ rule simulate_map:
         runtime=simulate_runtime("map"),
     params:
         block=study_block("map"),
-        code=CODE["simulate"],
+        code=script_code("simulate_map"),
     script:
         "../scripts/simulate_map.py"

@@ -7,31 +7,8 @@ localrules:
     draw_validation_figure,
 
 
-# Package sources each validation output depends on.
-VALIDATION_CODE = {
-    "work_precision": source_digest("validation/work_precision", "validation/peers",
-                                    "validation/reference", "impact", "_checks", "_files",
-                                    "pipeline/io", "pipeline/tasks"),
-    "stress": source_digest("validation/campaign", "validation/families",
-                            "validation/orbit_families", "validation/streaming",
-                            "validation/reference", "validation/compare", "validation/report",
-                            "impact", "orbits", "noise", "stats", "_checks", "_files",
-                            "pipeline/io", "pipeline/tasks"),
-    "figure": source_digest("plotting", "stats", "_files", "pipeline/io", "pipeline/tasks"),
-}
-
-# Each validation figure and the dataset it draws.
-VALIDATION_FIGURES = {
-    "work_precision": "results/validation/work_precision.nc",
-    "stress": "results/validation/stress_sample.nc",
-}
-
-# What `rule all` builds when validation.build is true (all_targets calls it: a fresh list each
-# call; a bound method rather than a function, so that this file holds rules only).
-validation_targets = [f"results/figures/{name}.png" for name in VALIDATION_FIGURES].copy
-
-
 rule measure_work_precision:
+    """The work-precision run: the simulator against its peers."""
     output:
         "results/validation/work_precision.nc",
     conda:
@@ -46,12 +23,13 @@ rule measure_work_precision:
         runtime=10,
     params:
         block=config["validation"]["work_precision"],
-        code=VALIDATION_CODE["work_precision"],
+        code=script_code("measure_work_precision"),
     script:
         "../scripts/measure_work_precision.py"
 
 
 rule sample_stress_families:
+    """A seeded quick sample of the stress families."""
     output:
         "results/validation/stress_sample.nc",
     conda:
@@ -66,18 +44,22 @@ rule sample_stress_families:
         runtime=10,
     params:
         block=config["validation"]["stress"],
-        code=VALIDATION_CODE["stress"],
+        code=script_code("sample_stress_families"),
     script:
         "../scripts/sample_stress_families.py"
 
 
 rule draw_validation_figure:
+    """Validation figure {validation_fig}, as PNG and PDF."""
     input:
         lookup(dpath="{validation_fig}", within=VALIDATION_FIGURES),
     output:
-        png=report("results/figures/{validation_fig}.png",
-                   caption="../report/validation_figure.rst", category="validation",
-                   labels={"figure": "{validation_fig}"}),
+        png=report(
+            "results/figures/{validation_fig}.png",
+            caption="../report/validation_figure.rst",
+            category="validation",
+            labels={"figure": "{validation_fig}"},
+        ),
         pdf="results/figures/{validation_fig}.pdf",
     wildcard_constraints:
         validation_fig="|".join(VALIDATION_FIGURES),
@@ -92,6 +74,6 @@ rule draw_validation_figure:
         mem_mb=BASE_MEM_MB,
         runtime=5,
     params:
-        code=VALIDATION_CODE["figure"],
+        code=script_code("draw_validation_figure"),
     script:
         "../scripts/draw_validation_figure.py"

@@ -226,6 +226,14 @@ def markdown_table(path, header):
     return pd.DataFrame(rows[1:], columns=rows[0])
 
 
+def csv_table(path):
+    """A CSV table (e.g. ``notebooks/stress_campaign.csv``, the full stress campaign) as a
+    DataFrame of strings, empty cells as ``""``."""
+    import pandas as pd
+
+    return pd.read_csv(path, dtype=str, keep_default_na=False)
+
+
 def work_precision_summary(ds):
     """Per play and method of the work-precision dataset (``results/validation/
     work_precision.nc``): the simulator's error against the round-off level, and each peer's

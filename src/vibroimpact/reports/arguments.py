@@ -1,0 +1,73 @@
+"""The papermill arguments of the report notebooks (``notebooks/*.ipynb``).
+
+The workflow's report rules pass every parameter of a notebook's ``parameters`` cell with
+``-p``: the paths of the rule's inputs, and for a study its name, forcing amplitude, the
+1/beta_f its density findings read and the plays its density figures draw. Plain values in,
+a string out: nothing here knows Snakemake.
+"""
+import shlex
+
+__all__ = ["DENSITY_INV_BETA", "REPORT_PARAMETERS", "nearest", "notebook_parameters",
+           "papermill_arguments", "study_report_kind"]
+
+#: The parameters of each notebook, in its `parameters` cell; each is passed with -p.
+REPORT_PARAMETERS = {
+    "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
+    "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
+                        "figures", "amplitude", "inv_beta", "density_delta"),
+    "periodic_motions": ("name", "orbits", "map", "figures"),
+    "performance": ("work_precision", "figures"),
+    "stability": ("stress", "campaign", "figures"),
+}
+
+#: The 1/beta_f of the paper's densities under harmonic plus random force (Figs. 13, 14:
+#: tau/1.1); a study's report reads the value of its grid nearest to it.
+DENSITY_INV_BETA = 1.1
+
+
+def study_report_kind(entry):
+    """The notebook of a study's report: random force alone, or harmonic plus random."""
+    return "harmonic_random" if float(entry.get("amplitude", 0.0)) != 0.0 else "random_force"
+
+
+def nearest(values, target):
+    """The value of ``values`` nearest to ``target`` (the first of two as near)."""
+    return min(values, key=lambda v: abs(v - target))
+
+
+def notebook_parameters(notebook, inputs, study=None, entry=None, inv_beta=(), orbits=None):
+    """``{name: value}`` of every parameter of ``notebook`` (a key of REPORT_PARAMETERS).
+
+    Parameters
+    ----------
+    notebook : str
+        The notebook's name.
+    inputs : mapping
+        The rule's named inputs, paths; ``figures`` a list of paths, joined by spaces.
+    study, entry : str and mapping, optional
+        A study report's study and its config entry.
+    inv_beta : sequence of float
+        The study's 1/beta_f grid.
+    orbits : str, optional
+        An orbits report's entry name.
+
+    Returns
+    -------
+    dict
+        Each parameter as a string; ``""`` for a dataset the study does not have.
+    """
+    given = {name: " ".join(value) if name == "figures" else str(value)
+             for name, value in inputs.items()}
+    if study is not None:
+        given.update(study=study, amplitude=float(entry.get("amplitude", 0.0)),
+                     inv_beta=nearest([float(v) for v in inv_beta], DENSITY_INV_BETA),
+                     density_delta=" ".join(str(float(d))
+                                            for d in entry.get("density_delta") or ()))
+    if orbits is not None:
+        given["name"] = orbits
+    return {name: str(given.get(name, "")) for name in REPORT_PARAMETERS[notebook]}
+
+
+def papermill_arguments(parameters):
+    """``-p name value`` for each parameter, quoted for a shell."""
+    return " ".join(f"-p {name} {shlex.quote(value)}" for name, value in parameters.items())
