@@ -187,3 +187,17 @@ def test_a_per_figure_listed_by_name_alone_is_drawn_at_every_grid_value():
     one = {"inv_beta": {"start": 1.1, "stop": 1.1, "step": 0.1}, "figures": ["fig12"]}
     assert figures.figure_targets(one) == ["fig12"]
     assert figures.figure_options(one, "fig12")["inv_beta"] == 1.1
+
+
+def test_every_study_key_reaches_the_jobs_that_read_it():
+    # a key that no job's params carry is silently ignored by the jobs (rebound_floor was)
+    from vibroimpact.pipeline.study import JOB_KEYS
+
+    schema = yaml.safe_load((ROOT / "config" / "schema.yaml").read_text())
+    keys = set(schema["$defs"]["study"]["properties"])
+    by_jobs = set().union(*JOB_KEYS.values())
+    by_figures = {key for fig in figures.FIGURES.values() for key in fig.get("options", ())}
+    before_jobs = {"rms", "seed"}           # the sweep expansion makes them a noise record
+    by_reports = {"figures", "report_with"}
+    assert keys == by_jobs | by_figures | before_jobs | by_reports
+    assert not by_jobs & by_figures         # a figure option reruns no simulation

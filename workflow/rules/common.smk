@@ -15,7 +15,7 @@ from types import SimpleNamespace
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.provenance import code_digest
-from vibroimpact.pipeline.study import Study, orbit_rows
+from vibroimpact.pipeline.study import JOB_KEYS, Study, orbit_rows
 from vibroimpact.reports import arguments
 
 
@@ -43,22 +43,13 @@ def script_code(rule):
 
 # --- config blocks --------------------------------------------------------------------------
 
-# Config keys each job reads from a study entry (nothing else of the entry reaches its params).
-_PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size", "sweep")
-_READS = {
-    "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins"),
-    "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map"),
-    "spectra": _PHYSICS + ("spectra",),
-    "trace": _PHYSICS + ("trace",),
-}
-
 
 def study_block(kind):
     """The part of ``studies[{study}]`` that a ``kind`` job reads."""
 
     def block(wildcards):
         entry = config["studies"][wildcards.study]
-        return {key: entry[key] for key in _READS[kind] if key in entry}
+        return {key: entry[key] for key in JOB_KEYS[kind] if key in entry}
 
     return block
 
@@ -404,4 +395,5 @@ def simulate_runtime(kind):
         grid = "events" if kind == "map" else kind
         cells = len(STUDIES[wildcards.study].tile(int(wildcards.tile), grid))
         return costs.simulate_runtime_min(cells, steps)
+
     return runtime

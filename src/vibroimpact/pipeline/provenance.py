@@ -85,10 +85,12 @@ def provenance(config_block, seed=None):
     """
     from datetime import datetime, timezone
 
-    from vibroimpact import PAPER_REFERENCE, __version__
+    # the function, not the lazy ``__version__``: a code digest follows a named function,
+    # while a name that only the package's ``__getattr__`` knows reaches all of it
+    from vibroimpact import PAPER_REFERENCE, _version
 
     commit, dirty = git_state()
-    attrs = dict(package_version=__version__, git_commit=commit, git_dirty=dirty,
+    attrs = dict(package_version=_version(), git_commit=commit, git_dirty=dirty,
                  config=config_text(config_block), config_digest=config_digest(config_block),
                  created=datetime.now(timezone.utc).isoformat(timespec="seconds"),
                  paper_reference=PAPER_REFERENCE)
@@ -254,8 +256,8 @@ class _Graph:
         tables = {fact[1] for stmt in getter for fact in module.facts[id(stmt)]
                   if fact[0] == "name"} & set(module.units)
         for stmt in (s for table in sorted(tables) for s in module.units[table]):
-            if not isinstance(stmt.value, ast.Dict):
-                continue
+            if not isinstance(getattr(stmt, "value", None), ast.Dict):
+                continue    # a function or an import the getter calls: not a table
             for key, value in zip(stmt.value.keys, stmt.value.values):
                 if isinstance(key, ast.Constant) and key.value == attr \
                         and isinstance(value, ast.Constant) and isinstance(value.value, str):
@@ -298,13 +300,22 @@ class _Graph:
 
     def _dynamic_import(self, module, call, stmt):
         """``importlib.import_module(<not a constant>)`` or ``getattr(<module>, <not a
-        constant>)``: the modules named by the strings of the tables ``stmt`` reads (a
-        lazy ``__getattr__``), else every module of the package."""
+        constant>)``: the modules under the constant prefix of an f-string name, else those
+        named by the strings of the tables ``stmt`` reads (a lazy ``__getattr__``), else
+        every module of the package."""
         if isinstance(call.func, ast.Name) and call.func.id == "getattr":
             base = self._resolve(module, call.args[0])
             if base is None:
                 return []
             return [(self.modules[base], unit) for unit in self.modules[base].units]
+        arg = call.args[0]
+        if isinstance(arg, ast.JoinedStr) and arg.values and isinstance(arg.values[0],
+                                                                         ast.Constant):
+            # import_module(f"vibroimpact.plotting.{name}"): the modules under that prefix
+            prefix = arg.values[0].value
+            found = [m for m in self.modules if m.startswith(prefix)]
+            if found:
+                return [part for m in found for part in self._top(m)]
         tables = {n.id for n in ast.walk(stmt) if isinstance(n, ast.Name)} & set(module.units)
         names = [c.value for t in tables for s in module.units[t] for c in ast.walk(s)
                  if isinstance(c, ast.Constant) and isinstance(c.value, str)]

@@ -13,6 +13,21 @@ import numpy as np
 GRID_DECIMALS = 10
 
 
+#: The keys of a study entry each kind of job reads (the workflow passes exactly these to the
+#: job as its params, so changing one reruns the jobs that read it and no other). Every other
+#: key of a study is read before any job (``rms``, ``seed``: its noise record, by the sweep
+#: expansion), by a figure (``figures`` and the figure options of `pipeline.figures`) or by
+#: its report (``report_with``); a test holds the schema's study keys to exactly these.
+_PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size", "sweep")
+JOB_KEYS = {
+    "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins",
+                          "rebound_floor"),
+    "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map"),
+    "spectra": _PHYSICS + ("spectra",),
+    "trace": _PHYSICS + ("trace",),
+}
+
+
 def grid_size(spec):
     """Number of values of a grid, without building it (a huge grid is refused on this count).
 

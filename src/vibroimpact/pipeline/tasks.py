@@ -12,7 +12,6 @@ import sys
 
 from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
-from vibroimpact.pipeline.figures import drawing_function, figure_variant
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import Study, grid_values, map_cap_steps, orbit_rows
 
@@ -270,7 +269,10 @@ def figure(target, inputs, out_png, options):
     ``target`` is ``fig07`` or ``fig13-1`` (`vibroimpact.pipeline.figures`); ``options``
     come from the owner's config entry through the figure table (`figure_options`).
     """
+    # here, not at the top: a code digest follows what a module's top level imports, and
+    # only the figure jobs reach the drawing functions
     from vibroimpact import plotting
+    from vibroimpact.pipeline.figures import drawing_function, figure_variant
 
     draw = drawing_function(figure_variant(target)[0])
     log.info("drawing %s from %s with %s", target, inputs, options)
