@@ -2,8 +2,9 @@
 # Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the fast suite, the slow (stress/convergence) suite, the
 # end-to-end workflow and SLURM suites (one session: the test config is built once; the
-# SLURM suite installs and starts a one-node cluster, as root), the import-layer contract and
-# the format of the Snakemake files (snakefmt).
+# SLURM suite installs and starts a one-node cluster, as root), the linter (ruff: the rules
+# in pyproject.toml), the import-layer contract and the format of the Snakemake files
+# (snakefmt); `make lint` runs Snakemake's linter, ruff and snakefmt.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -36,6 +37,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q
 	$(BIN)/python -m pytest -q -m slow
 	$(BIN)/python -m pytest -q -m "workflow or slurm"
+	$(BIN)/ruff check src tests benchmarks workflow/scripts
 	$(BIN)/lint-imports
 	$(BIN)/snakefmt --check Snakefile workflow/
 
@@ -44,6 +46,7 @@ bench: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/snakemake --lint
+	$(BIN)/ruff check src tests benchmarks workflow/scripts
 	$(BIN)/snakefmt --check Snakefile workflow/
 
 clean:

@@ -31,7 +31,6 @@ Usage::
 import argparse
 import hashlib
 import json
-import math
 import os
 import statistics
 import subprocess
@@ -290,7 +289,7 @@ def main(argv=None):
     print("spread (%) = (max - min) / median of the per-round medians; B/A best = ratio of the "
           "fastest single calls")
     print()
-    for name, text, paired, a, b, r_best in verdicts:
+    for name, _text, paired, a, b, _r_best in verdicts:
         print(f"{name}: paired per-round B/A {min(paired):.3f} .. {max(paired):.3f} "
               f"(median {statistics.median(paired):.3f}); cpu-time medians "
               f"B/A {b['cpu_median'] / a['cpu_median']:.3f}")

@@ -1,4 +1,5 @@
-"""Cost of the Fig. 15 probability map: where its CPU time goes, and against a peer in the same run.
+"""Cost of the Fig. 15 probability map: where its CPU time goes, and against a peer in the same
+run.
 
 Reads a built map (``results/datasets/motion_map_map.nc``, rule ``simulate_map``) and the
 noise record its cells ran over, then prints:
@@ -37,19 +38,19 @@ import os
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # before numba loads: one thread, as the jobs
 
-import argparse  # noqa: E402
-import math  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
+import argparse
+import math
+import sys
+import time
 
-import numpy as np  # noqa: E402
-import xarray as xr  # noqa: E402
-from scipy.optimize import nnls  # noqa: E402
+import numpy as np
+import xarray as xr
+from scipy.optimize import nnls
 
-from vibroimpact import simulate  # noqa: E402
-from vibroimpact import stats  # noqa: E402
-from vibroimpact.pipeline.cells import motion_map_cell  # noqa: E402
-from vibroimpact.pipeline.io import read_noise  # noqa: E402
+from vibroimpact import simulate
+from vibroimpact import stats
+from vibroimpact.pipeline.cells import motion_map_cell
+from vibroimpact.pipeline.io import read_noise
 
 SEED = 19741015
 DEFAULT_BOX = (1.0, 1.5, -0.5, 0.5)  # inv_beta lo, hi, delta lo, hi
@@ -118,11 +119,11 @@ def summary(ds):
     quantile_row("cpu_time", ds["cpu_time"], "s")
     quantile_row("n_impacts", _impacts(ds), "impacts (after the transient)")
     if capped.any():
+        sim_share = (float(ds['simulated_time'].where(capped).sum())
+                     / float(ds['simulated_time'].sum()))
         print(f"the {int(capped.sum())} capped cells (reached == 0) hold "
               f"{float(ds['cpu_time'].where(capped).sum()) / float(ds['cpu_time'].sum()):.1%} of "
-              f"the CPU time and "
-              f"{float(ds['simulated_time'].where(capped).sum()) / float(ds['simulated_time'].sum()):.1%}"
-              f" of the simulated time")
+              f"the CPU time and {sim_share:.1%} of the simulated time")
 
 
 def _blocks(n, k):
@@ -139,7 +140,8 @@ def block_table(ds, var, title, scale, fmt):
     print(f"{'inv_beta | delta':<16}" + "".join(f"{s:>{width}}" for s in labels))
     for r in rows:
         cells = [np.median(values[np.ix_(r, c)]) for c in cols]
-        print(f"{f'{ib[r[0]]:g}..{ib[r[-1]]:g}':<16}" + "".join(f"{v:>{width}{fmt}}" for v in cells))
+        print(f"{f'{ib[r[0]]:g}..{ib[r[-1]]:g}':<16}"
+              + "".join(f"{v:>{width}{fmt}}" for v in cells))
 
 
 def fit_cost(seconds, steps, impacts):
@@ -172,9 +174,9 @@ def cost_model(ds, dt):
     impacts = _impacts(ds).values.ravel()
     cpu = ds["cpu_time"].values.ravel()
     fit = fit_cost(cpu, steps, impacts)
-    print(f"\n== 3. Cost model of the stored CPU times, all {cpu.size} cells: cpu_time ~ a * steps "
-          f"+ b * n_impacts (NNLS), steps = record_end / dt (dt = {dt:g}; transient included), "
-          f"n_impacts after the transient ==")
+    print(f"\n== 3. Cost model of the stored CPU times, all {cpu.size} cells: cpu_time ~ a * "
+          f"steps + b * n_impacts (NNLS), steps = record_end / dt (dt = {dt:g}; transient "
+          f"included), n_impacts after the transient ==")
     print_fit_header()
     print_fit("map jobs (stored cpu_time)", fit)
     print(f"total: {steps.sum():.4g} steps, {impacts.sum():.4g} impacts, "
@@ -276,17 +278,17 @@ def peer(ds, samples, dt, kw, n_cells, repeats, seed):
     print_fit("simulate (plain, fixed length)", fit_sim)
     print_fit("motion_map_cell (this run)", fit_map)
     print_fit("motion_map_cell (stored cpu_time)", fit_stored)
-    print(f"total CPU on the sample: simulate {sim.sum():.3f} s, motion_map_cell {cmap.sum():.3f} s"
-          f": ratio map cell / simulate = {cmap.sum() / sim.sum():.3f}; median per-cell ratio "
-          f"{np.median(cmap / sim):.3f}")
+    print(f"total CPU on the sample: simulate {sim.sum():.3f} s, motion_map_cell "
+          f"{cmap.sum():.3f} s: ratio map cell / simulate = {cmap.sum() / sim.sum():.3f}; "
+          f"median per-cell ratio {np.median(cmap / sim):.3f}")
     print(f"this run's motion_map_cell vs the stored cpu_time of the same cells: "
           f"{cmap.sum():.3f} s / {stored.sum():.3f} s = {cmap.sum() / stored.sum():.3f}")
     n = len(rows)
-    print(f"reproduction: rerun cells with the stored record_end {sum(r['same_end'] for r in rows)}"
-          f"/{n}, stored n_impacts {sum(r['same_impacts'] for r in rows)}/{n}, stored "
-          f"probabilities bit for bit {sum(r['same_prob'] for r in rows)}/{n}; simulate's impacts "
-          f"after the transient == the cell's n_impacts {sum(r['sim_matches_cell'] for r in rows)}"
-          f"/{n}")
+    print(f"reproduction: rerun cells with the stored record_end "
+          f"{sum(r['same_end'] for r in rows)}/{n}, stored n_impacts "
+          f"{sum(r['same_impacts'] for r in rows)}/{n}, stored probabilities bit for bit "
+          f"{sum(r['same_prob'] for r in rows)}/{n}; simulate's impacts after the transient == "
+          f"the cell's n_impacts {sum(r['sim_matches_cell'] for r in rows)}/{n}")
     return fit_sim, fit_map
 
 
@@ -315,9 +317,9 @@ def peer_revision(ds, noise_path, kw, rev, stride):
         try:
             for name, src in (("this tree", root / "src"), (f"revision {rev}", where / "src")):
                 env = dict(os.environ, PYTHONPATH=str(src))
-                out = subprocess.run([sys.executable, str(root / "benchmarks" / "map_cells_cpu.py")],
-                                     input=job, capture_output=True, text=True, env=env,
-                                     check=True)
+                script = str(root / "benchmarks" / "map_cells_cpu.py")
+                out = subprocess.run([sys.executable, script], input=job,
+                                     capture_output=True, text=True, env=env, check=True)
                 results[name] = json.loads(out.stdout)
         finally:
             subprocess.run(["git", "worktree", "remove", "--force", str(where)], cwd=root,
@@ -381,8 +383,8 @@ def scaling(ds, samples, dt, kw, box):
     print(f"{f'steps halved {ib2.size} x {de2.size}':<26} {n2:>7d} {cpu2:>9.3f} "
           f"{cpu2 / n2 * 1e3:>9.3f} {imp2:>11d}")
     print(f"CPU ratio refined / map resolution: {cpu2 / cpu1:.3f} (ideal 4.0 for 4x cells; this "
-          f"box has {n2 / n1:.3f}x cells, since halving the steps of a closed grid of n points gives "
-          f"2n - 1); CPU per cell ratio {(cpu2 / n2) / (cpu1 / n1):.3f} (ideal 1.0)")
+          f"box has {n2 / n1:.3f}x cells, since halving the steps of a closed grid of n points "
+          f"gives 2n - 1); CPU per cell ratio {(cpu2 / n2) / (cpu1 / n1):.3f} (ideal 1.0)")
 
 
 def parse_box(text):

@@ -27,16 +27,16 @@ import os
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # before numba loads: one thread for everybody
 
-import argparse  # noqa: E402
-import math  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+import argparse
+import math
+import time
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-from vibroimpact import simulate  # noqa: E402
-from vibroimpact.validation import peers  # noqa: E402
-from vibroimpact.validation.work_precision import SIMULATOR, work_precision  # noqa: E402
+from vibroimpact import simulate
+from vibroimpact.validation import peers
+from vibroimpact.validation.work_precision import SIMULATOR, work_precision
 
 ZETA, EPS, DT = 0.05, 0.5, 0.1
 DELTAS = (1.0, 0.0, -0.5)
@@ -80,7 +80,7 @@ def throughput(noise, repeats):
     t_sim = n_steps * DT
     rows = {}
     for delta in (DELTA_FREE,) + DELTAS:
-        seconds, cpu, res = best_times(lambda: run_simulate(delta, noise), repeats)
+        seconds, cpu, res = best_times(lambda delta=delta: run_simulate(delta, noise), repeats)
         rows[delta] = dict(seconds=seconds, cpu=cpu, n_impacts=res.n_impacts,
                            n_chatter=res.n_chatter, contact=res.contact_time,
                            cost=seconds / t_sim, result=res)
@@ -104,7 +104,8 @@ def throughput(noise, repeats):
               f"{row['contact'] / t_sim:>8.3f} {per_impact:>10.1f} {marginal:>19.1f} "
               f"{cpu_marginal:>12.1f} {row['cost']:>16.3e}")
     print(f"{'floor':>8} {floor_seconds:>9.4f} {floor_seconds / n_steps * 1e9:>8.2f} "
-          f"{floor_cpu / n_steps * 1e9:>11.2f}   (bare 2x2 recurrence with forcing terms, no wall)")
+          f"{floor_cpu / n_steps * 1e9:>11.2f}   "
+          f"(bare 2x2 recurrence with forcing terms, no wall)")
     print("contact = fraction of time resting on the wall; marginal ns/impact = (time at delta "
           "- time with no impact) / impacts; cpu = time.process_time, for a shared machine")
     return rows, floor_seconds, floor_cpu

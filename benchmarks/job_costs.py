@@ -76,8 +76,8 @@ def main():
                 now, peer = cost.values()
                 print(f"{kind:24s} {now:14.2f} {peer:10.2f} {now / peer:7.2f}")
         finally:
-            subprocess.run(["git", "worktree", "remove", "--force", str(sides[f"peer {args.peer}"])],
-                           cwd=ROOT, capture_output=True)
+            subprocess.run(["git", "worktree", "remove", "--force",
+                            str(sides[f"peer {args.peer}"])], cwd=ROOT, capture_output=True)
 
 
 if __name__ == "__main__":

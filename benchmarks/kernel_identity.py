@@ -27,10 +27,10 @@ import os
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "2")  # the map's rows: same threads both sides
 
-import sys  # noqa: E402
-from pathlib import Path  # noqa: E402
+import sys
+from pathlib import Path
 
-import numpy as np  # noqa: E402
+import numpy as np
 
 SEED = 19740072
 N_STEPS = 200_000

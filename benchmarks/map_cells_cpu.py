@@ -15,15 +15,15 @@ import os
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")  # before numba loads: one thread, as the jobs
 
-import json  # noqa: E402
-import sys  # noqa: E402
-import time  # noqa: E402
+import json
+import sys
+import time
 
-import numpy as np  # noqa: E402
+import numpy as np
 
-import vibroimpact  # noqa: E402
-from vibroimpact.pipeline.cells import motion_map_cell  # noqa: E402
-from vibroimpact.pipeline.io import read_noise  # noqa: E402
+import vibroimpact
+from vibroimpact.pipeline.cells import motion_map_cell
+from vibroimpact.pipeline.io import read_noise
 
 
 def main():

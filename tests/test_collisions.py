@@ -181,7 +181,8 @@ def test_no_collision_statistic_depends_on_an_event_tolerance(tmp_path):
         other = _run(factors, tmp_path, tag)
         expected = [getattr(kernels, n) * f for n, f in sorted(factors.items())]
         assert np.allclose(other["applied"], expected, rtol=1e-12), tag
-        bound = max(kernels.CHATTER_TIME_TOL, kernels.CHATTER_TIME_TOL * factors["CHATTER_TIME_TOL"])
+        bound = max(kernels.CHATTER_TIME_TOL,
+                    kernels.CHATTER_TIME_TOL * factors["CHATTER_TIME_TOL"])
         for key, value in base.items():
             if key == "applied" or key.endswith("n_impacts_resolved"):
                 continue
@@ -189,7 +190,8 @@ def test_no_collision_statistic_depends_on_an_event_tolerance(tmp_path):
             if name == "stick_time_mean":
                 assert abs(other[key] - value) <= bound, (tag, key)
             elif name == "contact_fraction":       # <= bound per collision over the record
-                assert abs(other[key] - value) <= bound * base[f"{case}/collision_rate"], (tag, key)
+                assert abs(other[key] - value) <= bound * base[f"{case}/collision_rate"], \
+                    (tag, key)
             else:
                 assert np.array_equal(other[key], value, equal_nan=True), (tag, key)
         # the tolerances took effect: the chatter cells resolved other numbers of impacts

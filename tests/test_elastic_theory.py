@@ -40,7 +40,8 @@ def _batch(x):
 
 def _close(measured, stderr, expected, name):
     tol = 4.0 * stderr + SYSTEMATIC * abs(expected)
-    assert abs(measured - expected) <= tol, f"{name}: {measured:.5g} vs {expected:.5g} (tol {tol:.3g})"
+    assert abs(measured - expected) <= tol, \
+        f"{name}: {measured:.5g} vs {expected:.5g} (tol {tol:.3g})"
 
 
 @pytest.mark.parametrize("delta_over_sigma", [-0.5, 0.0, 1.0])

@@ -156,12 +156,12 @@ def test_fig16_names_every_reason_in_its_region(figures):
 
 def test_fig16_thin_domain_shows_its_colour(figures):
     ax = figures["fig16"].axes[1]
-    xe, ye = cell_edges(INV_BETA), cell_edges(DELTA)
+    ye = cell_edges(DELTA)
     row = THIN[1].start
     edges = [c for c in ax.collections if c.get_gid() == "stable-edge"]
     assert edges
     for c in edges:
-        for (x0, y0), (x1, y1) in c.get_segments():
+        for (_x0, y0), (_x1, y1) in c.get_segments():
             assert not (min(y0, y1) >= ye[row] - 1e-9 and max(y0, y1) <= ye[row + 1] + 1e-9), \
                 "an edge line covers the one-cell-wide domain"
     meshes = [c for c in ax.collections if c.get_cmap().name == "viridis_r"]

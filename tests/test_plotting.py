@@ -32,7 +32,8 @@ COMMON = dict(noise="band", zeta=0.05, eps=0.5, transient=100.0, tile_size=100, 
 RANDOM = dict(COMMON, amplitude=0.0, delta=[-1.0, -0.5, 0.0, 0.5, 1.0, 2.0, 3.0, 4.5, 6.0],
               trace=dict(delta=0.0, t_end=60.0))
 HARMONIC_INV_BETA = [0.8, 1.1, 1.4]
-HARMONIC = dict(COMMON, amplitude=1.0, inv_beta=HARMONIC_INV_BETA, delta=[-0.5, 0.0, 0.5, 1.0, 2.0],
+HARMONIC = dict(COMMON, amplitude=1.0, inv_beta=HARMONIC_INV_BETA,
+                delta=[-0.5, 0.0, 0.5, 1.0, 2.0],
                 trace=dict(delta=0.0, t_end=60.0, inv_beta=1 / 1.1))
 #: Deliberately off-grid, to exercise the nearest-delta selection (-> 2, 0.5, 0, -0.5).
 DENSITY_DELTA = [1.9, 0.52, 0.0, -0.5]
@@ -168,7 +169,7 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
     labels = _legend_texts(ax)
     assert len(lines) == len(DENSITY_DELTA)
     t = t_quantile(20)
-    for line, label, d in zip(lines, labels, [2.0, 0.5, 0.0, -0.5]):   # nearest, largest first
+    for _line, label, d in zip(lines, labels, [2.0, 0.5, 0.0, -0.5]):   # nearest, largest first
         cell = events.sel(delta=d)
         assert label.split("=")[1].split()[0] == f"{d:g}"
         assert f"({int(cell['n_collisions']):,} collisions" in label
@@ -239,7 +240,8 @@ def test_fig09_draws_rice_asymptotes_of_the_wall_free_response(data):
     """Rice's rate checked against its closed form at one point, independent of the code:
     sigma_x = sigma_v = sqrt(S0 / 4 zeta) for white noise of two-sided level S0."""
     # the aggregation stores the wall-free std's for the random force alone, not with a sine
-    assert data["events"].attrs["linear_sigma_x"] > 0 and data["events"].attrs["linear_sigma_v"] > 0
+    assert data["events"].attrs["linear_sigma_x"] > 0
+    assert data["events"].attrs["linear_sigma_v"] > 0
     assert "linear_sigma_x" not in data["events_h"].attrs
     events = data["events"].copy()
     zeta, s0 = 0.05, 0.02
@@ -397,7 +399,8 @@ def test_every_figure_states_its_parameters(data):
     for fig in figs:
         text = _title(fig)
         assert r"$\zeta$ = 0.05" in text and r"$\varepsilon$ = 0.5" in text
-        assert "rms$_r$ = 0.5" in text and "band-limited white" in text and r"$\beta_c$ = 4" in text
+        assert "rms$_r$ = 0.5" in text and "band-limited white" in text
+        assert r"$\beta_c$ = 4" in text
         assert "band_limited" not in text and "noise '" not in text     # no config keys
     assert r"$\delta$ = 0" in _title(figs[0])
 

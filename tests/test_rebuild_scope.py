@@ -1,4 +1,5 @@
-"""Rebuild scope: after a build, an edit reruns exactly the jobs it touches (README, "What reruns").
+"""Rebuild scope: after a build, an edit reruns exactly the jobs it touches
+(README, "What reruns").
 
 The test config is built once in a temporary git repository holding the working tree; each case
 edits one thing there and reads the job list of ``snakemake -n``. The package is imported from

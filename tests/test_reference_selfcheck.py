@@ -1,4 +1,5 @@
-"""Self-checks of the mpmath reference (vibroimpact.validation.reference), independent of the package.
+"""Self-checks of the mpmath reference (vibroimpact.validation.reference), independent of the
+package.
 
 The reference is checked against scipy (DOP853 restarted at every sample and impact, and
 ``scipy.signal.lsim``), against its own float64-like evaluation (dps=16), and against closed
@@ -12,7 +13,8 @@ from mpmath import mp, mpf
 from scipy.integrate import solve_ivp
 from scipy.signal import lsim
 
-from vibroimpact.validation.reference import agreeing_prefix, comparable_impacts, linear_peak, reference_impacts
+from vibroimpact.validation.reference import (agreeing_prefix, comparable_impacts, linear_peak,
+                                              reference_impacts)
 
 ZETA, EPS, DT = 0.05, 0.5, 0.1
 

@@ -9,7 +9,6 @@ from pathlib import Path
 import re
 
 import nbformat
-import numpy as np
 import pytest
 import xarray as xr
 

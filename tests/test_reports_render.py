@@ -12,7 +12,6 @@ report of it.
 import base64
 from html.parser import HTMLParser
 import json
-from pathlib import Path
 import re
 import subprocess
 import sys

@@ -1,4 +1,5 @@
-"""vibroimpact.simulate against the independent mpmath reference (vibroimpact.validation.reference).
+"""vibroimpact.simulate against the independent mpmath reference
+(vibroimpact.validation.reference).
 
 Every tolerance is stated where it is used, with the reason for its size. Heavier variants
 of the same checks are marked ``slow``.

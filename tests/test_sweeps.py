@@ -246,7 +246,8 @@ def test_sweep_attrs_of_an_expanded_block_only():
     attrs = provenance.provenance(config["studies"]["eps_sweep_4"], 7)
     assert {k: attrs[k] for k in attrs if k.startswith("sweep")} == {
         "sweep": "eps_sweep", "sweep_index": 4, "sweep_eps": 0.8, "sweep_rms": 0.3}
-    assert not any(k.startswith("sweep") for k in provenance.provenance(PAPER["studies"]["random"]))
+    attrs = provenance.provenance(PAPER["studies"]["random"])
+    assert not any(k.startswith("sweep") for k in attrs)
 
 
 SMALL = yaml.safe_load(textwrap.dedent("""\

@@ -26,7 +26,8 @@ _LAZY = {
     "orbit_map": "vibroimpact.orbits.api",
 }
 
-__all__ = [*_LAZY, "PAPER_REFERENCE", "__version__"]
+# PLE0604: ruff cannot see that the keys of _LAZY are strings
+__all__ = [*_LAZY, "PAPER_REFERENCE", "__version__"]  # noqa: PLE0604
 
 
 def _version():

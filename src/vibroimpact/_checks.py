@@ -56,7 +56,8 @@ def real(name, value, *, low=None, high=None, low_open=False, high_open=False):
 
 
 def integer(name, value, *, low=None, high=None):
-    """``value`` as an int within ``[low, high]``; integral floats (YAML's ``1.0e8``) are accepted."""
+    """``value`` as an int within ``[low, high]``; integral floats (YAML's ``1.0e8``) are
+    accepted."""
     message = f"{name} must be an integer{_range_text(low, high, False, False)}, got {value!r}"
     if isinstance(value, (bool, np.bool_)):
         raise ValueError(message)

@@ -25,12 +25,13 @@ Every kernel is compiled with ``njit(cache=True, error_model="numpy")``; the cac
 stamped with all of those modules (:mod:`vibroimpact.impact._jit`), so an edit of any one of
 them recompiles the kernels.
 """
-from vibroimpact.impact.events import (chatter_tail, first_contact, force_tol, leave_wall,
-                                       push_recovery, release_time, safe_step, stays_on_wall,
-                                       tolg_wall)
-from vibroimpact.impact.layout import *  # noqa: F401,F403  (the named slots and codes)
-from vibroimpact.impact.motion import (expm1, phase, push_eval, seg_eval, segment, sincos,
-                                       two_prod)
-from vibroimpact.impact.stepping import run_steps, slow_step
-from vibroimpact.impact.tolerances import *  # noqa: F401,F403  (every threshold)
+# every name below is a re-export: the kernel API, gathered for the driver (F401)
+from vibroimpact.impact.events import (  # noqa: F401
+    chatter_tail, first_contact, force_tol, leave_wall, push_recovery, release_time, safe_step,
+    stays_on_wall, tolg_wall)
+from vibroimpact.impact.layout import *  # noqa: F403  (the named slots and codes)
+from vibroimpact.impact.motion import (  # noqa: F401
+    expm1, phase, push_eval, seg_eval, segment, sincos, two_prod)
+from vibroimpact.impact.stepping import run_steps, slow_step  # noqa: F401
+from vibroimpact.impact.tolerances import *  # noqa: F403  (every threshold)
 

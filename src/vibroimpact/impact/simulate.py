@@ -136,7 +136,8 @@ def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, r
     beta = _checks.real("beta", beta, low=0.0, low_open=True)
     x0 = min(0.0, delta) if x0 is None else _checks.real("x0", x0)
     if x0 > delta:
-        raise ValueError(f"x0 must satisfy x0 <= delta (the mass lives in x <= delta), got x0={x0!r} > delta={delta!r}")
+        raise ValueError(f"x0 must satisfy x0 <= delta (the mass lives in x <= delta), "
+                         f"got x0={x0!r} > delta={delta!r}")
     v0 = _checks.real("v0", v0)
     if noise is not None:
         if getattr(noise, "ndim", 1) != 1 or len(noise) < 2:
@@ -147,7 +148,8 @@ def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, r
         t_end = (len(noise) - 1) * dt
     t_end = _checks.real("t_end", t_end, low=0.0, low_open=True)
     if noise is not None and t_end > (len(noise) - 1) * dt * (1.0 + 1e-12):
-        raise ValueError(f"t_end must not exceed (len(noise) - 1) * dt = {(len(noise) - 1) * dt!r}, got {t_end!r}")
+        raise ValueError(f"t_end must not exceed (len(noise) - 1) * dt = "
+                         f"{(len(noise) - 1) * dt!r}, got {t_end!r}")
     record_every = _checks.integer("record_every", record_every, low=0)
     chunk_size = _checks.integer("chunk_size", chunk_size, low=1)
     return zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size
@@ -164,7 +166,8 @@ def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
     P = np.empty(kernels.N_PARAMS)
     P[[kernels.P_ZETA, kernels.P_OMEGA, kernels.P_EPS, kernels.P_DELTA, kernels.P_DT]] = (
         zeta, omega, eps, delta, dt)
-    P[[kernels.P_A, kernels.P_BETA, kernels.P_AQ, kernels.P_PHI]] = amplitude, beta, amplitude * q, phi
+    P[[kernels.P_A, kernels.P_BETA, kernels.P_AQ, kernels.P_PHI]] = (
+        amplitude, beta, amplitude * q, phi)
     P[[kernels.P_COS_PHI, kernels.P_SIN_PHI]] = math.cos(phi), math.sin(phi)
     P[[kernels.P_BH_HI, kernels.P_BH_LO]] = bh_hi, bh_lo
     P[[kernels.P_M11, kernels.P_M12, kernels.P_M21, kernels.P_M22]] = (
@@ -218,7 +221,8 @@ def _raise_status(status, k, dt, r, k0, diag, P):
         raise ValueError(f"noise must be finite: noise[{bad}] = {float(r[bad - k0])!r}")
     if status == kernels.TOO_MANY_EVENTS:
         s, gap, v, mode, n_imp, n_stk = (float(d) for d in diag)    # layout.FT_FIELDS[1:]
-        delta, A, beta = (float(p) for p in (P[kernels.P_DELTA], P[kernels.P_A], P[kernels.P_BETA]))
+        delta, A, beta = (float(p)
+                          for p in (P[kernels.P_DELTA], P[kernels.P_A], P[kernels.P_BETA]))
         r0, r1 = float(r[k - k0]), float(r[k - k0 + 1])
         f0 = r0 + A * math.sin(beta * k * dt)
         f1 = r1 + A * math.sin(beta * (k + 1) * dt)
@@ -226,7 +230,8 @@ def _raise_status(status, k, dt, r, k0, diag, P):
             f"gave up in the force step [{k * dt!r}, {(k + 1) * dt!r}] (sample {k}) after "
             f"{kernels.STEP_HEADROOM - 2} events ({int(n_imp)} impacts, {int(n_stk)} sticking "
             f"starts and ends) without reaching its end: reached offset {s!r} with "
-            f"x - delta = {gap!r}, x' = {v!r}, {'resting on the wall' if mode == kernels.STUCK else 'free'}; "
+            f"x - delta = {gap!r}, x' = {v!r}, "
+            f"{'resting on the wall' if mode == kernels.STUCK else 'free'}; "
             f"force samples r = ({r0!r}, {r1!r}), f - delta at the step's ends = "
             f"({f0 - delta!r}, {f1 - delta!r}). Please report these inputs as a bug.")
 
@@ -273,7 +278,8 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
         final = k1 == n_full
         buf.grid_n[0] = 0
         buf.ftot[kernels.FT_CONTACT_TIME] = 0.0
-        parts = dict(imp_step=[], imp_off=[], imp_u=[], stk_step=[], stk_off=[], stk_kind=[], n_chatter=0)
+        parts = dict(imp_step=[], imp_off=[], imp_u=[], stk_step=[], stk_off=[], stk_kind=[],
+                     n_chatter=0)
         k = k0
         while k < k1:
             status, k = kernels.run_steps(r[k - k0 :], k, k1, state, P, buf.imp_step, buf.imp_off,
@@ -326,7 +332,8 @@ def _state_at(state, P, k):
     if Aq == 0.0:
         x, v = state[kernels.S_W], state[kernels.S_WV]
     else:
-        psi = kernels.phase(k, 0.0, P[kernels.P_BH_HI], P[kernels.P_BH_LO], beta) - P[kernels.P_PHI]
+        psi = (kernels.phase(k, 0.0, P[kernels.P_BH_HI], P[kernels.P_BH_LO], beta)
+               - P[kernels.P_PHI])
         x = state[kernels.S_W] + Aq * math.sin(psi)
         v = state[kernels.S_WV] + Aq * beta * math.cos(psi)
     if mode == kernels.WALL:
@@ -371,7 +378,8 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         ends.append(t_chunk)
         stick_open[0] = None
     n = int(buf.grid_n[0])
-    grid_time = (np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt if stride else np.empty(0)
+    grid_time = ((np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt
+                 if stride else np.empty(0))
     return SimulationResult(
         impact_time=imp_step * dt + imp_off,
         impact_velocity=imp_u,
@@ -442,8 +450,8 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
 
     Notes
     -----
-    Between samples and impacts the motion is the closed-form solution (docs/model.md, section 5; the
-    paper's eqs. 3-6); each impact is the smallest root of ``x - delta`` in its step, found
+    Between samples and impacts the motion is the closed-form solution (docs/model.md, section 5;
+    the paper's eqs. 3-6); each impact is the smallest root of ``x - delta`` in its step, found
     by a rigorous exclusion bound and refined to round-off, so grazing double crossings
     inside a step are caught. A chatter sequence is followed impact by impact until its
     remaining geometric tail is summed in closed form to within ``CHATTER_TIME_TOL``

@@ -74,7 +74,7 @@ class Reason(enum.IntEnum):
 
     STABLE = ok.REASON_STABLE              #: a stable admissible solution exists
     NO_SOLUTION = ok.REASON_NO_SOLUTION    #: no solution of eqs. (10)-(11) (paper: D, V, X)
-    INADMISSIBLE = ok.REASON_INADMISSIBLE  #: every solution has a flight crossing the wall (eq. 13)
+    INADMISSIBLE = ok.REASON_INADMISSIBLE  #: every solution's flight crosses the wall (eq. 13)
     UNSTABLE = ok.REASON_UNSTABLE          #: admissible solutions, none stable (eq. 22; paper: U)
 
     @property
@@ -85,7 +85,8 @@ class Reason(enum.IntEnum):
 _REASON_TEXT = {
     Reason.STABLE: "a stable admissible solution exists",
     Reason.NO_SOLUTION: "no solution of eqs. (10)-(11) with positive intervals and velocities",
-    Reason.INADMISSIBLE: "solutions exist but none is admissible (a flight crosses the wall, eq. 13)",
+    Reason.INADMISSIBLE: "solutions exist but none is admissible "
+                         "(a flight crosses the wall, eq. 13)",
     Reason.UNSTABLE: "admissible solutions exist but none is stable (eq. 22)",
 }
 #: ``{code: description}`` of `Reason` (kept for the datasets' attributes and old callers).

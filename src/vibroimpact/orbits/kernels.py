@@ -21,11 +21,12 @@ concept; this module gathers what :mod:`vibroimpact.orbits.api` and the tests us
 Every kernel is compiled with ``njit(cache=True)``; the cache is stamped with all of those
 modules (:mod:`vibroimpact.orbits._jit`), so an edit of any one of them recompiles the kernels.
 """
-from vibroimpact.orbits.domain_map import map_kernel
-from vibroimpact.orbits.flight import (flight, flight_max, harmonic_constants,
-                                       impact_map_jacobian, lam_of, monodromy, orbit_margin,
-                                       propagator)
-from vibroimpact.orbits.m1 import solve_m1
-from vibroimpact.orbits.newton import newton, uncertainty
-from vibroimpact.orbits.solve import solve_general, solve_type
-from vibroimpact.orbits.tolerances import *  # noqa: F401,F403  (every threshold)
+# every name below is a re-export: the kernel API, gathered for its callers (F401)
+from vibroimpact.orbits.domain_map import map_kernel  # noqa: F401
+from vibroimpact.orbits.flight import (  # noqa: F401
+    flight, flight_max, harmonic_constants, impact_map_jacobian, lam_of, monodromy, orbit_margin,
+    propagator)
+from vibroimpact.orbits.m1 import solve_m1  # noqa: F401
+from vibroimpact.orbits.newton import newton, uncertainty  # noqa: F401
+from vibroimpact.orbits.solve import solve_general, solve_type  # noqa: F401
+from vibroimpact.orbits.tolerances import *  # noqa: F403  (every threshold)

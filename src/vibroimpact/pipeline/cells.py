@@ -96,8 +96,8 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         harmonic force (``amplitude != 0``) also ``ratio_density(_stderr)``, ``ratio_beyond``,
         ``motion_probability`` (one value per motion of ``motions``, with free flights) and
         ``motion_stick_probability`` (their impact-stick variants, whose collisions stick);
-        without one there is no forcing period, so these are absent. The per-rebound view (``n_rebounds``,
-        ``rebound_v_after_mean``) counts every rebound leaving the wall at speed
+        without one there is no forcing period, so these are absent. The per-rebound view
+        (``n_rebounds``, ``rebound_v_after_mean``) counts every rebound leaving the wall at speed
         ``>= rebound_floor``.
 
     Notes

@@ -19,14 +19,17 @@ META = {
     "ratio": ("interval ratio z_j / z", "1"),
     "motion": ("impact motion (m/n)", "1"),
     "beta": ("frequency ratio beta = omega/omega_0", "1"),
-    "n_collisions": ("number of collisions (an impact after a free flight, with its chatter and sticking)", "1"),
+    "n_collisions": ("number of collisions (an impact after a free flight, with its chatter "
+                     "and sticking)", "1"),
     "collision_rate": ("collisions per unit time", "1"),
-    "n_impacts_resolved": ("impacts the simulator resolved one by one (numerical: set by its chatter tolerance; cost models only)", "1"),
+    "n_impacts_resolved": ("impacts the simulator resolved one by one (numerical: set by its "
+                           "chatter tolerance; cost models only)", "1"),
     "stuck_fraction": ("fraction of collisions that end sticking on the wall", "1"),
     "stick_time_mean": ("mean time on the wall per collision", "1"),
     "rebounds_mean": ("mean rebounds per collision leaving faster than the rebound floor", "1"),
     "n_rebounds": ("rebounds leaving faster than the rebound floor (per-rebound view)", "1"),
-    "rebound_v_after_mean": ("mean velocity after a rebound, rebounds above the floor (per-rebound view)", "1"),
+    "rebound_v_after_mean": ("mean velocity after a rebound, rebounds above the floor "
+                             "(per-rebound view)", "1"),
     "simulated_time": ("record length after the transient", "1"),
     "v_after_mean": ("mean velocity after impact (per collision)", "1"),
     "v_after_stderr": ("standard error of the mean velocity after impact (batch means)", "1"),
@@ -45,14 +48,18 @@ META = {
     "ratio_density": ("probability density of z_j / z", "1"),
     "ratio_density_stderr": ("batch-means standard error of the density of z_j / z", "1"),
     "ratio_beyond": ("fraction of ratios z_j / z beyond the last bin", "1"),
-    "motion_probability": ("probability of the impact motion with free flights (fraction of time)", "1"),
-    "motion_stick_probability": ("probability of the motion's impact-stick variant (fraction of time)", "1"),
+    "motion_probability": ("probability of the impact motion with free flights "
+                           "(fraction of time)", "1"),
+    "motion_stick_probability": ("probability of the motion's impact-stick variant "
+                                 "(fraction of time)", "1"),
     "probability": ("probability of the impact motion with free flights (fraction of time)", "1"),
     "probability_stderr": ("batch-means standard error of the probability", "1"),
-    "stick_probability": ("probability of the motion's impact-stick variant: a collision sticks (fraction of time)", "1"),
+    "stick_probability": ("probability of the motion's impact-stick variant: a collision sticks "
+                          "(fraction of time)", "1"),
     "stick_probability_stderr": ("batch-means standard error of the stick probability", "1"),
     "n_switches": ("changes between classified motions in the record", "1"),
-    "few_switches": ("1: between 1 and min_switches - 1 switches (probabilities not stationary)", "1"),
+    "few_switches": ("1: between 1 and min_switches - 1 switches (probabilities not "
+                     "stationary)", "1"),
     "reached": ("1: every probability reached the target standard error", "1"),
     "record_end": ("last simulated instant (from rest at tau = 0)", "1"),
     "n_checks": ("precision checks made while extending the record", "1"),
@@ -145,7 +152,8 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
 
 
 _MAP_SCALARS = ("n_switches", "few_switches", "reached", "n_collisions", "collision_rate",
-                "n_impacts_resolved", "v_after_mean", "simulated_time", "record_end", "n_checks", "cpu_time")
+                "n_impacts_resolved", "v_after_mean", "simulated_time", "record_end", "n_checks",
+                "cpu_time")
 
 
 def map_tile(cells, results, motions, attrs):
@@ -256,7 +264,8 @@ def orbit_map_dataset(result, attrs):
     dims = ("type", "inv_beta", "delta")
     ds = xr.Dataset({name: (dims, result[name]) for name in ORBIT_META if name != "type"},
                     coords=dict(type=types, inv_beta=result["inv_beta"], delta=result["delta"]),
-                    attrs=dict(attrs, reason_codes="0 stable, 1 no solution, 2 inadmissible, 3 unstable"))
+                    attrs=dict(attrs, reason_codes="0 stable, 1 no solution, 2 inadmissible, "
+                                                   "3 unstable"))
     ds["exists"] = ds["exists"].astype("int8")    # netCDF has no bool
     for name, (long_name, units) in {**META, **ORBIT_META}.items():
         if name in ds.variables:

@@ -22,7 +22,8 @@ class CorruptFileError(OSError):
     """A result file that exists but cannot be read; ``str()`` is one line."""
 
     def __init__(self, path, reason):
-        reason = str(reason).strip().splitlines()[-1] if str(reason).strip() else type(reason).__name__
+        reason = (str(reason).strip().splitlines()[-1] if str(reason).strip()
+                  else type(reason).__name__)
         super().__init__(f"{path}: cannot be read as netCDF ({reason}): the file is truncated "
                          f"or corrupt; delete it and run make (python -m vibroimpact run) "
                          f"again, which rebuilds it (plain snakemake does not: add "

@@ -9,7 +9,8 @@ import math
 
 import numpy as np
 
-#: Decimals kept when a grid is given as start/stop/step (so 0.1 * 3 is 0.3, not 0.30000000000000004).
+#: Decimals kept when a grid is given as start/stop/step (so 0.1 * 3 is 0.3, not
+#: 0.30000000000000004).
 GRID_DECIMALS = 10
 
 
@@ -105,7 +106,8 @@ class Study:
         return cls(name=name, zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                    amplitude=amplitude, inv_beta=inv_beta,
                    delta=grid_values(entry["delta"]) if "delta" in entry else np.empty(0),
-                   spectra_delta=grid_values(spectra["delta"]) if spectra.get("delta") else np.empty(0),
+                   spectra_delta=(grid_values(spectra["delta"]) if spectra.get("delta")
+                                  else np.empty(0)),
                    tile_size=int(entry["tile_size"]),
                    motions=tuple((int(m), int(n)) for m, n in entry.get("motions", ())))
 

@@ -241,7 +241,8 @@ def trace(name, block, noise_path, out):
 
 
 def aggregate(name, block, kind, tiles, out, noise_path=None):
-    """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: a study's dataset."""
+    """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: a study's
+    dataset."""
     study = Study.from_config(name, block)
     parts = [io.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)

@@ -277,7 +277,8 @@ def _kind_text(attrs):
 
 
 def _spectrum_parts(attrs):
-    """``["band-limited white", "beta_c = 4"]``: the input's spectrum from ``noise_*`` attributes."""
+    """``["band-limited white", "beta_c = 4"]``: the input's spectrum from ``noise_*``
+    attributes."""
     parts = [_kind_text(attrs)] if "noise_kind" in attrs else []
     return parts + _filter_parts(attrs)
 
@@ -704,7 +705,8 @@ def _require_harmonic(events, figure):
 
 
 #: What an impact statistic counts, printed on every figure of one (docs/figures.md).
-COLLISION_NOTE = (r"per collision (an impact after a free flight, with its chatter and sticking);  "
+COLLISION_NOTE = (r"per collision (an impact after a free flight, with its chatter and "
+                  r"sticking);  "
                   r"$\varepsilon u_{j-0}$: its first rebound, $z_j$: first impact to first impact")
 
 

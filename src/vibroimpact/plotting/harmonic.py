@@ -5,7 +5,7 @@ import numpy as np
 
 from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
-    _num, _psd_label, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
+    _num, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
     axis_label)
 
 

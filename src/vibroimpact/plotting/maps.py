@@ -399,8 +399,8 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
     if short.any():
         handles.append(Line2D([], [], ls="none", marker=".", color="C3",
                               label="target precision not reached (cap)"))
-    return _finish_figure(fig, motion_map, handles,
-                          "Fig. 15  Probability of the impact motions under harmonic plus random force")
+    return _finish_figure(fig, motion_map, handles, "Fig. 15  Probability of the impact motions "
+                          "under harmonic plus random force")
 
 
 def _orbits_on(motion_map, orbits, name):
@@ -499,7 +499,8 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
                 bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.85, pad=2))
         ax.set_title(f"({name})")
     _finish_axes(axes, motion_map)
-    handles = [Patch(facecolor="0.88", edgecolor="0.3", label=r"stable under $\sin(\beta_f\tau)$ alone (Fig. 16)"),
+    handles = [Patch(facecolor="0.88", edgecolor="0.3",
+                     label=r"stable under $\sin(\beta_f\tau)$ alone (Fig. 16)"),
                Line2D([], [], color="0.55", lw=0.4, label="its degree of stability $S$ (%)"),
                Line2D([], [], color="k", lw=1.8,
                       label=f"probability {', '.join(map(str, levels))} % with noise (Fig. 15)")]
@@ -507,5 +508,5 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
         handles.append(_cliff_handle(1.8))
     if few.any():
         handles.append(few_switches_handle(motion_map, short=True))
-    return _finish_figure(fig, motion_map, handles,
-                          "Fig. 15 over Fig. 16  Likely motions under noise and stable periodic motions")
+    return _finish_figure(fig, motion_map, handles, "Fig. 15 over Fig. 16  Likely motions under "
+                          "noise and stable periodic motions")

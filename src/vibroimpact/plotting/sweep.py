@@ -157,7 +157,8 @@ def sweep_means(datasets, labels):
     _panel_tag(axes[1], "(b)")
     if any_few:
         handles.append(Line2D([], [], ls="none", marker="s", mfc="white", color="0.3",
-                              markersize=4.5, label=f"fewer than {FEW_IMPACTS} collisions (no bar)"))
+                              markersize=4.5,
+                              label=f"fewer than {FEW_IMPACTS} collisions (no bar)"))
     t_text = (f"t = {_num(t_quantile(batches.pop(), CONFIDENCE))}" if len(batches) == 1
               else "t of B - 1 dof")
     title = rf"mean $\pm$ t$\cdot$batch-means s.e. ({100 * CONFIDENCE:g} %, {t_text})"

@@ -172,9 +172,9 @@ def map_summary(motion_map):
                                        "largest P": f"{float(p.max()):.2f}"}
     table = pd.DataFrame.from_dict(rows, orient="index")
     cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
-    table.attrs["note"] = (f"{cells} cells; {100 * float(motion_map.reached.mean()):.1f} % reached "
-                           f"the target standard error, {int(motion_map.few_switches.sum())} "
-                           f"hatched (too few switches)")
+    table.attrs["note"] = (f"{cells} cells; {100 * float(motion_map.reached.mean()):.1f} % "
+                           f"reached the target standard error, "
+                           f"{int(motion_map.few_switches.sum())} hatched (too few switches)")
     return table.style.set_caption(table.attrs["note"])
 
 

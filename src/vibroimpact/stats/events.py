@@ -1,4 +1,5 @@
-"""Impact events: intervals, velocities after impact, densities, batch means (Figs. 7-9, 13, 14)."""
+"""Impact events: intervals, velocities after impact, densities, batch means
+(Figs. 7-9, 13, 14)."""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -62,7 +63,7 @@ class Density(NamedTuple):
     centres: np.ndarray  #: bin centres, shape (nbins,)
     density: np.ndarray  #: probability density, integrates to 1 over the bins
     stderr: np.ndarray   #: standard error of `density` per bin (binomial, or batch means)
-    n: int               #: number of values the density is normalised by (inside the bins unless `total`)
+    n: int               #: number of values normalising the density (in the bins unless `total`)
     beyond: float = np.nan  #: fraction of the `n` values above the last bin edge (NaN if n = 0)
 
 

@@ -389,5 +389,6 @@ def motion_map_agreement(probability, stable, S, threshold: float = 0.5) -> dict
         rho = float(spearmanr(p[domain], S[domain]).statistic)
     return dict(n_dominant=n_dom,
                 dominant_inside=float((dominant & stable).sum() / n_dom) if n_dom else np.nan,
-                domain_covered=float((dominant & domain).sum() / domain.sum()) if domain.any() else np.nan,
+                domain_covered=(float((dominant & domain).sum() / domain.sum())
+                                if domain.any() else np.nan),
                 rank_correlation=rho, n_domain=int(domain.sum()))

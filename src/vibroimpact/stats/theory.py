@@ -1,4 +1,5 @@
-"""Exact results used as oracles: the wall-free linear response and elastic impacts under white noise."""
+"""Exact results used as oracles: the wall-free linear response and elastic impacts under white
+noise."""
 from __future__ import annotations
 
 from typing import Callable

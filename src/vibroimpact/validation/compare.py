@@ -138,7 +138,8 @@ def compare_events(res, ref, force, scale=1.0, u_scale=1.0, tol=TOL, horizon=mat
     t_end = min(float(ref["t_end"]), horizon)
     if ref.get("truncated"):
         # stopped at an impact: the simulation's may fall just before or after it
-        t_end = min(t_end, float(ref["time"][-2] + ref["time"][-1]) / 2 if len(ref["time"]) > 1 else 0.0)
+        t_end = min(t_end, float(ref["time"][-2] + ref["time"][-1]) / 2
+                    if len(ref["time"]) > 1 else 0.0)
     # impacts, chatter tails marked (their accumulation point is the sticking start)
     r_t = [float(t) for t in ref["time"]]
     r_u = [float(u) for u in ref["velocity"]]
@@ -181,7 +182,8 @@ def compare_events(res, ref, force, scale=1.0, u_scale=1.0, tol=TOL, horizon=mat
     s_stick = _merge(lead + res.stick_start.tolist(), lead + res.stick_end.tolist(), s_t, s_amb)
     ref_imp = [(t, u, a) for t, u, a, d, e in zip(r_t, r_u, r_a, r_tail, r_amb)
                if not (d or e) and t < horizon]
-    sim_imp = [(t, u) for t, u, d, e in zip(s_t, s_u, s_tail, s_amb) if not (d or e) and t < horizon]
+    sim_imp = [(t, u) for t, u, d, e in zip(s_t, s_u, s_tail, s_amb)
+               if not (d or e) and t < horizon]
     j = 0
     matched = [False] * len(sim_imp)
     for t, u, a in ref_imp:
@@ -230,7 +232,8 @@ def compare_events(res, ref, force, scale=1.0, u_scale=1.0, tol=TOL, horizon=mat
                         out.spurious += 1
                     if not out.first_problem:
                         out.first_problem = (f"{what} contact {kind} at tau={edge!r} has no "
-                                             f"counterpart within {allowed:.3g} (nearest {near:.3g})")
+                                             f"counterpart within {allowed:.3g} "
+                                             f"(nearest {near:.3g})")
     # the motion itself at every sample before the horizon (contact or flight alike)
     if "x" in ref and res.a.size:
         n = min(len(ref["x"]), res.a.size)
@@ -252,8 +255,8 @@ def compare_events(res, ref, force, scale=1.0, u_scale=1.0, tol=TOL, horizon=mat
             out.worst = max(out.worst, float(err.max()) / tol_x)
             if err.max() > tol_x and not out.first_problem:
                 k = int(np.argmax(err))
-                out.first_problem = (f"a(tau) or x' at tau={times[keep][k]!r} differs by {err[k]:.3g} "
-                                     f"(> {tol_x:.3g})")
+                out.first_problem = (f"a(tau) or x' at tau={times[keep][k]!r} differs by "
+                                     f"{err[k]:.3g} (> {tol_x:.3g})")
     return out
 
 

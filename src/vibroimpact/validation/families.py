@@ -315,7 +315,7 @@ def run_case(case, report):
     report.cases += 1
     try:
         res = simulate(**kw, record_every=1)
-    except Exception as err:        # noqa: BLE001  (any exception is a finding)
+    except Exception as err:        # any exception is a finding
         report.exceptions += 1
         report.fail(show, f"{type(err).__name__}: {err}")
         return

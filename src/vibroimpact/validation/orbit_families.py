@@ -490,7 +490,6 @@ def _solutions_m2(n, beta, delta, zeta, eps):
     crit, nodes, _ = _m2_critical(n, beta, zeta, eps)
     target = _L(abs(delta))
     ends = sorted([nodes[0], nodes[-1]] + [c[0] for c in crit])
-    tf = 2.0 * math.pi / beta
 
     def f(t):
         return float(_m2_d(np.array([t]), n, beta, zeta, eps)[0][0] - target)
@@ -971,7 +970,7 @@ def period_doubling_points(beta, zeta, eps, n=1, grid=120):
     for branch in (0, 1):
         vals = np.array([_pd_function(n, beta, d, zeta, eps, branch) for d in deltas])
         for k in np.flatnonzero(vals[:-1] * vals[1:] < 0.0):
-            d_pd = brentq(lambda d: _pd_function(n, beta, d, zeta, eps, branch),
+            d_pd = brentq(lambda d, branch=branch: _pd_function(n, beta, d, zeta, eps, branch),
                           deltas[k], deltas[k + 1], xtol=1e-15, rtol=8.9e-16)
             if not abs(_pd_function(n, beta, d_pd, zeta, eps, branch)) < 1e-9:
                 continue                  # the bracket held a gap of the branch, not a root
@@ -1014,7 +1013,7 @@ def grazing_points(n, beta, zeta, eps, grid=100):
         fin = np.isfinite(vals[:-1]) & np.isfinite(vals[1:])
         for k in np.flatnonzero(fin & (vals[:-1] * vals[1:] < 0.0)):
             try:
-                d_g = brentq(lambda d: _margin_m1(n, beta, d, zeta, eps, branch),
+                d_g = brentq(lambda d, branch=branch: _margin_m1(n, beta, d, zeta, eps, branch),
                              deltas[k], deltas[k + 1], xtol=1e-15, rtol=8.9e-16)
             except ValueError:           # the margin jumped (a maximum appeared): no tangency
                 continue

@@ -47,7 +47,8 @@ def _check_problem(zeta, eps, delta, noise, dt):
         raise ValueError(f"dt must be positive, got {dt!r}")
     noise = np.ascontiguousarray(noise, dtype=np.float64)
     if noise.ndim != 1 or noise.size < 2:
-        raise ValueError(f"noise must be a 1-D array of at least 2 samples, got shape {noise.shape}")
+        raise ValueError(f"noise must be a 1-D array of at least 2 samples, "
+                         f"got shape {noise.shape}")
     return noise
 
 
@@ -57,7 +58,8 @@ def _n_intervals(noise, dt, t_end):
         t_end = (noise.size - 1) * dt
     n = int(math.ceil(t_end / dt - 1e-9))
     if n > noise.size - 1:
-        raise ValueError(f"t_end={t_end} lies beyond the last noise sample at {(noise.size - 1) * dt}")
+        raise ValueError(f"t_end={t_end} lies beyond the last noise sample at "
+                         f"{(noise.size - 1) * dt}")
     return n, t_end
 
 

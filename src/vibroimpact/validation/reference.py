@@ -1,7 +1,7 @@
 """Independent high-precision reference simulator of the vibro-impact oscillator (mpmath).
 
-Written from the closed form of docs/model.md (section 5), without importing ``vibroimpact``, so that the
-package's float64 simulator can be tested against it.
+Written from the closed form of docs/model.md (section 5), without importing ``vibroimpact``, so
+that the package's float64 simulator can be tested against it.
 
 Between impacts, on a stretch where the random force is linear, ``r(s) = r0 + b s``::
 
@@ -229,7 +229,7 @@ def _examine(fn, M, L, R, depth, max_depth):
             if g1a <= 0 or g1b >= 0:
                 return None
             # g' decreasing on [a, b]: its zero is the maximum of g
-            neg = lambda s: tuple(-w for w in fn(s)[1:])  # noqa: E731  (-g', -g'')
+            neg = lambda s: tuple(-w for w in fn(s)[1:])  # -g', -g''
             c = _polish(neg, a, b, -g1a, -g1b, -g2a, -g2b)
             gc, g1c = fn(c)[:2]
             if gc < 0:
@@ -545,7 +545,7 @@ def linear_peak(zeta, noise, dt, amplitude=0.0, beta=1.0, x0=0.0, v0=0.0, t_end=
             r0 = mpf(0) if noise is None else mpf(float(noise[k]))
             b = mpf(0) if noise is None else (mpf(float(noise[k + 1])) - r0) / h
             fl = _Flight(P, k * h, lin["x"][k], lin["v"][k], r0, b)
-            neg = lambda s, fl=fl: tuple(-w for w in fl.eval(s)[1:])  # noqa: E731
+            neg = lambda s, fl=fl: tuple(-w for w in fl.eval(s)[1:])
             xdd0, xdd1 = fl.eval(mpf(0))[2], fl.eval(h)[2]
             s = _polish(neg, mpf(0), h, -lin["v"][k], -lin["v"][k + 1], -xdd0, -xdd1)
             x, _ = fl.state(s)

@@ -188,7 +188,8 @@ class MappedRecord:
                     else np.lib.format.read_array_header_2_0)
             shape, fortran, dtype = read(self._file)
             if len(shape) != 1 or dtype != np.dtype("<f8"):
-                raise ValueError(f"{path}: expected a 1-D <f8 array, got shape {shape}, dtype {dtype}")
+                raise ValueError(f"{path}: expected a 1-D <f8 array, got shape {shape}, "
+                                 f"dtype {dtype}")
             self.offset = self._file.tell()
             self._map = mmap.mmap(self._file.fileno(), 0, access=mmap.ACCESS_COPY)
         except BaseException:
@@ -286,7 +287,8 @@ def stream_run(record_path, chunk_size, out_prefix, params, record_every=1, a_to
 
     t0 = time.perf_counter()
     with MappedRecord(record_path) as rec, \
-            open(f"{out_prefix}.impacts", "wb") as f_imp, open(f"{out_prefix}.sticks", "wb") as f_stk:
+            open(f"{out_prefix}.impacts", "wb") as f_imp, \
+            open(f"{out_prefix}.sticks", "wb") as f_stk:
         gen = simulate_chunks(noise=rec.array, record_every=record_every, chunk_size=chunk_size,
                               **params)
         try:
@@ -331,7 +333,8 @@ def stream_run(record_path, chunk_size, out_prefix, params, record_every=1, a_to
                         violation(f"approach velocity {u[~ok_u][0]!r} at step {step[~ok_u][0]}")
                     if not ok_off.all():
                         out["n_offset_bad"] += int((~ok_off).sum())
-                        violation(f"offset {off[~ok_off][0]!r} outside [0, dt] at step {step[~ok_off][0]}")
+                        violation(f"offset {off[~ok_off][0]!r} outside [0, dt] at step "
+                                  f"{step[~ok_off][0]}")
                     out["min_u"] = min(out["min_u"], float(np.min(u)))
                     s_all = step if prev_step is None else np.concatenate([[prev_step], step])
                     o_all = off if prev_off is None else np.concatenate([[prev_off], off])
@@ -361,8 +364,9 @@ def stream_run(record_path, chunk_size, out_prefix, params, record_every=1, a_to
                     if not ok.all():
                         out["n_stick_bad"] += int((~ok).sum())
                         i = int(np.flatnonzero(~ok)[0])
-                        violation(f"sticking interval [{res.stick_start[i]!r}, {res.stick_end[i]!r}] "
-                                  f"disordered (previous end {prev_ends[i]!r})")
+                        violation(f"sticking interval [{res.stick_start[i]!r}, "
+                                  f"{res.stick_end[i]!r}] disordered (previous end "
+                                  f"{prev_ends[i]!r})")
                     prev_stick_end = float(res.stick_end[-1])
                     del st
 
@@ -393,7 +397,8 @@ def main(argv=None):
     ap.add_argument("--record", required=True)
     ap.add_argument("--chunk-size", type=int, required=True)
     ap.add_argument("--out", required=True)
-    ap.add_argument("--params", required=True, help="JSON dict: zeta, eps, delta, dt, amplitude, beta")
+    ap.add_argument("--params", required=True,
+                    help="JSON dict: zeta, eps, delta, dt, amplitude, beta")
     ap.add_argument("--record-every", type=int, default=1)
     ap.add_argument("--a-tol", type=float, default=A_TOL)
     args = ap.parse_args(argv)
@@ -487,7 +492,8 @@ def _compare_streams(ref, other, dt, kind):
             d = -math.inf if p < n else math.inf
         if abs(d) <= MATCH_WINDOW:
             if kind == "impacts":
-                err = max(abs(d), abs(float(ref["u"][p]) - float(other["u"][q])) / float(ref["u"][p]))
+                err = max(abs(d),
+                          abs(float(ref["u"][p]) - float(other["u"][q])) / float(ref["u"][p]))
             else:
                 err = max(abs(d), abs(float(ref["end"][p]) - float(other["end"][q])))
             if out["first"] is None and ref[p].tobytes() != other[q].tobytes():
@@ -665,7 +671,8 @@ def run_streamed_record(n_samples: int, seed: int, workdir, chunk_sizes=DEFAULT_
     t_start = time.perf_counter()
     chunk_sizes = [int(c) for c in chunk_sizes]
     if not chunk_sizes or min(chunk_sizes) < 1:
-        raise ValueError(f"chunk_sizes must be a non-empty sequence of integers >= 1, got {chunk_sizes!r}")
+        raise ValueError(f"chunk_sizes must be a non-empty sequence of integers >= 1, "
+                         f"got {chunk_sizes!r}")
     if int(record_every) < 1:
         raise ValueError(f"record_every must be >= 1 (the grid is checked), got {record_every!r}")
     params = dict(zeta=float(zeta), eps=float(eps), delta=float(delta), dt=float(dt),
@@ -692,7 +699,8 @@ def run_streamed_record(n_samples: int, seed: int, workdir, chunk_sizes=DEFAULT_
             runs.append(res)
             if "error" in res:
                 report.exceptions += 1
-                report.fail(dict(case, chunk_size=c), f"streaming run raised: {res['error'][:1500]}")
+                report.fail(dict(case, chunk_size=c),
+                            f"streaming run raised: {res['error'][:1500]}")
                 continue
             _check_run(report, res, case, n_samples, record_every)
         good = [r for r in runs if "error" not in r]
@@ -779,14 +787,18 @@ def _compare_runs(report, runs, tmp, params, case):
         del imp, stk
         report.missed += ci["missed"]
         report.spurious += ci["spurious"]
-        _note(report, ci["matched"], max(ci["worst"], cs["worst"]), dict(where, check="chunk size"))
+        _note(report, ci["matched"], max(ci["worst"], cs["worst"]),
+              dict(where, check="chunk size"))
         if ci["first"] is not None:
             report.fail(where, f"impacts differ across chunk sizes: {ci['missed']} missed, "
-                               f"{ci['spurious']} spurious, worst {ci['worst']:.3e}; first: {ci['first']}")
+                               f"{ci['spurious']} spurious, worst {ci['worst']:.3e}; "
+                               f"first: {ci['first']}")
         if cs["first"] is not None:
-            report.fail(where, f"sticking intervals differ across chunk sizes: {cs['missed']} missed, "
-                               f"{cs['spurious']} spurious, worst {cs['worst']:.3e}; first: {cs['first']}")
-        if (run["digests"]["a"], run["digests"]["v"]) != (ref["digests"]["a"], ref["digests"]["v"]):
+            report.fail(where, f"sticking intervals differ across chunk sizes: "
+                               f"{cs['missed']} missed, {cs['spurious']} spurious, "
+                               f"worst {cs['worst']:.3e}; first: {cs['first']}")
+        if ((run["digests"]["a"], run["digests"]["v"])
+                != (ref["digests"]["a"], ref["digests"]["v"])):
             report.fail(where, "recorded grid a, v differs across chunk sizes (SHA-256)")
         if run["final"] != ref["final"]:
             report.fail(where, f"final state {run['final']} differs from {ref['final']}")

@@ -261,9 +261,9 @@ def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, long_sa
         Per (delta, run): ``err_time``, ``err_velocity``, ``error``, ``error_ratio``,
         ``n_found``, ``timed_span``, ``seconds``, ``timing_spread``, ``cost``, ``cost_ratio``.
         Per delta: ``t_stretch``, ``n_compared``, ``n_reference``, ``roundoff``,
-        ``reference_seconds``. Scalars ``compile_seconds`` and ``build_seconds``. Every variable has ``long_name``
-        and ``units``; the timings are flagged ``run_measurement = 1``. The attributes
-        describe the problem, the record, how it was timed (``timing_statistic``,
+        ``reference_seconds``. Scalars ``compile_seconds`` and ``build_seconds``. Every variable
+        has ``long_name`` and ``units``; the timings are flagged ``run_measurement = 1``. The
+        attributes describe the problem, the record, how it was timed (``timing_statistic``,
         ``timing_repeats``, ``timing``), why the restarted solve_ivp hardly depends on its
         tolerance (``solve_ivp_restart``) and the machine (``load_average_start``,
         ``load_average_end``: 1-minute averages before and after the run).
@@ -369,14 +369,14 @@ def _measure_delta(i, delta, noise, runs, impacts, stretch, repeats, out, per_de
         if method.startswith("solve_ivp"):
             run = functools.partial(peers.solve_ivp_impacts, ZETA, EPS, delta, dt=DT,
                                     method=method.split()[1], rtol=rtol)
-            seconds, (t_imp, u_imp) = timed_runs(lambda: run(noise=timed), repeats)
+            seconds, (t_imp, u_imp) = timed_runs(lambda run=run: run(noise=timed), repeats)
             if short.size > timed.size:  # the errors are taken over the whole stretch
                 t_imp, u_imp = run(noise=short)
             span = (timed.size - 1) * DT
         else:
             fn = peers.rk4_event_impacts if method == RK4_EVENT else peers.rk4_clamp_impacts
-            seconds, (t_imp, u_imp) = timed_runs(lambda: fn(ZETA, EPS, delta, noise, DT, k),
-                                                 repeats)
+            seconds, (t_imp, u_imp) = timed_runs(
+                lambda fn=fn, k=k: fn(ZETA, EPS, delta, noise, DT, k), repeats)
             span = long_span
         record(j, seconds, span, *split_time(t_imp), u_imp)
         log.info("delta = %g, %s %s: error %.2e, %.3g s per unit time (spread %.0f %%)", delta,
