@@ -145,9 +145,9 @@ def test_every_caption_passes_docutils_without_a_system_message():
     captions = list(_paper_captions())
     assert len(captions) >= 15
     for target, caption in captions:
+        png = f"results/figures/x/{target}.png"
         rst = template.render(snakemake=SimpleNamespace(
-            params=SimpleNamespace(caption=caption),
-            output=SimpleNamespace(png=f"results/figures/x/{target}.png")))
+            config={"figure_captions": {png: caption}}, output=SimpleNamespace(png=png)))
         body = publish_parts(rst, writer="html",
                              settings_overrides={"warning_stream": False})["body"]
         assert "system-message" not in body and "System Message" not in body, (target, body)
