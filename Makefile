@@ -1,15 +1,17 @@
 # `make` installs into .venv and builds every figure and report of the default config, then
 # Snakemake's own report of that build (results/report.html);
-# `make test` installs and runs the fast suite, the slow (stress/convergence) suite, the
-# end-to-end workflow and SLURM suites (one session: the test config is built once; the
-# SLURM suite installs and starts a one-node cluster, as root), the linter (ruff: the rules
-# in pyproject.toml), the import-layer contract and the format of the Snakemake files
-# (snakefmt); `make lint` runs Snakemake's linter, ruff and snakefmt.
+# `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
+# of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, the
+# slow (stress/convergence) suite on two workers, the end-to-end workflow and SLURM suites
+# (one session: the test config is built once; the SLURM suite installs and starts a
+# one-node cluster, as root); `make lint` runs Snakemake's linter, ruff and snakefmt.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 CORES  ?= all
+# the slow suite's independent stress tests on both cores (pytest-xdist)
+SLOW_WORKERS ?= -n 2
 # your own config, layered on config/config.yaml: make CONFIG=my_study.yaml
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
@@ -33,13 +35,14 @@ $(STAMP): environment.txt pyproject.toml
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps -e .
 	touch $(STAMP)
 
+# the seconds-long checks first: a lint failure stops the build before the half-hour suites
 test: $(STAMP)
-	$(BIN)/python -m pytest -q
-	$(BIN)/python -m pytest -q -m slow
-	$(BIN)/python -m pytest -q -m "workflow or slurm"
 	$(BIN)/ruff check src tests benchmarks workflow/scripts
-	$(BIN)/lint-imports
 	$(BIN)/snakefmt --check Snakefile workflow/
+	$(BIN)/lint-imports
+	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -m slow $(SLOW_WORKERS)
+	$(BIN)/python -m pytest -q -m "workflow or slurm"
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
