@@ -38,6 +38,8 @@ import sys
 import tempfile
 import time
 
+from ab_no_impact import extract  # git archive REV src/vibroimpact (this folder is on sys.path)
+
 ZETA, EPS, DT = 0.05, 0.5, 0.1
 SEED = 19740072  # as benchmarks/bench_simulate.py
 SIM_DELTAS = (0.5, -0.5)
@@ -85,18 +87,6 @@ def child(src, n_steps, repeats):
 
 
 # ---------------------------------------------------------------------------- parent
-def extract(rev, dest):
-    """``git archive REV src/vibroimpact | tar -x -C dest``; returns ``dest/src``."""
-    dest.mkdir(parents=True)
-    archive = subprocess.Popen(["git", "-C", str(REPO), "archive", "--format=tar", rev,
-                                "src/vibroimpact"], stdout=subprocess.PIPE)
-    untar = subprocess.run(["tar", "-x", "-C", str(dest)], stdin=archive.stdout)
-    archive.stdout.close()
-    if archive.wait() != 0 or untar.returncode != 0:
-        raise SystemExit(f"FAIL: could not extract src/vibroimpact of {rev!r}")
-    return dest / "src"
-
-
 def run_child(build, n_steps, repeats):
     env = dict(os.environ, PYTHONPATH=str(build["src"]), NUMBA_NUM_THREADS="1",
                NUMBA_CACHE_DIR=str(build["cache"]))
