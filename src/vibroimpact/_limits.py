@@ -7,11 +7,23 @@ limits from here, so a config is refused by the same rule the code applies.
 """
 import math
 
-__all__ = ["MAX_M", "FIR_ATTENUATION_DB", "FIR_TRANSITION_FRACTION", "FIR_MAX_TAPS",
+__all__ = ["MAX_M", "ATTRACTOR_MATCH_TOL", "attractor_min_time", "FIR_ATTENUATION_DB", "FIR_TRANSITION_FRACTION", "FIR_MAX_TAPS",
            "FULL_BAND_RTOL", "fir_taps", "cutoff"]
 
 #: Largest number of impacts m a period of the (m/n) motions the orbit solver finds.
 MAX_M = 3
+
+#: A start has settled on a periodic orbit when its collisions match the orbit's impacts
+#: (phase over the forcing period, velocity relative) within this tolerance
+#: (`vibroimpact.orbits.attractors`).
+ATTRACTOR_MATCH_TOL = 1e-6
+
+
+def attractor_min_time(zeta, match_tol=ATTRACTOR_MATCH_TOL):
+    """Shortest cap on a start's time that can let it settle: ``ln(1/match_tol) / zeta``, the
+    time the damping alone takes to bring a perturbation of order one under the tolerance."""
+    return math.log(1.0 / match_tol) / zeta
+
 
 #: Stop-band attenuation (dB) of the Kaiser-window FIR of ``kind="band_limited"``; the pass
 #: band ripple of the amplitude is the same 10**(-80/20) = 1e-4.

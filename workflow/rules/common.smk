@@ -8,6 +8,7 @@
 # dirty flag, config digest, seed) is written by the jobs at run time, never passed through
 # params (a commit alone must not rerun anything).
 from pathlib import Path
+import math
 import shlex
 import sys
 from types import SimpleNamespace
@@ -15,13 +16,21 @@ from types import SimpleNamespace
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.provenance import code_digest
-from vibroimpact.pipeline.study import JOB_KEYS, Study, orbit_rows
+from vibroimpact.pipeline.study import (
+    JOB_KEYS,
+    ORBIT_JOB_KEYS,
+    Study,
+    attractor_rows,
+    grid_values,
+    orbit_rows,
+)
 from vibroimpact.reports import arguments
 
 
 wildcard_constraints:
     study="[A-Za-z][A-Za-z0-9_]*",
-    orbits="[A-Za-z][A-Za-z0-9_]*",
+    # not ending like the entry's derived datasets (results/orbits/<name>_basins.nc ...)
+    orbits="(?!.*_(boundaries|basins|lyapunov)$)[A-Za-z][A-Za-z0-9_]*",
     noise="[A-Za-z][A-Za-z0-9_]*",
     sweep="[A-Za-z][A-Za-z0-9_]*",
     tile="[0-9]+",
@@ -29,8 +38,8 @@ wildcard_constraints:
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
     # figNN or fig15_vs_fig16 of the figure table, -k: k-th value of a listed parameter (not a
     # sweep.png, nor the validation figures)
-    fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?(-[0-9]+)?",
-    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?",
+    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov)(-[0-9]+)?",
+    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov",
 
 
 STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}
@@ -59,9 +68,14 @@ def noise_entry(wildcards):
     return config["noises"][wildcards.noise]
 
 
-def orbits_entry(wildcards):
-    """The config entry ``orbits[{orbits}]``."""
-    return config["orbits"][wildcards.orbits]
+def orbits_block(kind):
+    """The part of ``orbits[{orbits}]`` that a ``kind`` job reads (``ORBIT_JOB_KEYS``)."""
+
+    def block(wildcards):
+        entry = config["orbits"][wildcards.orbits]
+        return {key: entry[key] for key in ORBIT_JOB_KEYS[kind] if key in entry}
+
+    return block
 
 
 # --- inputs of the simulations and aggregations ----------------------------------------------
@@ -88,6 +102,12 @@ def orbit_tiles(wildcards):
     return [f"results/orbits/{wildcards.orbits}/tiles/{t}.nc" for t in range(n)]
 
 
+def attractor_tiles(wildcards):
+    """The attractor-map tiles of orbits entry ``{orbits}``."""
+    _, n = attractor_rows(config["orbits"][wildcards.orbits])
+    return [f"results/orbits/{wildcards.orbits}/attractor_tiles/{t}.nc" for t in range(n)]
+
+
 # --- figures ----------------------------------------------------------------------------------
 
 
@@ -107,6 +127,9 @@ _DATASETS = {
     "events": "results/datasets/{name}_events.nc",
     "map": "results/datasets/{name}_map.nc",
     "orbits": "results/orbits/{name}.nc",
+    "boundaries": "results/orbits/{name}_boundaries.nc",
+    "basins": "results/orbits/{name}_basins.nc",
+    "lyapunov": "results/orbits/{name}_lyapunov.nc",
 }
 
 
@@ -268,12 +291,16 @@ def orbits_report_inputs(wildcards):
     inputs = {
         "notebook": "notebooks/periodic_motions.ipynb",
         "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
+        "boundaries": _DATASETS["boundaries"].format(name=wildcards.orbits),
         "figures": [
             f"results/figures/orbits/{wildcards.orbits}/{f}.png"
             for f in figures.figure_targets(entry)
         ],
     }
     inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
+    if entry.get("attractors"):
+        inputs.update({kind: _DATASETS[kind].format(name=wildcards.orbits)
+                       for kind in ("basins", "lyapunov")})
     return inputs
 
 
@@ -397,3 +424,15 @@ def simulate_runtime(kind):
         return costs.simulate_runtime_min(cells, steps)
 
     return runtime
+
+
+def attractor_runtime_min(wildcards):
+    """Minutes of an attractor tile: its cells' starts at the cost model's CPU time each,
+    with the simulate jobs' margin and floor."""
+    entry = config["orbits"][wildcards.orbits]
+    rows, n_tiles = attractor_rows(entry)
+    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(
+        grid_values(entry["attractors"]["delta"])
+    )
+    cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
+    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)

@@ -2,6 +2,7 @@
 # them into one dataset is cheap: run where Snakemake runs.
 localrules:
     aggregate_orbits,
+    aggregate_attractors,
 
 
 rule solve_orbit_tile:
@@ -20,7 +21,7 @@ rule solve_orbit_tile:
         mem_mb=BASE_MEM_MB + 200,
         runtime=30,
     params:
-        entry=orbits_entry,
+        entry=orbits_block("orbits"),
         code=script_code("solve_orbit_tile"),
     script:
         "../scripts/solve_orbit_tile.py"
@@ -43,7 +44,76 @@ rule aggregate_orbits:
         mem_mb=BASE_MEM_MB,
         runtime=5,
     params:
-        entry=orbits_entry,
+        entry=orbits_block("orbits"),
         code=script_code("aggregate_orbits"),
     script:
         "../scripts/aggregate_orbits.py"
+
+
+rule trace_boundaries:
+    """The exact edges of the stable domains of orbits entry {orbits}, seeded from its map."""
+    input:
+        "results/orbits/{orbits}.nc",
+    output:
+        "results/orbits/{orbits}_boundaries.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/trace_boundaries/{orbits}.log",
+    benchmark:
+        "results/benchmarks/trace_boundaries/{orbits}.tsv"
+    threads: 2
+    resources:
+        mem_mb=BASE_MEM_MB + 200,
+        runtime=30,
+    params:
+        entry=orbits_block("boundaries"),
+        code=script_code("trace_boundaries"),
+    script:
+        "../scripts/trace_boundaries.py"
+
+
+rule solve_attractor_tile:
+    """Basins of attraction and Lyapunov exponents on one tile of orbits entry {orbits}."""
+    output:
+        "results/orbits/{orbits}/attractor_tiles/{tile}.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/solve_attractor_tile/{orbits}/{tile}.log",
+    benchmark:
+        "results/benchmarks/solve_attractor_tile/{orbits}/{tile}.tsv"
+    # starts run in parallel numba threads: exactly the rule's threads (tasks.attractor_tile)
+    threads: 2
+    resources:
+        mem_mb=BASE_MEM_MB + 300,
+        runtime=attractor_runtime_min,
+    params:
+        entry=orbits_block("attractors"),
+        code=script_code("solve_attractor_tile"),
+    script:
+        "../scripts/solve_attractor_tile.py"
+
+
+rule aggregate_attractors:
+    """The basins and Lyapunov datasets of orbits entry {orbits}, from its tiles."""
+    input:
+        attractor_tiles,
+    output:
+        basins="results/orbits/{orbits}_basins.nc",
+        lyapunov="results/orbits/{orbits}_lyapunov.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/aggregate_attractors/{orbits}.log",
+    benchmark:
+        "results/benchmarks/aggregate_attractors/{orbits}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
+    params:
+        entry=orbits_block("attractors"),
+        code=script_code("aggregate_attractors"),
+    script:
+        "../scripts/aggregate_attractors.py"

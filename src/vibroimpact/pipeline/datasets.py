@@ -276,3 +276,164 @@ def orbit_map_dataset(result, attrs):
 def concat_orbit_tiles(tiles):
     """Join orbit-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
     return xr.concat(tiles, dim="inv_beta").sortby("inv_beta")
+
+
+def orbit_map_result(ds):
+    """The :func:`vibroimpact.orbits.orbit_map` dict of an orbits dataset (its seeds for
+    :func:`vibroimpact.orbits.domain_boundaries`)."""
+    out = {name: ds[name].values for name in ("n_solutions", "n_stable", "lam", "S", "reason")}
+    out["exists"] = ds["exists"].values.astype(bool)
+    out.update(inv_beta=ds["inv_beta"].values, delta=ds["delta"].values,
+               types=np.array([[int(k) for k in str(t).split("/")]
+                               for t in ds["type"].values], dtype=np.int64).reshape(-1, 2))
+    return out
+
+
+BOUNDARY_META = {
+    "inv_beta": ("1/beta_f of a point on a boundary curve", "1"),
+    "delta": ("play delta of a point on a boundary curve", "1"),
+    "curve": ("index of the curve the point lies on (points of a curve are consecutive, in "
+              "order along it)", "1"),
+    "kind": ("what happens on the curve: grazing, fold (multiplier +1), period_doubling "
+             "(multiplier -1), existence (another end of the stable solution)", "1"),
+    "type": ("impact motion (m/n) whose stable domain the curve bounds", "1"),
+    "codim2_inv_beta": ("1/beta_f of a codimension-two point (two kinds meet)", "1"),
+    "codim2_delta": ("play delta of a codimension-two point", "1"),
+    "codim2_type": ("impact motion (m/n) of the codimension-two point", "1"),
+    "codim2_kinds": ("the two kinds that meet there, joined by +", "1"),
+}
+
+
+def boundaries_dataset(curves_by_type, attrs):
+    """Dataset of the boundary curves of :func:`vibroimpact.orbits.domain_boundaries`, one
+    call per type: ``curves_by_type`` is ``{(m, n): result}``.
+
+    Dimensions ``point`` (every curve's points, curve after curve), ``curve`` and ``codim2``.
+    """
+    inv_beta, delta, index, kinds, types = [], [], [], [], []
+    c_ib, c_d, c_type, c_kinds = [], [], [], []
+    for (m, n), result in curves_by_type.items():
+        for curve in result:
+            inv_beta.append(np.asarray(curve.inv_beta, dtype=float))
+            delta.append(np.asarray(curve.delta, dtype=float))
+            index.append(np.full(inv_beta[-1].size, len(kinds), dtype=np.int32))
+            kinds.append(str(curve.kind))
+            types.append(f"{m}/{n}")
+        for point in result.codimension_two:
+            c_ib.append(float(point.inv_beta))
+            c_d.append(float(point.delta))
+            c_type.append(f"{m}/{n}")
+            c_kinds.append("+".join(point.kinds))
+
+    def cat(parts, dtype):
+        return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype)
+
+    ds = xr.Dataset(
+        {"inv_beta": ("point", cat(inv_beta, float)), "delta": ("point", cat(delta, float)),
+         "curve": ("point", cat(index, np.int32)),
+         "kind": ("curve", np.array(kinds, dtype=str)),
+         "type": ("curve", np.array(types, dtype=str)),
+         "codim2_inv_beta": ("codim2", np.array(c_ib, dtype=float)),
+         "codim2_delta": ("codim2", np.array(c_d, dtype=float)),
+         "codim2_type": ("codim2", np.array(c_type, dtype=str)),
+         "codim2_kinds": ("codim2", np.array(c_kinds, dtype=str))},
+        attrs=dict(attrs))
+    for name, (long_name, units) in BOUNDARY_META.items():
+        ds[name].attrs.update(long_name=long_name, units=units)
+    return ds
+
+
+#: Classes of a start of the attractor map (`vibroimpact.orbits.attractor_map`).
+ATTRACTOR_CLASSES = ("listed", "periodic_other", "sticking", "chaotic", "undecided")
+
+ATTRACTOR_META = {
+    "fraction": ("share of the starts that settle on a stable periodic motion of this type "
+                 "(other: every other start)", "1"),
+    "fraction_lo": ("lower end of the 95 % Clopper-Pearson interval of fraction", "1"),
+    "fraction_hi": ("upper end of the 95 % Clopper-Pearson interval of fraction", "1"),
+    "count": ("starts that settle on a stable periodic motion of this type", "1"),
+    "n_stable": ("stable admissible periodic motions of this type the solver finds", "1"),
+    "stick_fraction": ("share of the starts that settle on this type's impact-stick variant "
+                       "(counted in other)", "1"),
+    "class_fraction": ("share of the starts in each class", "1"),
+    "lyapunov": ("largest Lyapunov exponent over the cell's starts (-inf: every start sticks)",
+                 "1/tau"),
+    "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle", "1/tau"),
+    "cell_class": ("the most frequent class of the cell's starts", "1"),
+    "impact_rate": ("collisions per unit time, mean over the cell's starts", "1/tau"),
+    "lyapunov_start": ("largest Lyapunov exponent of each start", "1/tau"),
+    "motion_start": ("what each start settles on: index into motion", "1"),
+}
+
+
+def attractor_tile_dataset(result, attrs):
+    """Dataset of one :func:`vibroimpact.orbits.attractor_map` call over
+    ``(inv_beta, delta)``: what the basins and Lyapunov datasets are cut from."""
+    motions = list(result["motions"])
+    types = motions[:-1]
+    coords = dict(motion=motions, type=types, inv_beta=result["inv_beta"],
+                  delta=result["delta"], start=np.arange(result["lyapunov_start"].shape[0]),
+                  **{"class": list(ATTRACTOR_CLASSES)})
+    plane = ("inv_beta", "delta")
+    data = {name: (("motion", *plane), result[name])
+            for name in ("fraction", "fraction_lo", "fraction_hi", "count")}
+    data["n_stable"] = (("type", *plane), result["n_stable"])
+    data["stick_count"] = (("type", *plane), result["stick_count"])
+    data["class_count"] = (("class", *plane), result["class_count"])
+    for name in ("lyapunov", "lyapunov_stderr", "impact_rate"):
+        data[name] = (plane, result[name])
+    data["cell_class"] = (plane, result["cell_class"].astype(np.int8))
+    for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
+        data[name] = (("start", *plane), result[name])
+    return xr.Dataset(data, coords=coords, attrs=dict(attrs))
+
+
+def concat_attractor_tiles(tiles):
+    """Join attractor-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
+    return xr.concat(tiles, dim="inv_beta", data_vars="minimal", coords="minimal",
+                     compat="override").sortby("inv_beta")
+
+
+def _described(ds):
+    for name, (long_name, units) in ATTRACTOR_META.items():
+        if name in ds.variables:
+            ds[name].attrs.update(long_name=long_name, units=units)
+    return ds
+
+
+def basins_dataset(tiles):
+    """The basins dataset (``results/orbits/<name>_basins.nc``) of the joined attractor tiles:
+    ``fraction``, its interval, ``count`` over ``(motion, inv_beta, delta)``; ``n_stable`` and
+    ``stick_fraction`` over the same (the ``other`` row 0 and NaN); ``class_fraction`` over
+    ``(class, inv_beta, delta)``."""
+    n_starts = int(tiles.attrs["n_starts"])
+    other = xr.zeros_like(tiles["n_stable"].isel(type=0)).expand_dims(type=["other"])
+    n_stable = xr.concat([tiles["n_stable"], other], dim="type").rename(type="motion")
+    stick = (tiles["stick_count"] / n_starts)
+    stick = xr.concat([stick, xr.full_like(stick.isel(type=0), np.nan).expand_dims(
+        type=["other"])], dim="type").rename(type="motion")
+    ds = xr.Dataset(
+        {"fraction": tiles["fraction"], "fraction_lo": tiles["fraction_lo"],
+         "fraction_hi": tiles["fraction_hi"], "count": tiles["count"],
+         "n_stable": n_stable.assign_coords(motion=tiles["motion"].values),
+         "stick_fraction": stick.assign_coords(motion=tiles["motion"].values),
+         "class_fraction": tiles["class_count"] / n_starts,
+         "motion_start": tiles["motion_start"]},
+        attrs=dict(tiles.attrs))
+    return _described(ds)
+
+
+def lyapunov_dataset(tiles):
+    """The Lyapunov dataset (``results/orbits/<name>_lyapunov.nc``) of the joined attractor
+    tiles: ``lyapunov``, ``lyapunov_stderr``, ``cell_class`` (CF flags), ``impact_rate`` over
+    ``(inv_beta, delta)``, ``class_fraction`` and each start's exponent."""
+    n_starts = int(tiles.attrs["n_starts"])
+    ds = xr.Dataset(
+        {name: tiles[name] for name in ("lyapunov", "lyapunov_stderr", "cell_class",
+                                        "impact_rate", "lyapunov_start",
+                                        "lyapunov_second_start", "settle_time")},
+        attrs=dict(tiles.attrs))
+    ds["class_fraction"] = tiles["class_count"] / n_starts
+    ds["cell_class"].attrs.update(flag_values=np.arange(len(ATTRACTOR_CLASSES), dtype=np.int8),
+                                  flag_meanings=" ".join(ATTRACTOR_CLASSES))
+    return _described(ds)

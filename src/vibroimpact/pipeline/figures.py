@@ -12,6 +12,8 @@ value of its entry's grid of that parameter (:func:`per_values`). ``harmonic`` f
 ``sources`` reads those datasets from the config entry its item names (``fig15_vs_fig16``
 draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits: harmonic}``).
 
+``needs`` names the block of an ``orbits`` entry a figure draws from (``attractors``).
+
 ``draw`` names the function that draws the figure, ``"module:function"`` with the module
 under `vibroimpact.plotting` (``"random:fig07"``), resolved by :func:`drawing_function` when
 a job draws: the table is read at every workflow parse, which must not import matplotlib.
@@ -86,10 +88,21 @@ FIGURES = {
                            shows="the probability contours of Fig. 15 over the stable domains "
                                  "of Fig. 16, with the agreement measures of each motion"),
     "fig16": dict(draw="orbits:fig16",
-                  owner="orbits", reads=("orbits",),
+                  owner="orbits", reads=("orbits", "boundaries"),
                   shows="the domains over the (1/beta_f, delta) plane of stable periodic "
                         "(m/n) impact motions under sin(beta_f tau) alone, with contours of "
-                        "the degree of stability S"),
+                        "the degree of stability S; their edges are the exact grazing, fold, "
+                        "period-doubling and existence curves"),
+    "basins": dict(draw="attractors:basins",
+                   owner="orbits", reads=("basins", "orbits"), needs="attractors",
+                   shows="the share of starting states that settle on each stable (m/n) "
+                         "motion under sin(beta_f tau) alone (its basin of attraction), over "
+                         "the (1/beta_f, delta) plane of Fig. 15"),
+    "lyapunov": dict(draw="attractors:lyapunov",
+                     owner="orbits", reads=("lyapunov",), needs="attractors",
+                     shows="the largest Lyapunov exponent under sin(beta_f tau) alone and what "
+                           "each cell's starts settle on: a listed periodic motion, another "
+                           "periodic motion, sticking, chaos"),
 }
 
 #: The figures of the validation targets (rule ``draw_validation_figure``), each drawn from
@@ -240,7 +253,8 @@ def caption(kind, name, entry, target):
     fig, _ = figure_variant(target)
     number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
     what = FIGURES[fig]["shows"]
-    title = ("Fig. 15 against Fig. 16" if fig == "fig15_vs_fig16" else f"Fig. {number}")
+    title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
+             "lyapunov": "Lyapunov exponents"}.get(fig, f"Fig. {number}")
     parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
     if kind == "study":
         if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:

@@ -28,6 +28,14 @@ JOB_KEYS = {
     "trace": _PHYSICS + ("trace",),
 }
 
+#: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns
+#: only figures): the map's tiles, the boundary curves seeded from the map, the attractors.
+ORBIT_JOB_KEYS = {
+    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows"),
+    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types"),
+    "attractors": ("zeta", "eps", "types", "attractors"),
+}
+
 
 def grid_size(spec):
     """Number of values of a grid, without building it (a huge grid is refused on this count).
@@ -144,6 +152,14 @@ def orbit_rows(entry):
     """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
     rows = grid_values(entry["inv_beta"])
     return rows, -(-rows.size // int(entry["tile_rows"]))
+
+
+def attractor_rows(entry):
+    """The ``inv_beta`` values of an ``orbits`` entry's attractor map and its number of
+    tiles (row groups)."""
+    block = entry["attractors"]
+    rows = grid_values(block["inv_beta"])
+    return rows, -(-rows.size // int(block["tile_rows"]))
 
 
 def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_periods"):

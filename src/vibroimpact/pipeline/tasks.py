@@ -13,7 +13,8 @@ import sys
 from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
-from vibroimpact.pipeline.study import Study, grid_values, map_cap_steps, orbit_rows
+from vibroimpact.pipeline.study import (Study, attractor_rows, grid_values, map_cap_steps,
+                                        orbit_rows)
 
 log = logging.getLogger("vibroimpact")
 
@@ -306,3 +307,66 @@ def aggregate_orbits(entry, tiles, out):
     ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles])
     ds.attrs.update(provenance(entry))
     io.write_dataset(ds, out)
+
+
+def boundaries(entry, orbits_path, out, threads=None):
+    """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
+    the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
+    import numba
+
+    from vibroimpact.orbits import domain_boundaries
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
+    box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
+               delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
+    curves = {}
+    for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
+        curves[(m, n)] = domain_boundaries(
+            m, n, float(entry["zeta"]), float(entry["eps"]), **box,
+            resolution=(seeds["inv_beta"].size, seeds["delta"].size), seed_map=seeds)
+        log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
+    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]))
+    io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
+
+
+def _attractor_attrs(entry):
+    block = entry["attractors"]
+    gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
+    return dict(zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                n_starts=int(block["n_starts"]), max_time=float(block["max_time"]),
+                seed=int(block["seed"]), gap=list(gap), velocity=list(vel),
+                box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
+                    f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]; a scrambled Sobol sample, "
+                    f"the same in every cell")
+
+
+def attractor_tile(entry, tile, out, threads=None):
+    """Rule ``solve_attractor_tile``: basins and Lyapunov exponents on some 1/beta rows of
+    the entry's attractor grid (rows strided over tiles, as the orbit tiles)."""
+    import numba
+
+    from vibroimpact.orbits import attractor_map
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    block = entry["attractors"]
+    rows, n_tiles = attractor_rows(entry)
+    attrs = _attractor_attrs(entry)
+    result = attractor_map(rows[tile::n_tiles], grid_values(block["delta"]),
+                           float(entry["zeta"]), float(entry["eps"]),
+                           types=[tuple(int(k) for k in t) for t in entry["types"]],
+                           n_starts=attrs["n_starts"], gap=tuple(attrs["gap"]),
+                           velocity=tuple(attrs["velocity"]), max_time=attrs["max_time"],
+                           seed=attrs["seed"])
+    attrs = dict(provenance(entry), **attrs)
+    io.write_dataset(datasets.attractor_tile_dataset(result, attrs), out)
+
+
+def aggregate_attractors(entry, tiles, out_basins, out_lyapunov):
+    """Rule ``aggregate_attractors``: the basins and Lyapunov datasets of one entry."""
+    joined = datasets.concat_attractor_tiles([io.load_dataset(p) for p in tiles])
+    joined.attrs.update(provenance(entry))
+    io.write_dataset(datasets.basins_dataset(joined), out_basins)
+    io.write_dataset(datasets.lyapunov_dataset(joined), out_lyapunov)

@@ -15,7 +15,8 @@ REPORT_PARAMETERS = {
     "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
     "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
                         "figures", "amplitude", "inv_beta", "density_delta"),
-    "periodic_motions": ("name", "orbits", "map", "figures"),
+    "periodic_motions": ("name", "orbits", "boundaries", "basins", "lyapunov", "map",
+                         "figures"),
     "performance": ("work_precision", "figures"),
     "stability": ("stress", "campaign", "figures"),
 }

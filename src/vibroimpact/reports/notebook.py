@@ -206,6 +206,89 @@ def orbit_domains(orbits):
     return pd.DataFrame.from_dict(rows, orient="index")
 
 
+def boundary_summary(boundaries):
+    """Per motion type: the exact edge curves of its stable domain by kind (curves, points),
+    and the codimension-two points where two kinds meet."""
+    import pandas as pd
+
+    rows = {}
+    kinds = ("grazing", "fold", "period_doubling", "existence")
+    curve_kind = boundaries["kind"].values.astype(str)
+    curve_type = boundaries["type"].values.astype(str)
+    points = np.bincount(boundaries["curve"].values, minlength=curve_kind.size)
+    c2_type = boundaries["codim2_type"].values.astype(str)
+    c2_kinds = boundaries["codim2_kinds"].values.astype(str)
+    for name in dict.fromkeys(curve_type.tolist() + c2_type.tolist()):
+        row = {}
+        for kind in kinds:
+            sel = (curve_type == name) & (curve_kind == kind)
+            row[kind] = (f"{int(sel.sum())} ({int(points[sel].sum())} points)"
+                         if sel.any() else "")
+        here = c2_kinds[c2_type == name]
+        row["codimension-two points"] = ", ".join(
+            f"{k} x{int((here == k).sum())}" for k in sorted(set(here.tolist()))) or ""
+        rows[f"({name})"] = row
+    return pd.DataFrame.from_dict(rows, orient="index")
+
+
+def basin_summary(basins):
+    """Per motion type: where a stable orbit exists, how large its basin is (median and
+    extremes of the fraction of starts), in how many cells it takes every start, and in how
+    many it shares the plane with another stable type (multistable cells)."""
+    import pandas as pd
+
+    rows = {}
+    n_types = basins.sizes["motion"] - 1
+    types = basins["motion"].values[:n_types]
+    has = basins["n_stable"].values[:n_types] > 0
+    multistable = has.sum(axis=0) > 1
+    for k, name in enumerate(types):
+        f = basins["fraction"].values[k][has[k]]
+        lo = basins["fraction_lo"].values[k][has[k]]
+        hi = basins["fraction_hi"].values[k][has[k]]
+        rows[f"({name})"] = {
+            "cells with a stable orbit": int(has[k].sum()),
+            "basin median (%)": f"{100 * np.median(f):.1f}" if f.size else "",
+            "basin min - max (%)": f"{100 * f.min():.0f} - {100 * f.max():.0f}" if f.size
+            else "",
+            "cells where every start settles on it": int((f == 1.0).sum()),
+            "of them multistable": int(multistable[has[k]].sum()),
+            "median 95 % interval width (points)": f"{100 * np.median(hi - lo):.1f}"
+            if f.size else "",
+        }
+    other = basins["fraction"].values[n_types]
+    rows["other"] = {"cells with a stable orbit": "",
+                     "basin median (%)": f"{100 * np.median(other):.1f}",
+                     "basin min - max (%)": f"{100 * other.min():.0f} - {100 * other.max():.0f}"}
+    return pd.DataFrame.from_dict(rows, orient="index").fillna("")
+
+
+def lyapunov_summary(lyapunov, basins):
+    """How the plane divides by what its starts settle on (the cell's most frequent class),
+    over all cells and over the cells where the solver finds no stable listed motion (the
+    paper's D, V, X, U), with the largest exponent's range in each class."""
+    import pandas as pd
+
+    from vibroimpact.pipeline.datasets import ATTRACTOR_CLASSES
+
+    n_types = basins.sizes["motion"] - 1
+    none_stable = (basins["n_stable"].values[:n_types] > 0).sum(axis=0) == 0
+    cls = lyapunov["cell_class"].values
+    lam = lyapunov["lyapunov"].values
+    rows = {}
+    for code, name in enumerate(ATTRACTOR_CLASSES):
+        sel = cls == code
+        finite = lam[sel & np.isfinite(lam)]
+        rows[name.replace("_", " ")] = {
+            "cells": int(sel.sum()),
+            "of them with no stable listed orbit": int((sel & none_stable).sum()),
+            "largest exponent, range": (f"{finite.min():.3g} .. {finite.max():.3g}"
+                                        if finite.size else
+                                        ("-inf" if sel.any() else "")),
+        }
+    return pd.DataFrame.from_dict(rows, orient="index")
+
+
 def markdown_table(path, header):
     """The first Markdown table of file ``path`` whose header row starts with ``header``
     (e.g. the README's stress-campaign table), as a DataFrame of strings."""

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from vibroimpact._limits import MAX_M, cutoff
+from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time, cutoff
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
 from vibroimpact.pipeline.study import grid_size, grid_values, map_cap_steps, noise_record
@@ -131,6 +131,10 @@ def _check_figures(config, section, name, entry, problems, grids):
                          "its `inv_beta` draws it several times)")
         seen.add(fig)
         if kind != "study":
+            block = spec.get("needs")
+            if block and not entry.get(block):
+                problems.add(f"{section}.{name}.{block}", None, f"missing, and {fig} draws it",
+                             f"an `{block}:` block (config/schema.yaml), or drop {fig}")
             continue
         if spec.get("harmonic") and not entry.get("amplitude"):
             problems.add(f"studies.{name}.amplitude", entry.get("amplitude", 0.0),
@@ -341,7 +345,42 @@ def _check_orbits(config, name, entry, problems, limits):
     if len(set(types)) != len(types):
         problems.add(f"{where}.types", entry["types"], "a type is listed twice",
                      "distinct [m, n] pairs")
+    if entry.get("attractors"):
+        _check_attractors(where, entry, problems, limits)
     _check_figures(config, "orbits", name, entry, problems, None)
+
+
+def _check_attractors(where, entry, problems, limits):
+    """The attractors block of an orbits entry: its grid, a box of starts on the free side of
+    the wall, a cap long enough to settle."""
+    where = f"{where}.attractors"
+    block = entry["attractors"]
+    grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", block["inv_beta"],
+                               limits["max_orbit_cells"], positive=True),
+             "delta": _grid(problems, f"{where}.delta", block["delta"],
+                            limits["max_orbit_cells"])}
+    if entry.get("figures"):
+        for fig in ("basins", "lyapunov"):
+            if fig in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
+                _plane(problems, where, grids, fig)
+    low, high = (float(v) for v in block["gap"])
+    if low < 0.0:
+        problems.add(f"{where}.gap", block["gap"], f"a distance from the wall of {_num(low)} "
+                     "puts starts beyond the wall (x0 = delta - g > delta)",
+                     "[low, high] with 0 <= low < high")
+    elif not low < high:
+        problems.add(f"{where}.gap", block["gap"], "an empty range", "[low, high], low < high")
+    low, high = (float(v) for v in block["velocity"])
+    if not low < high:
+        problems.add(f"{where}.velocity", block["velocity"], "an empty range",
+                     "[low, high], low < high")
+    shortest = attractor_min_time(float(entry["zeta"]))
+    if float(block["max_time"]) < shortest:
+        problems.add(f"{where}.max_time", block["max_time"],
+                     f"too short for a start to settle: the damping alone needs "
+                     f"ln(1/{ATTRACTOR_MATCH_TOL:g})/zeta = {shortest:.4g} to bring a "
+                     f"perturbation under the matching tolerance {ATTRACTOR_MATCH_TOL:g}",
+                     f">= {shortest:.4g} (zeta = {_num(float(entry['zeta']))})")
 
 
 def _check_paper_figures(config, problems, only=None):

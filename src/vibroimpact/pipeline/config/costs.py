@@ -8,13 +8,16 @@ measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job c
 from vibroimpact.pipeline.study import Study, map_cap_steps
 
 __all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simulate_runtime_min",
-           "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s"]
+           "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
+           "attractor_cpu_s", "boundaries_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
+US_PER_START = 360.0       # one start of the attractor map, settled or run to its cap
+BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 FIGURE_S = 1.5             # one figure, start-up included
 REPORT_S = 4.0             # one report notebook executed and rendered (papermill, nbconvert)
 VALIDATION_S = 85.0        # the work-precision run and the stress sample together
@@ -89,3 +92,13 @@ def noise_cpu_s(n_samples):
 def orbit_cpu_s(cells, types):
     """CPU seconds of the orbit solves of ``cells`` (1/beta, delta) cells of ``types`` types."""
     return cells * types * US_PER_ORBIT * 1e-6
+
+
+def attractor_cpu_s(cells, n_starts):
+    """CPU seconds of the attractor map's ``n_starts`` starts in each of ``cells`` cells."""
+    return cells * n_starts * US_PER_START * 1e-6
+
+
+def boundaries_cpu_s(types):
+    """CPU seconds of tracing the stable domains' edges of ``types`` (m/n) types."""
+    return types * BOUNDARIES_S

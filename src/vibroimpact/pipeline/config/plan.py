@@ -18,7 +18,7 @@ from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVER
                                                VALIDATION_S)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
 from vibroimpact.pipeline.config.sweeps import drawn_sweeps
-from vibroimpact.pipeline.study import Study, grid_size, orbit_rows
+from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
 
 __all__ = ["Plan", "Row", "make_plan", "built_entries"]
 
@@ -229,8 +229,23 @@ def make_plan(config, own=None, *, results="results"):
         row = Row(f"orbits.{name}", f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}, "
                   f"{_n(targets, 'figure')}", orbit_cells=cells, jobs=n_tiles + 1 + targets,
                   bytes=2 * cells * len(entry["types"]) * 34 + targets * FIGURE_BYTES)
-        row.cpu_s = (costs.orbit_cpu_s(cells, len(entry["types"])) + row.jobs * JOB_START_S
-                     + targets * FIGURE_S)
+        row.cpu_s = costs.orbit_cpu_s(cells, len(entry["types"])) + targets * FIGURE_S
+        if "fig16" in figures.figure_targets(entry) and name in drawn["orbits"]:
+            row.jobs += 1                       # the boundary curves Fig. 16 draws
+            row.bytes += 200_000 * len(entry["types"])
+            row.cpu_s += costs.boundaries_cpu_s(len(entry["types"]))
+            row.detail += ", boundary curves"
+        block = entry.get("attractors")
+        if block:
+            a_rows, a_tiles = attractor_rows(entry)
+            a_cells = len(a_rows) * grid_size(block["delta"])
+            n_starts = int(block["n_starts"])
+            row.orbit_cells += a_cells
+            row.jobs += a_tiles + 1
+            row.bytes += a_cells * (8 * 5 * n_starts + 400) + 2 * FILE_OVERHEAD
+            row.cpu_s += costs.attractor_cpu_s(a_cells, n_starts)
+            row.detail += (f", attractors {_n(a_cells, 'cell')} x {_n(n_starts, 'start')}")
+        row.cpu_s += row.jobs * JOB_START_S
         plan.rows.append(row)
     for name in drawn_sweeps(config, drawn):
         n = len(config["sweeps"][name]["studies"])

@@ -1,0 +1,6 @@
+"""Rule solve_attractor_tile: basins and Lyapunov exponents on some 1/beta rows."""
+from vibroimpact.pipeline import tasks
+
+with tasks.logged(snakemake.log[0]):
+    tasks.attractor_tile(snakemake.params.entry, int(snakemake.wildcards.tile),
+                         snakemake.output[0], threads=snakemake.threads)
