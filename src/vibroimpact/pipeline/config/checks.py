@@ -328,8 +328,17 @@ def _plane(problems, where, grids, fig):
                          f"over the (1/beta_f, delta) plane", "at least 2 values")
 
 
+#: Endings of the datasets an orbits entry derives (results/orbits/<name>_basins.nc ...): an
+#: entry named like one would collide with another entry's file.
+DERIVED_SUFFIXES = ("_boundaries", "_basins", "_lyapunov")
+
+
 def _check_orbits(config, name, entry, problems, limits):
     where = f"orbits.{name}"
+    if name.endswith(DERIVED_SUFFIXES):
+        problems.add(where, name, "ends like a dataset an orbits entry derives "
+                     "(results/orbits/<name>_basins.nc ...)",
+                     f"a name not ending in {', '.join(DERIVED_SUFFIXES)}")
     grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_orbit_cells"], positive=True),
              "delta": _grid(problems, f"{where}.delta", entry["delta"],
