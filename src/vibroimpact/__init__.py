@@ -24,6 +24,8 @@ _LAZY = {
     "periodic_orbits": "vibroimpact.orbits.api",
     "PeriodicOrbit": "vibroimpact.orbits.api",
     "orbit_map": "vibroimpact.orbits.api",
+    "domain_boundaries": "vibroimpact.orbits.boundaries",
+    "attractor_map": "vibroimpact.orbits.attractors",
 }
 
 # PLE0604: ruff cannot see that the keys of _LAZY are strings
