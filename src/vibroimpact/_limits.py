@@ -7,8 +7,8 @@ limits from here, so a config is refused by the same rule the code applies.
 """
 import math
 
-__all__ = ["MAX_M", "ATTRACTOR_MATCH_TOL", "attractor_min_time", "FIR_ATTENUATION_DB", "FIR_TRANSITION_FRACTION", "FIR_MAX_TAPS",
-           "FULL_BAND_RTOL", "fir_taps", "cutoff"]
+__all__ = ["MAX_M", "ATTRACTOR_MATCH_TOL", "attractor_min_time", "FIR_ATTENUATION_DB",
+           "FIR_TRANSITION_FRACTION", "FIR_MAX_TAPS", "FULL_BAND_RTOL", "fir_taps", "cutoff"]
 
 #: Largest number of impacts m a period of the (m/n) motions the orbit solver finds.
 MAX_M = 3

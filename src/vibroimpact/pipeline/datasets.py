@@ -358,11 +358,15 @@ ATTRACTOR_META = {
     "class_fraction": ("share of the starts in each class", "1"),
     "lyapunov": ("largest Lyapunov exponent over the cell's starts (-inf: every start sticks)",
                  "1/tau"),
-    "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle", "1/tau"),
+    "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle",
+                        "1/tau"),
     "cell_class": ("the most frequent class of the cell's starts", "1"),
     "impact_rate": ("collisions per unit time, mean over the cell's starts", "1/tau"),
     "lyapunov_start": ("largest Lyapunov exponent of each start", "1/tau"),
     "motion_start": ("what each start settles on: index into motion", "1"),
+    "lyapunov_second_start": ("second Lyapunov exponent of each start", "1/tau"),
+    "settle_time": ("time a start takes to settle on a periodic motion (NaN: not settled)",
+                    "1"),
 }
 
 
