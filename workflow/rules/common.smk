@@ -299,8 +299,12 @@ def orbits_report_inputs(wildcards):
     }
     inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
     if entry.get("attractors"):
-        inputs.update({kind: _DATASETS[kind].format(name=wildcards.orbits)
-                       for kind in ("basins", "lyapunov")})
+        inputs.update(
+            {
+                kind: _DATASETS[kind].format(name=wildcards.orbits)
+                for kind in ("basins", "lyapunov")
+            }
+        )
     return inputs
 
 
