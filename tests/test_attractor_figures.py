@@ -136,6 +136,15 @@ def test_fig16_refuses_boundaries_of_another_system(data):
         plotting.fig16(data["orbits"], bad)
 
 
+def test_fig16_with_no_curves_draws_none(data):
+    empty = data["boundaries"].isel(point=slice(0, 0), curve=slice(0, 0),
+                                    codim2=slice(0, 0))
+    fig = plotting.fig16(data["orbits"], empty)
+    assert not any((a.get_gid() or "").startswith(("boundary", "overview-boundary", "codim2",
+                                                   "stable-edge"))
+                   for ax in fig.axes for a in ax.get_children())
+
+
 def _old_fig16():
     """fig16 as it was before `boundaries` (the module's source at `BEFORE_BOUNDARIES`)."""
     try:
@@ -214,6 +223,17 @@ def test_basins_draw_nan_cells_blank_without_warning(data):
                                                         ds.sizes["inv_beta"]).T
     assert mask[3:6, 4:8].all() and mask.sum() == 12
     assert not any(_gid(ax, "stable-domain") for ax in fig.axes)
+
+
+def test_basins_dot_starts_settled_where_the_solver_has_no_stable_orbit(data):
+    ds = data["basins"].copy(deep=True)
+    k = list(ds["motion"].values).index("1/3")
+    no_orbit = np.argwhere(ds["n_stable"].values[k] == 0)[5]
+    ds["fraction"].values[k, no_orbit[0], no_orbit[1]] = 2 / 64
+    fig = plotting.basins(ds)
+    (dots,) = _gid(_panel(fig, "(1/3)"), "stray")
+    assert (ds["inv_beta"].values[no_orbit[0]], ds["delta"].values[no_orbit[1]]) in set(
+        zip(dots.get_xdata(), dots.get_ydata()))
 
 
 def test_basins_refuse_an_orbit_map_of_another_system(data):

@@ -41,7 +41,7 @@ STICK_LINE_COLOR = "#009E73"
 #: The classes of a cell's starts (a dataset's ``class`` coordinate and ``cell_class``
 #: codes 0-4): colour and words.
 CLASSES = {
-    "listed": ("#0072B2", "periodic, of a type mapped here"),
+    "listed": ("#0072B2", "periodic, of a type of Fig. 16"),
     "periodic_other": ("#56B4E9", "periodic, of another type"),
     "sticking": ("#8C6D31", "sticking to the wall"),
     "chaotic": ("#D55E00", "chaotic"),
@@ -56,8 +56,11 @@ SIGN_STDERRS = 2.0
 #: A class holding less than this share of the cell's starts is hatched (a mixed cell).
 MIXED_SHARE = 0.5
 MIXED_HATCH = "////"
-#: Lyapunov colour map: diverging, centred at 0 (stable blue, chaotic red).
+#: Lyapunov colour map: diverging, centred at 0 (stable blue, chaotic red); each side ends at
+#: this quantile of its exponents' magnitudes, so that a few outlying cells (a finite-time
+#: estimate) do not wash out the rest; beyond it the end colour, an arrow on the colour bar.
 LYAPUNOV_CMAP = "RdBu_r"
+LYAPUNOV_QUANTILE = 0.99
 
 
 def _grid(ds):
@@ -262,12 +265,18 @@ def _class_names(ds):
 
 
 def _lyapunov_norm(finite):
-    """Diverging norm centred at 0 from the finite exponents (each side its own range)."""
-    low = float(np.min(finite, initial=0.0))
-    high = float(np.max(finite, initial=0.0))
-    scale = max(-low, high, 1e-12)
-    return TwoSlopeNorm(vcenter=0.0, vmin=min(low, -0.05 * scale),
-                        vmax=max(high, 0.05 * scale))
+    """Diverging norm centred at 0 from the finite exponents, each side ending at the
+    `LYAPUNOV_QUANTILE` of its magnitudes, and the colour bar's ``extend``."""
+    ends, beyond = [], []
+    for side in (-finite[finite < 0.0], finite[finite > 0.0]):
+        end = float(np.quantile(side, LYAPUNOV_QUANTILE)) if side.size else 0.0
+        ends.append(end)
+        beyond.append(bool(side.size) and float(side.max()) > end)
+    floor = 0.05 * max(*ends, 1e-12)        # a side without values keeps a sliver of colour
+    norm = TwoSlopeNorm(vcenter=0.0, vmin=-max(ends[0], floor), vmax=max(ends[1], floor))
+    extend = {(False, False): "neither", (True, False): "min", (False, True): "max",
+              (True, True): "both"}[tuple(beyond)]
+    return norm, extend
 
 
 @_styled
@@ -285,13 +294,14 @@ def lyapunov(lyapunov):
     Returns
     -------
     matplotlib.figure.Figure
-        (a) The exponent on a diverging map centred at 0 (`LYAPUNOV_CMAP`, each side scaled
-        to its own range: red chaotic, blue settling), cells of -inf in the sticking colour
-        (`STICK_COLOR`), cells without a value grey; a dot where the exponent lies
-        within `SIGN_STDERRS` standard errors of 0 (its sign unresolved); the edge of the
-        region where no start impacts (``impact_rate`` 0: the wall-free response, exponent
-        -zeta). (b) The class of each cell (`CLASSES`), hatched where that class holds less
-        than `MIXED_SHARE` of the cell's starts (``class_fraction``).
+        (a) The exponent on a diverging map centred at 0 (`LYAPUNOV_CMAP`, each side
+        scaled to its own range up to `LYAPUNOV_QUANTILE`: red chaotic, blue settling),
+        cells of -inf in the sticking colour (`STICK_COLOR`), cells without a value grey; a
+        dot where the exponent lies within `SIGN_STDERRS` standard errors of 0 (its sign
+        unresolved); the edge of the region where no start impacts (``impact_rate`` 0: the
+        wall-free response, exponent -zeta). (b) The class of each cell (`CLASSES`),
+        hatched where that class holds less than `MIXED_SHARE` of the cell's starts
+        (``class_fraction``).
     """
     x, y = _grid(lyapunov)
     xe, ye = cell_edges(x), cell_edges(y)
@@ -312,7 +322,7 @@ def lyapunov(lyapunov):
                         cmap=ListedColormap([STICK_COLOR]), rasterized=True, gid="sticking")
         handles_l.append(Patch(facecolor=STICK_COLOR, edgecolor="0.6",
                                label=r"every start sticks: $-\infty$"))
-    norm = _lyapunov_norm(lam[finite])
+    norm, extend = _lyapunov_norm(lam[finite])
     shaded = ax_l.pcolormesh(xe, ye, np.ma.masked_where(~finite, np.where(finite, lam, 0.0)).T,
                              cmap=LYAPUNOV_CMAP, norm=norm, rasterized=True, gid="lyapunov")
     if "lyapunov_stderr" in lyapunov:
@@ -334,7 +344,7 @@ def lyapunov(lyapunov):
             handles_l.append(Line2D([], [], color="0.2", lw=0.9,
                                     label=r"edge of no impact (wall-free response, "
                                           r"$-\zeta$)"))
-    fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend="neither",
+    fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend=extend,
                  label=r"largest Lyapunov exponent (per unit $\tau$)")
     ax_l.set_title("(a) largest Lyapunov exponent")
 

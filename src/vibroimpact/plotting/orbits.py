@@ -188,6 +188,8 @@ def boundary_curves(boundaries):
         raise ValueError(f"boundary kinds {unknown} are not among {list(BOUNDARY_KINDS)}")
     types = [str(t) for t in boundaries["type"].values]
     curve = np.asarray(boundaries["curve"].values, dtype=int)
+    if curve.size == 0:
+        return []
     xy = np.column_stack([np.asarray(boundaries["inv_beta"].values, dtype=float),
                           np.asarray(boundaries["delta"].values, dtype=float)])
     starts = np.flatnonzero(np.r_[True, curve[1:] != curve[:-1]])
