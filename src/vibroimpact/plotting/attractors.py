@@ -16,7 +16,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from vibroimpact.plotting._common import _attr, _header, _styled, _system_text, axis_label
+from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
+                                          axis_label)
 from vibroimpact.plotting.maps import cell_edges, cell_outline, cell_rectangles, label_contours
 
 #: The basin fraction (%) is filled in bands of `BASIN_BAND` and its labelled lines drawn
@@ -80,13 +81,6 @@ def _finish_axes(axes, ds, bottom):
     for ax in bottom:
         ax.xaxis.set_tick_params(labelbottom=True)
         ax.set_xlabel(axis_label(ds["inv_beta"]))
-
-
-def _same_system(a, b, what):
-    for key in ("zeta", "eps"):
-        if float(_attr(a, key)) != float(_attr(b, key)):
-            raise ValueError(f"the {what} has {key} = {_attr(b, key)!r} but this dataset "
-                             f"{_attr(a, key)!r}: not the same system")
 
 
 def _smoothed(p):
@@ -159,7 +153,7 @@ def basins(basins, orbits=None):
     95 % Clopper-Pearson interval of the map (``fraction_lo``, ``fraction_hi``).
     """
     if orbits is not None:
-        _same_system(basins, orbits, "orbit map")
+        _same_system(basins, orbits, ("the basins", "the orbit map"))
     motions = [str(m) for m in basins["motion"].values]
     types = [m for m in motions if m != "other"]
     panels = types + (["other"] if "other" in motions else [])

@@ -9,7 +9,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from vibroimpact.plotting._common import _attr, _header, _styled, _system_text, axis_label
+from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
+                                          axis_label)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -168,6 +169,7 @@ def _fits(allowed, bw, bh):
     return ndimage.minimum_filter(allowed.astype(np.uint8), size=(bw, bh), mode="constant",
                                   cval=0) > 0
 
+
 def boundary_curves(boundaries):
     """The curves of a boundaries dataset: ``[(index, type, kind, vertices)]``.
 
@@ -277,10 +279,7 @@ def fig16(orbits, boundaries=None):
     from scipy import ndimage
 
     if boundaries is not None:
-        for key in ("zeta", "eps"):
-            if float(_attr(boundaries, key)) != float(_attr(orbits, key)):
-                raise ValueError(f"the boundaries have {key} = {_attr(boundaries, key)!r} but "
-                                 f"the orbit map {_attr(orbits, key)!r}: not the same system")
+        _same_system(boundaries, orbits, ("the boundaries", "the orbit map"))
     types = [str(t) for t in orbits["type"].values]
     ncols = 3
     nrows = -(-(len(types) + 1) // ncols)
