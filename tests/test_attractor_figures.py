@@ -297,6 +297,22 @@ def test_lyapunov_classes_named_in_the_legend(data, lyapunov_figure):
     np.testing.assert_array_equal(np.asarray(mesh.get_array()).reshape(code.T.shape).T, code)
 
 
+def test_lyapunov_dots_exponents_of_unresolved_sign(data):
+    ds = data["lyapunov"].copy(deep=True)
+    ds["lyapunov"][2, 3] = 0.001
+    ds["lyapunov_stderr"][2, 3] = 0.004       # 0 lies within 2 s.e.
+    ds["lyapunov"][4, 5] = 0.02
+    ds["lyapunov_stderr"][4, 5] = 0.004       # positive, resolved
+    resolved = np.isfinite(ds["lyapunov_stderr"].values)
+    resolved &= np.abs(ds["lyapunov"].values) >= 2.0 * ds["lyapunov_stderr"].values
+    fig = plotting.lyapunov(ds)
+    (dots,) = _gid(fig.axes[0], "unresolved")
+    xy = set(zip(dots.get_xdata(), dots.get_ydata()))
+    x, y = ds["inv_beta"].values, ds["delta"].values
+    assert (x[2], y[3]) in xy and (x[4], y[5]) not in xy
+    assert len(xy) == np.sum(np.isfinite(ds["lyapunov_stderr"].values) & ~resolved)
+
+
 def test_lyapunov_refuses_unknown_classes(data):
     ds = data["lyapunov"].copy()
     ds["cell_class"].attrs["flag_meanings"] = "periodic chaotic"

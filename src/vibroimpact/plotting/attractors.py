@@ -351,7 +351,7 @@ def lyapunov(lyapunov):
                        label=f"{w} ({100.0 * np.mean(code == k):.2g} % of cells)")
                  for k, (c, w) in enumerate(zip(colors, words)) if (code == k).any()]
     if "class_fraction" in lyapunov:
-        cf = np.asarray(lyapunov["class_fraction"].values, dtype=float)
+        cf = np.asarray(lyapunov["class_fraction"].sel({"class": names}).values, dtype=float)
         own = np.take_along_axis(cf, np.clip(code, 0, cf.shape[0] - 1)[None], axis=0)[0]
         mixed = own < MIXED_SHARE
         if mixed.any():
