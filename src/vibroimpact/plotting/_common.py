@@ -160,6 +160,15 @@ def _attr(ds, name):
                        f"attributes present: {sorted(ds.attrs)}") from None
 
 
+def _same_system(a, b, names):
+    """Raise unless datasets `a` and `b` have the same zeta and eps (`names`: how the error
+    calls them, ``("the map", "the orbit map")``)."""
+    for key in ("zeta", "eps"):
+        if float(_attr(a, key)) != float(_attr(b, key)):
+            raise ValueError(f"{names[0]} has {key} = {_attr(a, key)!r} but {names[1]} "
+                             f"{_attr(b, key)!r}: not the same system")
+
+
 def _colors(n):
     """`n` colours along the style's colour map (one per curve of a family)."""
     cmap = matplotlib.colormaps[matplotlib.rcParams["image.cmap"]]

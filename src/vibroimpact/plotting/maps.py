@@ -17,9 +17,9 @@ from matplotlib.patches import Patch, Rectangle
 from matplotlib.path import Path
 
 from vibroimpact import stats
-from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _styled,
-                                          _system_text, axis_label, no_collision_text,
-                                          note_on_axes)
+from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _same_system,
+                                          _styled, _system_text, axis_label,
+                                          no_collision_text, note_on_axes)
 
 #: Probability contours (%) of Fig. 15 (the paper draws 10 % steps).
 PROBABILITY_LEVELS = (10, 20, 30, 40, 50, 60, 70, 80, 90)
@@ -460,10 +460,7 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
         cells with probability >= 50 % inside the stable domain; share of the domain where
         the motion dominates; Spearman's rank correlation of probability and S there).
     """
-    for key in ("zeta", "eps"):
-        if float(_attr(motion_map, key)) != float(_attr(orbits, key)):
-            raise ValueError(f"the map has {key} = {_attr(motion_map, key)!r} but the orbit map "
-                             f"{_attr(orbits, key)!r}: not the same system")
+    _same_system(motion_map, orbits, ("the map", "the orbit map"))
     agreement = map_agreement(motion_map, orbits)
     if not agreement:
         raise ValueError(f"no motion of the map {list(motion_map['motion'].values)} is in the "

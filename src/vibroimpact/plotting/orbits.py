@@ -9,7 +9,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from vibroimpact.plotting._common import _attr, _header, _styled, _system_text, axis_label
+from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
+                                          axis_label)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -34,6 +35,23 @@ LEADER_LENGTH = 0.3
 #: Width (pt) of a stable domain's edge: thin, so a domain one or two cells wide still
 #: shows its colour.
 EDGE_WIDTH = 0.8
+#: Line style of each kind of boundary curve (a boundaries dataset's ``kind``) and its words
+#: in the legend. The dotted style stays with the edge of complex multipliers.
+BOUNDARY_KINDS = {
+    "fold": ("-", "fold: a stable and an unstable solution meet and vanish"),
+    "grazing": ((0, (3.5, 1.5)), "grazing: the motion touches the wall, eq. (13) at its limit"),
+    "period_doubling": ((0, (7.0, 1.5, 1.5, 1.5)),
+                        "period doubling: a multiplier passes -1, eq. (22) at its limit"),
+    "existence": ((0, (0.1, 2.0)), "existence: the solution of eqs. (10), (11) ends"),
+}
+#: Kinds drawn wider with round caps: a dotted line of round dots, heavier than the fine
+#: dotted edge of complex multipliers.
+ROUND_KINDS = {"existence": 1.9}
+#: Width (pt) of a boundary curve on a type's panel and on the overview (a).
+BOUNDARY_WIDTH = 1.1
+OVERVIEW_WIDTH = 1.3
+#: Marker of a codimension-two point (two boundaries meet).
+CODIM2_STYLE = dict(ls="none", marker="o", ms=4.5, mfc="white", mew=1.0, zorder=4)
 #: lam within this relative distance of eps e^(-zeta z / m) counts as complex multipliers.
 COMPLEX_RTOL = 1e-7
 
@@ -151,8 +169,76 @@ def _fits(allowed, bw, bh):
     return ndimage.minimum_filter(allowed.astype(np.uint8), size=(bw, bh), mode="constant",
                                   cval=0) > 0
 
+
+def boundary_curves(boundaries):
+    """The curves of a boundaries dataset: ``[(index, type, kind, vertices)]``.
+
+    Parameters
+    ----------
+    boundaries : xarray.Dataset
+        ``inv_beta(point)``, ``delta(point)``, ``curve(point)`` (a curve's points
+        consecutive, in order along it), ``kind(curve)``, ``type(curve)``.
+
+    Returns
+    -------
+    list of (int, str, str, ndarray of shape (n, 2))
+        Vertices as ``(inv_beta, delta)``; a kind outside `BOUNDARY_KINDS` raises ValueError.
+    """
+    kinds = [str(k) for k in boundaries["kind"].values]
+    unknown = sorted(set(kinds) - set(BOUNDARY_KINDS))
+    if unknown:
+        raise ValueError(f"boundary kinds {unknown} are not among {list(BOUNDARY_KINDS)}")
+    types = [str(t) for t in boundaries["type"].values]
+    curve = np.asarray(boundaries["curve"].values, dtype=int)
+    if curve.size == 0:
+        return []
+    xy = np.column_stack([np.asarray(boundaries["inv_beta"].values, dtype=float),
+                          np.asarray(boundaries["delta"].values, dtype=float)])
+    starts = np.flatnonzero(np.r_[True, curve[1:] != curve[:-1]])
+    return [(int(curve[a]), types[curve[a]], kinds[curve[a]], piece)
+            for a, piece in zip(starts, np.split(xy, starts[1:]))]
+
+
+def _kind_style(kind):
+    """Line2D keywords of a boundary of `kind` on a type's panel (`BOUNDARY_KINDS`)."""
+    if kind in ROUND_KINDS:
+        return dict(ls=BOUNDARY_KINDS[kind][0], lw=ROUND_KINDS[kind], dash_capstyle="round")
+    return dict(ls=BOUNDARY_KINDS[kind][0], lw=BOUNDARY_WIDTH)
+
+
+def _draw_boundaries(overview, panels, boundaries):
+    """Boundary curves and codimension-two points of each type on its panel and on (a).
+
+    `panels` maps a type to ``(axes, colour)``. A curve is one Line2D per panel, gid
+    ``boundary-<curve>`` on the type's panel and ``overview-boundary-<curve>`` on (a); the
+    codimension-two points of a type are one Line2D of markers per panel, gid ``codim2``.
+    Returns the kinds drawn and whether a codimension-two point was.
+    """
+    drawn = set()
+    for c, name, kind, xy in boundary_curves(boundaries):
+        if name not in panels:
+            continue
+        ax, color = panels[name]
+        style = _kind_style(kind)
+        ax.plot(xy[:, 0], xy[:, 1], color="k", gid=f"boundary-{c}", **style)
+        overview.plot(xy[:, 0], xy[:, 1], color=color, gid=f"overview-boundary-{c}",
+                      **dict(style, lw=style["lw"] * OVERVIEW_WIDTH / BOUNDARY_WIDTH))
+        drawn.add(kind)
+    types = np.array([str(t) for t in boundaries["codim2_type"].values])
+    x = np.asarray(boundaries["codim2_inv_beta"].values, dtype=float)
+    y = np.asarray(boundaries["codim2_delta"].values, dtype=float)
+    marked = False
+    for name, (ax, color) in panels.items():
+        here = types == name
+        if here.any():
+            ax.plot(x[here], y[here], mec="k", gid="codim2", **CODIM2_STYLE)
+            overview.plot(x[here], y[here], mec=color, gid="codim2", **CODIM2_STYLE)
+            marked = True
+    return [k for k in BOUNDARY_KINDS if k in drawn], marked
+
+
 @_styled
-def fig16(orbits):
+def fig16(orbits, boundaries=None):
     """Domains of stable (m/n) periodic impact motions over the (1/beta, delta) plane.
 
     Parameters
@@ -160,6 +246,10 @@ def fig16(orbits):
     orbits : xarray.Dataset
         ``results/orbits/{name}.nc``: ``n_stable``, ``lam``, ``S``, ``reason`` over
         ``(type, inv_beta, delta)``; global attributes ``zeta``, ``eps``.
+    boundaries : xarray.Dataset, optional
+        ``results/orbits/{name}_boundaries.nc`` of the same system: the curves bounding each
+        type's stable domain (``inv_beta``, ``delta``, ``curve`` over ``point``; ``kind``,
+        ``type`` over ``curve``) and the points where two of them meet (``codim2_*``).
 
     Returns
     -------
@@ -174,6 +264,12 @@ def fig16(orbits):
         complex S depends on 1/beta alone (`complex_multipliers`), so no contour is drawn
         there and a dotted line marks that region's edge.
 
+        With `boundaries`, the edges of the stable domains (on the type's panel in black, on
+        panel (a) in the type's colour) are the curves, drawn in a line style per kind
+        (`BOUNDARY_KINDS`: fold, grazing, period doubling, end of existence), the
+        codimension-two points marked (`CODIM2_STYLE`); the cells keep S, the contours and the
+        region words, and no cell-edge line is drawn.
+
     Notes
     -----
     The paper (Section 5) names D, V, X the domains without a solution satisfying eqs. (10),
@@ -182,6 +278,8 @@ def fig16(orbits):
     """
     from scipy import ndimage
 
+    if boundaries is not None:
+        _same_system(boundaries, orbits, ("the boundaries", "the orbit map"))
     types = [str(t) for t in orbits["type"].values]
     ncols = 3
     nrows = -(-(len(types) + 1) // ncols)
@@ -193,13 +291,15 @@ def fig16(orbits):
     xe, ye = cell_edges(x), cell_edges(y)
     overview = axes[0]
     reason_cmap = ListedColormap([REASONS[c][0] for c in sorted(REASONS)])
-    shaded, regions = None, []
+    shaded, regions, panels = None, [], {}
     for i, name in enumerate(types):
         sel = orbits.sel(type=name)
         color = TYPE_COLORS[i % len(TYPE_COLORS)]
         stable = sel["n_stable"].values > 0
-        overview.add_collection(LineCollection(cell_outline(x, y, stable), colors=[color],
-                                               linewidths=1.3, capstyle="projecting"))
+        panels[name] = (axes[i + 1], color)
+        if boundaries is None:
+            overview.add_collection(LineCollection(cell_outline(x, y, stable), colors=[color],
+                                                   linewidths=1.3, capstyle="projecting"))
         overview.plot([], [], color=color, lw=1.8, label=f"({name})")
         ax = axes[i + 1]
         reason = sel["reason"].values
@@ -221,6 +321,7 @@ def fig16(orbits):
                 edge = np.where(stable, cplx, np.nan).T
                 ax.contour(x, y, edge, levels=[0.5], colors="0.1",
                            linewidths=0.9, linestyles=":")
+        if stable.any() and boundaries is None:
             # where the domain is at least three cells thick: a thinner one is its colour alone
             thick = ndimage.binary_opening(stable, structure=np.ones((3, 3), bool))
             ax.add_collection(LineCollection(cell_outline(x, y, stable, only=thick), colors="k",
@@ -228,6 +329,8 @@ def fig16(orbits):
                                              gid="stable-edge"))
         regions.append((ax, reason, stable))
         ax.set_title(f"({name})")
+    kinds, marked = ([], False) if boundaries is None else _draw_boundaries(overview, panels,
+                                                                            boundaries)
     overview.set_title("(a) stable domains")
     overview.legend(loc="lower right")
     for ax in axes:
@@ -245,9 +348,16 @@ def fig16(orbits):
     present = set(np.unique(orbits["reason"].values).tolist())
     handles = [Patch(facecolor=colour, edgecolor="0.6", label=cause)
                for code, (colour, _, cause) in REASONS.items() if code in present]
-    handles += [Line2D([], [], color="k", lw=EDGE_WIDTH,
-                       label="edge of the stable domain (where 3 cells thick or more)"),
-                Line2D([], [], color="0.1", lw=0.9, ls=":",
+    if boundaries is None:
+        handles.append(Line2D([], [], color="k", lw=EDGE_WIDTH,
+                              label="edge of the stable domain (where 3 cells thick or more)"))
+    handles += [Line2D([], [], color="k", label=f"edge of the stable domain, "
+                                                f"{BOUNDARY_KINDS[kind][1]}", **_kind_style(kind))
+                for kind in kinds]
+    if marked:
+        handles.append(Line2D([], [], mec="k", label="codimension two: two edges meet",
+                              **CODIM2_STYLE))
+    handles += [Line2D([], [], color="0.1", lw=0.9, ls=":",
                        label=r"edge of complex multipliers (inside: $S = 100(1 - "
                              r"\varepsilon e^{-\zeta z/m})$, no contours)")]
     if shaded is not None:
@@ -257,9 +367,10 @@ def fig16(orbits):
                title="the paper's D, V, X: no solution satisfying eqs. (10), (11), (13) "
                      "(white and grey here; it does not say which letter is which region)",
                title_fontsize=7)
+    edges = "" if boundaries is None else ";  bold lines: the domains' edges, by kind"
     _header(fig, "Fig. 16  Parameter domains of stable periodic impact motions",
             rf"{_system_text(orbits)};  $f(\tau) = \sin(\beta_f\tau)$;  thin lines: "
-            r"contours of the degree of stability $S$ (%)")
+            r"contours of the degree of stability $S$ (%)" + edges)
     fig.draw_without_rendering()       # the words are fitted to the panels' final size
     for ax, reason, stable in regions:
         _name_regions(ax, x, y, reason, stable)
