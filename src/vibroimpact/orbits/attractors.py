@@ -232,8 +232,16 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     the tangent map is 0 and both exponents are ``-inf``.
 
     **Exponents.** A start settled on a periodic motion gets exactly ``ln|mu|/z`` of the
-    eigenvalues of the tangent product over one period ``z`` of its settled motion (the last
-    period of its own trajectory): the limit of Benettin's estimate as the window grows.
+    eigenvalues of the tangent product (propagators and saltations) over one period ``z`` of
+    its settled motion: the limit of Benettin's estimate as the window grows. On a listed
+    orbit the product is taken along the solver orbit it matched (the trajectory is within
+    ``match_tol`` of it, and where the two multipliers are nearly equal that distance moves
+    them by its square root; along the solver orbit it agrees with the solver's multipliers,
+    from the impact-map Jacobian, to round-off); on another periodic motion along the last
+    period of the trajectory itself. The determinant of the product is used in its exact
+    form ``eps^(2 m) exp(-2 zeta z)`` (computed, it is lost to cancellation after a slow
+    impact), so for settled starts the two exponents sum to the contraction by
+    construction.
     An unsettled start gets Benettin's estimate (both tangent vectors, Gram-Schmidt at every
     impact and at every forcing period) over ``[max_time / 4, max_time]`` of its run; its
     standard error is from 8 batch means (``std / sqrt 8``). It is "chaotic" when the

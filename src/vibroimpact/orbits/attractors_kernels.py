@@ -314,26 +314,12 @@ def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk):
 
 
 @kernel
-def _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta):
-    """Eigenvalue moduli ``(|mu_max|, |mu_min|)`` of the tangent map over the last ``mm``
-    impacts: from just after impact ``n - mm - 1`` to just after impact ``n - 1``, the
-    product of flight propagators ``P(s)`` and impact saltation matrices."""
-    a11, a12, a21, a22 = 1.0, 0.0, 0.0, 1.0
-    for i in range(n_imp - mm, n_imp):
-        s = _dt(rk, rs, i, i - 1, h)
-        p11, p12, p21, p22 = propagator(s, zeta, omega)
-        b11 = p11 * a11 + p12 * a21
-        b12 = p11 * a12 + p12 * a22
-        b21 = p21 * a11 + p22 * a21
-        b22 = p21 * a12 + p22 * a22
-        f = math.sin(phase(rk[i % RING], rs[i % RING], P[P_BH_HI], P[P_BH_LO], P[P_BETA]))
-        g = (1.0 + eps) * (f - delta) / ru[i % RING]
-        a11 = -eps * b11
-        a12 = -eps * b12
-        a21 = g * b11 - eps * b21
-        a22 = g * b12 - eps * b22
+def _moduli(a11, a12, a21, a22, det):
+    """Eigenvalue moduli ``(|mu_max|, |mu_min|)`` of a 2x2 matrix whose determinant ``det`` is
+    known exactly (``eps^(2 m) exp(-2 zeta span)``: a product of saltations and
+    propagators); the computed one loses every digit to cancellation when a grazing-slow
+    impact (``1/u`` large) makes the entries huge."""
     tr = a11 + a22
-    det = a11 * a22 - a12 * a21
     disc = tr * tr - 4.0 * det
     if disc >= 0.0:
         big = 0.5 * (abs(tr) + math.sqrt(disc))
@@ -342,6 +328,50 @@ def _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta):
         big = math.sqrt(abs(det))
         small = big
     return big, small
+
+
+@kernel
+def _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta):
+    """Eigenvalue moduli ``(|mu_max|, |mu_min|)`` of the tangent map over the last ``mm``
+    impacts: from just after impact ``n - mm - 1`` to just after impact ``n - 1``, the
+    product of flight propagators ``P(s)`` and impact saltation matrices."""
+    a11, a12, a21, a22 = 1.0, 0.0, 0.0, 1.0
+    span = 0.0
+    for i in range(n_imp - mm, n_imp):
+        s = _dt(rk, rs, i, i - 1, h)
+        span += s
+        f = math.sin(phase(rk[i % RING], rs[i % RING], P[P_BH_HI], P[P_BH_LO], P[P_BETA]))
+        a11, a12, a21, a22 = _flight_impact(a11, a12, a21, a22, s, f, ru[i % RING], zeta,
+                                            omega, eps, delta)
+    return _moduli(a11, a12, a21, a22, eps ** (2 * mm) * math.exp(-2.0 * zeta * span))
+
+
+@kernel
+def _flight_impact(a11, a12, a21, a22, s, f, u, zeta, omega, eps, delta):
+    """``S P(s) A``: a flight of length ``s``, then the saltation of an impact with approach
+    velocity ``u`` where the force is ``f``."""
+    p11, p12, p21, p22 = propagator(s, zeta, omega)
+    b11 = p11 * a11 + p12 * a21
+    b12 = p11 * a12 + p12 * a22
+    b21 = p21 * a11 + p22 * a21
+    b22 = p21 * a12 + p22 * a22
+    g = (1.0 + eps) * (f - delta) / u
+    return -eps * b11, -eps * b12, g * b11 - eps * b21, g * b12 - eps * b22
+
+
+@kernel
+def _orbit_tangent_product(oph, ou, oz, m, z, zeta, omega, eps, delta):
+    """As :func:`_tangent_product`, over one period of the solver orbit itself (impact
+    phases ``oph``, approach velocities ``ou``, intervals ``oz``): the limit the settled
+    trajectory approaches, free of its remaining ``match_tol`` distance (which moves an
+    eigenvalue by its square root where the multipliers are nearly double)."""
+    a11, a12, a21, a22 = 1.0, 0.0, 0.0, 1.0
+    for l in range(1, m + 1):
+        j = l % m
+        f = math.sin(2.0 * math.pi * oph[j])
+        a11, a12, a21, a22 = _flight_impact(a11, a12, a21, a22, oz[(l - 1) % m], f, ou[j],
+                                            zeta, omega, eps, delta)
+    return _moduli(a11, a12, a21, a22, eps ** (2 * m) * math.exp(-2.0 * zeta * z))
 
 
 @kernel
@@ -586,9 +616,9 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
             for o in range(min(orb_n[t], K_ORBITS)):
                 if _match_orbit(rk, rs, ru, rph, n_imp, h, tf, k, m, oph[t, o], ou[t, o],
                                 oz[t, o], tol, last_stick):
-                    big, small = _tangent_product(rk, rs, ru, n_imp, m, h, P, zeta, omega,
-                                                  eps, delta)
                     z = types[t, 1] * tf
+                    big, small = _orbit_tangent_product(oph[t, o], ou[t, o], oz[t, o], m, z,
+                                                        zeta, omega, eps, delta)
                     i0 = n_imp - REPEATS * m
                     outf[F_SETTLE] = rk[i0 % RING] * h + rs[i0 % RING] - t0
                     outf[F_LYAP1] = math.log(big) / z
