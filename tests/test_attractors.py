@@ -169,3 +169,26 @@ def test_unlisted_orbit_exponent_from_the_trajectory_itself():
     assert np.all(outi[other, ak.I_PERIOD_M] == 1) and np.all(outi[other, ak.I_PERIOD_P] == 1)
     np.testing.assert_allclose(outf[other, ak.F_LYAP1], expected[0], rtol=0, atol=1e-6)
     np.testing.assert_allclose(outf[other, ak.F_LYAP2], expected[1], rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("inv_beta, delta", [(1.0, -0.5), (0.7, -0.6), (2.0, -0.2)])
+def test_impact_stick_collisions_agree_with_the_simulator(inv_beta, delta):
+    # a (1/1) impact-stick motion: ~15 resolved rebounds per period, one collision
+    beta = 1.0 / inv_beta
+    tf = 2.0 * math.pi / beta
+    outf, outi, _ = A._starts_at_cell(inv_beta, delta, ZETA, EPS, [0.0], [delta - 1.0], [0.5])
+    assert outi[0, ak.I_CLASS] == ak.STICKING and outf[0, ak.F_LYAP1] == -np.inf
+    mc, p, mm = outi[0, ak.I_STICK_M], outi[0, ak.I_STICK_P], outi[0, ak.I_PERIOD_M]
+    assert (mc, p) == (1, 1) and mm > 5
+    t_end = outf[0, ak.F_SETTLE] + 13 * tf
+    res = vibroimpact.simulate(ZETA, EPS, delta, amplitude=1.0, beta=beta, x0=delta - 1.0,
+                               v0=0.5, t_end=t_end, dt=ak.start_step(beta, 0.0)[0])
+    # periods well inside the record (the record's last chatter run is cut by its end)
+    lo, hi = outf[0, ak.F_SETTLE] + 2 * tf, t_end - 3 * tf
+    inside = (res.collision_time >= lo) & (res.collision_time < lo + 7 * tf)
+    assert hi > lo + 7 * tf
+    assert np.count_nonzero(inside) == 7 * mc
+    assert np.all(res.collision_stuck[inside])
+    # and every one of them holds the period's mm resolved impacts
+    first = np.flatnonzero(inside)
+    assert np.all(np.diff(res.collisions.first)[first] == mm)

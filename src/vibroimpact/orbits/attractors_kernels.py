@@ -271,26 +271,32 @@ def _period_of(rk, rs, ru, n_imp, h, tf, t_now_k, p, tol):
 
 @kernel
 def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk):
-    """Collisions among the last ``mm`` impacts of a periodic motion (period ``zp``): the
-    grouping of :func:`vibroimpact.stats.group_collisions` on two periods of impacts (the
-    chatter run ending in sticking joins the impact that starts it)."""
-    L = 2 * mm
+    """Collisions per period of a periodic motion (period ``zp``, ``mm`` impacts): the
+    grouping of :func:`vibroimpact.stats.group_collisions` (a chatter run ending in sticking
+    joins the impact that starts it) on three periods, counted in the middle one."""
+    # three periods: the last two as recorded, the next one by periodicity, so that a
+    # chatter run that the period's edge cuts is seen whole from the middle period
+    L = 3 * mm
     t = np.empty(L + 1)
     u = np.empty(L + 1)
-    base = n_imp - L
-    for j in range(L):
+    base = n_imp - 2 * mm
+    for j in range(2 * mm):
         i = base + j
         t[j] = rk[i % RING] * h + rs[i % RING]
         u[j] = ru[i % RING]
-    t[L] = t[mm] + zp
-    u[L] = u[mm]
+    for j in range(2 * mm, L + 1):
+        t[j] = t[j - mm] + zp
+        u[j] = u[j - mm]
     ends = np.zeros(L, np.bool_)
     for j in range(L):
         for e in range(max(0, n_stk - STICK_RING), n_stk):
             if skind[e % STICK_RING] == 1.0:
                 ts = sk[e % STICK_RING] * h + ss[e % STICK_RING]
-                ts_p = ts + zp          # the onset one period later (the motion repeats)
-                if (t[j] <= ts < t[j + 1]) or (t[j] <= ts_p < t[j + 1]):
+                if ts < t[0] - zp:
+                    continue            # before the verified periodic stretch
+                # the onset, and its copies one and two periods on (the motion repeats)
+                if ((t[j] <= ts < t[j + 1]) or (t[j] <= ts + zp < t[j + 1])
+                        or (t[j] <= ts + 2.0 * zp < t[j + 1])):
                     ends[j] = True
                     break
     cont = np.zeros(L, np.bool_)
@@ -298,7 +304,7 @@ def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk):
         shrinks = (t[j + 1] - t[j]) > (t[j + 2] - t[j + 1])
         cont[j] = (not ends[j]) and u[j + 1] < u[j] and (ends[j + 1] or shrinks)
     n_coll = 0
-    for j in range(mm, L):
+    for j in range(mm, 2 * mm):
         # impact j joins j - 1 when j - 1 lies on a shrinking run ending in sticking
         joins = False
         if not ends[j - 1]:
