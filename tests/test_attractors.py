@@ -192,3 +192,37 @@ def test_impact_stick_collisions_agree_with_the_simulator(inv_beta, delta):
     # and every one of them holds the period's mm resolved impacts
     first = np.flatnonzero(inside)
     assert np.all(np.diff(res.collisions.first)[first] == mm)
+
+
+@pytest.mark.slow
+def test_whole_plane_exponents_and_bookkeeping():
+    # the default Fig. 15 plane, 4 starts per cell (~20 s on 2 threads)
+    inv_beta = np.round(np.arange(0.2, 3.0 + 1e-9, 0.05), 10)
+    delta = np.round(np.arange(-1.5, 3.0 + 1e-9, 0.05), 10)
+    checked = A._validate(inv_beta, delta, ZETA, EPS, A.DEFAULT_TYPES, 4, (0.0, 4.0),
+                          (-4.0, 4.0), A.DEFAULT_MAX_TIME, A.DEFAULT_MATCH_TOL, 0)
+    raw = A._simulate_starts(*checked)
+    outf, outi, lnmu = raw["outf"], raw["outi"], raw["lnmu"]
+    assert not np.any(outi[:, ak.I_STATUS])
+    cls = outi[:, ak.I_CLASS]
+    # every listed start: the exponent of one of the cell's stable solver orbits of its type
+    for i in np.flatnonzero(cls == ak.LISTED):
+        b, d = divmod(raw["cell_of"][i], delta.size)
+        t = outi[i, ak.I_MOTION]
+        z = 2 * math.pi * A.DEFAULT_TYPES[t][1] * inv_beta[b]
+        cand = lnmu[b, d, t][np.isfinite(lnmu[b, d, t])] / z
+        assert np.min(np.abs(cand - outf[i, ak.F_LYAP1])) < 1e-12
+    # both exponents sum to the contraction, settled or not (Benettin's QR logs)
+    finite = np.isfinite(outf[:, ak.F_LYAP1]) & (outf[:, ak.F_IMPACTS] > 0)
+    assert np.max(np.abs(_exponent_sum_residual(outf[finite]))) < 1e-6
+    unsettled = (cls == ak.CHAOTIC) | (cls == ak.UNDECIDED)
+    assert np.max(np.abs(_exponent_sum_residual(outf[unsettled & finite]))) < 1e-9
+    assert np.all(np.isnan(outf[unsettled, ak.F_SETTLE]))
+    # the rest settled, except starts still sticking now and then at the cap (class
+    # "sticking", not periodic within the cap)
+    late = np.isnan(outf[:, ak.F_SETTLE]) & ~unsettled
+    assert np.all(cls[late] == ak.STICKING) and late.sum() < 0.01 * cls.size
+    # sticking: exponents -inf; impact-free settled motions: both -zeta
+    assert np.all(outf[cls == ak.STICKING, ak.F_LYAP1] == -np.inf)
+    free = (cls == ak.PERIODIC_OTHER) & (outi[:, ak.I_PERIOD_M] == 0)
+    assert free.any() and np.all(outf[free, ak.F_LYAP1] == -ZETA)
