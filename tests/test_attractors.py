@@ -1,0 +1,228 @@
+"""Basins of attraction and Lyapunov exponents under sin(beta tau) alone (`attractor_map`).
+
+Cells of the default Fig. 15 plane (zeta = 0.05, eps = 0.5), found with `periodic_orbits`:
+(1/beta, delta) = (1.0, 2.0) has one stable motion, (1/1); (1.0, 0.0) one, (2/1);
+(1.45, 0.95) has a stable (1/1) and a stable (2/1) with basins of comparable size;
+(0.35, 0.0) has chaotic starts.
+"""
+import math
+
+import numpy as np
+import pytest
+
+import vibroimpact
+from vibroimpact import periodic_orbits
+from vibroimpact.orbits import attractor_map
+from vibroimpact.orbits import attractors as A
+from vibroimpact.orbits import attractors_kernels as ak
+
+ZETA, EPS = 0.05, 0.5
+
+
+def _one_cell(inv_beta, delta, **kw):
+    return attractor_map([inv_beta], [delta], ZETA, EPS, **kw)
+
+
+def _stable(m, n, inv_beta, delta):
+    return [o for o in periodic_orbits(m, n, 1.0 / inv_beta, delta, ZETA, EPS) if o.stable]
+
+
+def test_single_stable_motion_takes_every_start():
+    assert len(_stable(1, 1, 1.0, 2.0)) == 1
+    assert all(not _stable(m, n, 1.0, 2.0) for m, n in ((2, 1), (1, 2), (1, 3), (3, 1)))
+    r = _one_cell(1.0, 2.0, n_starts=64)
+    assert r["motions"][0] == "1/1" and r["motions"][-1] == "other"
+    assert np.all(r["lyapunov_start"] < 0.0)
+    assert r["count"][0, 0, 0] == 64 and r["fraction"][0, 0, 0] == 1.0
+    assert r["fraction_hi"][0, 0, 0] == 1.0 and r["fraction_lo"][0, 0, 0] > 0.9
+    assert r["n_stable"][:, 0, 0].tolist() == [1, 0, 0, 0, 0]
+    assert r["class_count"][0, 0, 0] == 64 and r["cell_class"][0, 0] == 0
+    assert np.all(np.isfinite(r["settle_time"])) and np.isnan(r["lyapunov_stderr"][0, 0])
+    # one collision per forcing period
+    assert r["impact_rate"][0, 0] == pytest.approx(1.0 / (2.0 * math.pi), rel=1e-12)
+
+
+def test_bistable_fraction_agrees_with_a_dense_grid():
+    inv_beta, delta = 1.45, 0.95
+    assert _stable(1, 1, inv_beta, delta) and _stable(2, 1, inv_beta, delta)
+    r = _one_cell(inv_beta, delta, n_starts=64)
+    frac = r["fraction"][:, 0, 0]
+    assert 0.1 < frac[0] < 0.9 and 0.1 < frac[1] < 0.9
+    # brute force: a regular 16 x 16 x 16 grid (cell centres) over the same box
+    g = (np.arange(16) + 0.5) / 16
+    th, gg, vv = np.meshgrid(2 * math.pi * g, 4.0 * g, -4.0 + 8.0 * g, indexing="ij")
+    outf, outi, _ = A._starts_at_cell(inv_beta, delta, ZETA, EPS, th.ravel(),
+                                      delta - gg.ravel(), vv.ravel())
+    motion = outi[:, ak.I_MOTION]
+    for t in (0, 1):
+        dense = np.mean(motion == t)
+        assert r["fraction_lo"][t, 0, 0] <= dense <= r["fraction_hi"][t, 0, 0], (t, dense)
+    assert np.mean(motion >= 0) > 0.95
+
+
+@pytest.mark.parametrize("m, n, inv_beta, delta", [
+    (1, 1, 0.8, 0.0),       # real multipliers 0.70, 0.22
+    (2, 1, 1.0, -0.1),      # real multipliers 0.38, 0.087
+    (1, 1, 1.0, 2.0),       # complex: |mu| = eps exp(-zeta z) for both
+])
+def test_settled_exponent_is_the_solver_multiplier(m, n, inv_beta, delta):
+    (orbit,) = _stable(m, n, inv_beta, delta)
+    expected = math.log(abs(orbit.multipliers[0])) / orbit.period
+    second = math.log(abs(orbit.multipliers[1])) / orbit.period
+    r = _one_cell(inv_beta, delta, n_starts=16)
+    t = r["motions"].index(f"{m}/{n}")
+    on = r["motion_start"][:, 0, 0] == t
+    assert on.sum() >= 8
+    np.testing.assert_allclose(r["lyapunov_start"][on, 0, 0], expected, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(r["lyapunov_second_start"][on, 0, 0], second, rtol=0,
+                               atol=1e-12)
+    assert r["lyapunov"][0, 0] >= expected - 1e-12
+
+
+def _exponent_sum_residual(outf):
+    nu = outf[:, ak.F_IMPACTS] / outf[:, ak.F_WINDOW]
+    total = outf[:, ak.F_LYAP1] + outf[:, ak.F_LYAP2]
+    return total - (-2.0 * ZETA + 2.0 * nu * math.log(EPS))
+
+
+def test_exponent_sum_is_the_phase_space_contraction():
+    # settled on the (2/1) orbit: two impacts per forcing period
+    _, theta, g, v0 = A.sobol_starts(8, (0.0, 4.0), (-4.0, 4.0), 0)
+    outf, outi, _ = A._starts_at_cell(1.0, 0.0, ZETA, EPS, theta, 0.0 - g, v0)
+    assert np.all(outi[:, ak.I_CLASS] == ak.LISTED)
+    # (the determinant of a settled orbit's tangent product is taken in its exact form, so
+    # this checks the bookkeeping; the unsettled case below checks Benettin's QR logs)
+    np.testing.assert_allclose(_exponent_sum_residual(outf), 0.0, atol=1e-12)
+    # unsettled and chaotic (Benettin over the last three quarters of the run)
+    _, theta, g, v0 = A.sobol_starts(64, (0.0, 4.0), (-4.0, 4.0), 0)
+    outf, outi, _ = A._starts_at_cell(0.35, 0.0, ZETA, EPS, theta, 0.0 - g, v0)
+    chaotic = outi[:, ak.I_CLASS] == ak.CHAOTIC
+    assert chaotic.any()
+    assert np.all(outf[chaotic, ak.F_LYAP1] > 3 * outf[chaotic, ak.F_STDERR])
+    np.testing.assert_allclose(_exponent_sum_residual(outf[chaotic]), 0.0, atol=1e-9)
+
+
+@pytest.mark.parametrize("dt", [0.2, 0.1])
+def test_start_follows_the_public_simulator(dt):
+    inv_beta, delta, x0, v0 = 1.0, 2.0, 1.0, 0.5
+    h, k0, t0 = ak.start_step(1.0 / inv_beta, 0.0)
+    assert (h, k0, t0) == (0.2, 0, 0.0)
+    outf, outi, (tk, ts, tu) = A._starts_at_cell(inv_beta, delta, ZETA, EPS, [0.0], [x0],
+                                                 [v0], trace=20)
+    n = int(np.count_nonzero(np.isfinite(tu)))
+    assert n >= 5
+    t_kernel = tk[:n] * h + ts[:n]
+    res = vibroimpact.simulate(ZETA, EPS, delta, amplitude=1.0, beta=1.0 / inv_beta, x0=x0,
+                               v0=v0, t_end=t_kernel[-1] + 1.0, dt=dt)
+    assert res.n_impacts >= n
+    tol = 0.0 if dt == h else 1e-9        # the same steps: bit for bit; other steps: round-off
+    np.testing.assert_allclose(res.impact_time[:n], t_kernel, rtol=0, atol=tol)
+    np.testing.assert_allclose(res.impact_velocity[:n], tu[:n], rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize("kw, name", [
+    (dict(n_starts=0), "n_starts"),
+    (dict(gap=(-0.5, 1.0)), "gap"),
+    (dict(gap=(1.0, 1.0)), "gap"),
+    (dict(velocity=(2.0, -2.0)), "velocity"),
+    (dict(max_time=100.0), "max_time"),
+    (dict(match_tol=0.0), "match_tol"),
+    (dict(types=((4, 1),)), "m of types"),
+])
+def test_bad_input_is_refused_naming_the_argument(kw, name):
+    with pytest.raises(ValueError, match=name):
+        _one_cell(1.0, 2.0, **kw)
+
+
+def test_gap_below_zero_says_beyond_the_wall():
+    with pytest.raises(ValueError, match="beyond the wall"):
+        _one_cell(1.0, 2.0, gap=(-0.1, 1.0))
+    with pytest.raises(ValueError, match=r"ln\(1/match_tol\)/zeta = 276"):
+        _one_cell(1.0, 2.0, max_time=200.0)
+
+
+def test_sticking_starts_have_minus_infinite_exponents():
+    # delta < -1: f - delta > 0 always, every start ends resting on the wall for good;
+    # (1/beta, delta) = (2.0, -0.2): a (1/1) impact-stick motion (one collision per period:
+    # an impact, its chatter and the sticking up to the release) takes every start
+    r = attractor_map([2.0], [-1.2, -0.2], ZETA, EPS, n_starts=16)
+    sticking = A.CLASSES.index("sticking")
+    assert np.all(r["class_count"][sticking] == 16)
+    assert np.all(r["lyapunov"] == -np.inf) and np.all(r["lyapunov_start"] == -np.inf)
+    assert np.all(r["count"][-1] == 16)                   # not on a listed solver orbit
+    assert r["impact_rate"][0, 0] == 0.0
+    assert r["stick_count"][0, 0, 1] == 16 and r["stick_count"][:, 0, 0].sum() == 0
+    assert r["impact_rate"][0, 1] == pytest.approx(1.0 / (4.0 * math.pi), rel=1e-12)
+    assert np.all(r["period_start"][1, :, 0, 1] == 1)
+
+
+def test_unlisted_orbit_exponent_from_the_trajectory_itself():
+    # (1/1) left out of types: the same motion settles as "periodic_other", and its exponent
+    # comes from the tangent product along the last period of the trajectory (real
+    # multipliers 0.70 and 0.22, so not fixed by the determinant alone)
+    (orbit,) = _stable(1, 1, 0.8, 0.0)
+    expected = [math.log(abs(mu)) / orbit.period for mu in orbit.multipliers]
+    _, theta, g, v0 = A.sobol_starts(8, (0.0, 4.0), (-4.0, 4.0), 0)
+    outf, outi, _ = A._starts_at_cell(0.8, 0.0, ZETA, EPS, theta, 0.0 - g, v0, types=((1, 3),))
+    other = outi[:, ak.I_CLASS] == ak.PERIODIC_OTHER
+    assert other.sum() >= 4
+    assert np.all(outi[other, ak.I_PERIOD_M] == 1) and np.all(outi[other, ak.I_PERIOD_P] == 1)
+    np.testing.assert_allclose(outf[other, ak.F_LYAP1], expected[0], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(outf[other, ak.F_LYAP2], expected[1], rtol=0, atol=1e-6)
+
+
+@pytest.mark.parametrize("inv_beta, delta", [(1.0, -0.5), (0.7, -0.6), (2.0, -0.2)])
+def test_impact_stick_collisions_agree_with_the_simulator(inv_beta, delta):
+    # a (1/1) impact-stick motion: ~15 resolved rebounds per period, one collision
+    beta = 1.0 / inv_beta
+    tf = 2.0 * math.pi / beta
+    outf, outi, _ = A._starts_at_cell(inv_beta, delta, ZETA, EPS, [0.0], [delta - 1.0], [0.5])
+    assert outi[0, ak.I_CLASS] == ak.STICKING and outf[0, ak.F_LYAP1] == -np.inf
+    mc, p, mm = outi[0, ak.I_STICK_M], outi[0, ak.I_STICK_P], outi[0, ak.I_PERIOD_M]
+    assert (mc, p) == (1, 1) and mm > 5
+    t_end = outf[0, ak.F_SETTLE] + 13 * tf
+    res = vibroimpact.simulate(ZETA, EPS, delta, amplitude=1.0, beta=beta, x0=delta - 1.0,
+                               v0=0.5, t_end=t_end, dt=ak.start_step(beta, 0.0)[0])
+    # periods well inside the record (the record's last chatter run is cut by its end)
+    lo, hi = outf[0, ak.F_SETTLE] + 2 * tf, t_end - 3 * tf
+    inside = (res.collision_time >= lo) & (res.collision_time < lo + 7 * tf)
+    assert hi > lo + 7 * tf
+    assert np.count_nonzero(inside) == 7 * mc
+    assert np.all(res.collision_stuck[inside])
+    # and every one of them holds the period's mm resolved impacts
+    first = np.flatnonzero(inside)
+    assert np.all(np.diff(res.collisions.first)[first] == mm)
+
+
+@pytest.mark.slow
+def test_whole_plane_exponents_and_bookkeeping():
+    # the default Fig. 15 plane, 4 starts per cell (~20 s on 2 threads)
+    inv_beta = np.round(np.arange(0.2, 3.0 + 1e-9, 0.05), 10)
+    delta = np.round(np.arange(-1.5, 3.0 + 1e-9, 0.05), 10)
+    checked = A._validate(inv_beta, delta, ZETA, EPS, A.DEFAULT_TYPES, 4, (0.0, 4.0),
+                          (-4.0, 4.0), A.DEFAULT_MAX_TIME, A.DEFAULT_MATCH_TOL, 0)
+    raw = A._simulate_starts(*checked)
+    outf, outi, lnmu = raw["outf"], raw["outi"], raw["lnmu"]
+    assert not np.any(outi[:, ak.I_STATUS])
+    cls = outi[:, ak.I_CLASS]
+    # every listed start: the exponent of one of the cell's stable solver orbits of its type
+    for i in np.flatnonzero(cls == ak.LISTED):
+        b, d = divmod(raw["cell_of"][i], delta.size)
+        t = outi[i, ak.I_MOTION]
+        z = 2 * math.pi * A.DEFAULT_TYPES[t][1] * inv_beta[b]
+        cand = lnmu[b, d, t][np.isfinite(lnmu[b, d, t])] / z
+        assert np.min(np.abs(cand - outf[i, ak.F_LYAP1])) < 1e-12
+    # both exponents sum to the contraction, settled or not (Benettin's QR logs)
+    finite = np.isfinite(outf[:, ak.F_LYAP1]) & (outf[:, ak.F_IMPACTS] > 0)
+    assert np.max(np.abs(_exponent_sum_residual(outf[finite]))) < 1e-6
+    unsettled = (cls == ak.CHAOTIC) | (cls == ak.UNDECIDED)
+    assert np.max(np.abs(_exponent_sum_residual(outf[unsettled & finite]))) < 1e-9
+    assert np.all(np.isnan(outf[unsettled, ak.F_SETTLE]))
+    # the rest settled, except starts still sticking now and then at the cap (class
+    # "sticking", not periodic within the cap)
+    late = np.isnan(outf[:, ak.F_SETTLE]) & ~unsettled
+    assert np.all(cls[late] == ak.STICKING) and late.sum() < 0.01 * cls.size
+    # sticking: exponents -inf; impact-free settled motions: both -zeta
+    assert np.all(outf[cls == ak.STICKING, ak.F_LYAP1] == -np.inf)
+    free = (cls == ak.PERIODIC_OTHER) & (outi[:, ak.I_PERIOD_M] == 0)
+    assert free.any() and np.all(outf[free, ak.F_LYAP1] == -ZETA)
