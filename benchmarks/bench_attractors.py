@@ -12,8 +12,8 @@ import time
 import numba
 import numpy as np
 
-from vibroimpact.orbits import attractors
-from vibroimpact.orbits import attractors_kernels as ak
+from vibroimpact.attractors import api as attractors
+from vibroimpact.attractors import kernels as ak
 
 
 def main():

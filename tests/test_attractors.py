@@ -12,9 +12,9 @@ import pytest
 
 import vibroimpact
 from vibroimpact import periodic_orbits
-from vibroimpact.orbits import attractor_map
-from vibroimpact.orbits import attractors as A
-from vibroimpact.orbits import attractors_kernels as ak
+from vibroimpact.attractors import attractor_map
+from vibroimpact.attractors import api as A
+from vibroimpact.attractors import kernels as ak
 
 ZETA, EPS = 0.05, 0.5
 

@@ -25,7 +25,7 @@ _LAZY = {
     "PeriodicOrbit": "vibroimpact.orbits.api",
     "orbit_map": "vibroimpact.orbits.api",
     "domain_boundaries": "vibroimpact.orbits.boundaries",
-    "attractor_map": "vibroimpact.orbits.attractors",
+    "attractor_map": "vibroimpact.attractors.api",
 }
 
 # PLE0604: ruff cannot see that the keys of _LAZY are strings

@@ -6,23 +6,7 @@ admissibility (`flight`), linear algebra (`linalg`), Newton (`newton`), one orbi
 (`solutions`), the (1/n) closed form (`m1`), the (m/n) scans (`intervals`, `scan_m2`,
 `scan_m3`, `solve`) and the row-parallel map (`domain_map`); thresholds in `tolerances`
 (docs/model.md, section 8).
-
-`attractor_map` (`attractors`, kernels in `attractors_kernels`) maps the basins of the stable
-motions and the Lyapunov exponents over a grid by running starts through the simulator's
-kernel. It is exported lazily: it loads the simulator, which the orbit solver (and the code
-digest of every job that only solves orbits) does not otherwise depend on.
 """
-import importlib
-
 from vibroimpact.orbits.api import REASON_CODES, PeriodicOrbit, Reason, orbit_map, periodic_orbits
 
-__all__ = ["periodic_orbits", "PeriodicOrbit", "orbit_map", "Reason", "REASON_CODES",
-           "attractor_map"]
-
-
-def __getattr__(name):
-    if name != "attractor_map":
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = importlib.import_module(f"{__name__}.attractors").attractor_map
-    globals()[name] = value
-    return value
+__all__ = ["periodic_orbits", "PeriodicOrbit", "orbit_map", "Reason", "REASON_CODES"]

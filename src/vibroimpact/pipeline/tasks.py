@@ -347,7 +347,7 @@ def attractor_tile(entry, tile, out, threads=None):
     the entry's attractor grid (rows strided over tiles, as the orbit tiles)."""
     import numba
 
-    from vibroimpact.orbits import attractor_map
+    from vibroimpact.attractors import attractor_map
 
     if threads is not None:
         numba.set_num_threads(int(threads))

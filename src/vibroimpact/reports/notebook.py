@@ -269,14 +269,12 @@ def lyapunov_summary(lyapunov, basins):
     paper's D, V, X, U), with the largest exponent's range in each class."""
     import pandas as pd
 
-    from vibroimpact.pipeline.datasets import ATTRACTOR_CLASSES
-
     n_types = basins.sizes["motion"] - 1
     none_stable = (basins["n_stable"].values[:n_types] > 0).sum(axis=0) == 0
     cls = lyapunov["cell_class"].values
     lam = lyapunov["lyapunov"].values
     rows = {}
-    for code, name in enumerate(ATTRACTOR_CLASSES):
+    for code, name in enumerate(lyapunov["cell_class"].attrs["flag_meanings"].split()):
         sel = cls == code
         finite = lam[sel & np.isfinite(lam)]
         rows[name.replace("_", " ")] = {

@@ -1,4 +1,4 @@
-"""Numba kernels of :func:`vibroimpact.orbits.attractors.attractor_map`: many starts of the
+"""Numba kernels of :func:`vibroimpact.attractors.attractor_map`: many starts of the
 forced impact oscillator, each run by the simulator's own sample loop until it settles, with
 its tangent dynamics along the way.
 
@@ -36,9 +36,12 @@ from vibroimpact.orbits.solve import solve_type
 from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, MAX_SOLUTIONS,
                                            SCAN_STEP_M2, SCAN_STEP_M3)
 
+#: Stamped with this file and every kernel module of the orbit solver and the simulator that
+#: these kernels inline (:mod:`vibroimpact._kernel_cache`): an edit of any recompiles them.
 kernel = kernel_decorator(
-    njit, _orbits_jit.__file__,
-    _orbits_jit.KERNEL_MODULES + tuple(f"../impact/{m}" for m in _impact_jit.KERNEL_MODULES),
+    njit, __file__,
+    ("kernels.py",) + tuple(f"../orbits/{m}" for m in _orbits_jit.KERNEL_MODULES)
+    + tuple(f"../impact/{m}" for m in _impact_jit.KERNEL_MODULES),
     error_model="numpy")
 
 # --- constants ------------------------------------------------------------------------------

@@ -4,7 +4,7 @@ For every cell ``(1/beta, delta)`` of a grid, :func:`attractor_map` runs ``n_sta
 states without noise until each settles on a periodic motion or reaches a time cap, and tells
 which motion it settled on (a stable (m/n) orbit of :func:`vibroimpact.periodic_orbits`, an
 impact-stick motion, another periodic motion) together with its Lyapunov exponents. Kernels:
-:mod:`vibroimpact.orbits.attractors_kernels`.
+:mod:`vibroimpact.attractors.kernels`.
 """
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ import numba
 import numpy as np
 
 from vibroimpact import _checks
-from vibroimpact._limits import MAX_M
-from vibroimpact.orbits import attractors_kernels as ak
+from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time
+from vibroimpact.attractors import kernels as ak
 
 __all__ = ["attractor_map", "CLASSES", "DEFAULT_TYPES"]
 
@@ -26,7 +26,7 @@ DEFAULT_TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))
 #: Default cap on a start's run (dimensionless time): ~64 natural periods, 5.5 times the
 #: time ln(1e6)/zeta = 276 that damping alone needs at zeta = 0.05 and match_tol = 1e-6.
 DEFAULT_MAX_TIME = 1500.0
-DEFAULT_MATCH_TOL = 1e-6
+DEFAULT_MATCH_TOL = ATTRACTOR_MATCH_TOL
 #: Two-sided level of the Clopper-Pearson interval of ``fraction``.
 CONFIDENCE = 0.95
 
@@ -89,7 +89,7 @@ def clopper_pearson(k, n, confidence=CONFIDENCE):
 
 def stable_orbits(inv_beta, delta, types, zeta, eps):
     """Stable admissible solver orbits per cell and type (arrays of
-    :func:`attractors_kernels.cell_orbits`): ``n_stable (n_types, nb, nd)``, and per cell,
+    :func:`kernels.cell_orbits`): ``n_stable (n_types, nb, nd)``, and per cell,
     type and orbit the phases, approach velocities, intervals and ``ln max|mu|``."""
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
     shape = (nb, nd, nt, ak.K_ORBITS, ak.M_COLS)
@@ -116,7 +116,7 @@ def _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_ti
     gap = _interval("gap", gap, low=0.0)
     velocity = _interval("velocity", velocity)
     match_tol = _checks.real("match_tol", match_tol, low=0.0, high=1e-2, low_open=True)
-    need = math.log(1.0 / match_tol) / zeta
+    need = attractor_min_time(zeta, match_tol)
     max_time = _checks.real("max_time", max_time, low=0.0, low_open=True)
     if max_time < need:
         raise ValueError(f"max_time must be >= ln(1/match_tol)/zeta = {need:.6g} (the time "
@@ -341,7 +341,7 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
                     max_time=DEFAULT_MAX_TIME, match_tol=DEFAULT_MATCH_TOL, trace=0):
     """Given starts ``(theta, x0, v0)`` (arrays) at one cell, through the same kernels as
     :func:`attractor_map`: the raw records ``outf (n, N_F)``, ``outi (n, N_I)`` (slots
-    ``attractors_kernels.F_*, I_*``) and, with ``trace > 0``, the first ``trace`` impacts
+    ``kernels.F_*, I_*``) and, with ``trace > 0``, the first ``trace`` impacts
     ``(step, offset, velocity)`` of the first start, run serially (tests, brute force)."""
     types = _types(types)
     ib = np.array([float(inv_beta)])
