@@ -321,13 +321,20 @@ def boundaries(entry, orbits_path, out, threads=None):
     seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
     box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
                delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
+    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                 traced=1)
+    if float(entry["eps"]) == 0.0:
+        # every impact ends at rest on the wall: a flight's maximum is its start, and no
+        # boundary condition is regular there (domain_boundaries refuses eps = 0)
+        attrs.update(traced=0, not_traced="eps = 0: the edges are the map's cell edges")
+        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
+        return
     curves = {}
     for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
         curves[(m, n)] = domain_boundaries(
             m, n, float(entry["zeta"]), float(entry["eps"]), **box,
             resolution=(seeds["inv_beta"].size, seeds["delta"].size), seed_map=seeds)
         log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
-    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]))
     io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
 
 

@@ -249,7 +249,8 @@ def fig16(orbits, boundaries=None):
     boundaries : xarray.Dataset, optional
         ``results/orbits/{name}_boundaries.nc`` of the same system: the curves bounding each
         type's stable domain (``inv_beta``, ``delta``, ``curve`` over ``point``; ``kind``,
-        ``type`` over ``curve``) and the points where two of them meet (``codim2_*``).
+        ``type`` over ``curve``) and the points where two of them meet (``codim2_*``). One
+        with the attribute ``traced = 0`` (eps = 0, not traced) is drawn as None is.
 
     Returns
     -------
@@ -278,6 +279,8 @@ def fig16(orbits, boundaries=None):
     """
     from scipy import ndimage
 
+    if boundaries is not None and not int(boundaries.attrs.get("traced", 1)):
+        boundaries = None           # not traced (eps = 0): the cell edges, as without them
     if boundaries is not None:
         _same_system(boundaries, orbits, ("the boundaries", "the orbit map"))
     types = [str(t) for t in orbits["type"].values]
