@@ -30,7 +30,7 @@ from vibroimpact.reports import arguments
 wildcard_constraints:
     study="[A-Za-z][A-Za-z0-9_]*",
     # not ending like the entry's derived datasets (results/orbits/<name>_basins.nc ...)
-    orbits="(?![A-Za-z0-9_]*_(boundaries|basins|lyapunov)(?![A-Za-z0-9_]))[A-Za-z][A-Za-z0-9_]*",
+    orbits="[A-Za-z][A-Za-z0-9_]*(?<!_boundaries)(?<!_basins)(?<!_lyapunov)",
     noise="[A-Za-z][A-Za-z0-9_]*",
     sweep="[A-Za-z][A-Za-z0-9_]*",
     tile="[0-9]+",
