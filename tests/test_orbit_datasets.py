@@ -117,3 +117,29 @@ def test_orbit_map_result_round_trips_the_map():
     for key in ("exists", "n_solutions", "n_stable", "reason", "inv_beta", "delta", "types"):
         np.testing.assert_array_equal(back[key], result[key])
     np.testing.assert_array_equal(back["lam"], result["lam"])
+
+
+def test_no_curves_are_traced_at_eps_zero_and_fig16_keeps_the_cell_edges(tmp_path):
+    """eps = 0: every impact ends at rest on the wall, no boundary condition is regular; the
+    boundaries job says so in its dataset, and Fig. 16 draws the cells' edges as without it."""
+    from vibroimpact import plotting
+    from vibroimpact.orbits import orbit_map
+    from vibroimpact.pipeline import tasks
+
+    entry = dict(zeta=0.05, eps=0.0, inv_beta=[0.8, 1.0, 1.2], delta=[0.0, 0.5, 1.0, 1.5],
+                 types=[[1, 1]])
+    result = orbit_map(entry["inv_beta"], entry["delta"], types=[(1, 1)], zeta=0.05, eps=0.0)
+    orbits_path = tmp_path / "o.nc"
+    io.write_dataset(datasets.orbit_map_dataset(result, dict(zeta=0.05, eps=0.0)), orbits_path)
+    out = tmp_path / "b.nc"
+    tasks.boundaries(entry, orbits_path, out)
+    ds = io.load_dataset(out)
+    assert ds.attrs["traced"] == 0 and "eps = 0" in ds.attrs["not_traced"]
+    assert ds.sizes["curve"] == 0 and ds.sizes["point"] == 0
+    orbits = io.load_dataset(orbits_path)
+    with plotting.style():
+        without = plotting.fig16(orbits)
+        given = plotting.fig16(orbits, ds)
+    assert ([a.get_gid() for a in without.axes[1].collections]
+            == [a.get_gid() for a in given.axes[1].collections])
+    assert "stable-edge" in [a.get_gid() for a in given.axes[1].collections]

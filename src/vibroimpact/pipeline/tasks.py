@@ -312,12 +312,6 @@ def aggregate_orbits(entry, tiles, out):
 def boundaries(entry, orbits_path, out, threads=None):
     """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
     the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
-    import numba
-
-    from vibroimpact.orbits import domain_boundaries
-
-    if threads is not None:
-        numba.set_num_threads(int(threads))
     seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
     box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
                delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
@@ -329,6 +323,12 @@ def boundaries(entry, orbits_path, out, threads=None):
         attrs.update(traced=0, not_traced="eps = 0: the edges are the map's cell edges")
         io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
         return
+    import numba
+
+    from vibroimpact.orbits import domain_boundaries
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
     curves = {}
     for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
         curves[(m, n)] = domain_boundaries(
