@@ -29,9 +29,13 @@ stable domain), or where it closes on itself. Parts of a curve where another sta
 orbit coexists (so the point is inside the stable domain, not on its edge) are cut out.
 
 Accuracy: every point is a Newton solution of the augmented system whose last correction (the
-estimate ``J^-1 F`` of its distance to the exact curve, so it includes the conditioning) is
-below ``BOUNDARY_STEP_RTOL (1 + |x|)`` in every unknown; the curve's ``error`` holds that last
-correction of delta at each point (~1e-13 or below in practice).
+estimate ``J^-1 F`` of its distance to the exact root, so it includes the conditioning) is
+below ``BOUNDARY_STEP_RTOL (1 + |x|)`` in every unknown. The curve's ``error`` is then
+re-estimated independently at each point: the parameter part of the minimum-norm correction
+``J^+ F`` of the (2m + 1) x (2m + 2) system (the distance to the exact curve, ~1e-15 in
+practice; where the curve is not vertical, delta at fixed 1/beta is off by that over the cosine
+of the slope). ``tol`` bounds it. The tests check it against the (1/n) closed forms (1e-12)
+and against the solver's own stability verdict 2e-9 either side of the curve.
 """
 from __future__ import annotations
 
@@ -61,6 +65,16 @@ MIN_STEP_OF_DIAGONAL = 1e-9
 #: A stalled curve (step below the minimum) tries a codimension-two point with every other
 #: test function below this at its last point.
 LOST_NEAR_ZERO = 1e-3
+#: The end points of a curve may be this many times less accurate than ``tol``: where a
+#: flight's maximum merges with a grazing impact (u -> 0) the grazing curve and the curve
+#: u = 0 are tangent, and their common point is determined only to ~sqrt(round-off): measured
+#: 1e-9 .. 4e-8 at the (1/2) corners of the default box.
+END_TOL_FACTOR = 1000.0
+#: Near a cusp of the curve's projection on the plane (the orbit unknowns move, 1/beta and delta
+#: hardly): the step in all unknowns is capped at this many times the largest plane step, and
+#: the turn is not checked where the plane part of the unit tangent is below CUSP_SPEED.
+CUSP_STEP_FACTOR = 10.0
+CUSP_SPEED = 0.05
 #: Hard cap on the points of one curve (each direction).
 MAX_POINTS = 20000
 #: Seed walk from the stable cell to its unstable neighbour: first step (fraction of the
@@ -87,7 +101,8 @@ class BoundaryCurve:
     orbits : ndarray, shape (len, 2m)
         The orbit on the curve at each point: ``(tau_0..tau_{m-1}, u_0..u_{m-1})``.
     error : ndarray
-        Last Newton correction of delta at each point (an estimate of its error).
+        Estimated distance of each point to the exact curve in the (1/beta, delta) plane: the
+        parameter part of the minimum-norm Newton correction there.
     ends : tuple of str
         Why the curve ends at its first and last point: ``"box"``, ``"codim2"``, ``"closed"``,
         ``"coexist"`` (another stable orbit takes over), ``"lost"`` (continuation failed).
@@ -161,6 +176,7 @@ class _Tracer:
         self.jac = np.empty((self.nn + 1, self.nn + 2))
         self.dummy = np.zeros(self.nn + 2)
         self.codim2 = []
+        self.hint = -1.0        # grazing curves: time of the followed maximum in its flight
 
     # --- kernels' wrappers ---------------------------------------------------------------
     def tests(self, x):
@@ -169,26 +185,44 @@ class _Tracer:
                      self.stack, self.tmat, out)
         return out
 
-    def newton(self, x, code, j, mode=0, code2=0, j2=0, tvec=None, xref=None, idx=0, val=0.0):
+    def peak(self, code, j, x, hint=None):
+        hint = self.hint if hint is None else hint
+        return bk.peak_of(code, j, hint, x, self.m, self.n, self.zeta, self.eps)
+
+    def side_tests(self, x, code, j, own):
+        """Every test function; the own entry is the other maxima of the own flight (margin
+        curves: a second maximum reaching the wall ends the curve) or +inf."""
+        t = self.tests(x)
+        t[own] = self.peak(bk.COND_OTHER_PEAK, j, x)[0] if code == bk.COND_MARGIN else np.inf
+        return t
+
+    def second(self, i, own, code, j, x):
+        """Code, index and hint of side test ``i`` as a curve condition (at ``x``)."""
+        if i == own:
+            return bk.COND_MARGIN, j, self.peak(bk.COND_OTHER_PEAK, j, x)[1]
+        return _test_code(int(i), self.m) + (-1.0,)
+
+    def newton(self, x, code, j, mode=0, code2=0, j2=0, tvec=None, xref=None, idx=0, val=0.0,
+               hint2=-1.0):
         x = np.array(x, dtype=float)
-        it, _ = bk.newton_aug(x, self.m, self.n, self.zeta, self.eps, code, j, mode, code2, j2,
-                              self.dummy if tvec is None else tvec,
+        it, _ = bk.newton_aug(x, self.m, self.n, self.zeta, self.eps, code, j, self.hint, mode,
+                              code2, j2, hint2, self.dummy if tvec is None else tvec,
                               self.dummy if xref is None else xref, idx, val)
         return (x, it) if it >= 0 else (None, it)
 
     def tangent(self, x, code, j):
-        bk.aug_system(x, self.m, self.n, self.zeta, self.eps, code, j, self.fvec, self.jac)
+        bk.aug_system(x, self.m, self.n, self.zeta, self.eps, code, j, self.hint, self.fvec,
+                      self.jac)
         t = np.linalg.svd(self.jac)[2][-1]
         return t / np.linalg.norm(t)
 
-    def error_of(self, x, code, j):
-        """Newton correction of delta at ``x`` with 1/beta fixed (distance to the curve)."""
-        bk.aug_system(x, self.m, self.n, self.zeta, self.eps, code, j, self.fvec, self.jac)
-        a = np.delete(self.jac, self.nn, axis=1)
-        try:
-            return abs(np.linalg.solve(a, -self.fvec)[-1])
-        except np.linalg.LinAlgError:
-            return np.nan
+    def error_of(self, x, code, j, hint):
+        """Distance of ``x`` to the exact curve in the (1/beta, delta) plane: the parameter
+        part of the minimum-norm Newton correction ``J^+ F`` (the conditioning included)."""
+        bk.aug_system(x, self.m, self.n, self.zeta, self.eps, code, j, hint, self.fvec,
+                      self.jac)
+        dx = np.linalg.lstsq(self.jac, -self.fvec, rcond=None)[0]
+        return float(np.hypot(dx[-2], dx[-1]))
 
     def inside(self, x):
         b = self.box
@@ -242,6 +276,7 @@ class _Tracer:
                 x = x + np.nan_to_num(np.min(frac), nan=0.5) * (x1 - x)
             for i in order:
                 code, j = _test_code(int(i), self.m)
+                self.hint = -1.0
                 xs, it = self.newton(x, code, j, mode=1, idx=fix, val=ps[fix - self.nn])
                 if xs is None:
                     continue
@@ -249,32 +284,38 @@ class _Tracer:
                 tt = float(np.dot(xs[-2:] - ps, seg) / np.dot(seg, seg))
                 if not (-1e-3 <= tt <= 1.0 + 1e-3):
                     continue
-                return xs, code, j
+                hint = self.peak(bk.COND_MARGIN, j, xs)[1] if code == bk.COND_MARGIN else -1.0
+                return xs, code, j, hint
             return None
         return None
 
     # --- continuation --------------------------------------------------------------------
-    def trace(self, x0, code, j):
-        """Both directions from the boundary point ``x0``: ``(points, ends)``."""
+    def trace(self, x0, code, j, hint):
+        """Both directions from the boundary point ``x0``: ``(points, hints, ends)``."""
+        self.hint = hint
         t0 = self.tangent(x0, code, j)
-        fwd, end_f = self._branch(x0, t0, code, j)
+        fwd, hf, end_f = self._branch(x0, t0, code, j)
         if end_f == "closed":
-            return fwd, ("closed", "closed")
-        bwd, end_b = self._branch(x0, -t0, code, j)
-        return bwd[::-1] + fwd[1:], (end_b, end_f)
+            return fwd, hf, ("closed", "closed")
+        self.hint = hint
+        bwd, hb, end_b = self._branch(x0, -t0, code, j)
+        return bwd[::-1] + fwd[1:], hb[::-1] + hf[1:], (end_b, end_f)
 
     def _branch(self, x0, t0, code, j):
         own = self._own_index(code, j)
         pts = [x0]
+        hints = self._hints = [self.hint]
         x, t = x0, t0
         h = 0.5 * self.hmax
-        tests_x = self.tests(x0)
+        tests_x = self.side_tests(x0, code, j, own)
         travelled = 0.0
         while len(pts) < MAX_POINTS:
             if h < self.hmin:
                 return self._lost(pts, tests_x, own, code, j)
             tp = math.hypot(t[-2], t[-1])
-            big = h / max(tp, 1e-3)
+            # the step along the curve in all unknowns: h in the (1/beta, delta) plane, capped
+            # where the curve turns in the orbit unknowns only (a cusp of its projection)
+            big = min(h / max(tp, 1e-12), CUSP_STEP_FACTOR * self.hmax)
             xp = x + big * t
             xn, it = self.newton(xp, code, j, mode=0, tvec=t, xref=xp)
             if xn is None or it > 8:
@@ -284,19 +325,19 @@ class _Tracer:
             tn = self.tangent(xn, code, j)
             if np.dot(tn, t) < 0.0:
                 tn = -tn
-            turn = _angle(t[-2:], tn[-2:])
+            # the turn in the plane, unless the curve is near a cusp of its projection there
+            turn = _angle(t[-2:], tn[-2:]) if min(tp, math.hypot(*tn[-2:])) > CUSP_SPEED else 0.0
             if (dp > 2.0 * h or np.dot(tn, t) < 0.9 or turn > MAX_TURN) and h > 4 * self.hmin:
                 h *= 0.5
                 continue
-            tests_n = self.tests(xn)
+            tests_n = self.side_tests(xn, code, j, own)
             ok = tests_n > 0.0
-            ok[own] = True
             out = not self.inside(xn)
             if out and not (self.box[0] < x[-2] < self.box[1]
                             and self.box[2] < x[-1] < self.box[3]):
-                return pts, "box"         # started on the box's edge, going out
+                return pts, hints, "box"  # started on the box's edge, going out
             if not np.all(ok) or out:
-                end = self._finish(x, xn, tests_x, tests_n, ok, out, code, j)
+                end = self._finish(x, xn, tests_x, tests_n, ok, out, code, j, own)
                 if end is None:           # could not solve the end point: smaller step
                     if h > 4 * self.hmin:
                         h *= 0.5
@@ -304,19 +345,24 @@ class _Tracer:
                     return self._lost(pts, tests_x, own, code, j)
                 xe, why = end
                 pts.append(xe)
-                return pts, why
+                hints.append(self.hint)
+                return pts, hints, why
             travelled += dp
             if (travelled > 4 * self.hmax and len(pts) > 8
                     and math.hypot(xn[-2] - x0[-2], xn[-1] - x0[-1]) < 1.5 * h
                     and np.dot(tn, t0) > 0.0):
                 pts.append(xn)
                 pts.append(x0)
-                return pts, "closed"
+                hints.extend([self.hint, hints[0]])
+                return pts, hints, "closed"
+            if code == bk.COND_MARGIN:
+                self.hint = self.peak(bk.COND_MARGIN, j, xn)[1]
             pts.append(xn)
+            hints.append(self.hint)
             x, t, tests_x = xn, tn, tests_n
             if it <= 4 and turn < 0.3 * MAX_TURN:
                 h = min(1.5 * h, self.hmax)
-        return pts, "lost"
+        return pts, hints, "lost"
 
     def _lost(self, pts, tests_x, own, code, j):
         """The continuation stalled: typically next to a point where a second test function
@@ -324,23 +370,27 @@ class _Tracer:
         impact). Try that codimension-two point from the last point; else end "lost"."""
         x = pts[-1]
         for i in np.argsort(np.abs(tests_x)):
-            if i == own or not abs(tests_x[i]) < LOST_NEAR_ZERO:
+            if not abs(tests_x[i]) < LOST_NEAR_ZERO:
                 continue
-            c2, j2 = _test_code(int(i), self.m)
-            xs, _ = self.newton(x, code, j, mode=2, code2=c2, j2=j2)
+            c2, j2, h2 = self.second(i, own, code, j, x)
+            if i == own and h2 < 0.0:
+                continue                  # no other maximum on the flight
+            xs, _ = self.newton(x, code, j, mode=2, code2=c2, j2=j2, hint2=h2)
             if xs is not None and math.hypot(xs[-2] - x[-2], xs[-1] - x[-1]) < 10 * self.hmin:
                 self.codim2.append(CodimTwoPoint(float(xs[-2]), float(xs[-1]),
                                                  (_KIND_OF_CODE[code], _KIND_OF_CODE[c2]),
                                                  self.m, self.n))
-                return pts + [xs], "codim2"
-        return pts, "lost"
+                self._hints.append(self.hint)
+                return pts + [xs], self._hints, "codim2"
+        return pts, self._hints, "lost"
 
     def _own_index(self, code, j):
         m = self.m
+        j = j % m
         return {bk.COND_FOLD: 0, bk.COND_PD: 1, bk.COND_U: 2 + j, bk.COND_MARGIN: 2 + m + j,
                 bk.COND_Z: 2 + 2 * m + j}[code]
 
-    def _finish(self, x, xn, tests_x, tests_n, ok, out, code, j):
+    def _finish(self, x, xn, tests_x, tests_n, ok, out, code, j, own):
         """The end point between ``x`` and ``xn``: a codimension-two point or the box edge."""
         cands = []
         for i in np.flatnonzero(~ok):
@@ -360,18 +410,19 @@ class _Tracer:
                 col, edge = what
                 xs, _ = self.newton(xi, code, j, mode=1, idx=self.nn + 2 + col, val=edge)
             else:
-                c2, j2 = _test_code(what, self.m)
-                xs, _ = self.newton(xi, code, j, mode=2, code2=c2, j2=j2)
+                c2, j2, h2 = self.second(what, own, code, j, xn)
+                xs, _ = self.newton(xi, code, j, mode=2, code2=c2, j2=j2, hint2=h2)
             if xs is None or np.linalg.norm(xs[-2:] - xi[-2:]) > 2.0 * np.linalg.norm(
                     xn[-2:] - x[-2:]) + 1e-12:
                 return None
             if why == "codim2" and not self.inside(xs):
                 # the second condition holds only outside the box: cut at the box's edge
-                return self._finish(x, xs, tests_x, tests_x, np.ones_like(ok), True, code, j)
+                return self._finish(x, xs, tests_x, tests_x, np.ones_like(ok), True, code, j,
+                                    own)
             if why == "codim2":
                 self.codim2.append(CodimTwoPoint(
                     float(xs[-2]), float(xs[-1]),
-                    (_KIND_OF_CODE[code], _KIND_OF_CODE[_test_code(what, self.m)[0]]),
+                    (_KIND_OF_CODE[code], _KIND_OF_CODE[c2]),
                     self.m, self.n))
             return xs, why
         return None
@@ -486,8 +537,10 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
         An ``orbit_map`` result holding the (m, n) type (others are ignored); its pixel edges
         (``n_stable > 0`` against ``== 0``) seed the curves.
     tol : float
-        Required accuracy of each point's delta; a point whose estimated error (the Newton
-        correction of delta at fixed 1/beta) exceeds it raises RuntimeError.
+        Required accuracy of each point; a point whose estimated distance to the exact curve
+        (``BoundaryCurve.error``) exceeds it raises RuntimeError. The two end points may be
+        ``END_TOL_FACTOR`` (1000) times less accurate: a codimension-two point where a flight's
+        maximum merges with a grazing impact is a tangency, found to ~1e-9 .. 4e-8 only.
 
     Returns
     -------
@@ -531,18 +584,18 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
         if covered[k]:
             continue
         covered[k] = True
-        for x0, code, j in tr.localize(ps, pu):
+        for x0, code, j, hint in tr.localize(ps, pu):
             if _near_known(raw, x0, code, tr.hmax):
                 continue
-            pts, ends = tr.trace(x0, code, j)
+            pts, hints, ends = tr.trace(x0, code, j, hint)
             pts = np.array(pts)
-            raw.append((pts, code, j, ends))
+            raw.append((pts, code, j, ends, np.array(hints)))
             covered |= _crosses(pts[:, -2:], seg_arr)
     curves = []
-    for pts, code, j, ends in raw:
-        for piece, pends in _edge_pieces(tr, pts, ends):
-            err = np.array([tr.error_of(x, code, j) for x in piece])
-            if np.any(err > tol):
+    for pts, code, j, ends, hints in raw:
+        for piece, phints, pends in _edge_pieces(tr, pts, hints, ends):
+            err = np.array([tr.error_of(x, code, j, h) for x, h in zip(piece, phints)])
+            if np.any(err[1:-1] > tol) or np.any(err[[0, -1]] > END_TOL_FACTOR * tol):
                 raise RuntimeError(f"boundary point not converged to tol={tol}: "
                                    f"max error estimate {np.nanmax(err):.3g}")
             curves.append(BoundaryCurve(
@@ -550,15 +603,15 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
                 delta=piece[:, -1].copy(), orbits=piece[:, :2 * m].copy(), error=err,
                 ends=pends))
     ends = [(c.inv_beta[k], c.delta[k]) for c in curves for k in (0, -1)]
-    codim2 = [p for p in _dedupe(tr.codim2)
-              if any(abs(p.inv_beta - a) <= 1e-12 and abs(p.delta - b) <= 1e-12
-                     for a, b in ends)]          # not those of parts cut out (coexistence)
+    codim2 = _dedupe([p for p in tr.codim2
+                      if any(abs(p.inv_beta - a) <= 1e-12 and abs(p.delta - b) <= 1e-12
+                             for a, b in ends)])  # not those of parts cut out (coexistence)
     return DomainBoundaries(curves, codim2)
 
 
 def _near_known(raw, x0, code, hmax):
     """Whether ``x0`` lies on a curve already traced with the same kind of condition."""
-    return any(c == code and _chord_gap(pts, x0) <= 0.01 * hmax for pts, c, _, _ in raw)
+    return any(c == code and _chord_gap(pts, x0) <= 0.01 * hmax for pts, c, *_ in raw)
 
 
 def _chord_gap(pts, x0):
@@ -574,7 +627,7 @@ def _chord_gap(pts, x0):
     return float(np.min(np.hypot(*(a + s[:, None] * ab - q).T)))
 
 
-def _edge_pieces(tr, pts, ends):
+def _edge_pieces(tr, pts, hints, ends):
     """Split a traced curve where another stable orbit coexists (not an edge there)."""
     inner = np.array([tr.other_stable(x) for x in pts])
     pieces = []
@@ -587,7 +640,7 @@ def _edge_pieces(tr, pts, ends):
             if stop - start >= 2:
                 e0 = ends[0] if start == 0 else "coexist"
                 e1 = ends[1] if stop == len(pts) else "coexist"
-                pieces.append((pts[start:stop], (e0, e1)))
+                pieces.append((pts[start:stop], hints[start:stop], (e0, e1)))
             start = None
     return pieces
 
@@ -595,7 +648,7 @@ def _edge_pieces(tr, pts, ends):
 def _dedupe(points):
     out = []
     for p in points:
-        if not any(abs(p.inv_beta - o.inv_beta) < 1e-8 and abs(p.delta - o.delta) < 1e-8
+        if not any(abs(p.inv_beta - o.inv_beta) < 1e-6 and abs(p.delta - o.delta) < 1e-6
                    for o in out):
             out.append(p)
     return out

@@ -30,7 +30,8 @@ from vibroimpact.orbits.tolerances import (BOUNDARY_FD_REL, BOUNDARY_NEWTON_MAXI
                                            BOUNDARY_PEAK_STEP, BOUNDARY_STEP_RTOL)
 
 #: Test-function codes (``cond_value``); the index ``j`` picks the impact / flight.
-COND_FOLD, COND_PD, COND_U, COND_MARGIN, COND_Z = 0, 1, 2, 3, 4
+#: COND_OTHER_PEAK (flight j): the highest maximum of the flight other than the one followed.
+COND_FOLD, COND_PD, COND_U, COND_MARGIN, COND_Z, COND_OTHER_PEAK = 0, 1, 2, 3, 4, 5
 
 
 @kernel
@@ -69,11 +70,12 @@ def scaled_trace(y, m, z, beta, delta, zeta, eps):
 
 
 @kernel
-def cond_value(code, j, y, m, n, beta, delta, zeta, eps, stack, tmat, smooth):
+def cond_value(code, j, y, m, n, beta, delta, zeta, eps, stack, tmat, smooth, hint):
     """Value of test function ``code`` (index ``j``) of the orbit ``y`` at ``(beta, delta)``.
 
     ``smooth``: the margin from ``flight_peak`` (a smooth function, for the curves'
-    equations) rather than ``flight_max`` (the global, certified maximum, for the signs).
+    equations; the maximum nearest to the time ``hint`` after the impact, or the highest if
+    ``hint < 0``) rather than ``flight_max`` (the global, certified maximum, for the signs).
     """
     z = 2.0 * pi * n / beta
     if code == COND_FOLD or code == COND_PD:
@@ -88,8 +90,18 @@ def cond_value(code, j, y, m, n, beta, delta, zeta, eps, stack, tmat, smooth):
     tb = y[b] + (z if j == m - 1 else 0.0)
     if code == COND_Z:
         return tb - y[j]
-    if smooth:
-        return delta - flight_peak(y[j], y[m + j], tb - y[j], beta, delta, zeta, eps)
+    if smooth or code == COND_OTHER_PEAK:
+        # the maximum nearest to hint (hint < 0: the highest); COND_OTHER_PEAK: the highest
+        # of the others
+        if code == COND_MARGIN:
+            top, place = flight_peak(y[j], y[m + j], tb - y[j], beta, delta, zeta, eps, hint,
+                                     -1.0)
+        else:
+            top, place = flight_peak(y[j], y[m + j], tb - y[j], beta, delta, zeta, eps, -1.0,
+                                     hint)
+        if place < 0.0:
+            return np.inf
+        return delta - top
     top = flight_max(y[j], y[m + j], tb - y[j], beta, delta, zeta, eps, stack)
     if top == -np.inf:
         return np.inf
@@ -97,14 +109,19 @@ def cond_value(code, j, y, m, n, beta, delta, zeta, eps, stack, tmat, smooth):
 
 
 @kernel
-def flight_peak(tau_a, u_a, s_end, beta, delta, zeta, eps):
-    """Height of the highest interior local maximum of a flight, as a smooth function.
+def flight_peak(tau_a, u_a, s_end, beta, delta, zeta, eps, hint, skip):
+    """``(height, place)`` of one interior local maximum of a flight, as a smooth function.
 
     The grazing condition of a curve needs a test function free of the bracketing noise of
-    ``flight_max`` near a flat maximum: the maximum is located on a grid of BOUNDARY_PEAK_STEP
-    radians (and the flight's end, so a maximum just past the impact, where it merges with the
-    impact as u -> 0, is followed too) and then converged by Newton on the velocity, unclamped.
-    Returns ``-inf`` if the flight has no local maximum.
+    ``flight_max`` near a flat maximum, and it must follow one maximum: where two maxima of a
+    flight (a long flight has one per forcing cycle) are equally high the highest one jumps,
+    and the edge of the domain has a corner (two grazing conditions: a codimension-two point).
+    The local maxima are located on a grid of BOUNDARY_PEAK_STEP radians (when following one,
+    one step past the flight's end too, so a maximum that merges with the impact as u -> 0 is
+    followed through);
+    the one nearest to the time ``hint`` (``hint < 0``: the highest, but not the one nearest
+    to ``skip`` if ``skip >= 0``) is converged by Newton on the velocity, unclamped.
+    Returns ``(-inf, -1)`` when there is no such maximum.
     """
     wd, q, phi = harmonic_constants(beta, zeta)
     psi = beta * tau_a - phi
@@ -114,18 +131,41 @@ def flight_peak(tau_a, u_a, s_end, beta, delta, zeta, eps):
     d_coef = -(zeta * c_coef + wd * a_coef)
     fast = max(beta, wd)
     npts = max(64, int(ceil(s_end * fast / BOUNDARY_PEAK_STEP)))
+    step = s_end / npts
+    # the maximum nearest to skip, to be left out
+    s_skip = -1.0
+    if hint < 0.0 and skip >= 0.0:
+        far = np.inf
+        x0, v0, a0, j0 = _flight_xv(0.0, psi, a_coef, c_coef, b_coef, d_coef, beta, zeta, wd, q)
+        for k in range(1, npts + 1):
+            s1 = step * k
+            x1, v1, a1, j1 = _flight_xv(s1, psi, a_coef, c_coef, b_coef, d_coef, beta, zeta,
+                                        wd, q)
+            if v0 > 0.0 and v1 <= 0.0 and abs(s1 - skip) < far:
+                far = abs(s1 - skip)
+                s_skip = s1
+            v0 = v1
     best = -np.inf
     s_best = -1.0
+    # one step past the flight's end only to follow a maximum (not to find the highest)
+    last = npts + 2 if hint >= 0.0 else npts + 1
     x0, v0, a0, j0 = _flight_xv(0.0, psi, a_coef, c_coef, b_coef, d_coef, beta, zeta, wd, q)
-    for k in range(1, npts + 2):
-        s1 = s_end * k / npts
+    for k in range(1, last):
+        s1 = step * k
         x1, v1, a1, j1 = _flight_xv(s1, psi, a_coef, c_coef, b_coef, d_coef, beta, zeta, wd, q)
-        if v0 > 0.0 and v1 <= 0.0 and max(x0, x1) > best:
-            best = max(x0, x1)
-            s_best = s1 if x1 > x0 else s1 - s_end / npts
+        if v0 > 0.0 and v1 <= 0.0 and s1 != s_skip:
+            top = max(x0, x1)
+            place = s1 if x1 > x0 else s1 - step
+            if hint >= 0.0:
+                take = s_best < 0.0 or abs(place - hint) < abs(s_best - hint)
+            else:
+                take = top > best
+            if take:
+                best = top
+                s_best = place
         x0, v0 = x1, v1
     if s_best < 0.0:
-        return -np.inf
+        return -np.inf, -1.0
     s = s_best
     for _ in range(BOUNDARY_NEWTON_MAXIT):
         xs, vs, as_, js = _flight_xv(s, psi, a_coef, c_coef, b_coef, d_coef, beta, zeta, wd, q)
@@ -136,27 +176,46 @@ def flight_peak(tau_a, u_a, s_end, beta, delta, zeta, eps):
         if abs(ds) <= 1e-15 * (1.0 + abs(s)):
             break
     xs, vs, as_, js = _flight_xv(s, psi, a_coef, c_coef, b_coef, d_coef, beta, zeta, wd, q)
-    return xs
+    return xs, s
+
+
+@kernel
+def peak_of(code, j, hint, x, m, n, zeta, eps):
+    """``(margin, place)`` of the maximum that test ``code`` (COND_MARGIN or COND_OTHER_PEAK)
+    picks on flight ``j`` with ``hint``, at ``x = (y, 1/beta, delta)``."""
+    nn = 2 * m
+    beta = 1.0 / x[nn]
+    delta = x[nn + 1]
+    z = 2.0 * pi * n / beta
+    b = (j + 1) % m
+    tb = x[b] + (z if j == m - 1 else 0.0)
+    if code == COND_MARGIN:
+        top, place = flight_peak(x[j], x[m + j], tb - x[j], beta, delta, zeta, eps, hint, -1.0)
+    else:
+        top, place = flight_peak(x[j], x[m + j], tb - x[j], beta, delta, zeta, eps, -1.0, hint)
+    if place < 0.0:
+        return np.inf, place
+    return delta - top, place
 
 
 @kernel
 def all_tests(y, m, n, beta, delta, zeta, eps, stack, tmat, out):
     """Every test function into ``out`` (length 2 + 3m): fold, pd, u_j, margin_j, z_j."""
-    out[0] = cond_value(COND_FOLD, 0, y, m, n, beta, delta, zeta, eps, stack, tmat, False)
-    out[1] = cond_value(COND_PD, 0, y, m, n, beta, delta, zeta, eps, stack, tmat, False)
+    out[0] = cond_value(COND_FOLD, 0, y, m, n, beta, delta, zeta, eps, stack, tmat, False, -1.0)
+    out[1] = cond_value(COND_PD, 0, y, m, n, beta, delta, zeta, eps, stack, tmat, False, -1.0)
     for j in range(m):
         out[2 + j] = y[m + j]
         out[2 + m + j] = cond_value(COND_MARGIN, j, y, m, n, beta, delta, zeta, eps, stack,
-                                    tmat, False)
+                                    tmat, False, -1.0)
         out[2 + 2 * m + j] = cond_value(COND_Z, j, y, m, n, beta, delta, zeta, eps, stack,
-                                        tmat, False)
+                                        tmat, False, -1.0)
 
 
 @kernel
-def _cond_x(code, j, x, m, n, zeta, eps, stack, tmat):
+def _cond_x(code, j, hint, x, m, n, zeta, eps, stack, tmat):
     nn = 2 * m
     return cond_value(code, j, x[:nn], m, n, 1.0 / x[nn], x[nn + 1], zeta, eps, stack, tmat,
-                      True)
+                      True, hint)
 
 
 @kernel
@@ -169,7 +228,7 @@ def _orbit_rows(x, m, n, zeta, eps, res, jy):
 
 
 @kernel
-def _cond_row(code, j, x, m, n, zeta, eps, stack, tmat, xs, row):
+def _cond_row(code, j, hint, x, m, n, zeta, eps, stack, tmat, xs, row):
     """Central-difference gradient of a test function in X into ``row``; returns its value."""
     na = 2 * m + 2
     for c in range(na):
@@ -177,16 +236,16 @@ def _cond_row(code, j, x, m, n, zeta, eps, stack, tmat, xs, row):
     for c in range(na):
         h = BOUNDARY_FD_REL * (1.0 + abs(x[c]))
         xs[c] = x[c] + h
-        fp = _cond_x(code, j, xs, m, n, zeta, eps, stack, tmat)
+        fp = _cond_x(code, j, hint, xs, m, n, zeta, eps, stack, tmat)
         xs[c] = x[c] - h
-        fm = _cond_x(code, j, xs, m, n, zeta, eps, stack, tmat)
+        fm = _cond_x(code, j, hint, xs, m, n, zeta, eps, stack, tmat)
         xs[c] = x[c]
         row[c] = (fp - fm) / (2.0 * h)
-    return _cond_x(code, j, x, m, n, zeta, eps, stack, tmat)
+    return _cond_x(code, j, hint, x, m, n, zeta, eps, stack, tmat)
 
 
 @kernel
-def aug_system(x, m, n, zeta, eps, code, j, fvec, jac):
+def aug_system(x, m, n, zeta, eps, code, j, hint, fvec, jac):
     """The 2m orbit equations and test function ``code`` (rows of ``fvec``) at ``x``, with the
     (2m + 1) x (2m + 2) Jacobian ``jac`` (analytic in y, central differences elsewhere)."""
     nn = 2 * m
@@ -214,11 +273,12 @@ def aug_system(x, m, n, zeta, eps, code, j, fvec, jac):
         _orbit_rows(xs, m, n, zeta, eps, res_m, jtmp)
         for i in range(nn):
             jac[i, c] = (res_p[i] - res_m[i]) / (2.0 * h)
-    fvec[nn] = _cond_row(code, j, x, m, n, zeta, eps, stack, tmat, xs, jac[nn])
+    fvec[nn] = _cond_row(code, j, hint, x, m, n, zeta, eps, stack, tmat, xs, jac[nn])
 
 
 @kernel
-def newton_aug(x, m, n, zeta, eps, code, j, mode, code2, j2, tvec, xref, idx, val):
+def newton_aug(x, m, n, zeta, eps, code, j, hint, mode, code2, j2, hint2, tvec, xref, idx,
+               val):
     """Newton in place on ``x`` for the orbit equations, test ``code`` = 0, and a last equation:
 
     - ``mode 0``: ``tvec . (x - xref) = 0`` (pseudo-arclength);
@@ -244,7 +304,7 @@ def newton_aug(x, m, n, zeta, eps, code, j, mode, code2, j2, tvec, xref, idx, va
     for it in range(BOUNDARY_NEWTON_MAXIT):
         if not (x[nn] > 0.0):
             return -1, np.inf
-        aug_system(x, m, n, zeta, eps, code, j, fvec, jac)
+        aug_system(x, m, n, zeta, eps, code, j, hint, fvec, jac)
         for i in range(nn + 1):
             for c in range(na):
                 a[i, c] = jac[i, c]
@@ -261,7 +321,7 @@ def newton_aug(x, m, n, zeta, eps, code, j, mode, code2, j2, tvec, xref, idx, va
             a[nn + 1, idx] = 1.0
             rhs[nn + 1] = -(x[idx] - val)
         else:
-            g = _cond_row(code2, j2, x, m, n, zeta, eps, stack, tmat, xs, row2)
+            g = _cond_row(code2, j2, hint2, x, m, n, zeta, eps, stack, tmat, xs, row2)
             for c in range(na):
                 a[nn + 1, c] = row2[c]
             rhs[nn + 1] = -g
