@@ -75,6 +75,8 @@ END_TOL_FACTOR = 1000.0
 #: the turn is not checked where the plane part of the unit tangent is below CUSP_SPEED.
 CUSP_STEP_FACTOR = 10.0
 CUSP_SPEED = 0.05
+#: Coexistence cuts: bisection along the curve down to this distance in the plane.
+CUT_TOL = 1e-11
 #: Hard cap on the points of one curve (each direction).
 MAX_POINTS = 20000
 #: Seed walk from the stable cell to its unstable neighbour: first step (fraction of the
@@ -128,13 +130,20 @@ class BoundaryCurve:
 
 @dataclass(frozen=True)
 class CodimTwoPoint:
-    """A point where two boundary conditions hold at once (a curve's end)."""
+    """A point where two boundary conditions hold at once (a curve's end).
+
+    ``kinds``: the curve's own kind and the other condition's. ``other_orbit``: False when
+    both hold for the curve's orbit (e.g. a period-doubling orbit that grazes); True where the
+    curve meets the boundary of another stable (m/n) orbit, beyond which that orbit coexists
+    and the curve is no longer an edge of the stable domain (the curve's end "coexist").
+    """
 
     inv_beta: float
     delta: float
     kinds: tuple
     m: int
     n: int
+    other_orbit: bool = False
 
     def __getitem__(self, key):
         if not isinstance(key, str) or key not in self.__dataclass_fields__:
@@ -384,6 +393,13 @@ class _Tracer:
                 return pts + [xs], self._hints, "codim2"
         return pts, self._hints, "lost"
 
+    def crossing(self, x, code, kind):
+        """Record where the curve meets the boundary of another stable orbit (coexistence)."""
+        if kind is not None:
+            self.codim2.append(CodimTwoPoint(float(x[-2]), float(x[-1]),
+                                             (_KIND_OF_CODE[code], kind), self.m, self.n,
+                                             other_orbit=True))
+
     def _own_index(self, code, j):
         m = self.m
         j = j % m
@@ -429,7 +445,7 @@ class _Tracer:
 
     # --- coexistence ---------------------------------------------------------------------
     def other_stable(self, x):
-        """Whether a stable admissible (m/n) orbit other than ``x``'s exists at its point."""
+        """A stable admissible (m/n) orbit other than ``x``'s at its point, or None."""
         m, nn = self.m, self.nn
         beta = 1.0 / x[-2]
         tf = 2.0 * math.pi / beta
@@ -445,8 +461,38 @@ class _Tracer:
                     and np.max(np.abs(np.sort(y[m:]) - u0)) <= OTHER_ORBIT_RTOL * uscale):
                 continue
             if np.all(self.tests(np.concatenate((y, x[-2:]))) > 0.0):
-                return True
-        return False
+                return y
+        return None
+
+    def cut(self, xg, xb, hint, code, j):
+        """Where, between the curve points ``xg`` (an edge) and ``xb`` (another stable orbit
+        coexists), the other orbit appears: bisection along the curve (each trial point
+        corrected onto it) down to CUT_TOL in the plane. Returns the last edge point and the
+        kind of the other orbit's condition that vanishes there (its smallest test)."""
+        self.hint = hint
+        d = xb - xg
+        tvec = d / np.linalg.norm(d)
+        lo, hi = 0.0, 1.0
+        x_lo, y_hi, x_hi = xg, None, xb
+        plane = math.hypot(d[-2], d[-1])
+        while (hi - lo) * plane > CUT_TOL:
+            mid = 0.5 * (lo + hi)
+            xp = xg + mid * d
+            xs, _ = self.newton(xp, code, j, mode=0, tvec=tvec, xref=xp)
+            if xs is None:
+                break
+            y = self.other_stable(xs)
+            if y is None:
+                lo, x_lo = mid, xs
+            else:
+                hi, y_hi, x_hi = mid, y, xs
+        if y_hi is None:
+            y_hi = self.other_stable(x_hi)
+        kind = None
+        if y_hi is not None:
+            t = self.tests(np.concatenate((y_hi, x_hi[-2:])))
+            kind = _KIND_OF_CODE[_test_code(int(np.argmin(t)), self.m)[0]]
+        return x_lo, kind
 
 
 def _angle(a, b):
@@ -593,7 +639,7 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
             covered |= _crosses(pts[:, -2:], seg_arr)
     curves = []
     for pts, code, j, ends, hints in raw:
-        for piece, phints, pends in _edge_pieces(tr, pts, hints, ends):
+        for piece, phints, pends in _edge_pieces(tr, pts, hints, ends, code, j):
             err = np.array([tr.error_of(x, code, j, h) for x, h in zip(piece, phints)])
             if np.any(err[1:-1] > tol) or np.any(err[[0, -1]] > END_TOL_FACTOR * tol):
                 raise RuntimeError(f"boundary point not converged to tol={tol}: "
@@ -627,21 +673,34 @@ def _chord_gap(pts, x0):
     return float(np.min(np.hypot(*(a + s[:, None] * ab - q).T)))
 
 
-def _edge_pieces(tr, pts, hints, ends):
+def _edge_pieces(tr, pts, hints, ends, code, j):
     """Split a traced curve where another stable orbit coexists (not an edge there)."""
-    inner = np.array([tr.other_stable(x) for x in pts])
-    pieces = []
+    inner = np.array([tr.other_stable(x) is not None for x in pts])
+    runs = []
     start = None
     for i, bad in enumerate(inner):
         if not bad and start is None:
             start = i
         if (bad or i == len(pts) - 1) and start is not None:
-            stop = i if bad else i + 1
-            if stop - start >= 2:
-                e0 = ends[0] if start == 0 else "coexist"
-                e1 = ends[1] if stop == len(pts) else "coexist"
-                pieces.append((pts[start:stop], hints[start:stop], (e0, e1)))
+            runs.append((start, i if bad else i + 1))
             start = None
+    pieces = []
+    for start, stop in runs:
+        p, h = list(pts[start:stop]), list(hints[start:stop])
+        e0 = ends[0] if start == 0 else "coexist"
+        e1 = ends[1] if stop == len(pts) else "coexist"
+        if start > 0:
+            xe, kind = tr.cut(pts[start], pts[start - 1], hints[start], code, j)
+            p.insert(0, xe)
+            h.insert(0, hints[start])
+            tr.crossing(xe, code, kind)
+        if stop < len(pts):
+            xe, kind = tr.cut(pts[stop - 1], pts[stop], hints[stop - 1], code, j)
+            p.append(xe)
+            h.append(hints[stop - 1])
+            tr.crossing(xe, code, kind)
+        if len(p) >= 2:
+            pieces.append((np.array(p), np.array(h), (e0, e1)))
     return pieces
 
 
