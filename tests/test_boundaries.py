@@ -316,6 +316,21 @@ def test_every_seed_pixel_edge_is_within_a_cell_of_a_curve(seed, curves, mn):
         assert dist <= 1.0, (mn, mid)
 
 
+@pytest.mark.parametrize("mn", TYPES)
+def test_curves_are_ordered_fine_and_inside_the_box(curves, mn):
+    diag = math.hypot(2.8, 4.5)
+    for c in curves[mn]:
+        assert c.kind in ("fold", "period_doubling", "grazing", "existence")
+        assert (c.m, c.n) == mn and len(c) >= 2
+        assert c.orbits.shape == (len(c), 2 * mn[0])
+        steps = np.hypot(np.diff(c.inv_beta), np.diff(c.delta))
+        assert np.all(steps <= diag / 200)
+        assert np.all(c.inv_beta >= 0.2 - 1e-12) and np.all(c.inv_beta <= 3.0 + 1e-12)
+        assert np.all(c.delta >= -1.5 - 1e-12) and np.all(c.delta <= 3.0 + 1e-12)
+        assert np.all(c.error[1:-1] <= 1e-10) and np.all(c.error <= 1e-7)
+        assert "lost" not in c.ends
+
+
 def test_result_api(curves):
     res = curves[(1, 1)]
     assert isinstance(res, list) and isinstance(res, DomainBoundaries)
@@ -331,14 +346,6 @@ def test_result_api(curves):
         assert len(p.kinds) == 2 and all(k in ("fold", "period_doubling", "grazing",
                                                 "existence") for k in p.kinds)
         assert p["inv_beta"] == p.inv_beta
-    diag = math.hypot(2.8, 4.5)
-    for c in res:
-        assert c.kind in ("fold", "period_doubling", "grazing", "existence")
-        steps = np.hypot(np.diff(c.inv_beta), np.diff(c.delta))
-        assert np.all(steps <= diag / 200)
-        assert np.all(c.inv_beta >= 0.2 - 1e-12) and np.all(c.inv_beta <= 3.0 + 1e-12)
-        assert np.all(c.delta >= -1.5 - 1e-12) and np.all(c.delta <= 3.0 + 1e-12)
-        assert np.all(c.error[1:-1] <= 1e-10) and np.all(c.error <= 1e-7)
 
 
 # ------------------------------------------------------------------------------------------
@@ -363,3 +370,46 @@ def test_bad_input_names_the_argument(kwargs, name):
 def test_seed_map_without_the_type(seed):
     with pytest.raises(ValueError, match="seed_map"):
         domain_boundaries(1, 3, ZETA, EPS, seed_map=seed)
+
+
+# ------------------------------------------------------------------------------------------
+# slow: the whole default Fig. 16 (141 x 226 seeds, five types), against bisection
+
+def _bisect_edge(mn, ib, lo, hi, iters=45):
+    """The stability flip of the solver between delta = lo and hi at fixed 1/beta."""
+    def stable(d):
+        return any(o.stable for o in periodic_orbits(*mn, 1.0 / ib, d, ZETA, EPS))
+    s_lo = stable(lo)
+    assert stable(hi) != s_lo
+    for _ in range(iters):
+        mid = 0.5 * (lo + hi)
+        if stable(mid) == s_lo:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+@pytest.mark.slow
+def test_default_figure_16_all_types():
+    types = [(1, 1), (2, 1), (1, 2), (1, 3), (3, 1)]
+    mp = orbit_map(np.linspace(0.2, 3.0, 141), np.linspace(-1.5, 3.0, 226), types=types,
+                   zeta=ZETA, eps=EPS)
+    ib, dd = mp["inv_beta"], mp["delta"]
+    for t, mn in enumerate(types):
+        res = domain_boundaries(*mn, ZETA, EPS, **BOX, seed_map=mp)
+        assert res
+        pts = np.concatenate([np.c_[c.inv_beta, c.delta] for c in res])
+        for ps, pu in _seed_segments(mp["n_stable"][t] > 0, ib, dd):
+            mid = 0.5 * (ps + pu)
+            dist = np.min(np.hypot((pts[:, 0] - mid[0]) / (ib[1] - ib[0]),
+                                   (pts[:, 1] - mid[1]) / (dd[1] - dd[0])))
+            assert dist <= 1.5, (mn, mid)        # points, not the polyline: half a step more
+        for c in res:
+            assert "lost" not in c.ends, (mn, c.kind, c.ends)
+            slope = np.gradient(c.delta, c.inv_beta) if len(c) > 2 else np.zeros(len(c))
+            for k in _flip_points(c, 2):
+                if abs(slope[k]) > 20.0:
+                    continue
+                d_star = _bisect_edge(mn, c.inv_beta[k], c.delta[k] - 1e-6, c.delta[k] + 1e-6)
+                assert abs(d_star - c.delta[k]) <= 1e-9, (mn, c.kind, c.inv_beta[k])

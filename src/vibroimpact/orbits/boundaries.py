@@ -622,7 +622,8 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
                                            eps)
     box = (inv_beta[0], inv_beta[1], delta[0], delta[1])
     tr = _Tracer(m, n, zeta, eps, box)
-    segs = _seed_segments(stable, ib_grid, d_grid)
+    segs = [(ps, pu) for ps, pu in _seed_segments(stable, ib_grid, d_grid)
+            if tr.inside(ps) and tr.inside(pu)]    # a seed map may be larger than the box
     seg_arr = np.array(segs).reshape(-1, 2, 2)
     covered = np.zeros(len(segs), dtype=bool)
     raw = []                                   # (points (N, 2m+2), code, j, ends)
