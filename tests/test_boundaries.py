@@ -353,7 +353,7 @@ def test_result_api(curves):
 
 @pytest.mark.parametrize("kwargs, name", [
     (dict(m=4), "m"), (dict(m=0), "m"), (dict(n=0), "n"), (dict(m=1.5), "m"),
-    (dict(zeta=1.0), "zeta"), (dict(eps=2.0), "eps"),
+    (dict(zeta=1.0), "zeta"), (dict(eps=2.0), "eps"), (dict(eps=0.0), "eps"),
     (dict(inv_beta=(1.0, 1.0)), "inv_beta"), (dict(inv_beta=(2.0, 1.0)), "inv_beta"),
     (dict(inv_beta=(-1.0, 1.0)), "inv_beta"), (dict(inv_beta=()), "inv_beta"),
     (dict(delta=(0.0, 0.0)), "delta"), (dict(delta=(1.0, float("nan"))), "delta"),

@@ -574,7 +574,8 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
     m, n : int
         Motion type (m <= 3).
     zeta, eps : float
-        Damping ratio in (0, 1), restitution coefficient in [0, 1].
+        Damping ratio in (0, 1), restitution coefficient in (0, 1] (eps = 0, where every
+        flight starts at rest on the wall with a degenerate maximum there, is not supported).
     inv_beta, delta : (lo, hi)
         The box of the ``(1/beta, delta)`` plane; curves are cut at its edges.
     resolution : (nb, nd)
@@ -606,6 +607,10 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
         raise ValueError(f"m must be at most {MAX_M}, got {m}")
     zeta = _checks.zeta(zeta)
     eps = _checks.eps(eps)
+    if eps == 0.0:
+        raise ValueError("eps must be > 0 for domain_boundaries, got 0.0 (with eps = 0 every "
+                         "flight starts at rest on the wall, where its maximum is degenerate; "
+                         "not supported)")
     inv_beta = _range("inv_beta", inv_beta)
     if inv_beta[0] <= 0.0:
         raise ValueError(f"inv_beta must be positive, got {inv_beta}")
