@@ -20,13 +20,25 @@ multipliers have ``|mu| = sqrt(det T) < 1`` and stability is lost only at mu = +
 
 An impact velocity going to 0 (a grazing impact) is not an edge in practice: ``T`` has
 ``1 / u_j`` in it, so ``|tr T|`` diverges and the orbit loses stability (a fold or a period
-doubling) before it grazes; the tracing finds whichever test function vanishes first.
+doubling) before it grazes; the tracing finds whichever test function vanishes first. The fold
+and period-doubling conditions are taken times ``prod u_j`` (regular there), so their curves
+run into the grazing-impact point (for (1/n): ``delta = q``, the linear response touching the
+wall) and end there as codimension-two points. In the default Fig. 16 box the edges are fold,
+period-doubling and grazing (flight maximum) curves; no ``"existence"`` edge occurs.
+
+Seeds: every pixel edge of the map's stable mask. Each stable orbit at the stable pixel is
+followed (Newton) along the segment to its unstable neighbour until a test function vanishes
+(or the branch ends: a fold); that point is solved exactly (1/beta or delta fixed) and the
+curve through it is traced both ways. A seed is skipped when a curve already traced crosses
+its segment.
 
 Each curve ends where it leaves the box, where a second test function of its orbit vanishes
 (a codimension-two point, e.g. a period-doubling curve meeting a grazing curve: beyond it the
 orbit on the curve is no longer stable and admissible, so the curve no longer bounds the
-stable domain), or where it closes on itself. Parts of a curve where another stable (m/n)
-orbit coexists (so the point is inside the stable domain, not on its edge) are cut out.
+stable domain; also a corner where two maxima of one flight both touch the wall), or where it
+closes on itself. Where another stable (m/n) orbit coexists the point is inside the stable
+domain, not on its edge: those parts are cut out, the cut located by bisection along the curve
+(to 1e-11) and listed among the codimension-two points with ``other_orbit=True``.
 
 Accuracy: every point is a Newton solution of the augmented system whose last correction (the
 estimate ``J^-1 F`` of its distance to the exact root, so it includes the conditioning) is
@@ -597,9 +609,13 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
 
     Notes
     -----
-    See the module docstring: the kinds, why there is no Neimark-Sacker edge, the ends of a
-    curve, the accuracy. Points are at most 1/250 of the box's diagonal apart and the
-    direction turns by at most 0.1 rad between them.
+    Kinds: ``"fold"`` (a multiplier at +1), ``"period_doubling"`` (at -1), ``"grazing"`` (a
+    flight's interior maximum reaches the wall, or an impact velocity reaches 0),
+    ``"existence"`` (an interval reaches 0). There is no Neimark-Sacker edge: ``det T =
+    eps^(2m) exp(-2 zeta z) < 1``, so complex multipliers are always inside the unit circle.
+    See the module docstring for the method, the ends of a curve and the accuracy. Points are
+    at most 1/250 of the box's diagonal apart and the direction turns by at most 0.1 rad
+    between them (except across a cusp of the curve's projection).
     """
     m = _checks.integer("m", m, low=1)
     n = _checks.integer("n", n, low=1)
