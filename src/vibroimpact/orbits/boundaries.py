@@ -679,7 +679,7 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
 
 def _near_known(raw, x0, code, hmax):
     """Whether ``x0`` lies on a curve already traced with the same kind of condition."""
-    return any(c == code and _chord_gap(pts, x0) <= 0.01 * hmax for pts, c, *_ in raw)
+    return any(c == code and _chord_gap(pts, x0) <= 0.05 * hmax for pts, c, *_ in raw)
 
 
 def _chord_gap(pts, x0):
