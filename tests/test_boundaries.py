@@ -413,3 +413,14 @@ def test_default_figure_16_all_types():
                     continue
                 d_star = _bisect_edge(mn, c.inv_beta[k], c.delta[k] - 1e-6, c.delta[k] + 1e-6)
                 assert abs(d_star - c.delta[k]) <= 1e-9, (mn, c.kind, c.inv_beta[k])
+
+
+def test_own_seed_map_gives_the_same_curves(curves):
+    """Without seed_map the function computes its own map (here a coarser one): the curves are
+    exact, so their codimension-two points are the same."""
+    res = domain_boundaries(1, 1, ZETA, EPS, **BOX, resolution=(36, 57))
+    ref = curves[(1, 1)]
+    assert sorted(c.kind for c in res) == sorted(c.kind for c in ref)
+    for p in ref.codimension_two:
+        assert any(math.hypot(p.inv_beta - o.inv_beta, p.delta - o.delta) < 1e-9
+                   for o in res.codimension_two), p
