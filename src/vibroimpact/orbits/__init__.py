@@ -4,9 +4,13 @@
 gathers the numba kernels, one module per concept: flights, the impact-map Jacobian and
 admissibility (`flight`), linear algebra (`linalg`), Newton (`newton`), one orbit once
 (`solutions`), the (1/n) closed form (`m1`), the (m/n) scans (`intervals`, `scan_m2`,
-`scan_m3`, `solve`) and the row-parallel map (`domain_map`); thresholds in `tolerances`
+`scan_m3`, `solve`), the row-parallel map (`domain_map`) and the exact boundaries of the
+stable domains (`boundaries`, kernels in `boundaries_kernels`); thresholds in `tolerances`
 (docs/model.md, section 8).
 """
 from vibroimpact.orbits.api import REASON_CODES, PeriodicOrbit, Reason, orbit_map, periodic_orbits
+from vibroimpact.orbits.boundaries import (BoundaryCurve, CodimTwoPoint, DomainBoundaries,
+                                           domain_boundaries)
 
-__all__ = ["periodic_orbits", "PeriodicOrbit", "orbit_map", "Reason", "REASON_CODES"]
+__all__ = ["periodic_orbits", "PeriodicOrbit", "orbit_map", "Reason", "REASON_CODES",
+           "domain_boundaries", "BoundaryCurve", "CodimTwoPoint", "DomainBoundaries"]

@@ -7,6 +7,6 @@ from vibroimpact._kernel_cache import kernel_decorator
 #: The modules the compiled kernels are made of (constants included).
 KERNEL_MODULES = ("tolerances.py", "flight.py", "linalg.py", "newton.py", "solutions.py",
                   "m1.py", "intervals.py", "scan_m2.py", "scan_m3.py", "solve.py",
-                  "domain_map.py")
+                  "domain_map.py", "boundaries_kernels.py")
 
 kernel = kernel_decorator(njit, __file__, KERNEL_MODULES)

@@ -98,3 +98,20 @@ BILINEAR_MAXIT = 12
 BILINEAR_XTOL = 1e-6
 BILINEAR_DIVERGED = 2.0
 BILINEAR_ACCEPT = 0.75
+
+# --- stable-domain boundaries (boundaries.py, boundaries_kernels.py) --------------------------
+#: Central-difference step of the test functions' and the parameters' derivatives, relative to
+#: 1 + |x|: ~ the cube root of the float64 epsilon, balancing truncation (h^2 ~ 4e-11) and
+#: round-off (1e-16 / h ~ 2e-11), so the augmented Jacobian is good to ~1e-10 relative and
+#: Newton gains ~10 digits per step (the equations themselves are evaluated exactly).
+BOUNDARY_FD_REL = 6e-6
+#: Newton on the augmented system: iterations at most (it converges in 3-5 from a predictor).
+BOUNDARY_NEWTON_MAXIT = 30
+#: Converged when the last Newton correction of every unknown is below this times 1 + |x|:
+#: the correction estimates the distance to the exact root (it is J^-1 F), so delta is exact to
+#: ~1e-12 (1 + |delta|), well inside the 1e-9 asked of the curves.
+BOUNDARY_STEP_RTOL = 1e-12
+#: Grazing curves: the grid (radians of the fastest of beta and wd) on which a flight's highest
+#: maximum is located before Newton converges it (``flight_peak``); x oscillates with periods
+#: >= 2 pi in those units, so 0.05 rad puts >= 60 nodes on every oscillation.
+BOUNDARY_PEAK_STEP = 0.05
