@@ -352,8 +352,7 @@ def _attractor_attrs(entry):
                 n_starts=int(block["n_starts"]), max_time=float(block["max_time"]),
                 seed=int(block["seed"]), gap=list(gap), velocity=list(vel),
                 box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
-                    f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]; a scrambled Sobol sample, "
-                    f"the same in every cell")
+                    f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
 
 
 def attractor_tile(entry, tile, out, threads=None):

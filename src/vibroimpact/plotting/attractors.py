@@ -240,10 +240,11 @@ def basins(basins, orbits=None):
 def _starts_text(basins):
     """``N = 64 starts per cell (box); 95 % Clopper-Pearson intervals up to +-x pp``."""
     n = int(_attr(basins, "n_starts"))
-    text = f"{n} starts per cell: {_attr(basins, 'box')}"
+    text = (f"{n} starts per cell, a scrambled Sobol sample, the same in every cell:\n"
+            f"{_attr(basins, 'box')}")
     if "fraction_lo" in basins and "fraction_hi" in basins:
         half = 0.5 * np.nanmax(np.asarray(basins["fraction_hi"] - basins["fraction_lo"]))
-        text += (rf";  shares $\pm$ up to {100.0 * half:.0f} pp "
+        text += (rf"\nshares $\pm$ up to {100.0 * half:.0f} pp "
                  "(95 % Clopper-Pearson interval)")
     return text
 
@@ -330,7 +331,10 @@ def lyapunov(lyapunov):
                                     label=rf"sign unresolved: within {SIGN_STDERRS:g} s.e. "
                                           "of 0"))
     if "impact_rate" in lyapunov:
-        quiet = np.asarray(lyapunov["impact_rate"].values, dtype=float) == 0.0
+        # no impact with a finite exponent: the wall-free response (not the mass at rest
+        # on the wall, whose exponent is -inf)
+        quiet = ((np.asarray(lyapunov["impact_rate"].values, dtype=float) == 0.0)
+                 & np.isfinite(np.asarray(lyapunov["lyapunov"].values, dtype=float)))
         if quiet.any() and not quiet.all():
             ax_l.add_collection(LineCollection(cell_outline(x, y, quiet), colors="0.2",
                                                linewidths=0.9, gid="no-impact"),
