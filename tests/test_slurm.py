@@ -95,7 +95,8 @@ def test_the_datasets_through_slurm_equal_the_local_build(cluster, built, tmp_pa
     assert "rule_generate_noise" in kinds, kinds
     assert any(k.startswith("group_cells_") for k in kinds), kinds
     assert any(k.startswith("group_orbit_tiles_") for k in kinds), kinds
-    alone = r"rule_(simulate|solve_orbit_tile|aggregate|draw_figure|copy_paper_figure)"
+    alone = (r"rule_(simulate|solve_orbit_tile|solve_attractor_tile|trace_boundaries|aggregate"
+             r"|draw_figure|copy_paper_figure)")
     assert not [k for k in kinds if re.match(alone, k)], kinds
 
     assert_same_data(built, workdir)

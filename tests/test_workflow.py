@@ -44,7 +44,15 @@ def test_fig04_needs_only_the_noise(workdir):
 
 def test_fig16_runs_no_simulation(workdir):
     assert scheduled_rules(workdir, "results/figures/fig16.png") == {
-        "solve_orbit_tile", "aggregate_orbits", "draw_figure", "copy_paper_figure"}
+        "solve_orbit_tile", "aggregate_orbits", "trace_boundaries", "draw_figure",
+        "copy_paper_figure"}
+
+
+def test_basins_and_lyapunov_run_the_attractor_tiles_and_no_noise(workdir):
+    for fig in ("basins", "lyapunov"):
+        assert scheduled_rules(workdir, f"results/figures/orbits/harmonic/{fig}.png") == (
+            {"solve_attractor_tile", "aggregate_attractors", "draw_figure"}
+            | ({"solve_orbit_tile", "aggregate_orbits"} if fig == "basins" else set()))
 
 
 def test_fig15_runs_no_orbit_computation(workdir):
