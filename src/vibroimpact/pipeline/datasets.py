@@ -300,7 +300,7 @@ BOUNDARY_META = {
     "codim2_inv_beta": ("1/beta_f of a codimension-two point (two kinds meet)", "1"),
     "codim2_delta": ("play delta of a codimension-two point", "1"),
     "codim2_type": ("impact motion (m/n) of the codimension-two point", "1"),
-    "codim2_kinds": ("the two kinds that meet there, joined by +", "1"),
+    "codim2_kinds": ("the two kinds that meet there, in alphabetical order, joined by +", "1"),
 }
 
 
@@ -323,7 +323,7 @@ def boundaries_dataset(curves_by_type, attrs):
             c_ib.append(float(point.inv_beta))
             c_d.append(float(point.delta))
             c_type.append(f"{m}/{n}")
-            c_kinds.append("+".join(point.kinds))
+            c_kinds.append("+".join(sorted(point.kinds)))
 
     def cat(parts, dtype):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype)

@@ -257,10 +257,10 @@ def basin_summary(basins):
             if f.size else "",
         }
     other = basins["fraction"].values[n_types]
-    rows["other"] = {"cells with a stable orbit": "",
-                     "basin median (%)": f"{100 * np.median(other):.1f}",
-                     "basin min - max (%)": f"{100 * other.min():.0f} - {100 * other.max():.0f}"}
-    return pd.DataFrame.from_dict(rows, orient="index").fillna("")
+    rows["other (every cell)"] = dict.fromkeys(next(iter(rows.values())), "") | {
+        "basin median (%)": f"{100 * np.median(other):.1f}",
+        "basin min - max (%)": f"{100 * other.min():.0f} - {100 * other.max():.0f}"}
+    return pd.DataFrame.from_dict(rows, orient="index")
 
 
 def lyapunov_summary(lyapunov, basins):
