@@ -244,7 +244,7 @@ def _starts_text(basins):
             f"{_attr(basins, 'box')}")
     if "fraction_lo" in basins and "fraction_hi" in basins:
         half = 0.5 * np.nanmax(np.asarray(basins["fraction_hi"] - basins["fraction_lo"]))
-        text += (rf"\nshares $\pm$ up to {100.0 * half:.0f} pp "
+        text += ("\n" + rf"shares $\pm$ up to {100.0 * half:.0f} pp "
                  "(95 % Clopper-Pearson interval)")
     return text
 
