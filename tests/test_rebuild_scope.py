@@ -29,7 +29,9 @@ STRESS_RULES = {"sample_stress_families", "draw_validation_figure", "validation_
 VALIDATION_RULES = STRESS_RULES | {"measure_work_precision"}
 STUDY_RULES = {"simulate_events", "simulate_spectra", "simulate_trace", "aggregate_events",
                "aggregate_spectra"}
-ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits"}
+ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits", "trace_boundaries"}
+# the basins and Lyapunov exponents run the simulator's kernel against the orbit solver's
+ATTRACTOR_RULES = {"solve_attractor_tile", "aggregate_attractors"}
 MAP_RULES = {"simulate_map", "aggregate_map"}
 
 
@@ -194,8 +196,10 @@ def test_figure_only_key_reruns_only_that_figure(repo, edit):
 def test_simulator_edit_reruns_the_studies_and_downstream(repo, edit):
     edit("src/vibroimpact/impact/kernels.py", _append_code)    # uncommitted
     jobs = scheduled(repo)
-    assert set(jobs) == STUDY_RULES | MAP_RULES | FIGURE_RULES | REPORT_RULES | VALIDATION_RULES
+    assert set(jobs) == (STUDY_RULES | MAP_RULES | ATTRACTOR_RULES | FIGURE_RULES | REPORT_RULES
+                         | VALIDATION_RULES)
     assert "fig16.png" not in {Path(p).name for p in jobs["draw_figure"]}
+    assert {"basins.png", "lyapunov.png"} <= {Path(p).name for p in jobs["draw_figure"]}
 
 
 def test_statistics_edit_reruns_the_studies_that_use_it(repo, edit):
@@ -223,11 +227,19 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
                                   {"start": -1.5, "stop": 3.0, "step": 0.5}))
     jobs = scheduled(repo)
     assert set(jobs) == ORBIT_RULES | FIGURE_RULES | {"orbits_report"}
+    # the basins figure draws the map's stable domains; the attractors do not read its grid
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
-        "fig16.png", "fig15_vs_fig16.png"}
+        "fig16.png", "fig15_vs_fig16.png", "basins.png"}
+    (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
+    edit("config/test.yaml", _set(("orbits", "harmonic", "attractors", "n_starts"), 4))
+    jobs = scheduled(repo)
+    assert set(jobs) == ATTRACTOR_RULES | FIGURE_RULES | {"orbits_report"}
+    assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
+        "basins.png", "lyapunov.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
     edit("src/vibroimpact/orbits/kernels.py", _append_code)     # the stress sample too
-    assert set(scheduled(repo)) == ORBIT_RULES | FIGURE_RULES | {"orbits_report"} | STRESS_RULES
+    assert set(scheduled(repo)) == (ORBIT_RULES | ATTRACTOR_RULES | FIGURE_RULES
+                                    | {"orbits_report"} | STRESS_RULES)
 
 
 def test_outputs_record_the_dirty_flag(repo, edit):
