@@ -86,14 +86,9 @@ def _exponent_sum_residual(outf):
 
 
 def test_exponent_sum_is_the_phase_space_contraction():
-    # settled on the (2/1) orbit: two impacts per forcing period
-    _, theta, g, v0 = A.sobol_starts(8, (0.0, 4.0), (-4.0, 4.0), 0)
-    outf, outi, _ = A._starts_at_cell(1.0, 0.0, ZETA, EPS, theta, 0.0 - g, v0)
-    assert np.all(outi[:, ak.I_CLASS] == ak.LISTED)
-    # (the determinant of a settled orbit's tangent product is taken in its exact form, so
-    # this checks the bookkeeping; the unsettled case below checks Benettin's QR logs)
-    np.testing.assert_allclose(_exponent_sum_residual(outf), 0.0, atol=1e-12)
-    # unsettled and chaotic (Benettin over the last three quarters of the run)
+    # unsettled and chaotic (Benettin over the last three quarters of the run): the tangent
+    # products' QR logs, impact by impact (a settled start's determinant is taken in its
+    # exact form, so its sum would hold by construction and is not a check)
     _, theta, g, v0 = A.sobol_starts(64, (0.0, 4.0), (-4.0, 4.0), 0)
     outf, outi, _ = A._starts_at_cell(0.35, 0.0, ZETA, EPS, theta, 0.0 - g, v0)
     chaotic = outi[:, ak.I_CLASS] == ak.CHAOTIC

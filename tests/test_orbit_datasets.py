@@ -143,3 +143,15 @@ def test_no_curves_are_traced_at_eps_zero_and_fig16_keeps_the_cell_edges(tmp_pat
     assert ([a.get_gid() for a in without.axes[1].collections]
             == [a.get_gid() for a in given.axes[1].collections])
     assert "stable-edge" in [a.get_gid() for a in given.axes[1].collections]
+
+
+def test_the_class_names_are_one_list():
+    """The kernels' class codes, the datasets' flag meanings and the figure's colours name
+    the same classes in the same order (a reordering would remap every cell_class)."""
+    from vibroimpact.attractors import CLASSES
+    from vibroimpact.attractors import kernels as ak
+    from vibroimpact.plotting import attractors as drawn
+
+    assert tuple(CLASSES) == datasets.ATTRACTOR_CLASSES == tuple(drawn.CLASSES)
+    assert [ak.LISTED, ak.PERIODIC_OTHER, ak.STICKING, ak.CHAOTIC, ak.UNDECIDED] == list(
+        range(len(CLASSES)))

@@ -15,7 +15,7 @@ MAX_M = 3
 
 #: A start has settled on a periodic orbit when its collisions match the orbit's impacts
 #: (phase over the forcing period, velocity relative) within this tolerance
-#: (`vibroimpact.orbits.attractors`).
+#: (`vibroimpact.attractors`).
 ATTRACTOR_MATCH_TOL = 1e-6
 
 

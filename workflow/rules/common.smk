@@ -291,13 +291,14 @@ def orbits_report_inputs(wildcards):
     inputs = {
         "notebook": "notebooks/periodic_motions.ipynb",
         "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
-        "boundaries": _DATASETS["boundaries"].format(name=wildcards.orbits),
         "figures": [
             f"results/figures/orbits/{wildcards.orbits}/{f}.png"
             for f in figures.figure_targets(entry)
         ],
     }
     inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
+    if "fig16" in figures.figure_targets(entry):
+        inputs["boundaries"] = _DATASETS["boundaries"].format(name=wildcards.orbits)
     if entry.get("attractors"):
         inputs.update(
             {

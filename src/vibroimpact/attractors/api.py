@@ -276,12 +276,21 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     class_count = np.stack([(cls == c).sum(axis=0) for c in range(len(CLASSES))])
     frac = count / n_starts
     lo, hi = clopper_pearson(count, n_starts)
+    status = to_s(outi[:, ak.I_STATUS])
+    if np.any(status != 0):
+        # the simulator's kernel refused a step (as simulate() would raise): no result of
+        # that start can be trusted, so none of the map's is written
+        s, ib, d = (int(v[0]) for v in np.nonzero(status != 0))
+        raise RuntimeError(f"attractor_map: the simulator's kernel stopped with status "
+                           f"{int(status[s, ib, d])} on start {s} of the cell 1/beta = "
+                           f"{inv_beta[ib]:g}, delta = {delta[d]:g} "
+                           f"({int(np.count_nonzero(status))} starts in all)")
     lyap1 = to_s(outf[:, ak.F_LYAP1])
     lyap2 = to_s(outf[:, ak.F_LYAP2])
     stderr = to_s(outf[:, ak.F_STDERR])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        lyap = np.nanmax(np.where(np.isnan(lyap1), -np.inf, lyap1), axis=0)
+        lyap = np.nanmax(lyap1, axis=0)      # -inf: every start sticks; NaN: no exponent
         unsettled = (cls == ak.CHAOTIC) | (cls == ak.UNDECIDED)
         lyap_se = np.nanmax(np.where(unsettled, stderr, np.nan), axis=0)
         rate = np.nanmean(to_s(outf[:, ak.F_RATE]), axis=0)

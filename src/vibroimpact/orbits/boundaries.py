@@ -442,7 +442,7 @@ class _Tracer:
                 xs, _ = self.newton(xi, code, j, mode=2, code2=c2, j2=j2, hint2=h2)
             if xs is None or np.linalg.norm(xs[-2:] - xi[-2:]) > 2.0 * np.linalg.norm(
                     xn[-2:] - x[-2:]) + 1e-12:
-                return None
+                continue                    # not this end: the next candidate may hold
             if why == "codim2" and not self.inside(xs):
                 # the second condition holds only outside the box: cut at the box's edge
                 return self._finish(x, xs, tests_x, tests_x, np.ones_like(ok), True, code, j,
@@ -663,7 +663,8 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
     for pts, code, j, ends, hints in raw:
         for piece, phints, pends in _edge_pieces(tr, pts, hints, ends, code, j):
             err = np.array([tr.error_of(x, code, j, h) for x, h in zip(piece, phints)])
-            if np.any(err[1:-1] > tol) or np.any(err[[0, -1]] > END_TOL_FACTOR * tol):
+            # (not `> tol`: a NaN estimate is a failure too)
+            if not (np.all(err[1:-1] <= tol) and np.all(err[[0, -1]] <= END_TOL_FACTOR * tol)):
                 raise RuntimeError(f"boundary point not converged to tol={tol}: "
                                    f"max error estimate {np.nanmax(err):.3g}")
             curves.append(BoundaryCurve(

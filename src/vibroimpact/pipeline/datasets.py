@@ -297,6 +297,8 @@ BOUNDARY_META = {
     "kind": ("what happens on the curve: grazing, fold (multiplier +1), period_doubling "
              "(multiplier -1), existence (another end of the stable solution)", "1"),
     "type": ("impact motion (m/n) whose stable domain the curve bounds", "1"),
+    "ends": ("why the curve stops at its two ends (box, codim2, coexist, closed, lost), "
+             "joined by +", "1"),
     "codim2_inv_beta": ("1/beta_f of a codimension-two point (two kinds meet)", "1"),
     "codim2_delta": ("play delta of a codimension-two point", "1"),
     "codim2_type": ("impact motion (m/n) of the codimension-two point", "1"),
@@ -310,7 +312,7 @@ def boundaries_dataset(curves_by_type, attrs):
 
     Dimensions ``point`` (every curve's points, curve after curve), ``curve`` and ``codim2``.
     """
-    inv_beta, delta, index, kinds, types = [], [], [], [], []
+    inv_beta, delta, index, kinds, types, ends = [], [], [], [], [], []
     c_ib, c_d, c_type, c_kinds = [], [], [], []
     for (m, n), result in curves_by_type.items():
         for curve in result:
@@ -319,6 +321,7 @@ def boundaries_dataset(curves_by_type, attrs):
             index.append(np.full(inv_beta[-1].size, len(kinds), dtype=np.int32))
             kinds.append(str(curve.kind))
             types.append(f"{m}/{n}")
+            ends.append("+".join(str(e) for e in getattr(curve, "ends", ())))
         for point in result.codimension_two:
             c_ib.append(float(point.inv_beta))
             c_d.append(float(point.delta))
@@ -333,6 +336,7 @@ def boundaries_dataset(curves_by_type, attrs):
          "curve": ("point", cat(index, np.int32)),
          "kind": ("curve", np.array(kinds, dtype=str)),
          "type": ("curve", np.array(types, dtype=str)),
+         "ends": ("curve", np.array(ends, dtype=str)),
          "codim2_inv_beta": ("codim2", np.array(c_ib, dtype=float)),
          "codim2_delta": ("codim2", np.array(c_d, dtype=float)),
          "codim2_type": ("codim2", np.array(c_type, dtype=str)),
@@ -343,7 +347,7 @@ def boundaries_dataset(curves_by_type, attrs):
     return ds
 
 
-#: Classes of a start of the attractor map (`vibroimpact.orbits.attractor_map`).
+#: Classes of a start of the attractor map (`vibroimpact.attractor_map`).
 ATTRACTOR_CLASSES = ("listed", "periodic_other", "sticking", "chaotic", "undecided")
 
 ATTRACTOR_META = {
@@ -371,7 +375,7 @@ ATTRACTOR_META = {
 
 
 def attractor_tile_dataset(result, attrs):
-    """Dataset of one :func:`vibroimpact.orbits.attractor_map` call over
+    """Dataset of one :func:`vibroimpact.attractor_map` call over
     ``(inv_beta, delta)``: what the basins and Lyapunov datasets are cut from."""
     motions = list(result["motions"])
     types = motions[:-1]

@@ -342,6 +342,10 @@ def boundaries(entry, orbits_path, out, threads=None):
             resolution=(seeds["inv_beta"].size, seeds["delta"].size), seed_map=seeds,
             tol=BOUNDARY_TOL)
         log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
+        lost = sum(c.ends.count("lost") for c in curves[(m, n)])
+        if lost:
+            log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
+                        "there (the dataset's `ends` says which curves)", m, n, lost)
     io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
 
 

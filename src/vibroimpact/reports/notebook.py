@@ -282,7 +282,7 @@ def lyapunov_summary(lyapunov, basins):
             "of them with no stable listed orbit": int((sel & none_stable).sum()),
             "largest exponent, range": (f"{finite.min():.3g} .. {finite.max():.3g}"
                                         if finite.size else
-                                        ("-inf" if sel.any() else "")),
+                                        "-inf" if np.isneginf(lam[sel]).any() else ""),
         }
     return pd.DataFrame.from_dict(rows, orient="index")
 
