@@ -49,14 +49,14 @@ def test_the_cut_ends_are_censored_whatever_the_state():
 
 def test_label_pieces_keeps_the_intervals_between_the_first_and_last_collision():
     """Before the first and after the last collision the type is unknown: no piece; an
-    unclassified interval is "none"; no collision at all: the record is one piece of none."""
+    unclassified interval is "none"; no interval at all: the record is one piece of none."""
     edges, states = stats.label_pieces([2.0, 3.0, 5.0, 6.0], [0, -1, 1], 1.0, 8.0, 2)
     assert edges.tolist() == [2.0, 3.0, 5.0, 6.0] and states.tolist() == [0, 2, 1]
     edges, states = stats.label_pieces([], [], 1.0, 8.0, 2)
     assert edges.tolist() == [1.0, 8.0] and states.tolist() == [2]
-    edges, states = stats.label_pieces([4.0], [], 1.0, 8.0, 2)
-    assert edges.tolist() == [4.0] and states.tolist() == []
-    r = stats.residence_statistics(edges, states, 3)          # no piece: nothing known
+    edges, states = stats.label_pieces([4.0], [], 1.0, 8.0, 2)     # one collision: no interval
+    assert edges.tolist() == [1.0, 8.0] and states.tolist() == [2]
+    r = stats.residence_statistics([4.0], [], 3)                    # no piece: nothing known
     assert r.n_stretches.tolist() == [0, 0, 0] and np.isnan(r.rate).all()
     with pytest.raises(ValueError, match="one more"):
         stats.label_pieces([1.0, 2.0], [0, 0], 0.0, 3.0, 2)

@@ -44,9 +44,9 @@ def label_pieces(impact_time, labels, t_start: float, t_stop: float, n_motions: 
     Returns
     -------
     edges : ndarray, shape (K + 1,)
-        ``[t_0, ..., t_N]``: the collisions; with no collision ``[t_start, t_stop]``.
+        ``[t_0, ..., t_N]``: the collisions; with no interval ``[t_start, t_stop]``.
     states : ndarray of int, shape (K,)
-        State of each piece: the interval's motion, "none" for -1; with no collision the
+        State of each piece: the interval's motion, "none" for -1; with no interval the
         one piece is "none".
 
     Notes
@@ -55,15 +55,17 @@ def label_pieces(impact_time, labels, t_start: float, t_stop: float, n_motions: 
     began before ``t_start`` or end after ``t_stop``, whose type is unknown: the probabilities
     count them as no motion, but they are left out here, so that the first and the last
     classified stretches are the ones cut by the record's ends (`residence_statistics`
-    censors them). With no collision at all the record is certainly in no motion: one cut
-    stretch of "none". With one collision there is no interval and no piece.
+    censors them). With fewer than two collisions there is no interval, every probability is
+    0, and the record is one cut stretch of "none" (with one collision, the neighbouring
+    intervals run beyond the record and their type is unknown; "none" is what the
+    probabilities say).
     """
     t = np.asarray(impact_time, dtype=float)
     labels = np.asarray(labels, dtype=np.int64)
     if t.size != labels.size + 1 and not (t.size == 0 and labels.size == 0):
         raise ValueError(f"impact_time must hold one more value than labels, got {t.size} "
                          f"and {labels.size}")
-    if not t.size:
+    if t.size < 2:
         return np.array([float(t_start), float(t_stop)]), np.array([int(n_motions)])
     return t.copy(), np.where(labels >= 0, labels, int(n_motions))
 
