@@ -101,8 +101,10 @@ def residence_statistics(edges, states, n_states: int) -> ResidenceStatistics:
     biases the mean low by O(1/n_stretches) relative (a long stretch is more likely to be
     cut), below its stderr once there are a few stretches; with none or one complete stretch
     the mean is NaN or has no error, and the map marks such cells. The censored-data
-    estimator ``time / exits`` would keep the cut stretches, but it is exact only for
-    exponential residence times, which is what one may want to check, not assume.
+    estimator ``time / exits`` would keep the cut stretches' time; it is the
+    maximum-likelihood mean only for exponential residence times (a Markov sequence, which
+    is what one wants to check, not assume), whereas the mean of the complete stretches
+    assumes nothing about their distribution and gives its spread directly.
 
     *Rates.* ``rate[i, j] = count[i, j] / time[i]``: switches from i to j per unit time spent
     in i, with ``time[i]`` holding the cut stretches too. This is the maximum-likelihood
