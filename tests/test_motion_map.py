@@ -109,3 +109,130 @@ def test_a_cell_stops_at_its_precision_or_at_the_cap(record):
     assert capped["record_end"] == pytest.approx(200.0 + 50 * 2 * np.pi * 2.0, abs=DT)
     with pytest.raises(ValueError, match="max_periods"):
         _map_cell(record[:1000], 2.0, 0.95, transient=200.0, max_periods=50)
+
+
+# --- residence times and switching rates of a cell (stats.residence_statistics) -------------
+
+@pytest.fixture(scope="module")
+def test_config_map():
+    """The noise and map parameters of the `motion_map` study of config/test.yaml."""
+    import yaml
+    from pathlib import Path
+
+    config = yaml.safe_load((Path(__file__).parents[1] / "config" / "test.yaml").read_text())
+    study = config["studies"]["motion_map"]
+    spec = dict(config["noises"][study["noise"]])
+    n, seed = spec.pop("n_samples"), spec.pop("seed")
+    noise = generate_array(NoiseSpec(**spec), n, seed)
+    kw = dict(zeta=study["zeta"], eps=study["eps"], amplitude=study["amplitude"],
+              transient=study["transient"], n_batches=study["n_batches"],
+              window=study["motion_window"], motions=tuple(map(tuple, study["motions"])),
+              **study["map"])
+    return noise, spec["dt"], kw
+
+
+# many switches, 7 switches with none (a few-switches cell), and the (2/1)-dominated cell
+@pytest.mark.parametrize("inv_beta, delta", [(2.5, 1.0), (1.5, -1.0), (1.0, 1.0), (1.5, 0.5)])
+def test_stationary_distribution_of_the_rates_is_the_time_on_the_cell(test_config_map,
+                                                                      inv_beta, delta):
+    """The stationary distribution of the cell's rate matrix against the fractions of time it
+    stores (probability plus its stick variant; "none" the rest): within one standard
+    error. They differ only by the time before the first and after the last collision
+    (counted as "none" by the probabilities, unknown for the stretches) and by the one
+    switch by which the first and last states' ins and outs differ: an identity of the
+    bookkeeping, Markov or not (`stats.residence_statistics`). Measured (the four cells):
+    |pi - p| <= 0.014, at most 0.46 of the standard error."""
+    noise, dt, kw = test_config_map
+    cell = motion_map_cell(noise, dt, delta=delta, beta_f=1.0 / inv_beta, **kw)
+    p = cell["probability"] + cell["stick_probability"]
+    p = np.append(p, 1.0 - p.sum())
+    err = np.hypot(cell["stderr"], cell["stick_stderr"])
+    err = np.append(err, np.sqrt((err ** 2).sum()))
+    pi = stats.stationary_distribution(cell["switch_rate"])
+    assert pi.sum() == pytest.approx(1.0)
+    assert (np.abs(pi - p) <= err).all(), (pi, p, err)
+    # the residence times and rates are in forcing periods and agree with the counts
+    period = 2 * np.pi * inv_beta
+    seen = cell["n_stretches"] + cell["n_censored"] > 0
+    assert (cell["switch_count"].sum(axis=1)[seen] >= cell["n_stretches"][seen]).all()
+    assert np.isnan(cell["switch_rate"][~seen]).all()
+    assert np.nanmax(cell["residence_time"]) < cell["simulated_time"] / period
+
+
+def test_residence_of_a_stable_orbit_without_noise_is_one_cut_stretch():
+    """r = 0, the (1/1) orbit: one stretch, cut at both ends: no complete stretch, no mean,
+    no switch."""
+    inv_beta, delta = 1.1, 1.0
+    noise = np.zeros(int((TRANSIENT + 600 * 2 * np.pi * inv_beta) / DT) + 10)
+    cell = _map_cell(noise, inv_beta, delta)
+    assert cell["n_stretches"].tolist() == [0, 0, 0, 0]
+    assert cell["n_censored"].tolist() == [1, 0, 0, 0]
+    assert np.isnan(cell["residence_time"]).all() and not cell["switch_count"].any()
+    assert cell["switch_rate"][0].tolist() == [0.0] * 4
+    assert stats.stationary_distribution(cell["switch_rate"]).tolist() == [1.0, 0.0, 0.0, 0.0]
+
+
+def test_the_map_dataset_stores_residence_and_rates_beside_the_probabilities(tmp_path):
+    """The workflow's tasks (`simulate_map` tile, `aggregate_map`) on a 2 x 2 map: the new
+    variables over ``state`` / ``from_motion``, ``to_motion`` and the plane, described, and
+    each cell's values those of `motion_map_cell` run alone."""
+    import xarray as xr
+
+    from vibroimpact.pipeline import tasks
+
+    noise = tmp_path / "noise.nc"
+    tasks.make_noise(dict(kind="band_limited", rms=0.29, dt=DT, beta_c=4.0, n_samples=60_001,
+                          seed=5, nperseg=256), noise)
+    block = dict(noise="n", zeta=ZETA, eps=EPS, amplitude=1.0, inv_beta=[1.0, 2.0],
+                 delta=[0.0, 1.0], transient=200.0, tile_size=100, n_batches=20,
+                 motion_window=0.1, motions=[[1, 1], [2, 1], [1, 2]],
+                 map=dict(target_stderr=0.05, min_time=500.0, max_periods=300,
+                          min_switches=10))
+    tasks.map_tile("m", block, 0, noise, tmp_path / "tile.nc")
+    tasks.aggregate("m", block, "map", [tmp_path / "tile.nc"], tmp_path / "map.nc")
+    ds = xr.load_dataset(tmp_path / "map.nc")
+    states = ["1/1", "2/1", "1/2", "none"]
+    assert ds["motion"].values.tolist() == states[:3]
+    assert ds["probability"].dims == ("motion", "inv_beta", "delta")
+    for name in ("residence_time", "residence_time_stderr", "n_stretches", "n_censored"):
+        assert ds[name].dims == ("state", "inv_beta", "delta"), name
+        assert ds[name].attrs["long_name"], name
+    for name in ("switch_rate", "switch_count"):
+        assert ds[name].dims == ("from_motion", "to_motion", "inv_beta", "delta"), name
+        assert ds[name].attrs["long_name"], name
+    for dim in ("state", "from_motion", "to_motion"):
+        assert ds[dim].values.tolist() == states
+    from vibroimpact.pipeline import io
+
+    samples, dt, _ = io.read_noise(noise)
+    cell = motion_map_cell(samples, dt, zeta=ZETA, eps=EPS, delta=1.0, beta_f=0.5,
+                           transient=200.0, target_stderr=0.05, min_time=500.0,
+                           max_periods=300, min_switches=10, motions=MOTIONS)
+    got = ds.sel(inv_beta=2.0, delta=1.0)
+    np.testing.assert_array_equal(got["residence_time"].values, cell["residence_time"])
+    np.testing.assert_array_equal(got["switch_rate"].values, cell["switch_rate"])
+    np.testing.assert_array_equal(got["n_stretches"].values, cell["n_stretches"])
+    np.testing.assert_array_equal(got["probability"].values, cell["probability"])
+    assert cell["n_stretches"].sum() > 0
+
+
+def test_residence_of_a_map_cell_is_that_of_the_cell_alone(record):
+    """The residence times and rates read the same labelled record as the probabilities:
+    `simulate` to the cell's record end, classified and cut into stretches, gives them to the
+    last bit (in forcing periods)."""
+    inv_beta, delta = 2.0, 0.95
+    cell = _map_cell(record, inv_beta, delta, transient=200.0, max_periods=1500,
+                     target_stderr=0.02)
+    res, step, offset, _ = _alone(record, inv_beta, delta, 200.0, cell["record_end"])
+    z = stats.impact_intervals(step, offset, DT)
+    labels = stats.classify_impact_intervals(stats.interval_ratio(z, 1.0 / inv_beta),
+                                             motions=MOTIONS)
+    edges, states = stats.label_pieces(step * DT + offset, labels, 200.0, cell["record_end"],
+                                       len(MOTIONS))
+    r = stats.residence_statistics(edges, states, len(MOTIONS) + 1)
+    period = 2 * np.pi * inv_beta
+    np.testing.assert_array_equal(cell["residence_time"], r.mean / period)
+    np.testing.assert_array_equal(cell["residence_time_stderr"], r.stderr / period)
+    np.testing.assert_array_equal(cell["switch_rate"], r.rate * period)
+    np.testing.assert_array_equal(cell["switch_count"], r.count)
+    assert r.n_stretches.sum() >= 20

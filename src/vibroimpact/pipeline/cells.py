@@ -312,7 +312,15 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         models only), ``simulated_time, record_end`` (the last simulated instant: simulating
         the cell alone to ``t_end = record_end`` reproduces it bit for bit), ``reached``
         (every stderr at target), ``few_switches`` (1 to ``min_switches - 1`` switches: the
-        probabilities say where the record started), ``n_checks``.
+        probabilities say where the record started), ``n_checks``. Over the states (the
+        motions, then "none": time in no listed motion, as the probabilities count it):
+        ``residence_time, residence_time_stderr`` (mean length of the complete stretches of
+        the motion, merged over its free and impact-stick variants, in forcing periods),
+        ``n_stretches, n_censored`` (complete stretches, and those cut by the record's ends,
+        left out of the mean), ``switch_rate`` (S, S: switches from motion i to j per forcing
+        period spent in i, NaN rows for motions never seen) and ``switch_count``; see
+        `stats.residence_statistics`. They read the same labelled record as the
+        probabilities: no further simulation.
 
     Raises
     ------
@@ -349,6 +357,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         gen.close()
     duration = k * dt - transient
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
+    stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     return dict(probability=res.probability, stderr=res.stderr,
                 stick_probability=res.stick_probability, stick_stderr=res.stick_stderr,
                 n_switches=res.n_switches,
@@ -356,4 +365,16 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
                 n_impacts_resolved=n_resolved,
                 v_after_mean=float(eps * col.velocity.mean()) if col.time.size else math.nan,
                 simulated_time=duration, record_end=k * dt, reached=bool(reached),
-                few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks)
+                few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks,
+                **stays)
+
+
+def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
+    """Residence times and switching rates of a map cell's labelled record, in forcing
+    periods (`stats.residence_statistics`; the states are the motions, then "none")."""
+    period = 2.0 * math.pi / beta_f
+    edges, states = stats.label_pieces(impact_time, labels, t_start, t_stop, n_motions)
+    r = stats.residence_statistics(edges, states, n_motions + 1)
+    return dict(residence_time=r.mean / period, residence_time_stderr=r.stderr / period,
+                n_stretches=r.n_stretches, n_censored=r.n_censored,
+                switch_rate=r.rate * period, switch_count=r.count)

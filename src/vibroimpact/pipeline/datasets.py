@@ -58,6 +58,20 @@ META = {
                           "(fraction of time)", "1"),
     "stick_probability_stderr": ("batch-means standard error of the stick probability", "1"),
     "n_switches": ("changes between classified motions in the record", "1"),
+    "state": ("impact motion (m/n), free and impact-stick variants together, or none (time in "
+              "no listed motion)", "1"),
+    "from_motion": ("motion switched from (as state)", "1"),
+    "to_motion": ("motion switched to (as state)", "1"),
+    "residence_time": ("mean residence time: mean length of the complete stretches of the "
+                       "motion, in forcing periods 2 pi / beta_f", "1"),
+    "residence_time_stderr": ("standard error of the mean residence time (spread of the "
+                              "stretches), in forcing periods", "1"),
+    "n_stretches": ("complete stretches of the motion (both ends inside the record)", "1"),
+    "n_censored": ("stretches of the motion cut by the record's start or end (not in the "
+                   "mean)", "1"),
+    "switch_rate": ("switches from from_motion to to_motion per forcing period spent in "
+                    "from_motion (NaN: from_motion never seen)", "1"),
+    "switch_count": ("switches from from_motion to to_motion in the record", "1"),
     "few_switches": ("1: between 1 and min_switches - 1 switches (probabilities not "
                      "stationary)", "1"),
     "reached": ("1: every probability reached the target standard error", "1"),
@@ -171,13 +185,21 @@ def map_tile(cells, results, motions, attrs):
                                  np.stack([r["stick_probability"] for r in results]))
     data["stick_probability_stderr"] = (("cell", "motion"),
                                         np.stack([r["stick_stderr"] for r in results]))
-    coords = dict(_cell_coords(cells), motion=_motion_names(motions))
+    for name in ("residence_time", "residence_time_stderr", "n_stretches", "n_censored"):
+        data[name] = (("cell", "state"), np.stack([r[name] for r in results]))
+    for name in ("switch_rate", "switch_count"):
+        data[name] = (("cell", "from_motion", "to_motion"),
+                      np.stack([r[name] for r in results]))
+    states = _motion_names(motions) + ["none"]
+    coords = dict(_cell_coords(cells), motion=_motion_names(motions), state=states,
+                  from_motion=states, to_motion=states)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
 def aggregate_map(tiles, study, attrs):
     """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
-    ds = _to_grid(tiles, study.inv_beta, study.delta).transpose("motion", "inv_beta", "delta")
+    ds = _to_grid(tiles, study.inv_beta, study.delta).transpose(
+        "motion", "state", "from_motion", "to_motion", "inv_beta", "delta", missing_dims="ignore")
     ds.attrs = dict(attrs)
     return _annotate(ds)
 

@@ -507,3 +507,71 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
         handles.append(few_switches_handle(motion_map, short=True))
     return _finish_figure(fig, motion_map, handles, "Fig. 15 over Fig. 16  Likely motions under "
                           "noise and stable periodic motions")
+
+
+#: Complete stretches a cell needs for its mean residence time to be drawn unmarked.
+RESIDENCE_MIN_STRETCHES = 5
+#: Look of the cells with fewer complete stretches (their mean is a few samples, or none).
+FEW_STRETCHES_STYLE = dict(facecolor="none", edgecolor="0.35", hatch="xxx", linewidth=0.0)
+
+
+@_styled
+def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
+    """Mean residence time of each motion (and of "none") over the (1/beta, delta) plane.
+
+    Parameters
+    ----------
+    motion_map : xarray.Dataset
+        ``results/datasets/{study}_map.nc`` with ``residence_time(state, inv_beta, delta)``
+        and ``n_stretches`` (docs/datasets.md).
+    min_stretches : int
+        Cells with fewer complete stretches of the state are cross-hatched (a mean of a few
+        stretches, or none: then also left blank).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per state, whole cells coloured by the mean length of the complete stretches
+        in forcing periods on one logarithmic scale for all panels; hatched cells
+        (gid ``"few_stretches"``) hold fewer than `min_stretches` complete stretches.
+    """
+    from matplotlib.colors import LogNorm
+
+    states = [str(s) for s in motion_map["state"].values]
+    x, y = _grid(motion_map)
+    xe, ye = cell_edges(x), cell_edges(y)
+    t = motion_map["residence_time"].transpose("state", "inv_beta", "delta").values
+    n = motion_map["n_stretches"].transpose("state", "inv_beta", "delta").values
+    shown = np.isfinite(t) & (t > 0)
+    norm = (LogNorm(vmin=float(t[shown].min()), vmax=max(float(t[shown].max()),
+                                                          1.01 * float(t[shown].min())))
+            if shown.any() else None)
+    fig = Figure(figsize=(3.6 * len(states) + 1.0, 4.4))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, len(states), sharex=True, sharey=True, squeeze=False).ravel()
+    mesh = None
+    few_any = False
+    for ax, name, ts, ns, ok in zip(axes, states, t, n, shown):
+        if ok.any():
+            mesh = ax.pcolormesh(xe, ye, np.ma.masked_where(~ok, ts).T, norm=norm,
+                                 cmap="viridis", gid="residence")
+        few = ns < min_stretches
+        if few.any():
+            few_any = True
+            ax.add_collection(PatchCollection(cell_rectangles(x, y, few), gid="few_stretches",
+                                              **FEW_STRETCHES_STYLE), autolim=False)
+        ax.set_title("none" if name == "none" else f"({name})")
+    _finish_axes(axes, motion_map)
+    for ax in axes:                       # cells drawn whole: the extent is the cells' edges
+        ax.set_xlim(xe[0], xe[-1])
+        ax.set_ylim(ye[0], ye[-1])
+    if mesh is not None:
+        fig.colorbar(mesh, ax=axes.tolist(), shrink=0.85,
+                     label="mean residence time (forcing periods)")
+    else:
+        note_on_axes(axes[0], "no complete stretch of any motion")
+    handles = ([Patch(**{**FEW_STRETCHES_STYLE, "linewidth": 0.7},
+                      label=f"fewer than {min_stretches} complete stretches (blank: none)")]
+               if few_any else [])
+    return _finish_figure(fig, motion_map, handles, "Mean residence time in each impact motion "
+                          "under harmonic plus random force")

@@ -9,6 +9,7 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
 - `collisions`: impacts grouped with the chatter and sticking they start (the unit of every
   impact statistic);
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
+- `residence`: residence times in the motions and the rates of switching between them;
 - `theory`: the wall-free linear response, elastic impacts under white noise.
 
 Every public name is re-exported here lazily (``vibroimpact.stats.density``), so a job that
@@ -16,7 +17,7 @@ needs one helper does not import the others' scipy modules.
 """
 import importlib
 
-_SUBMODULES = ("spectra", "events", "collisions", "motions", "theory")
+_SUBMODULES = ("spectra", "events", "collisions", "motions", "residence", "theory")
 _WHERE = {
     "PSD_DETREND": "spectra", "WelchAccumulator": "spectra", "welch_psd": "spectra",
     "onesided_to_angular": "spectra", "variance_from_psd": "spectra",
@@ -31,6 +32,8 @@ _WHERE = {
     "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
     "count_motion_switches": "motions", "MotionStatistics": "motions",
     "motion_statistics": "motions", "motion_map_agreement": "motions",
+    "ResidenceStatistics": "residence", "label_pieces": "residence",
+    "residence_statistics": "residence", "stationary_distribution": "residence",
     "linear_response_std": "theory", "elastic_impact_rate": "theory",
     "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory",

@@ -1,0 +1,52 @@
+"""The `residence` map (`plotting.maps.residence`): not in the figure table yet."""
+import numpy as np
+import xarray as xr
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import LogNorm
+
+from vibroimpact.plotting.maps import residence
+
+STATES = ["1/1", "2/1", "1/2", "none"]
+ATTRS = dict(zeta=0.05, eps=0.5, amplitude=1.0, noise_kind="band_limited", noise_rms=0.29,
+             noise_beta_c=4.0, dt=0.1, motion_window=0.1, transient=200.0, target_stderr=0.03,
+             min_time=500.0, max_periods=500, min_switches=10)
+
+
+def _map(t, n):
+    plane = ("inv_beta", "delta")
+    shape = t.shape[1:]
+    return xr.Dataset(
+        dict(residence_time=(("state", *plane), t), n_stretches=(("state", *plane), n),
+             reached=(plane, np.ones(shape, np.int8)), simulated_time=(plane, np.full(shape, 1e3)),
+             n_collisions=(plane, np.full(shape, 100))),
+        coords=dict(state=STATES, inv_beta=[0.5, 1.0, 1.5], delta=[0.0, 1.0]), attrs=ATTRS)
+
+
+def test_one_log_scale_panel_per_state_with_few_stretches_hatched():
+    rng = np.random.default_rng(0)
+    t = 10 ** rng.uniform(-0.5, 1.5, (4, 3, 2))
+    n = rng.integers(0, 20, (4, 3, 2))
+    t[n == 0] = np.nan
+    fig = residence(_map(t, n))
+    FigureCanvasAgg(fig).draw()
+    panels = [ax for ax in fig.axes if ax.get_title()]
+    assert [ax.get_title() for ax in panels] == ["(1/1)", "(2/1)", "(1/2)", "none"]
+    meshes = [c for ax in panels for c in ax.collections if c.get_gid() == "residence"]
+    assert len(meshes) == 4
+    norm = meshes[0].norm
+    assert isinstance(norm, LogNorm) and all(m.norm is norm for m in meshes)
+    assert norm.vmin == np.nanmin(t) and norm.vmax == np.nanmax(t)
+    for ax, few in zip(panels, n < 5):
+        hatched = [c for c in ax.collections if c.get_gid() == "few_stretches"]
+        assert len(hatched) == int(few.any())
+        if few.any():
+            assert len(hatched[0].get_paths()) == few.sum()
+    # a cell without a complete stretch is left blank (masked)
+    assert meshes[0].get_array().mask.sum() == (n[0] == 0).sum()
+
+
+def test_a_map_without_any_complete_stretch_says_so():
+    fig = residence(_map(np.full((4, 3, 2), np.nan), np.zeros((4, 3, 2), int)))
+    FigureCanvasAgg(fig).draw()
+    notes = [t.get_text() for ax in fig.axes for t in ax.texts if t.get_gid() == "note"]
+    assert notes == ["no complete stretch of any motion"]
