@@ -62,7 +62,8 @@ def _audit(res, r, eps, delta, amplitude=0.0, scale=1.0):
 
 @pytest.mark.parametrize("eps, delta, amplitude", [(1.0, 0.5, 0.0), (1.0, -0.3, 0.0),
                                                    (1.0, 0.3, 1.0), (0.5, 0.0, 0.0),
-                                                   (0.5, -0.5, 0.0), (0.5, 0.3, 1.0)])
+                                                   (0.5, -0.5, 0.0), (0.5, 0.3, 1.0),
+                                                   (0.0, -0.3, 0.0)])
 def test_the_residual_is_the_boundary_term_to_round_off(record, eps, delta, amplitude):
     """The quadrature is exact: residual - boundary term is round-off, chatter tails summed
     in closed form and sticking included (docs/model.md, section 7.1)."""

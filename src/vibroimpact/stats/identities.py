@@ -99,52 +99,73 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
         raise ValueError(f"need x, v of n samples and r of n + 1, got {n}, {v.size}, {r.size}")
     batch = np.zeros(n, np.int64) if batch is None else np.asarray(batch, dtype=np.int64)
     k = k_first + np.arange(n)
+    tk = k * dt
     t_imp = np.asarray(impact_time, dtype=float)
     u_imp = np.asarray(impact_velocity, dtype=float)
     s0 = np.asarray(stick_start, dtype=float)
     s1 = np.asarray(stick_end, dtype=float)
-    t_lo, t_hi = k_first * dt, (k_first + n) * dt
-    inside = lambda t: t[(t >= t_lo) & (t <= t_hi)]
+    t_lo, t_hi = tk[0] if n else 0.0, (k_first + n) * dt
     hit = (t_imp >= t_lo) & (t_imp <= t_hi)
-    on, off = inside(s0), inside(s1)
-    # boundaries: samples (kind 0), impacts (1), sticking onsets (2) and releases (3); at
-    # equal times the sample comes first, so an event at a sample sets the state after it
-    times = np.concatenate([k * dt, t_imp[hit], on, off])
-    kind = np.repeat([0.0, 1.0, 2.0, 3.0], [n, np.count_nonzero(hit), on.size, off.size])
-    x0 = np.concatenate([x, np.full(times.size - n, delta)])
-    v0 = np.concatenate([v, -eps * u_imp[hit], np.zeros(on.size + off.size)])
-    step = np.concatenate([np.arange(n), np.full(times.size - n, -1)])
-    order = np.lexsort((kind, times))
-    times, kind, x0, v0, step = times[order], kind[order], x0[order], v0[order], step[order]
-    step = np.maximum.accumulate(step)          # the step each piece lies in (0-based)
-    length = np.diff(np.append(times, t_hi))
-    mid = times + 0.5 * length
-    j = np.searchsorted(s0, mid, side="right") - 1
-    stuck = (j >= 0) & (mid < s1[np.maximum(j, 0)]) if s0.size else np.zeros(mid.size, bool)
-    # the closed-form end of a chatter sequence: from its last resolved rebound to the onset
-    tail = (kind == 1) & (np.append(kind[1:], 0) == 2) & (-v0 < TAIL_REBOUND)
-    stuck |= tail
-    # a free piece from one sample to the next is a whole step: its nodes are fixed
-    whole = (kind == 0) & (np.append(kind[1:], 0) == 0) & ~stuck
+    on = s0[(s0 >= t_lo) & (s0 <= t_hi)]
+    off = s1[(s1 >= t_lo) & (s1 <= t_hi)]
+    # events: impacts (kind 1), sticking onsets (2) and releases (3), each in the step of the
+    # last sample at or before it; at equal times the sample comes first, so an event at a
+    # sample sets the state after it
+    ev_t = np.concatenate([t_imp[hit], on, off])
+    ev_kind = np.repeat([1.0, 2.0, 3.0], [np.count_nonzero(hit), on.size, off.size])
+    ev_v = np.concatenate([-eps * u_imp[hit], np.zeros(on.size + off.size)])
+    ev_step = np.searchsorted(tk, ev_t, side="right") - 1
+    busy = np.zeros(n, bool)
+    busy[ev_step] = True
+    held = _resting(tk + 0.5 * dt, s0, s1)
     out = np.zeros((len(MOMENTS), int(n_batches)))
+    add = lambda rows, st, m: [out.__setitem__(j, out[j] + np.bincount(
+        batch[st], weights=m[i], minlength=out.shape[1])) for i, j in enumerate(rows)]
+    # steps without events, free: a quadratic form of the state at their start
+    i = np.flatnonzero(~busy & ~held)
+    for lo in range(0, i.size, BLOCK):
+        st = i[lo:lo + BLOCK]
+        add(range(4), st, _whole_step_integrals(k[st], x[st], v[st], r[st], r[st + 1], dt,
+                                                zeta, amplitude, beta_f))
+    # steps without events, resting on the wall: x = delta, v = 0
+    st = np.flatnonzero(~busy & held)
+    f_int = 0.5 * dt * (r[st] + r[st + 1])
+    if amplitude != 0.0:
+        f_int += amplitude / beta_f * (np.cos(beta_f * tk[st]) - np.cos(beta_f * (tk[st] + dt)))
+    add((1, 3, 4), st, (np.full(st.size, delta * delta * dt), delta * f_int, f_int - delta * dt))
+    # steps with events: cut into pieces at every event
+    bs = np.flatnonzero(busy)
+    times = np.concatenate([tk[bs], ev_t])
+    kind = np.concatenate([np.zeros(bs.size), ev_kind])
+    step = np.concatenate([bs, ev_step])
+    x0 = np.concatenate([x[bs], np.full(ev_t.size, delta)])
+    v0 = np.concatenate([v[bs], ev_v])
+    order = np.lexsort((kind, times, step))
+    times, kind, step, x0, v0 = times[order], kind[order], step[order], x0[order], v0[order]
+    same = np.append(step[1:] == step[:-1], False)           # the next piece is in the step
+    end = np.where(same, np.append(times[1:], 0.0), (step + k_first + 1) * dt)
+    length = np.maximum(end - times, 0.0)
+    stuck = _resting(times + 0.5 * length, s0, s1)
+    # the closed-form end of a chatter sequence: from its last resolved rebound to the onset
+    tail = (kind == 1) & same & (np.append(kind[1:], 0) == 2) & (-v0 < TAIL_REBOUND)
+    stuck |= tail
     w = -v0[tail]
-    out[5] = np.bincount(batch[step[tail]], weights=w, minlength=out.shape[1])
-    out[6] = np.bincount(batch[step[tail]], weights=w * w, minlength=out.shape[1])
-    i = np.flatnonzero(whole)
-    m = _whole_step_integrals(step[i] + k_first, x0[i], v0[i], r[step[i]], r[step[i] + 1], dt,
-                              zeta, amplitude, beta_f)
-    for j in range(len(m)):                              # no push: a whole step is free
-        out[j] += np.bincount(batch[step[i]], weights=m[j], minlength=out.shape[1])
-    idx = np.flatnonzero(~whole)
-    for lo in range(0, idx.size, BLOCK):
-        i = idx[lo:lo + BLOCK]
-        st = step[i]
-        m = _piece_integrals(times[i] - (st + k_first) * dt, length[i], st + k_first, x0[i],
-                             v0[i], stuck[i], r[st], r[st + 1], dt, zeta, delta, amplitude,
-                             beta_f)
-        for j in range(len(m)):
-            out[j] += np.bincount(batch[st], weights=m[j], minlength=out.shape[1])
+    add((5, 6), step[tail], (w, w * w))
+    for lo in range(0, times.size, BLOCK):
+        sl = slice(lo, lo + BLOCK)
+        st = step[sl]
+        add(range(5), st, _piece_integrals(times[sl] - (st + k_first) * dt, length[sl],
+                                           st + k_first, x0[sl], v0[sl], stuck[sl], r[st],
+                                           r[st + 1], dt, zeta, delta, amplitude, beta_f))
     return out
+
+
+def _resting(t, s0, s1):
+    """Whether the instants ``t`` lie inside a sticking phase ``[s0, s1)`` (sorted)."""
+    if not s0.size:
+        return np.zeros(t.size, bool)
+    j = np.searchsorted(s0, t, side="right") - 1
+    return (j >= 0) & (t < s1[np.maximum(j, 0)])
 
 
 def _whole_step_integrals(k, x0, v0, r0, r1, dt, zeta, A, beta):
@@ -167,7 +188,9 @@ def _whole_step_integrals(k, x0, v0, r0, r1, dt, zeta, A, beta):
     b = np.array([zero, one, -S, E - zeta * S, -q * beta * sp, q * beta * cp])  # v
     c = np.array([one, sig, zero, zero, A * np.cos(beta * sig), A * np.sin(beta * sig)])  # f
     form = lambda g, h: 0.5 * ((g * w) @ h.T + (h * w) @ g.T)
-    M = np.stack([form(b, b), form(a, a), form(c, b), form(a, c)]).reshape(24, 6)
+    M = np.stack([form(b, b), form(a, a), form(c, b), form(a, c)])
+    iu, ju = np.triu_indices(6)
+    coef = M[:, iu, ju] * np.where(iu == ju, 1.0, 2.0)          # z^T M z = coef . (z_i z_j)
     slope = (r1 - r0) / dt
     psi = beta * (k * dt)
     if A != 0.0:
@@ -179,11 +202,7 @@ def _whole_step_integrals(k, x0, v0, r0, r1, dt, zeta, A, beta):
     y0 = x0 - (r0 - 2.0 * zeta * slope + q * sin_pa)
     yv0 = v0 - (slope + q * beta * cos_pa)
     z = np.array([r0, slope, y0, yv0, sin_psi, cos_psi])     # (6, n): rows contiguous
-    out = np.empty((4, k.size))
-    for lo in range(0, k.size, BLOCK):
-        zz = z[:, lo:lo + BLOCK]
-        out[:, lo:lo + BLOCK] = ((M @ zz).reshape(4, 6, -1) * zz).sum(axis=1)
-    return out
+    return coef @ (z[iu] * z[ju])
 
 
 def _piece_integrals(s_a, L, k, x0, v0, stuck, r0, r1, dt, zeta, delta, A, beta):
