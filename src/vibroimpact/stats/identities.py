@@ -119,14 +119,20 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
     busy[ev_step] = True
     held = _resting(tk + 0.5 * dt, s0, s1)
     out = np.zeros((len(MOMENTS), int(n_batches)))
-    add = lambda rows, st, m: [out.__setitem__(j, out[j] + np.bincount(
-        batch[st], weights=m[i], minlength=out.shape[1])) for i, j in enumerate(rows)]
-    # steps without events, free: a quadratic form of the state at their start
+
+    def add(rows, st, values):                  # per-step values into their batches
+        for row, value in zip(rows, values):
+            out[row] += np.bincount(batch[st], weights=value, minlength=out.shape[1])
+
+    # steps without events, free: quadratic forms z^T M z of the state at their start, summed
+    # per batch as <M, sum z z^T> over each run of steps of one batch
     i = np.flatnonzero(~busy & ~held)
-    for lo in range(0, i.size, BLOCK):
-        st = i[lo:lo + BLOCK]
-        add(range(4), st, _whole_step_integrals(k[st], x[st], v[st], r[st], r[st + 1], dt,
-                                                zeta, amplitude, beta_f))
+    if i.size:
+        M, z = _whole_step_forms(k[i], x[i], v[i], r[i], r[i + 1], dt, zeta, amplitude, beta_f)
+        cuts = np.flatnonzero(np.diff(batch[i])) + 1
+        for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [i.size]])):
+            zs = z[:, lo:hi]
+            out[:4, batch[i[lo]]] += np.einsum("mij,ij->m", M, zs @ zs.T)
     # steps without events, resting on the wall: x = delta, v = 0
     st = np.flatnonzero(~busy & held)
     f_int = 0.5 * dt * (r[st] + r[st + 1])
@@ -168,12 +174,18 @@ def _resting(t, s0, s1):
     return (j >= 0) & (t < s1[np.maximum(j, 0)])
 
 
-def _whole_step_integrals(k, x0, v0, r0, r1, dt, zeta, A, beta):
-    """Integrals of v^2, x^2, f v, x f over whole free steps, shape (4, n).
+def _whole_step_forms(k, x0, v0, r0, r1, dt, zeta, A, beta):
+    """Quadratic forms of the integrals of v^2, x^2, f v, x f over whole free steps.
 
     On a whole step x, v and f at the fixed nodes are linear in
     ``z = (r0, b, y0, y0', sin psi, cos psi)`` (``b`` the slope, ``y`` the free response,
-    ``psi = beta k h``), so each integral is a quadratic form ``z^T M z`` with M computed once.
+    ``psi = beta k h``), so each integral is ``z^T M z`` with M computed once.
+
+    Returns
+    -------
+    M : ndarray, shape (4, 6, 6)
+        The symmetric matrices, in the order v^2, x^2, f v, x f.
+    z : ndarray, shape (6, n)
     """
     wd = np.sqrt(1.0 - zeta * zeta)
     sig = 0.5 * dt * (1.0 + _XI)
@@ -189,8 +201,6 @@ def _whole_step_integrals(k, x0, v0, r0, r1, dt, zeta, A, beta):
     c = np.array([one, sig, zero, zero, A * np.cos(beta * sig), A * np.sin(beta * sig)])  # f
     form = lambda g, h: 0.5 * ((g * w) @ h.T + (h * w) @ g.T)
     M = np.stack([form(b, b), form(a, a), form(c, b), form(a, c)])
-    iu, ju = np.triu_indices(6)
-    coef = M[:, iu, ju] * np.where(iu == ju, 1.0, 2.0)          # z^T M z = coef . (z_i z_j)
     slope = (r1 - r0) / dt
     psi = beta * (k * dt)
     if A != 0.0:
@@ -201,8 +211,7 @@ def _whole_step_integrals(k, x0, v0, r0, r1, dt, zeta, A, beta):
         sin_psi = cos_psi = sin_pa = cos_pa = np.zeros(k.size)
     y0 = x0 - (r0 - 2.0 * zeta * slope + q * sin_pa)
     yv0 = v0 - (slope + q * beta * cos_pa)
-    z = np.array([r0, slope, y0, yv0, sin_psi, cos_psi])     # (6, n): rows contiguous
-    return coef @ (z[iu] * z[ju])
+    return M, np.array([r0, slope, y0, yv0, sin_psi, cos_psi])
 
 
 def _piece_integrals(s_a, L, k, x0, v0, stuck, r0, r1, dt, zeta, delta, A, beta):
