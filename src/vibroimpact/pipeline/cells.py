@@ -243,19 +243,20 @@ class _IdentityRecord:
         return ((k - self.k_start) * self.n_batches) // max(n, 1)
 
     def add(self, chunk):
-        k = np.rint(chunk.grid_time / self.dt).astype(np.int64)
-        keep = (k >= self.k_start) & (k < self.k_stop)
-        if keep.any():
-            k = k[keep]
-            delta = self.params["delta"]
-            r = np.asarray(self.noise[k[0] : k[-1] + 2], dtype=float)
+        # the chunk's grid holds every sample from its first, k0 (record_every=1)
+        k0 = int(round(chunk.grid_time[0] / self.dt)) if chunk.grid_time.size else 0
+        lo = max(self.k_start, k0)
+        hi = min(self.k_stop, k0 + chunk.grid_time.size)
+        if hi > lo:
+            keep = slice(lo - k0, hi - k0)
+            r = np.asarray(self.noise[lo : hi + 1], dtype=float)
             start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
                                                 chunk.stuck_since, chunk.t_end)
             self.moments += stats.flight_moments(
-                int(k[0]), delta - chunk.a[keep], chunk.v[keep], r, self.dt, **self.params,
-                impact_time=chunk.impact_time, impact_velocity=chunk.impact_velocity,
-                stick_start=start, stick_end=end, batch=self._batch(k),
-                n_batches=self.n_batches)
+                lo, self.params["delta"] - chunk.a[keep], chunk.v[keep], r, self.dt,
+                **self.params, impact_time=chunk.impact_time,
+                impact_velocity=chunk.impact_velocity, stick_start=start, stick_end=end,
+                batch=self._batch(np.arange(lo, hi)), n_batches=self.n_batches)
         step = chunk.impact_step
         hit = (step >= self.k_start) & (step < self.k_stop)
         u, b = chunk.impact_velocity[hit], self._batch(step[hit])

@@ -126,19 +126,20 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
 
     # steps without events, free: quadratic forms z^T M z of the state at their start, summed
     # per batch as <M, sum z z^T> over each run of steps of one batch
-    i = np.flatnonzero(~busy & ~held)
+    free = ~busy & ~held
+    i = np.flatnonzero(free)
     if i.size:
-        M, z = _whole_step_forms(k[i], x[i], v[i], r[i], r[i + 1], dt, zeta, amplitude, beta_f)
+        pick = slice(None) if i.size == n else i          # most chunks: every step, no copy
+        M, z = _whole_step_forms(k[pick], x[pick], v[pick], r[:-1][pick], r[1:][pick], dt, zeta,
+                                 amplitude, beta_f)
         cuts = np.flatnonzero(np.diff(batch[i])) + 1
         for lo, hi in zip(np.concatenate([[0], cuts]), np.concatenate([cuts, [i.size]])):
             zs = z[:, lo:hi]
             out[:4, batch[i[lo]]] += np.einsum("mij,ij->m", M, zs @ zs.T)
     # steps without events, resting on the wall: x = delta, v = 0
     st = np.flatnonzero(~busy & held)
-    f_int = 0.5 * dt * (r[st] + r[st + 1])
-    if amplitude != 0.0:
-        f_int += amplitude / beta_f * (np.cos(beta_f * tk[st]) - np.cos(beta_f * (tk[st] + dt)))
-    add((1, 3, 4), st, (np.full(st.size, delta * delta * dt), delta * f_int, f_int - delta * dt))
+    add((1, 3, 4), st, _resting_integrals(np.zeros(st.size), dt, st, r, k_first, dt, delta,
+                                          amplitude, beta_f))
     # steps with events: cut into pieces at every event
     bs = np.flatnonzero(busy)
     times = np.concatenate([tk[bs], ev_t])
@@ -157,13 +158,28 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
     stuck |= tail
     w = -v0[tail]
     add((5, 6), step[tail], (w, w * w))
-    for lo in range(0, times.size, BLOCK):
-        sl = slice(lo, lo + BLOCK)
+    offset = times - (step + k_first) * dt
+    j = np.flatnonzero(stuck)
+    add((1, 3, 4), step[j], _resting_integrals(offset[j], length[j], step[j], r, k_first, dt,
+                                               delta, amplitude, beta_f))
+    j = np.flatnonzero(~stuck)
+    for lo in range(0, j.size, BLOCK):
+        sl = j[lo:lo + BLOCK]
         st = step[sl]
-        add(range(5), st, _piece_integrals(times[sl] - (st + k_first) * dt, length[sl],
-                                           st + k_first, x0[sl], v0[sl], stuck[sl], r[st],
-                                           r[st + 1], dt, zeta, delta, amplitude, beta_f))
+        add(range(4), st, _piece_integrals(offset[sl], length[sl], st + k_first, x0[sl],
+                                           v0[sl], r[st], r[st + 1], dt, zeta, amplitude,
+                                           beta_f))
     return out
+
+
+def _resting_integrals(s_a, L, st, r, k_first, dt, delta, A, beta):
+    """Integrals of x^2, x f and the push f - delta over pieces resting on the wall."""
+    slope = (r[st + 1] - r[st]) / dt
+    f_int = L * (r[st] + slope * (s_a + 0.5 * L))
+    if A != 0.0:
+        tau = (st + k_first) * dt + s_a
+        f_int = f_int + A / beta * (np.cos(beta * tau) - np.cos(beta * (tau + L)))
+    return np.broadcast_to(delta * delta * L, f_int.shape), delta * f_int, f_int - delta * L
 
 
 def _resting(t, s0, s1):
@@ -183,9 +199,10 @@ def _whole_step_forms(k, x0, v0, r0, r1, dt, zeta, A, beta):
 
     Returns
     -------
-    M : ndarray, shape (4, 6, 6)
+    M : ndarray, shape (4, m, m)
         The symmetric matrices, in the order v^2, x^2, f v, x f.
-    z : ndarray, shape (6, n)
+    z : ndarray, shape (m, n)
+        ``m = 6``, or 4 without a harmonic force (no ``sin psi, cos psi``).
     """
     wd = np.sqrt(1.0 - zeta * zeta)
     sig = 0.5 * dt * (1.0 + _XI)
@@ -202,31 +219,29 @@ def _whole_step_forms(k, x0, v0, r0, r1, dt, zeta, A, beta):
     form = lambda g, h: 0.5 * ((g * w) @ h.T + (h * w) @ g.T)
     M = np.stack([form(b, b), form(a, a), form(c, b), form(a, c)])
     slope = (r1 - r0) / dt
+    if A == 0.0:
+        return M[:, :4, :4], np.array([r0, slope, x0 - r0 + 2.0 * zeta * slope, v0 - slope])
     psi = beta * (k * dt)
-    if A != 0.0:
-        sin_psi, cos_psi = np.sin(psi), np.cos(psi)
-        sin_pa = sin_psi * np.cos(phi) - cos_psi * np.sin(phi)
-        cos_pa = cos_psi * np.cos(phi) + sin_psi * np.sin(phi)
-    else:
-        sin_psi = cos_psi = sin_pa = cos_pa = np.zeros(k.size)
+    sin_psi, cos_psi = np.sin(psi), np.cos(psi)
+    sin_pa = sin_psi * np.cos(phi) - cos_psi * np.sin(phi)
+    cos_pa = cos_psi * np.cos(phi) + sin_psi * np.sin(phi)
     y0 = x0 - (r0 - 2.0 * zeta * slope + q * sin_pa)
     yv0 = v0 - (slope + q * beta * cos_pa)
     return M, np.array([r0, slope, y0, yv0, sin_psi, cos_psi])
 
 
-def _piece_integrals(s_a, L, k, x0, v0, stuck, r0, r1, dt, zeta, delta, A, beta):
-    """Integrals of v^2, x^2, f v, x f and push over pieces (rows of MOMENTS).
+def _piece_integrals(s_a, L, k, x0, v0, r0, r1, dt, zeta, A, beta):
+    """Integrals of v^2, x^2, f v and x f over free pieces.
 
-    A piece starts at offset ``s_a`` of step ``k`` and lasts ``L`` (scalars for whole steps,
-    whose node values of exp, cos and sin are then computed once).
+    A piece starts at offset ``s_a`` of step ``k`` and lasts ``L``.
     """
     wd = np.sqrt(1.0 - zeta * zeta)
     slope = (r1 - r0) / dt
     s_a = np.asarray(s_a, dtype=float)
-    L = np.asarray(L, dtype=float)[..., None]
+    L = np.asarray(L, dtype=float)[:, None]
     sig = 0.5 * L * (1.0 + _XI)                          # nodes, from the piece's start
     wts = 0.5 * L * _W
-    s = np.asarray(s_a)[..., None] + sig                 # offsets in the step
+    s = s_a[:, None] + sig                               # offsets in the step
     f = r0[:, None] + slope[:, None] * s
     p = f - (2.0 * zeta * slope)[:, None]                # particular solution, linear force
     dp = np.broadcast_to(slope[:, None], f.shape)
@@ -250,14 +265,7 @@ def _piece_integrals(s_a, L, k, x0, v0, stuck, r0, r1, dt, zeta, delta, A, beta)
     xs = p + (c + zeta * sn) * y0 + sn * yv0
     vs = dp - sn * y0 + (c - zeta * sn) * yv0
     integ = lambda g: np.sum(wts * g, axis=1)
-    if stuck.any():
-        held = stuck[:, None]
-        xs = np.where(held, delta, xs)
-        vs = np.where(held, 0.0, vs)
-        push = integ(np.where(held, f - delta, 0.0))
-    else:
-        push = np.zeros(stuck.size)
-    return (integ(vs * vs), integ(xs * xs), integ(f * vs), integ(xs * f), push)
+    return integ(vs * vs), integ(xs * xs), integ(f * vs), integ(xs * f)
 
 
 class IdentityResiduals(NamedTuple):
