@@ -109,3 +109,20 @@ def test_the_events_tile_carries_the_audit(record):
         assert ds[name].dims == ("cell",)
         assert ds[name].attrs["long_name"] and ds[name].attrs["units"] == "1"
         assert ds[name].values[0] == out[name]
+
+
+def test_identity_residuals_of_given_sums():
+    """The pure combination: two batches whose residuals are known by hand."""
+    # rows v2, x2, fv, xf, push, tail, tail2; batches of length 2 and 2
+    m = np.array([[1.0, 1.0], [0.5, 0.5], [0.3, 0.5], [0.2, 0.2], [0.4, 0.0],
+                  [0.0, 0.1], [0.0, 0.01]])
+    out = stats.identity_residuals(m, [1.0, 2.0], [2.0, 4.0], [2.0, 2.0], zeta=0.05, eps=0.5,
+                                   delta=-0.5)
+    power = np.array([0.3 - 0.1 - 0.375 * 2.0, 0.5 - 0.1 - 0.375 * 4.0 - 0.005]) / 2.0
+    virial = np.array([1.0 - 0.5 + 0.2 + 0.5 * (1.5 + 0.4), 1.0 - 0.5 + 0.2 + 0.5 * (3.0 - 0.1)]
+                      ) / 2.0
+    assert out.power == pytest.approx(power.mean())
+    assert out.virial == pytest.approx(virial.mean())
+    assert out.power_stderr == pytest.approx(np.std(power, ddof=1) / np.sqrt(2.0))
+    assert out.virial_stderr == pytest.approx(np.std(virial, ddof=1) / np.sqrt(2.0))
+    assert (out.power_input, out.virial_scale, out.n_batches) == (0.2, 0.5, 2)

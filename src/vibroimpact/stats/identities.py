@@ -8,9 +8,11 @@ boundary terms that fall as 1/T and for any delta and eps,
     virial:  <v^2> - <x^2> + <x f> = delta [(1 + eps) / T sum_j V_j + <(f - delta) 1_stuck>]
 
 with ``V_j`` the approach velocity of every impact (every rebound of a chatter sequence,
-not only a collision's first) and ``1_stuck`` the time resting on the wall. The averages of
-the motion are exact integrals of the closed-form motion between events
-(:func:`flight_moments`), so the residuals test the impact record against the motion.
+not only a collision's first) and ``1_stuck`` the time resting on the wall. A chatter tail
+the simulator summed in closed form adds, per tail, ``w^2 / 2`` to the power's loss and
+``-w`` to the virial's impulse, ``w`` its last resolved rebound (:func:`flight_moments`).
+The averages of the motion are exact integrals of the closed-form motion between events,
+so the residuals test the impact record against the motion.
 
 Pure numpy: no simulation; :mod:`vibroimpact.pipeline.cells` feeds it chunk by chunk.
 """
