@@ -257,6 +257,19 @@ def test_finding4_means_grow_until_impacts_cease(events):
     assert rate[-1] < 0.01 * rate.max()
 
 
+@pytest.mark.workflow
+@pytest.mark.parametrize("name", ["random_events.nc", "harmonic_events.nc"])
+def test_every_events_dataset_passes_its_self_audit(built, name):
+    """The power balance and the virial (docs/model.md, section 7.1) hold within 3 standard
+    errors in every cell of the test config's events datasets."""
+    ds = xr.load_dataset(built / "results" / "datasets" / name)
+    for identity in ("power", "virial"):
+        res = ds[f"{identity}_residual"].values
+        se = ds[f"{identity}_residual_stderr"].values
+        assert np.all(np.isfinite(res)) and np.all(se > 0), identity
+        assert np.all(np.abs(res) <= 3.0 * se), (identity, res / se)
+
+
 # --- harmonic plus random force: findings 5-7 and the map (docs/figures.md) -------------------
 
 @pytest.fixture(scope="module")

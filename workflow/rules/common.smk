@@ -426,7 +426,7 @@ def simulate_runtime(kind):
         steps = costs.study_steps(kind, entry, _study_noise_entry(wildcards.study))
         grid = "events" if kind == "map" else kind
         cells = len(STUDIES[wildcards.study].tile(int(wildcards.tile), grid))
-        return costs.simulate_runtime_min(cells, steps)
+        return costs.simulate_runtime_min(cells, steps, audit=kind == "events")
 
     return runtime
 

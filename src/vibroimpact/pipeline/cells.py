@@ -91,7 +91,10 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         Scalars ``n_collisions, collision_rate, simulated_time, n_batches, v_after_mean,
         v_after_stderr, v_after_lag1, interval_mean, interval_stderr, interval_lag1,
         contact_fraction, stuck_fraction, stick_time_mean, rebounds_mean, n_rebounds,
-        rebound_v_after_mean, v_after_beyond, interval_beyond`` and arrays
+        rebound_v_after_mean, v_after_beyond, interval_beyond``, the self-audit
+        ``power_residual(_stderr), power_input, virial_residual(_stderr), virial_scale``
+        (:func:`vibroimpact.stats.identity_residuals`, over the samples from
+        ``ceil(transient / dt)`` to ``floor(t_end / dt)``) and arrays
         ``v_after_density(_stderr), interval_density(_stderr)`` (on the bins). With a
         harmonic force (``amplitude != 0``) also ``ratio_density(_stderr)``, ``ratio_beyond``,
         ``motion_probability`` (one value per motion of ``motions``, with free flights) and
@@ -113,9 +116,13 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     n_batches = int(n_batches)
     harmonic = amplitude != 0.0
     events = _EventRecord(dt)
+    audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, zeta=zeta, eps=eps,
+                            delta=delta, amplitude=amplitude, beta_f=beta_f)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                 beta=beta_f, t_end=t_end, chunk_size=chunk_size):
+                                 beta=beta_f, t_end=t_end, record_every=1,
+                                 chunk_size=chunk_size):
         events.add(chunk)
+        audit.add(chunk)
     col = events.collisions(eps, rebound_floor, transient)
     contact = _clipped_contact(*events.sticking(), transient)
     duration = t_end - transient
@@ -153,6 +160,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         interval_density=z_dens.density, interval_density_stderr=z_dens.stderr,
         interval_beyond=z_dens.beyond,
     )
+    out.update(audit.result())
     if harmonic:
         ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
                                    n_batches=n_batches)
@@ -208,6 +216,66 @@ class _EventRecord:
         start, end = self.sticking()
         return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor).after(transient)
+
+
+class _IdentityRecord:
+    """Per-batch integrals of the power balance and the virial, gathered chunk by chunk.
+
+    The window runs over whole force steps, from sample ``ceil(transient / dt)`` to sample
+    ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. Each chunk
+    brings the state at its samples (``record_every=1``) and its impacts and sticking
+    phases; :func:`vibroimpact.stats.flight_moments` integrates its steps exactly.
+    """
+
+    def __init__(self, noise, dt, transient, t_end, n_batches, **params):
+        self.noise, self.dt, self.params = noise, dt, params
+        self.k_start = int(math.ceil(transient / dt - 1e-9))
+        self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
+        self.n_batches = n_batches
+        n = self.k_stop - self.k_start
+        self.steps = np.bincount((np.arange(n) * n_batches) // max(n, 1), minlength=n_batches)
+        self.moments = np.zeros((len(stats.identities.MOMENTS), n_batches))
+        self.sum_u = np.zeros(n_batches)
+        self.sum_u2 = np.zeros(n_batches)
+
+    def _batch(self, k):
+        n = self.k_stop - self.k_start
+        return ((k - self.k_start) * self.n_batches) // max(n, 1)
+
+    def add(self, chunk):
+        # the chunk's grid holds every sample from its first, k0 (record_every=1)
+        k0 = int(round(chunk.grid_time[0] / self.dt)) if chunk.grid_time.size else 0
+        lo = max(self.k_start, k0)
+        hi = min(self.k_stop, k0 + chunk.grid_time.size)
+        if hi > lo:
+            keep = slice(lo - k0, hi - k0)
+            r = np.asarray(self.noise[lo : hi + 1], dtype=float)
+            start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
+                                                chunk.stuck_since, chunk.t_end)
+            self.moments += stats.flight_moments(
+                lo, self.params["delta"] - chunk.a[keep], chunk.v[keep], r, self.dt,
+                **self.params, impact_time=chunk.impact_time,
+                impact_velocity=chunk.impact_velocity, stick_start=start, stick_end=end,
+                batch=self._batch(np.arange(lo, hi)), n_batches=self.n_batches)
+        step = chunk.impact_step
+        hit = (step >= self.k_start) & (step < self.k_stop)
+        u, b = chunk.impact_velocity[hit], self._batch(step[hit])
+        self.sum_u += np.bincount(b, weights=u, minlength=self.n_batches)
+        self.sum_u2 += np.bincount(b, weights=u * u, minlength=self.n_batches)
+
+    def result(self):
+        """The residuals and their errors, as ``event_statistics`` keys (NaN: no batches)."""
+        p = self.params
+        if self.n_batches < 2 or np.any(self.steps == 0):
+            nan = math.nan
+            return dict(power_residual=nan, power_residual_stderr=nan, power_input=nan,
+                        virial_residual=nan, virial_residual_stderr=nan, virial_scale=nan)
+        res = stats.identity_residuals(self.moments, self.sum_u, self.sum_u2,
+                                       self.steps * self.dt, zeta=p["zeta"], eps=p["eps"],
+                                       delta=p["delta"])
+        return dict(power_residual=res.power, power_residual_stderr=res.power_stderr,
+                    power_input=res.power_input, virial_residual=res.virial,
+                    virial_residual_stderr=res.virial_stderr, virial_scale=res.virial_scale)
 
 
 def _clipped_contact(start, end, transient):

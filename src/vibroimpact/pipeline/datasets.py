@@ -37,6 +37,15 @@ META = {
     "interval_mean": ("mean interval between collisions", "1"),
     "interval_stderr": ("standard error of the mean interval (batch means)", "1"),
     "interval_lag1": ("lag-1 autocorrelation of the batch means of the interval", "1"),
+    "power_residual": ("residual of the power balance <f v> - 2 zeta <v^2> - "
+                       "(1 - eps^2) nu <V^2> / 2 (exact identity: zero within its error)", "1"),
+    "power_residual_stderr": ("standard error of the power-balance residual (batch means)",
+                              "1"),
+    "power_input": ("mean power of the force <f v> (scale of the power-balance residual)", "1"),
+    "virial_residual": ("residual of the virial <v^2> - <x^2> + <x f> - delta [(1 + eps) nu <V> "
+                        "+ <wall reaction while resting>] (exact identity)", "1"),
+    "virial_residual_stderr": ("standard error of the virial residual (batch means)", "1"),
+    "virial_scale": ("mean square velocity <v^2> (scale of the virial residual)", "1"),
     "n_batches": ("batches B of the batch-means standard errors (t quantile: B - 1 dof)", "1"),
     "contact_fraction": ("fraction of time resting on the wall", "1"),
     "v_after_density": ("probability density of the velocity after impact", "1"),
@@ -100,7 +109,9 @@ _EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches
                   "v_after_mean", "v_after_stderr", "v_after_lag1", "interval_mean",
                   "interval_stderr", "interval_lag1", "contact_fraction", "stuck_fraction",
                   "stick_time_mean", "rebounds_mean", "n_rebounds", "rebound_v_after_mean",
-                  "v_after_beyond", "interval_beyond")
+                  "v_after_beyond", "interval_beyond", "power_residual",
+                  "power_residual_stderr", "power_input", "virial_residual",
+                  "virial_residual_stderr", "virial_scale")
 _EVENT_DENSITIES = (("v_after_density", "v_after"), ("v_after_density_stderr", "v_after"),
                     ("interval_density", "interval"), ("interval_density_stderr", "interval"))
 #: Statistics that need a forcing period: present only for a harmonic study (amplitude != 0).

@@ -10,14 +10,16 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
   impact statistic);
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
 - `residence`: residence times in the motions and the rates of switching between them;
-- `theory`: the wall-free linear response, elastic impacts under white noise.
+- `theory`: the wall-free linear response, elastic impacts under white noise;
+- `identities`: the power balance and the virial of a stationary record (a self-audit).
 
 Every public name is re-exported here lazily (``vibroimpact.stats.density``), so a job that
 needs one helper does not import the others' scipy modules.
 """
 import importlib
 
-_SUBMODULES = ("spectra", "events", "collisions", "motions", "residence", "theory")
+_SUBMODULES = ("spectra", "events", "collisions", "motions", "residence", "theory",
+               "identities")
 _WHERE = {
     "PSD_DETREND": "spectra", "WelchAccumulator": "spectra", "welch_psd": "spectra",
     "onesided_to_angular": "spectra", "variance_from_psd": "spectra",
@@ -37,6 +39,8 @@ _WHERE = {
     "linear_response_std": "theory", "elastic_impact_rate": "theory",
     "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory",
+    "flight_moments": "identities", "identity_residuals": "identities",
+    "IdentityResiduals": "identities",
 }
 __all__ = list(_WHERE)
 

@@ -14,6 +14,10 @@ __all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simula
 # --- CPU seconds -----------------------------------------------------------------------------
 JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
+#: The self-audit of an events cell (`stats.flight_moments`: exact integrals over every step),
+#: per step on top of NS_PER_STEP: 100-250 ns CPU measured across the delta sweep on a
+#: shared 2-core node under load (~400 ns at the densest impacts, delta = -0.5, eps = 0.5).
+NS_PER_AUDIT_STEP = 150.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 US_PER_START = 360.0       # one start of the attractor map, settled or run to its cap
@@ -39,8 +43,9 @@ BASE_MEM_MB = 600
 #: estimates.
 NOISE_MEM_MB = BASE_MEM_MB + 200
 #: A simulate job: the simulator's chunk buffers (~100 MB at the default chunk of 2**20
-#: samples), besides the noise record held in memory (8 bytes a sample).
-SIMULATE_BUFFERS_MB = 150
+#: samples) and the events cell's self-audit on a chunk (~110 MB more measured), besides the
+#: noise record held in memory (8 bytes a sample).
+SIMULATE_BUFFERS_MB = 300
 
 
 def record_steps(n_samples, dt, t_end=None):
@@ -69,14 +74,15 @@ def study_steps(kind, entry, noise, inv_beta=None):
     return record_steps(n, dt, block.get("t_end"))
 
 
-def simulate_cpu_s(cells, steps):
-    """CPU seconds of ``cells`` cells of ``steps`` sample steps each."""
-    return cells * steps * NS_PER_STEP * 1e-9
+def simulate_cpu_s(cells, steps, audit=False):
+    """CPU seconds of ``cells`` cells of ``steps`` sample steps each (``audit``: events cells,
+    which also integrate the power balance and the virial over every step)."""
+    return cells * steps * (NS_PER_STEP + (NS_PER_AUDIT_STEP if audit else 0.0)) * 1e-9
 
 
-def simulate_runtime_min(cells, steps):
+def simulate_runtime_min(cells, steps, audit=False):
     """Minutes a simulate job of ``cells`` cells of ``steps`` steps asks of a scheduler."""
-    return RUNTIME_FLOOR_MIN + int(simulate_cpu_s(cells, steps) * RUNTIME_MARGIN / 60)
+    return RUNTIME_FLOOR_MIN + int(simulate_cpu_s(cells, steps, audit) * RUNTIME_MARGIN / 60)
 
 
 def simulate_mem_mb(n_samples):

@@ -194,7 +194,7 @@ def make_plan(config, own=None, *, results="results"):
             bins = sum(int(b["n"]) for b in entry["bins"].values())
             per_cell = 12 * (bins + 100)
             _add(row, cells, study.n_tiles("events") + 1, 2 * cells * per_cell,
-                 costs.simulate_cpu_s(cells, steps))
+                 costs.simulate_cpu_s(cells, steps, audit=True))
             parts.append(f"events {_n(cells, 'cell')}")
         if "map" in needs:
             cells = len(study.cells("events"))
