@@ -10,7 +10,9 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 CORES  ?= all
-# the slow suite's independent stress tests on both cores (pytest-xdist)
+# the fast suite's tests and the slow suite's independent stress tests on both cores
+# (pytest-xdist; the fast suite is CPU-bound, mostly numba compilation on a fresh clone)
+FAST_WORKERS ?= -n 2
 SLOW_WORKERS ?= -n 2
 # your own config, layered on config/config.yaml: make CONFIG=my_study.yaml
 CONFIG ?=
@@ -40,7 +42,7 @@ test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks workflow/scripts
 	$(BIN)/snakefmt --check Snakefile workflow/
 	$(BIN)/lint-imports
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q $(FAST_WORKERS)
 	$(BIN)/python -m pytest -q -m slow $(SLOW_WORKERS)
 	$(BIN)/python -m pytest -q -m "workflow or slurm"
 
