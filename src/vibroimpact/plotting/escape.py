@@ -128,15 +128,15 @@ def escape_vs_noise(escape):
             ax.yaxis.set_major_formatter(plain)
             ax.yaxis.set_minor_formatter(FuncFormatter(
                 lambda v, _: f"{v:g}" if f"{v:g}"[0] in "25" else ""))
+            ax.legend(loc="upper left", fontsize=6.5, title_fontsize=6.5,
+                      title=r"fit $\ln T = \ln C + \Delta/\mathrm{rms}_r^2$:  $\Delta$ "
+                      f"[{int(100 * CONFIDENCE)} % interval]" + r", $\chi^2$ per d.o.f. $\nu$")
         ax.set_title(rf"$1/\beta_f$ = {_num(cell['inv_beta'])}, $\delta$ = "
                      rf"{_num(cell['delta'])}: {_state_label(states[home])} "
                      rf"{100 * share[home]:.0f} % at rms {_num(escape['rms'].values[weakest])}")
         ax.set_xlim(x_line[0], x_line[-1])
         ax.set_xlabel(r"$1/\mathrm{rms}_r^2$")
         ax.set_ylabel("mean residence time (forcing periods)")
-        ax.legend(loc="upper left", fontsize=6.5, title_fontsize=6.5,
-                  title=r"fit $\ln T = \ln C + \Delta/\mathrm{rms}_r^2$:  $\Delta$ "
-                  f"[{int(100 * CONFIDENCE)} % interval]" + r", $\chi^2$ per d.o.f. $\nu$")
         top_axis = ax.secondary_xaxis("top", functions=(_rms_of, _inv2_of))
         top_axis.set_xticks(escape["rms"].values)
         top_axis.set_xticklabels([_num(v) for v in escape["rms"].values], fontsize=7)

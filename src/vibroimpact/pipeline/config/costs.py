@@ -117,8 +117,9 @@ def escape_record_samples(entry, dt):
 
 def escape_cpu_s(entry, dt, levels=None):
     """CPU seconds of the escape jobs of study ``entry`` (``levels``: that many of them; None:
-    every level): each generates its record and runs every cell over it, start-up included."""
+    every level): each generates its record and runs every cell over it (start-up apart, as
+    `simulate_cpu_s`: the plan adds it per job)."""
     n = escape_record_samples(entry, dt)
     levels = len(entry["escape"]["rms"]) if levels is None else int(levels)
     cells = len(entry["escape"]["cells"])
-    return levels * (noise_cpu_s(n) + simulate_cpu_s(cells, n - 1))
+    return levels * (n * NS_PER_SAMPLE * 1e-9 + simulate_cpu_s(cells, n - 1))
