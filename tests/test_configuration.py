@@ -80,12 +80,14 @@ def test_an_identical_entry_needs_no_replace():
 
 def test_plan_of_the_paper_config():
     """Cells from the grids of config.yaml; disk and time within a factor of the default
-    build measured at 61270b2 (120 MB on disk; 190 CPU-s in results/benchmarks)."""
+    build measured at 61270b2 (120 MB on disk; 190 CPU-s in results/benchmarks), plus the
+    escape study (~15 CPU-s estimated: 6 jobs and a figure; ~25 CPU-s measured on a shared
+    node, benchmarks/bench_escape.py)."""
     _, plan = configuration.load(root=ROOT)
-    assert plan.cells == 71 + 8 + 16 + 10 + 57 * 91     # the random study: 8 spectra plays
+    assert plan.cells == 71 + 8 + 16 + 10 + 57 * 91 + 3 * 5   # 8 spectra plays; escape 3 x 5
     assert plan.orbit_cells == 141 * 226 + 57 * 91     # Fig. 16's map, the attractors' grid
     assert 60e6 < plan.bytes < 250e6
-    assert 90 < plan.cpu_s < 600
+    assert 90 < plan.cpu_s < 650
     text = plan.format()
     for key in ("limits.max_cells", "limits.max_disk_gb", "studies.motion_map", "total"):
         assert key in text
@@ -96,7 +98,7 @@ def test_a_build_beyond_a_limit_is_refused_with_the_estimate_and_the_key():
     with pytest.raises(configuration.ConfigError) as info:
         configuration.load(user, root=ROOT)
     text = str(info.value)
-    assert "limits.max_cells = 1,000" in text and "5,292 simulation cells" in text
+    assert "limits.max_cells = 1,000" in text and "5,307 simulation cells" in text
     assert "raise limits.max_cells" in text
 
 

@@ -3,6 +3,7 @@ localrules:
     aggregate_events,
     aggregate_spectra,
     aggregate_map,
+    aggregate_escape,
 
 
 rule aggregate_events:
@@ -73,3 +74,27 @@ rule aggregate_map:
         code=script_code("aggregate_map"),
     script:
         "../scripts/aggregate_map.py"
+
+
+rule aggregate_escape:
+    """The escape dataset of study {study}, from its noise levels, with the escape fits."""
+    input:
+        escape_levels,
+    output:
+        "results/datasets/{study}_escape.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/aggregate_escape/{study}.log",
+    benchmark:
+        "results/benchmarks/aggregate_escape/{study}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB,
+        runtime=5,
+    params:
+        block=study_block("escape"),
+        noise=escape_noise,
+        code=script_code("aggregate_escape"),
+    script:
+        "../scripts/aggregate_escape.py"

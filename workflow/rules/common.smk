@@ -34,12 +34,13 @@ wildcard_constraints:
     noise="[A-Za-z][A-Za-z0-9_]*",
     sweep="[A-Za-z][A-Za-z0-9_]*",
     tile="[0-9]+",
+    level="[0-9]+",
     # a study name, or orbits/<name> for an `orbits` entry (their figures never collide)
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
     # figNN or fig15_vs_fig16 of the figure table, -k: k-th value of a listed parameter (not a
     # sweep.png, nor the validation figures)
-    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov)(-[0-9]+)?",
-    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov",
+    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|escape_vs_noise)(-[0-9]+)?",
+    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|escape_vs_noise",
 
 
 STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}
@@ -86,6 +87,19 @@ def study_noise(wildcards):
     return f"results/noise/{config['studies'][wildcards.study]['noise']}.nc"
 
 
+def escape_noise(wildcards):
+    """What an escape job reads of study ``{study}``'s noise entry: its spectrum, ``dt`` and
+    seed (each level's rms is the study's; no record file, no ``n_samples``)."""
+    entry = config["noises"][config["studies"][wildcards.study]["noise"]]
+    return {k: entry[k] for k in ("kind", "dt", "beta_c", "zeta_f", "seed") if k in entry}
+
+
+def escape_levels(wildcards):
+    """The escape levels of study ``{study}``, one file each."""
+    n = len(config["studies"][wildcards.study]["escape"]["rms"])
+    return [f"results/cells/{wildcards.study}/escape/{k}.nc" for k in range(n)]
+
+
 def tiles(kind):
     """The ``kind`` tiles of study ``{study}``."""
 
@@ -126,6 +140,7 @@ _DATASETS = {
     "spectra": "results/datasets/{name}_spectra.nc",
     "events": "results/datasets/{name}_events.nc",
     "map": "results/datasets/{name}_map.nc",
+    "escape": "results/datasets/{name}_escape.nc",
     "orbits": "results/orbits/{name}.nc",
     "boundaries": "results/orbits/{name}_boundaries.nc",
     "basins": "results/orbits/{name}_basins.nc",
@@ -429,6 +444,19 @@ def simulate_runtime(kind):
         return costs.simulate_runtime_min(cells, steps, audit=kind == "events")
 
     return runtime
+
+
+def escape_runtime_min(wildcards):
+    """Minutes of an escape job: its record generated, its cells simulated on it."""
+    entry = config["studies"][wildcards.study]
+    cpu = costs.escape_cpu_s(entry, escape_noise(wildcards)["dt"], levels=1)
+    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)
+
+
+def escape_mem_mb(wildcards):
+    """Memory of an escape job: the simulate job's, over its own record."""
+    entry = config["studies"][wildcards.study]
+    return costs.simulate_mem_mb(costs.escape_record_samples(entry, escape_noise(wildcards)["dt"]))
 
 
 def attractor_runtime_min(wildcards):

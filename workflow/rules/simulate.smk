@@ -88,3 +88,25 @@ rule simulate_map:
         code=script_code("simulate_map"),
     script:
         "../scripts/simulate_map.py"
+
+
+rule simulate_escape:
+    """Residence times of the escape cells of study {study} at noise level {level}."""
+    output:
+        "results/cells/{study}/escape/{level}.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/simulate_escape/{study}/{level}.log",
+    benchmark:
+        "results/benchmarks/simulate_escape/{study}/{level}.tsv"
+    threads: 1
+    resources:
+        mem_mb=escape_mem_mb,
+        runtime=escape_runtime_min,
+    params:
+        block=study_block("escape"),
+        noise=escape_noise,
+        code=script_code("simulate_escape"),
+    script:
+        "../scripts/simulate_escape.py"

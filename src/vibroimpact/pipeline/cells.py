@@ -12,7 +12,7 @@ import numpy as np
 
 from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
-from vibroimpact.pipeline.study import map_cap_steps
+from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
 log = logging.getLogger("vibroimpact")
 
@@ -446,3 +446,63 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
     return dict(residence_time=r.mean / period, residence_time_stderr=r.stderr / period,
                 n_stretches=r.n_stretches, n_censored=r.n_censored,
                 switch_rate=r.rate * period, switch_count=r.count)
+
+
+def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
+                record_length, motions=stats.DEFAULT_MOTIONS,
+                window=stats.DEFAULT_MOTION_WINDOW):
+    """Residence times of one cell on a record of fixed length (escape against noise level).
+
+    The labelling of `motion_map_cell` (the same collisions, classification and
+    `stats.residence_statistics`), on a record whose length is set in advance instead of
+    extended to a precision: from rest at tau = 0, ``transient`` discarded, then
+    ``record_length`` (rounded up to a whole sample step).
+
+    Parameters
+    ----------
+    noise : array_like, shape (N,)
+        Random force samples at spacing ``dt``; at least
+        ``study.escape_samples(transient, record_length, dt)`` of them.
+    zeta, eps, delta, beta_f, amplitude : float
+        Physical parameters; the force is ``amplitude sin(beta_f tau) + r(tau)``.
+    transient, record_length : float
+        Time discarded, and the record after it.
+    motions, window
+        Motions classified and the half-width w, as `motion_map_cell`.
+
+    Returns
+    -------
+    dict
+        Over the states (the motions, then "none"): ``residence_time,
+        residence_time_stderr`` (forcing periods), ``n_stretches, n_censored`` as
+        `motion_map_cell`'s, and ``probability`` (fraction of the record after the
+        transient: a motion's free and impact-stick variants together, "none" the rest);
+        ``n_collisions``, ``simulated_time``, ``record_end``.
+
+    Notes
+    -----
+    `motion_map_cell` with ``min_time = record_length`` and a target it reaches at once
+    (``target_stderr = 0.5``, ``min_switches = 1``) stops at the same sample and returns the
+    same residence times, bit for bit (``tests/test_escape.py``).
+    """
+    n_end = escape_samples(transient, record_length, dt) - 1
+    if n_end > len(noise) - 1:
+        raise ValueError(f"record_length = {record_length!r} after the transient "
+                         f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
+                         f"holds {len(noise)}")
+    events = _EventRecord(dt)
+    k = 0
+    for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
+                                 beta=beta_f, t_end=n_end * dt):
+        events.add(chunk)
+        k += chunk.n_steps
+    col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
+    res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
+                                  window=window, motions=motions, stuck=col.stuck)
+    share = res.probability + res.stick_probability
+    stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
+    return dict(probability=np.append(share, max(0.0, 1.0 - float(share.sum()))),
+                n_collisions=int(col.time.size), simulated_time=k * dt - transient,
+                record_end=k * dt, residence_time=stays["residence_time"],
+                residence_time_stderr=stays["residence_time_stderr"],
+                n_stretches=stays["n_stretches"], n_censored=stays["n_censored"])

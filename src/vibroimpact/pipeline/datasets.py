@@ -478,3 +478,88 @@ def lyapunov_dataset(tiles):
     ds["cell_class"].attrs.update(flag_values=np.arange(len(ATTRACTOR_CLASSES), dtype=np.int8),
                                   flag_meanings=" ".join(ATTRACTOR_CLASSES))
     return _described(ds)
+
+
+#: The escape dataset's own variables (``results/datasets/{study}_escape.nc``); the residence
+#: variables keep their `META` entries, ``probability`` and the cells' coordinates get these.
+ESCAPE_META = {
+    "rms": ("rms of the random force r(tau) (samples)", "1"),
+    "inv_rms2": ("1 / rms^2 of the random force", "1"),
+    "spawn_key": ("SeedSequence spawn key of the level's record: SeedSequence(seed, "
+                  "spawn_key=(k,))", "1"),
+    "cell": ("escape cell (index into the config's escape.cells)", "1"),
+    "inv_beta": ("inverse forcing frequency ratio 1/beta_f of the cell", "1"),
+    "delta": ("play delta of the cell", "1"),
+    "probability": ("fraction of the record after the transient in the state (a motion with "
+                    "its impact-stick variant; none: the rest)", "1"),
+    "slope": ("Delta: slope of ln(residence_time) against 1 / rms^2 (weighted least squares "
+              "over the levels with fit_used = 1)", "1"),
+    "slope_stderr": ("standard error of the slope (scaled by sqrt(chi2_red) when > 1)", "1"),
+    "slope_lo": ("lower end of the slope's 95 % interval", "1"),
+    "slope_hi": ("upper end of the slope's 95 % interval", "1"),
+    "intercept": ("ln C of the fit ln(residence_time) = ln C + slope / rms^2 (C in forcing "
+                  "periods)", "1"),
+    "chi2_red": ("chi^2 per degree of freedom of the fit (about 1: ln(residence_time) is "
+                 "linear in 1 / rms^2 within the errors; NaN with two levels)", "1"),
+    "n_fit": ("noise levels in the fit", "1"),
+    "fit_used": ("1: the level enters the fit (enough complete stretches, rms <= "
+                 "fit_max_rms)", "1"),
+}
+_ESCAPE_STATES = ("residence_time", "residence_time_stderr", "n_stretches", "n_censored",
+                  "probability")
+
+
+def escape_part(index, rms, cells, results, motions, attrs):
+    """Dataset of one escape job (one noise level, every cell) along ``rms`` (length 1).
+
+    ``cells`` are ``(inv_beta, delta)`` pairs, ``results`` their
+    :func:`vibroimpact.pipeline.cells.escape_cell` dicts.
+    """
+    data = {name: (("rms", "cell", "state"), np.stack([r[name] for r in results])[None])
+            for name in _ESCAPE_STATES}
+    for name in ("n_collisions", "simulated_time"):
+        data[name] = (("rms", "cell"), np.array([[r[name] for r in results]]))
+    data["spawn_key"] = ("rms", np.array([int(index)]))
+    pairs = np.asarray(cells, dtype=float).reshape(-1, 2)
+    coords = dict(rms=[float(rms)], cell=np.arange(len(results)), state=_motion_names(motions)
+                  + ["none"], inv_beta=("cell", pairs[:, 0]), delta=("cell", pairs[:, 1]))
+    return _escape_described(_annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
+
+
+def aggregate_escape(parts, attrs, min_stretches, fit_max_rms=None):
+    """The escape dataset (``docs/datasets.md``): the levels joined along ``rms`` (ascending)
+    and the fit of ``ln(residence_time)`` against ``1 / rms^2`` of every (cell, state)
+    (`stats.escape_fit`: levels with at least ``min_stretches`` complete stretches and, unless
+    None, ``rms <= fit_max_rms``)."""
+    ds = xr.concat(parts, dim="rms").sortby("rms")
+    ds = ds.assign_coords(inv_rms2=("rms", 1.0 / ds["rms"].values ** 2))
+    allowed = (np.ones(ds.sizes["rms"], dtype=bool) if fit_max_rms is None
+               else ds["rms"].values <= float(fit_max_rms) * (1 + 1e-12))
+    shape = (ds.sizes["cell"], ds.sizes["state"])
+    fits = {name: np.full(shape, np.nan) for name in ("slope", "slope_stderr", "slope_lo",
+                                                      "slope_hi", "intercept", "chi2_red")}
+    fits["n_fit"] = np.zeros(shape, dtype=np.int64)
+    used = np.zeros((ds.sizes["rms"],) + shape, dtype=np.int8)
+    t = ds["residence_time"].transpose("rms", "cell", "state").values
+    e = ds["residence_time_stderr"].transpose("rms", "cell", "state").values
+    n = ds["n_stretches"].transpose("rms", "cell", "state").values
+    for c in range(shape[0]):
+        for s in range(shape[1]):
+            fit = stats.escape_fit(ds["inv_rms2"].values, t[:, c, s], e[:, c, s], n[:, c, s],
+                                   min_stretches=min_stretches, allowed=allowed)
+            for name in fits:
+                fits[name][c, s] = getattr(fit, "n_used" if name == "n_fit" else name)
+            used[:, c, s] = fit.used
+    for name, values in fits.items():
+        ds[name] = (("cell", "state"), values)
+    ds["fit_used"] = (("rms", "cell", "state"), used)
+    ds.attrs = dict(attrs, min_stretches=int(min_stretches),
+                    fit_max_rms=float("nan") if fit_max_rms is None else float(fit_max_rms))
+    return _escape_described(_annotate(ds.transpose("rms", "cell", "state")))
+
+
+def _escape_described(ds):
+    for name, (long_name, units) in ESCAPE_META.items():
+        if name in ds.variables:
+            ds[name].attrs.update(long_name=long_name, units=units)
+    return ds

@@ -103,6 +103,12 @@ FIGURES = {
                      shows="the largest Lyapunov exponent under sin(beta_f tau) alone and what "
                            "each cell's starts settle on: a listed periodic motion, another "
                            "periodic motion, sticking, chaos"),
+    "escape_vs_noise": dict(draw="escape:escape_vs_noise",
+                            owner="study", reads=("escape",), harmonic=True,
+                            shows="the mean residence time in each impact motion against "
+                                  "1/rms^2 of the random force at a few cells of the "
+                                  "(1/beta_f, delta) plane, with the fitted escape law "
+                                  "ln T = ln C + Delta/rms^2"),
 }
 
 #: The figures of the validation targets (rule ``draw_validation_figure``), each drawn from
@@ -254,7 +260,8 @@ def caption(kind, name, entry, target):
     number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
     what = FIGURES[fig]["shows"]
     title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
-             "lyapunov": "Lyapunov exponents"}.get(fig, f"Fig. {number}")
+             "lyapunov": "Lyapunov exponents",
+             "escape_vs_noise": "Escape against noise level"}.get(fig, f"Fig. {number}")
     parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
     if kind == "study":
         if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:

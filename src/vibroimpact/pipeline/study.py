@@ -26,6 +26,10 @@ JOB_KEYS = {
     "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map"),
     "spectra": _PHYSICS + ("spectra",),
     "trace": _PHYSICS + ("trace",),
+    # its own records (no noise file, no grid): the noise entry's spectrum and seed reach the
+    # job as a param of their own (common.smk, ``escape_noise``)
+    "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
+               "motions", "escape"),
 }
 
 #: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns
@@ -140,6 +144,20 @@ class Study:
         if not 0 <= t < n:
             raise ValueError(f"tile must lie in [0, {n - 1}], got {t!r}")
         return self.cells(kind)[t::n]
+
+
+def escape_seed(seed, index):
+    """The seed of the escape record at noise level ``index``: ``SeedSequence(seed,
+    spawn_key=(index,))``, the ``index``-th child of the noise entry's seed
+    (``SeedSequence(seed).spawn``), so the levels' records are independent of each other and
+    of the entry's own record, and each is fixed by ``(seed, index)`` alone."""
+    return np.random.SeedSequence(int(seed), spawn_key=(int(index),))
+
+
+def escape_samples(transient, record_length, dt):
+    """Samples of an escape record: ``transient + record_length`` rounded up to whole sample
+    steps, plus the first sample (`pipeline.cells.escape_cell`)."""
+    return int(math.ceil((float(transient) + float(record_length)) / float(dt) - 1e-9)) + 1
 
 
 def noise_record(entry):

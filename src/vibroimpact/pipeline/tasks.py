@@ -13,8 +13,8 @@ import sys
 from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
-from vibroimpact.pipeline.study import (Study, attractor_rows, grid_values, map_cap_steps,
-                                        orbit_rows)
+from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
+                                        grid_values, map_cap_steps, orbit_rows)
 
 log = logging.getLogger("vibroimpact")
 
@@ -239,6 +239,64 @@ def trace(name, block, noise_path, out):
     attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
                  beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
+
+
+def _escape_attrs(name, block, noise):
+    """Global attributes of the escape datasets: the study's system, the noise entry's
+    spectrum (its rms is the levels' coordinate) and seed, the record."""
+    spec = {f"noise_{k}": noise[k] for k in _NOISE_FIELDS
+            if k != "rms" and noise.get(k) is not None}
+    escape = block["escape"]
+    return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])), study=name,
+                zeta=float(block["zeta"]), eps=float(block["eps"]),
+                amplitude=float(block["amplitude"]), noise=block["noise"],
+                dt=float(noise["dt"]), **spec, transient=float(block["transient"]),
+                record_length=float(escape["record_length"]),
+                motion_window=float(block["motion_window"]),
+                seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
+
+
+def escape_level(name, block, noise, index, out):
+    """Rule ``simulate_escape``: the residence times of every escape cell of study ``name``
+    on the record of noise level ``index`` (``block["escape"]["rms"][index]``).
+
+    The record is generated here (`vibroimpact.noise.generate_array`, no file): the study's
+    noise entry ``noise`` (spectrum, ``dt``, seed) at the level's rms, seeded by
+    `study.escape_seed` (seed, index); every cell runs from rest on it.
+    """
+    from vibroimpact.noise import generate_array
+    from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
+
+    escape = block["escape"]
+    rms = float(escape["rms"][index])
+    spec = noise_spec(dict(noise, rms=rms))
+    transient, length = float(block["transient"]), float(escape["record_length"])
+    n = escape_samples(transient, length, spec.dt)
+    log.info("level %d: rms %g, %d samples of %s", index, rms, n, spec)
+    samples = generate_array(spec, n, escape_seed(noise["seed"], index))
+    motions = [tuple(int(k) for k in m) for m in block["motions"]]
+    progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]))
+    results = []
+    for inv_beta, delta in escape["cells"]:
+        results.append(cells.escape_cell(
+            samples, spec.dt, zeta=float(block["zeta"]), eps=float(block["eps"]),
+            delta=float(delta), beta_f=1.0 / float(inv_beta),
+            amplitude=float(block["amplitude"]), transient=transient, record_length=length,
+            motions=motions, window=float(block["motion_window"])))
+        progress.cell_done(results[-1])
+    io.write_dataset(datasets.escape_part(index, rms, escape["cells"], results, motions,
+                                          _escape_attrs(name, block, noise)), out)
+
+
+def aggregate_escape(name, block, noise, parts, out):
+    """Rule ``aggregate_escape``: the escape dataset of study ``name`` from its levels, with
+    the fit of ln(residence time) against 1 / rms^2."""
+    escape = block["escape"]
+    ds = datasets.aggregate_escape([io.load_dataset(p) for p in parts],
+                                   _escape_attrs(name, block, noise),
+                                   min_stretches=int(escape["min_stretches"]),
+                                   fit_max_rms=escape.get("fit_max_rms"))
+    io.write_dataset(ds, out)
 
 
 def aggregate(name, block, kind, tiles, out, noise_path=None):

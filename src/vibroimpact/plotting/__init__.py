@@ -17,6 +17,7 @@ Datasets and the figures that read them (docs/figures.md)::
     results/datasets/{study}_spectra.nc fig06, fig11, fig12    (random, harmonic)
     results/datasets/{study}_events.nc  fig07, fig08, fig09, fig13, fig14
     results/datasets/{study}_map.nc     fig15, fig15_vs_fig16  (harmonic)
+    results/datasets/{study}_escape.nc  escape_vs_noise        (harmonic)
     results/orbits/{name}.nc            fig16, fig15_vs_fig16  (orbits), basins (attractors)
     results/orbits/{name}_boundaries.nc fig16                  (orbits)
     results/orbits/{name}_basins.nc     basins                 (attractors)
@@ -31,6 +32,7 @@ from vibroimpact.plotting._common import (LABELS, MIN_BIN_COUNT, STYLE_FILE, axi
                                           bin_counts, family_styles, merge_sparse_bins, save,
                                           style)
 from vibroimpact.plotting.attractors import basins, lyapunov
+from vibroimpact.plotting.escape import escape_vs_noise
 from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
 from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement
 from vibroimpact.plotting.orbits import fig16
@@ -43,5 +45,5 @@ __all__ = [
     "bin_counts", "family_styles", "merge_sparse_bins",
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
     "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
-    "map_agreement", "basins", "lyapunov", "work_precision", "stress",
+    "map_agreement", "basins", "lyapunov", "work_precision", "stress", "escape_vs_noise",
 ]

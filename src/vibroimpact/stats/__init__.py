@@ -10,6 +10,7 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
   impact statistic);
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
 - `residence`: residence times in the motions and the rates of switching between them;
+- `escape`: the Arrhenius fit of residence times against the noise level;
 - `theory`: the wall-free linear response, elastic impacts under white noise;
 - `identities`: the power balance and the virial of a stationary record (a self-audit).
 
@@ -18,8 +19,8 @@ needs one helper does not import the others' scipy modules.
 """
 import importlib
 
-_SUBMODULES = ("spectra", "events", "collisions", "motions", "residence", "theory",
-               "identities")
+_SUBMODULES = ("spectra", "events", "collisions", "motions", "residence", "escape",
+               "theory", "identities")
 _WHERE = {
     "PSD_DETREND": "spectra", "WelchAccumulator": "spectra", "welch_psd": "spectra",
     "onesided_to_angular": "spectra", "variance_from_psd": "spectra",
@@ -36,6 +37,7 @@ _WHERE = {
     "motion_statistics": "motions", "motion_map_agreement": "motions",
     "ResidenceStatistics": "residence", "label_pieces": "residence",
     "residence_statistics": "residence", "stationary_distribution": "residence",
+    "EscapeFit": "escape", "escape_fit": "escape",
     "linear_response_std": "theory", "elastic_impact_rate": "theory",
     "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory",

@@ -16,7 +16,8 @@ import numpy as np
 from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time, cutoff
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
-from vibroimpact.pipeline.study import grid_size, grid_values, map_cap_steps, noise_record
+from vibroimpact.pipeline.study import (escape_samples, grid_size, grid_values, map_cap_steps,
+                                        noise_record)
 
 __all__ = ["GRID_RTOL", "check"]
 
@@ -139,7 +140,7 @@ def _check_figures(config, section, name, entry, problems, grids):
         if spec.get("harmonic") and not entry.get("amplitude"):
             problems.add(f"studies.{name}.amplitude", entry.get("amplitude", 0.0),
                          f"{fig} shows the harmonic force", "amplitude != 0 for this figure")
-        for block in ("trace", "spectra"):
+        for block in ("trace", "spectra", "escape"):
             if block in spec["reads"] and not entry.get(block):
                 problems.add(f"studies.{name}.{block}", None,
                              f"missing, and {fig} draws it",
@@ -315,9 +316,56 @@ def _check_study(config, name, entry, problems, limits, unforced):
                          f"0 < min_time <= {tau - transient:.6g}")
     if "map" in uses and harmonic:
         _plane(problems, where, grids, "fig15")
+    if entry.get("escape"):
+        _check_escape(where, entry, grids, harmonic, dt, problems)
     if all(g is not None for g in grids.values()):
         _check_figures(config, "studies", name, entry, problems, grids)
     return grids
+
+
+#: Samples of one escape record, held in memory by its job (8 bytes each: 400 MB).
+ESCAPE_MAX_SAMPLES = 50_000_000
+
+
+def _check_escape(where, entry, grids, harmonic, dt, problems):
+    """The escape block: cells inside the study's (1/beta_f, delta) plane, distinct levels,
+    a record its job can hold, a fit with two levels at least."""
+    where = f"{where}.escape"
+    block = entry["escape"]
+    if not harmonic:
+        problems.add(where, None, "the escape cells lie in the (1/beta_f, delta) plane of the "
+                     "harmonic force, and this study has none (amplitude = 0)",
+                     "leave it out, or give the study an amplitude != 0")
+        return
+    box = {k: (float(g.min()), float(g.max())) for k, g in grids.items() if g is not None}
+    for i, cell in enumerate(block["cells"]):
+        inv_beta, delta = (float(v) for v in cell)
+        if inv_beta <= 0.0:
+            problems.add(f"{where}.cells[{i}]", cell, f"1/beta_f = {_num(inv_beta)} is not a "
+                         "forcing period ratio", "[inv_beta, delta] with inv_beta > 0")
+            continue
+        outside = [f"{k} in [{_num(lo)}, {_num(hi)}]" for k, v in (("inv_beta", inv_beta),
+                                                                  ("delta", delta))
+                   if k in box for lo, hi in [box[k]]
+                   if not lo - GRID_RTOL * max(1.0, abs(lo)) <= v
+                   <= hi + GRID_RTOL * max(1.0, abs(hi))]
+        if outside:
+            problems.add(f"{where}.cells[{i}]", cell, "outside the study's (1/beta_f, delta) "
+                         "plane", "a cell with " + " and ".join(outside))
+    pairs = [tuple(float(v) for v in c) for c in block["cells"]]
+    if len(set(pairs)) != len(pairs):
+        problems.add(f"{where}.cells", block["cells"], "a cell is listed twice",
+                     "distinct [inv_beta, delta] pairs")
+    _distinct(problems, f"{where}.rms", block["rms"])
+    n = escape_samples(entry["transient"], block["record_length"], dt)
+    if n > ESCAPE_MAX_SAMPLES:
+        problems.add(f"{where}.record_length", block["record_length"],
+                     f"{n:,} samples at dt = {_num(dt)}, held in memory by each job",
+                     f"transient + record_length <= {_num(ESCAPE_MAX_SAMPLES * dt)}")
+    top = block.get("fit_max_rms")
+    if top is not None and sum(float(r) <= float(top) for r in block["rms"]) < 2:
+        problems.add(f"{where}.fit_max_rms", top, "leaves fewer than 2 noise levels for the "
+                     "fits", "null, or at least the second smallest of escape.rms")
 
 
 def _plane(problems, where, grids, fig):

@@ -5,11 +5,11 @@ what a build costs, printed and checked against ``limits`` before it runs) and f
 resources each rule asks of a scheduler (``workflow/rules/common.smk``). The costs were
 measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job costs").
 """
-from vibroimpact.pipeline.study import Study, map_cap_steps
+from vibroimpact.pipeline.study import Study, escape_samples, map_cap_steps
 
 __all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simulate_runtime_min",
            "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
-           "attractor_cpu_s", "boundaries_cpu_s"]
+           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
@@ -108,3 +108,18 @@ def attractor_cpu_s(cells, n_starts):
 def boundaries_cpu_s(types):
     """CPU seconds of tracing the stable domains' edges of ``types`` (m/n) types."""
     return types * BOUNDARIES_S
+
+
+def escape_record_samples(entry, dt):
+    """Samples of one escape record of study ``entry`` at sample step ``dt``."""
+    return escape_samples(entry["transient"], entry["escape"]["record_length"], dt)
+
+
+def escape_cpu_s(entry, dt, levels=None):
+    """CPU seconds of the escape jobs of study ``entry`` (``levels``: that many of them; None:
+    every level): each generates its record and runs every cell over it (start-up apart, as
+    `simulate_cpu_s`: the plan adds it per job)."""
+    n = escape_record_samples(entry, dt)
+    levels = len(entry["escape"]["rms"]) if levels is None else int(levels)
+    cells = len(entry["escape"]["cells"])
+    return levels * (n * NS_PER_SAMPLE * 1e-9 + simulate_cpu_s(cells, n - 1))

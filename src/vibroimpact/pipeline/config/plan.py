@@ -167,7 +167,7 @@ def built_entries(config, own=None):
             fig = item if isinstance(item, str) else item["name"]
             for kind, other in figures.figure_sources(entry, fig).items():
                 reads[kind].add(other)
-        if _study_needs(entry) - {"orbits"}:
+        if _study_needs(entry) - {"orbits", "escape"}:    # escape: records of its own
             reads["noises"].add(entry["noise"])
     return drawn, reads
 
@@ -211,6 +211,14 @@ def make_plan(config, own=None, *, results="results"):
                  2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1),
                  costs.simulate_cpu_s(cells, steps))
             parts.append(f"spectra {_n(cells, 'cell')}")
+        if "escape" in needs:
+            block = entry["escape"]
+            levels, cells = len(block["rms"]), len(block["cells"])
+            states = len(entry["motions"]) + 1
+            _add(row, levels * cells, levels + 1,
+                 2 * levels * cells * states * 40 + cells * states * 60,
+                 costs.escape_cpu_s(entry, float(noise["dt"])))
+            parts.append(f"escape {_n(cells, 'cell')} x {_n(levels, 'noise level')}")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
             _add(row, 0, 1, 40 * steps, 0.0)

@@ -1,0 +1,175 @@
+"""Escape against noise level: the residence times of the impact motions against 1/rms^2.
+
+One panel per cell of the (1/beta_f, delta) plane: the mean residence time of each state
+(the motions and "none") on a log axis against 1/rms^2, with the straight line of
+ln(residence time) against 1/rms^2 fitted over the weak-noise levels (`stats.escape_fit`,
+stored in the dataset by the aggregation: the figure draws, it does not fit).
+"""
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch
+from matplotlib.ticker import FuncFormatter
+
+from vibroimpact.plotting._common import (CONFIDENCE, _attr, _header, _num, _spectrum_parts,
+                                          _styled, _system_text, note_on_axes)
+from vibroimpact.plotting.maps import TYPE_COLORS
+
+__all__ = ["escape_vs_noise"]
+
+#: Colour of the state "none" (time in no listed motion).
+NONE_COLOR = "0.45"
+#: Markers of the states, in the order of the dataset's ``state``.
+STATE_MARKERS = ("o", "s", "^", "D", "v", "P")
+#: Look of the levels left out of the fits by ``fit_max_rms``: a light band.
+OUTSIDE_FIT_STYLE = dict(color="0.9", zorder=0, linewidth=0)
+
+
+def _state_label(name):
+    return "none" if name == "none" else f"({name})"
+
+
+def _fit_text(cell, k):
+    """``Delta = 0.163 [0.156, 0.171]``, with chi^2/dof when there is one."""
+    text = (rf"$\Delta$ = {cell['slope'].values[k]:.3g} "
+            rf"[{cell['slope_lo'].values[k]:.3g}, {cell['slope_hi'].values[k]:.3g}]")
+    chi2 = float(cell["chi2_red"].values[k])
+    return text + (rf", $\chi^2/\nu$ = {chi2:.2g}" if np.isfinite(chi2) else "")
+
+
+def _panel(ax, cell, states, min_stretches, x_line, home):
+    """One cell: points with error bars (filled: in the fit), the fitted lines (solid for the
+    cell's ``home`` state, thin dashed for the others); returns whether it holds a point."""
+    x = cell["inv_rms2"].values
+    drawn = False
+    for k, name in enumerate(states):
+        t = cell["residence_time"].values[:, k]
+        e = cell["residence_time_stderr"].values[:, k]
+        n = cell["n_stretches"].values[:, k]
+        used = cell["fit_used"].values[:, k].astype(bool)
+        shown = np.isfinite(t) & (t > 0) & (n >= min(min_stretches, 2))
+        if not shown.any() or (n < min_stretches).all():
+            continue            # a state never held long enough to say anything
+        drawn = True
+        color = NONE_COLOR if name == "none" else TYPE_COLORS[k % len(TYPE_COLORS)]
+        marker = STATE_MARKERS[k % len(STATE_MARKERS)]
+        err = np.where(np.isfinite(e), e, 0.0)
+        label = _state_label(name)
+        fitted = np.isfinite(cell["slope"].values[k])
+        if fitted:
+            label += ": " + _fit_text(cell, k)
+        for mask, face, gid in ((shown & used, color, "fitted_points"),
+                                (shown & ~used, "white", "excluded_points")):
+            if mask.any():
+                ax.errorbar(x[mask], t[mask], yerr=err[mask], fmt=marker, color=color,
+                            markerfacecolor=face, markersize=5, capsize=2, linestyle="none",
+                            gid=gid, label=label if gid == "fitted_points" or not fitted
+                            and not (shown & used).any() else None)
+        if fitted:
+            line = np.exp(cell["intercept"].values[k] + cell["slope"].values[k] * x_line)
+            ax.plot(x_line, line, color=color, gid="fit",
+                    **(dict(linewidth=1.4) if k == home else dict(linewidth=0.8,
+                                                                   linestyle="--")))
+    return drawn
+
+
+@_styled
+def escape_vs_noise(escape):
+    """Mean residence time of each impact motion against 1/rms^2, one panel per cell.
+
+    Parameters
+    ----------
+    escape : xarray.Dataset
+        ``results/datasets/{study}_escape.nc`` (docs/datasets.md): ``residence_time``,
+        ``residence_time_stderr``, ``n_stretches``, ``probability``, ``fit_used`` over
+        ``(rms, cell, state)``, the fits ``slope``, ``slope_lo``, ``slope_hi``,
+        ``intercept``, ``chi2_red`` over ``(cell, state)``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Per cell: the residence times (forcing periods, log axis) with +-1 standard error
+        bars, filled where the level is in the fit (gid ``"fitted_points"``), open where it
+        is not (``"excluded_points"``: fewer than ``min_stretches`` complete stretches, or
+        rms above ``fit_max_rms``, whose levels lie in a grey band); the fitted lines
+        (``"fit"``) with Delta, its 95 % interval and chi^2 per degree of freedom in the
+        legend. A state with fewer than ``min_stretches`` complete stretches at every level
+        is not drawn.
+    """
+    states = [str(s) for s in escape["state"].values]
+    n_cells = escape.sizes["cell"]
+    min_stretches = int(_attr(escape, "min_stretches"))
+    top = float(escape.attrs.get("fit_max_rms", np.nan))
+    x = escape["inv_rms2"].values
+    x_line = np.linspace(0.75 * x.min(), 1.05 * x.max(), 200)
+    ncols = min(n_cells, 3)
+    nrows = -(-n_cells // ncols)
+    fig = Figure(figsize=(4.6 * ncols + 0.4, 4.4 * nrows + 1.6), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
+    for ax in axes[n_cells:]:
+        ax.set_visible(False)
+    weakest = int(np.argmin(escape["rms"].values))
+    for c, ax in enumerate(axes[:n_cells]):
+        cell = escape.isel(cell=c)
+        if np.isfinite(top):
+            ax.axvspan(x_line[0], 1.0 / top ** 2, gid="outside_fit", **OUTSIDE_FIT_STYLE)
+        share = cell["probability"].values[weakest]
+        home = int(np.argmax(share))
+        if not _panel(ax, cell, states, min_stretches, x_line, home):
+            note_on_axes(ax, f"no state with {min_stretches} complete stretches\n"
+                             "at any noise level")
+        else:
+            ax.set_yscale("log")
+            plain = FuncFormatter(lambda v, _: f"{v:g}")
+            ax.yaxis.set_major_formatter(plain)
+            ax.yaxis.set_minor_formatter(FuncFormatter(
+                lambda v, _: f"{v:g}" if f"{v:g}"[0] in "25" else ""))
+            ax.legend(loc="upper left", fontsize=6.5, title_fontsize=6.5,
+                      title=r"fit $\ln T = \ln C + \Delta/\mathrm{rms}_r^2$:  $\Delta$ "
+                      f"[{int(100 * CONFIDENCE)} % interval]" + r", $\chi^2$ per d.o.f. $\nu$")
+        ax.set_title(rf"$1/\beta_f$ = {_num(cell['inv_beta'])}, $\delta$ = "
+                     rf"{_num(cell['delta'])}: {_state_label(states[home])} "
+                     rf"{100 * share[home]:.0f} % at rms {_num(escape['rms'].values[weakest])}")
+        ax.set_xlim(x_line[0], x_line[-1])
+        ax.set_xlabel(r"$1/\mathrm{rms}_r^2$")
+        ax.set_ylabel("mean residence time (forcing periods)")
+        top_axis = ax.secondary_xaxis("top", functions=(_rms_of, _inv2_of))
+        top_axis.set_xticks(escape["rms"].values)
+        top_axis.set_xticklabels([_num(v) for v in escape["rms"].values], fontsize=7)
+        top_axis.set_xlabel(r"rms$_r$", fontsize=8)
+    handles = [Line2D([], [], marker="o", color="0.3", linestyle="none",
+                      label="in the fit (bars: $\\pm$1 s.e. of the mean)"),
+               Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
+                      linestyle="none",
+                      label=f"not in the fit (fewer than {min_stretches} complete stretches"
+                            + (f", or rms > {_num(top)}" if np.isfinite(top) else "") + ")")]
+    if np.isfinite(top):
+        handles.append(Patch(label=f"rms > {_num(top)}: outside the fits",
+                             **{k: v for k, v in OUTSIDE_FIT_STYLE.items() if k == "color"}))
+    fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=7)
+    noise = ", ".join(_spectrum_parts(escape.attrs))
+    _header(fig, "Escape from the impact motions against the noise level",
+            f"{_system_text(escape)};  "
+            rf"$f(\tau)$ = $\sin(\beta_f\tau) + r(\tau)$ ({noise});  "
+            f"each cell from rest on one record per rms, "
+            f"{float(_attr(escape, 'record_length')):,.0f} time units after the transient "
+            f"{_num(_attr(escape, 'transient'))} "
+            f"(seed {_attr(escape, 'seed')}, a spawned child per rms)\n"
+            "residence time T: mean length of the complete stretches of a motion (free and "
+            rf"impact-stick together), $w$ = {_num(_attr(escape, 'motion_window'))};  "
+            r"$\Delta$: slope of $\ln T$ against $1/\mathrm{rms}_r^2$ (weighted)")
+    return fig
+
+
+def _rms_of(x):
+    """rms from 1/rms^2 (the top axis; kept finite where matplotlib probes x <= 0)."""
+    return 1.0 / np.sqrt(np.maximum(np.asarray(x, dtype=float), 1e-300))
+
+
+def _inv2_of(r):
+    """1/rms^2 from rms."""
+    return 1.0 / np.maximum(np.asarray(r, dtype=float), 1e-150) ** 2

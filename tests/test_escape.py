@@ -1,0 +1,338 @@
+"""Escape against noise level: the fit, the cell, the seeds, the config, the figure, the rules.
+
+- `stats.escape_fit` recovers a known slope of ln T against 1/rms^2;
+- `pipeline.cells.escape_cell` labels its record as `motion_map_cell` does (bit for bit);
+- each noise level's record is seeded ``SeedSequence(seed, spawn_key=(k,))``;
+- a bad ``escape`` block is refused naming its key;
+- `plotting.escape_vs_noise` draws points, excluded points and fitted lines;
+- the figure needs only the escape jobs (dry run), and builds (``workflow``).
+"""
+import copy
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+from vibroimpact import stats
+from vibroimpact.noise import NoiseSpec, generate_array
+from vibroimpact.pipeline import config as configuration
+from vibroimpact.pipeline import datasets, tasks
+from vibroimpact.pipeline.cells import escape_cell, motion_map_cell
+from vibroimpact.pipeline.study import escape_samples, escape_seed
+
+from helpers import ROOT, assert_figure, make_workdir, scheduled_rules, snakemake
+
+TEST_CONFIG = yaml.safe_load((ROOT / "config" / "test.yaml").read_text())
+SYSTEM = dict(zeta=0.05, eps=0.5, amplitude=1.0)
+
+
+# --- the fit ---------------------------------------------------------------------------------
+
+def test_fit_recovers_a_known_slope_exactly_from_exact_data():
+    x = 1.0 / np.array([0.15, 0.18, 0.22, 0.29]) ** 2
+    t = 3.0 * np.exp(0.16 * x)
+    fit = stats.escape_fit(x, t, 0.05 * t, np.full(4, 100))
+    assert fit.slope == pytest.approx(0.16, rel=1e-12)
+    assert fit.intercept == pytest.approx(np.log(3.0), rel=1e-12)
+    assert fit.chi2_red == pytest.approx(0.0, abs=1e-20) and fit.n_used == 4
+    # unscaled (chi2_red < 1): the interval of known errors, 1.96 s.e. each side
+    assert fit.slope_hi - fit.slope == pytest.approx(1.959964 * fit.slope_stderr, rel=1e-6)
+
+
+def test_fit_covers_the_slope_of_noisy_data_at_its_confidence():
+    """500 synthetic data sets of 5 levels, each ln T off by its stated error: the 95 %
+    interval holds the true slope in 95 % of them (binomial 3 sigma: +-3 %), chi2_red ~ 1."""
+    rng = np.random.default_rng(7)
+    x = 1.0 / np.array([0.15, 0.18, 0.22, 0.26, 0.29]) ** 2
+    rel = np.array([0.2, 0.08, 0.04, 0.02, 0.015])     # few stretches where T is long
+    hits, chi2 = 0, []
+    for _ in range(500):
+        t = 2.0 * np.exp(0.07 * x + rel * rng.standard_normal(5))
+        fit = stats.escape_fit(x, t, rel * t, np.full(5, 50))
+        hits += fit.slope_lo <= 0.07 <= fit.slope_hi
+        chi2.append(fit.chi2_red)
+    assert 0.92 <= hits / 500 <= 0.99
+    assert np.mean(chi2) == pytest.approx(1.0, abs=0.15)
+
+
+def test_fit_leaves_out_levels_with_few_stretches_or_above_the_cut():
+    x = 1.0 / np.array([0.15, 0.2, 0.29, 0.4]) ** 2
+    t = np.exp(0.1 * x)
+    t_bad = t.copy()
+    t_bad[0] *= 50.0                                     # a wild mean of few stretches
+    t_bad[3] *= 0.01                                     # strong noise off the law
+    fit = stats.escape_fit(x, t_bad, 0.01 * t, [3, 30, 30, 30], min_stretches=20,
+                           allowed=[True, True, True, False])
+    assert fit.used.tolist() == [False, True, True, False] and fit.n_used == 2
+    assert fit.slope == pytest.approx(0.1, rel=1e-12) and np.isnan(fit.chi2_red)
+
+
+def test_fit_with_fewer_than_two_levels_is_nan_and_uses_none():
+    fit = stats.escape_fit([10.0, 20.0], [5.0, np.nan], [0.5, np.nan], [30, 0])
+    assert np.isnan(fit.slope) and fit.n_used == 0 and not fit.used.any()
+
+
+# --- the cell and its seeds ------------------------------------------------------------------
+
+def test_escape_cell_labels_as_motion_map_cell_bit_for_bit():
+    """The same record, the same cell: motion_map_cell stopped at the same sample (a target it
+    reaches at once, min_time = record_length) gives identical residence times."""
+    transient, length, dt = 200.0, 3000.0, 0.1
+    r = generate_array(NoiseSpec("band_limited", 0.29, dt, 4.0),
+                       escape_samples(transient, length, dt) + 400, 5)
+    beta_f = 1.0 / 1.1
+    for delta in (1.0, 0.1, 2.5):
+        got = escape_cell(r, dt, **SYSTEM, delta=delta, beta_f=beta_f, transient=transient,
+                          record_length=length)
+        ref = motion_map_cell(r, dt, **SYSTEM, delta=delta, beta_f=beta_f,
+                              transient=transient, target_stderr=0.5, min_time=length,
+                              max_periods=int(length * beta_f / (2 * np.pi)) + 1,
+                              min_switches=1)
+        assert got["record_end"] == ref["record_end"] == transient + length
+        for key in ("residence_time", "residence_time_stderr", "n_stretches", "n_censored"):
+            np.testing.assert_array_equal(got[key], ref[key], err_msg=key)
+        shares = np.append(ref["probability"] + ref["stick_probability"], 0.0)
+        np.testing.assert_allclose(got["probability"][:-1], shares[:-1], rtol=0, atol=0)
+        assert got["probability"].sum() == pytest.approx(1.0, abs=1e-12)
+        assert got["n_collisions"] == ref["n_collisions"]
+
+
+def test_escape_cell_refuses_a_short_record():
+    with pytest.raises(ValueError, match="record_length"):
+        escape_cell(np.zeros(100), 0.1, **SYSTEM, delta=1.0, beta_f=1.0, transient=5.0,
+                    record_length=10.0)
+
+
+def test_each_level_is_the_spawned_child_of_the_noise_seed():
+    draw = [np.random.Generator(np.random.PCG64(escape_seed(19741001, k))).random(4)
+            for k in range(3)]
+    children = np.random.SeedSequence(19741001).spawn(3)
+    for k in range(3):
+        np.testing.assert_array_equal(
+            draw[k], np.random.Generator(np.random.PCG64(children[k])).random(4))
+    assert not np.array_equal(draw[0], draw[1])
+
+
+# --- the config ------------------------------------------------------------------------------
+
+def _refused(change):
+    """The problems of test.yaml with ``change(cfg)`` applied to a copy."""
+    cfg = copy.deepcopy(TEST_CONFIG)
+    change(cfg)
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.load(cfg, root=ROOT)
+    problems = info.value.problems
+    assert all(len(p.splitlines()) <= 2 for p in problems)
+    return "\n".join(problems)
+
+
+def _escape(cfg):
+    return cfg["studies"]["motion_map"]["escape"]
+
+
+@pytest.mark.parametrize("change, key, fragment", [
+    (lambda c: _escape(c).update(cells=[]), "studies.motion_map.escape.cells", "empty"),
+    (lambda c: _escape(c).update(rms=[0.2, 0.0]), "studies.motion_map.escape.rms[1]", "> 0"),
+    (lambda c: _escape(c).update(rms=[0.2, -0.3]), "studies.motion_map.escape.rms[1]", "> 0"),
+    (lambda c: _escape(c).update(rms=[0.2]), "studies.motion_map.escape.rms",
+     "at least 2"),
+    (lambda c: _escape(c).update(rms=[0.2, 0.2]), "studies.motion_map.escape.rms",
+     "listed more than once"),
+    (lambda c: _escape(c).update(cells=[[1.0, 1.0], [5.0, 1.0]]),
+     "studies.motion_map.escape.cells[1]", "inv_beta in [0.5, 2.5]"),
+    (lambda c: _escape(c).update(cells=[[1.0, 7.0]]),
+     "studies.motion_map.escape.cells[0]", "delta in [-1, 3]"),
+    (lambda c: _escape(c).update(cells=[[-1.0, 1.0]]),
+     "studies.motion_map.escape.cells[0]", "inv_beta > 0"),
+    (lambda c: _escape(c).update(cells=[[1.0]]), "studies.motion_map.escape.cells[0]",
+     "at least 2"),
+    (lambda c: _escape(c).update(record_length=0.0),
+     "studies.motion_map.escape.record_length", "> 0"),
+    (lambda c: _escape(c).update(record_length=9e6),
+     "studies.motion_map.escape.record_length", "held in memory"),
+    (lambda c: _escape(c).update(fit_max_rms=0.25), "studies.motion_map.escape.fit_max_rms",
+     "fewer than 2 noise levels"),
+    (lambda c: _escape(c).update(min_stretches=1), "studies.motion_map.escape.min_stretches",
+     ">= 2"),
+    (lambda c: c["studies"]["motion_map"].pop("escape"), "studies.motion_map.escape",
+     "escape_vs_noise draws it"),
+    (lambda c: c["studies"]["random"].update(escape={"cells": [[1.0, 0.0]], "rms": [0.2, 0.3]}),
+     "studies.random.escape", "amplitude != 0"),
+], ids=["empty_cells", "rms_zero", "rms_negative", "one_level", "repeated_rms",
+        "cell_beyond_inv_beta", "cell_beyond_delta", "cell_negative_inv_beta", "cell_one_value",
+        "record_zero", "record_too_long", "cut_leaves_one_level", "min_stretches_one",
+        "figure_without_block", "escape_on_a_random_study"])
+def test_a_bad_escape_block_is_refused_naming_its_key(change, key, fragment):
+    text = _refused(change)
+    assert key in text, text
+    assert fragment in text, text
+
+
+def test_the_schema_fills_the_escape_defaults():
+    cfg = copy.deepcopy(TEST_CONFIG)
+    _escape(cfg).clear()
+    _escape(cfg).update(rms=[0.2, 0.3])
+    config, _ = configuration.load(cfg, root=ROOT)
+    block = config["studies"]["motion_map"]["escape"]
+    assert block["cells"] == [[1.1, 1.0], [1.1, 0.1], [1.2, 2.5]]
+    assert block["record_length"] == 1e6 and block["min_stretches"] == 20
+    assert block["fit_max_rms"] is None
+
+
+def test_the_plan_counts_the_escape_jobs():
+    """The escape study of the paper's config: 5 levels and their aggregation, 15 cells."""
+    config, plan = configuration.load(root=ROOT)
+    row = next(r for r in plan.rows if r.key == "studies.motion_map")
+    assert "escape 3 cells x 5 noise levels" in row.detail
+    from vibroimpact.pipeline.config import costs
+
+    cpu = costs.escape_cpu_s(config["studies"]["motion_map"], 0.1)
+    assert 2.0 < cpu < 30.0          # measured ~1 s per level of 1e7 samples (3 cells)
+
+
+# --- the task and the dataset ----------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def escape_dataset(tmp_path_factory):
+    """The test config's escape levels and dataset, made by the tasks the rules call."""
+    cfg, _ = configuration.load(copy.deepcopy(TEST_CONFIG), root=ROOT)
+    block = cfg["studies"]["motion_map"]
+    noise = {k: v for k, v in cfg["noises"][block["noise"]].items()
+             if k in ("kind", "dt", "beta_c", "zeta_f", "seed")}
+    path = tmp_path_factory.mktemp("escape")
+    parts = [path / f"{k}.nc" for k in range(len(block["escape"]["rms"]))]
+    for k, part in enumerate(parts):
+        tasks.escape_level("motion_map", block, noise, k, part)
+    tasks.aggregate_escape("motion_map", block, noise, parts, path / "escape.nc")
+    return xr.load_dataset(path / "escape.nc"), block
+
+
+def test_the_dataset_holds_every_level_cell_and_state(escape_dataset):
+    ds, block = escape_dataset
+    assert dict(ds.sizes) == {"rms": 3, "cell": 2, "state": 4}
+    assert ds["rms"].values.tolist() == sorted(block["escape"]["rms"])
+    np.testing.assert_array_equal(ds["inv_beta"], [c[0] for c in block["escape"]["cells"]])
+    np.testing.assert_allclose(ds["probability"].sum("state"), 1.0, atol=1e-12)
+    assert (ds["simulated_time"] == block["escape"]["record_length"]).all()
+    for name in ("residence_time", "slope", "chi2_red", "fit_used", "n_stretches"):
+        assert ds[name].attrs["long_name"] and ds[name].attrs["units"] == "1"
+    assert ds.attrs["seed"] == 19741001 and ds.attrs["min_stretches"] == 5
+    assert ds["spawn_key"].values.tolist() == [0, 1, 2]
+
+
+def test_weak_noise_holds_the_motion_longer(escape_dataset):
+    """At 1/beta_f = 1, delta = 1 the (1/1) motion (stable there under sin(beta tau) alone)
+    is left less often as the noise weakens: its residence time falls with rms, and its fit
+    has a positive slope."""
+    ds, _ = escape_dataset
+    home = ds.isel(cell=0).sel(state="1/1")
+    assert (np.diff(home["residence_time"].values) < 0).all()
+    assert home["slope"] > 0 and home["slope_lo"] > 0
+
+
+def test_the_dataset_is_reproducible_from_its_seeds(escape_dataset, tmp_path):
+    ds, block = escape_dataset
+    cfg, _ = configuration.load(copy.deepcopy(TEST_CONFIG), root=ROOT)
+    noise = {k: v for k, v in cfg["noises"][block["noise"]].items()
+             if k in ("kind", "dt", "beta_c", "zeta_f", "seed")}
+    tasks.escape_level("motion_map", block, noise, 1, tmp_path / "1.nc")
+    again = xr.load_dataset(tmp_path / "1.nc")
+    np.testing.assert_array_equal(again["residence_time"].isel(rms=0),
+                                  ds["residence_time"].sel(rms=block["escape"]["rms"][1]))
+
+
+# --- the figure ------------------------------------------------------------------------------
+
+def _synthetic(slopes=(0.16, 0.07), n_weak=(39, 3000)):
+    """An escape dataset of two cells whose home motions follow ln T = 1 + slope / rms^2."""
+    rms = [0.15, 0.18, 0.22, 0.29, 0.4]
+    cells = [(1.1, 1.0), (1.1, 0.1)]
+    parts = []
+    for k, r in enumerate(rms):
+        results = []
+        for c, slope in enumerate(slopes):
+            t = np.array([1.0, 1.0, 1.0, 0.7])
+            t[c] = np.exp(1.0 + slope / r ** 2)
+            n = np.array([500, 500, 0, 500])
+            n[c] = n_weak[c] if k == 0 else 400
+            t[n == 0] = np.nan
+            results.append(dict(residence_time=t, residence_time_stderr=0.1 * t,
+                                n_stretches=n, n_censored=np.zeros(4, int),
+                                probability=np.array([0.9, 0.05, 0.0, 0.05]) if c == 0
+                                else np.array([0.05, 0.9, 0.0, 0.05]),
+                                n_collisions=1000, simulated_time=1e6))
+        parts.append(datasets.escape_part(k, r, cells, results, ((1, 1), (2, 1), (1, 2)),
+                                          {}))
+    attrs = dict(zeta=0.05, eps=0.5, amplitude=1.0, noise_kind="band_limited",
+                 noise_beta_c=4.0, dt=0.1, seed=19741001, transient=200.0,
+                 record_length=1e6, motion_window=0.1)
+    return datasets.aggregate_escape(parts, attrs, min_stretches=20, fit_max_rms=0.29)
+
+
+def test_the_aggregate_fits_the_synthetic_slopes():
+    ds = _synthetic()
+    assert ds["slope"].sel(state="1/1").values[0] == pytest.approx(0.16, rel=1e-9)
+    assert ds["slope"].sel(state="2/1").values[1] == pytest.approx(0.07, rel=1e-9)
+    assert ds["n_fit"].sel(state="1/1").values[0] == 4      # rms 0.4 above the cut
+    assert np.isnan(ds["slope"].sel(state="1/2")).all()
+
+
+def test_the_figure_draws_points_excluded_points_and_fits():
+    ds = _synthetic(n_weak=(5, 3000))          # (1/1)'s weakest level: 5 stretches, excluded
+    fig = plotting_escape(ds)
+    FigureCanvasAgg(fig).draw()
+    panels = [ax for ax in fig.axes if ax.get_visible() and ax.get_ylabel()]
+    assert len(panels) == 2
+    for ax in panels:
+        assert ax.get_yscale() == "log"
+        assert any(p.get_gid() == "outside_fit" for p in ax.patches)
+    first = panels[0]
+    fits = [line for line in first.get_lines() if line.get_gid() == "fit"]
+    assert len(fits) == 3                       # (1/1), (2/1) and none: each >= 2 levels
+    excluded = [c for c in first.containers if c.lines[0].get_gid() == "excluded_points"]
+    assert excluded                               # rms 0.4 and the weak (1/1) level
+    legend = " ".join(t.get_text() for t in first.get_legend().get_texts())
+    assert "(1/1): $\\Delta$ = 0.16 [" in legend
+    assert "(1/1) 90 % at rms 0.15" in first.get_title()
+
+
+def test_a_figure_without_a_usable_state_says_so():
+    ds = _synthetic()
+    ds["n_stretches"][:] = 1
+    fig = plotting_escape(ds)
+    FigureCanvasAgg(fig).draw()
+    notes = [t.get_text() for ax in fig.axes for t in ax.texts if t.get_gid() == "note"]
+    assert notes and "no state with 20 complete stretches" in notes[0]
+
+
+def plotting_escape(ds):
+    from vibroimpact.plotting import escape_vs_noise
+
+    return escape_vs_noise(ds)
+
+
+# --- the rules -------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    return make_workdir(tmp_path_factory.mktemp("wf_escape"))
+
+
+def test_escape_vs_noise_schedules_only_the_escape_jobs(workdir):
+    """No noise file, no map simulation: the levels make their own records."""
+    assert scheduled_rules(workdir, "results/figures/escape_vs_noise.png") == {
+        "simulate_escape", "aggregate_escape", "draw_figure", "copy_paper_figure"}
+
+
+@pytest.mark.workflow
+def test_escape_vs_noise_builds(workdir):
+    snakemake(workdir, "results/figures/escape_vs_noise.png", timeout=600)
+    for ext in ("png", "pdf"):
+        assert_figure(workdir / f"results/figures/escape_vs_noise.{ext}")
+    ds = xr.load_dataset(workdir / "results/datasets/motion_map_escape.nc")
+    assert dict(ds.sizes) == {"rms": 3, "cell": 2, "state": 4}
+    assert ds.attrs["config_digest"] and ds.attrs["seed"] == 19741001
+    assert not list((workdir / "results").rglob(".*.nc*"))      # no temporaries left
+    assert not (workdir / "results" / "noise").exists()
