@@ -298,6 +298,10 @@ def test_fig09_envelope_theory_only_where_it_applies_unless_asked(data):
                  t.get_text()][0]
         assert "white noise at $\\omega = 1$" in label and "\\varepsilon \\to 1" in label
         assert ("OUTSIDE its range" in label) == (not attrs)
+    silent = events.copy()
+    silent.attrs.update(linear_sigma_x=0.0, eps=0.9)   # no random force: nothing to say
+    assert not [t for t in plotting.fig09(silent).legends[0].get_texts()
+                if "energy-envelope" in t.get_text()]
     with pytest.raises(ValueError, match="envelope"):
         plotting.fig09(events, envelope="yes")
 

@@ -172,7 +172,7 @@ def fig07(events, density_delta=None, envelope="auto"):
                                 _events_params(events, 0), density_delta, linear=True)
     theory = _envelope(events, envelope)
     if theory is None:
-        if envelope == "auto" and events.attrs.get("linear_sigma_x") is not None:
+        if envelope == "auto":
             _envelope_note(fig, None, False, "", events)
         return fig
     ds = events.isel(inv_beta=0)
@@ -192,7 +192,8 @@ def fig07(events, density_delta=None, envelope="auto"):
             line.set_gid("envelope")
         drawn = True
     axes[0].set_ylim(low, top)      # the theory's far tail does not stretch the log axis
-    _envelope_note(fig, theory, drawn, "wide pale lines, each in its $\\delta$'s colour")
+    _envelope_note(fig, theory, drawn, "wide pale lines, each in its $\\delta$'s colour",
+                   events)
     return fig
 
 
@@ -363,7 +364,7 @@ def fig09(events, envelope="auto"):
         marks.append(Line2D([], [], color=ENVELOPE_COLOR, ls=theory["ls"], lw=1.2,
                             label=_envelope_label(theory, r"(a) $\varepsilon\langle V\rangle$, "
                                                           r"(b) $1/\nu$")))
-    elif theory is not None or envelope == "auto":
+    elif envelope != "never" and _envelope_absent(events, theory):
         marks.append(Line2D([], [], ls="none", label=_envelope_absent(events, theory)))
     if record is not None:
         marks.append(Line2D([], [], color="0.45", ls=":", lw=1.0,
@@ -421,26 +422,31 @@ def _envelope_label(theory, what, sep=" "):
 
 
 def _envelope_absent(events, theory, sep=" "):
-    """Legend text saying why the energy-envelope theory is not drawn."""
-    if theory is None and events.attrs.get("linear_sigma_x") is not None and float(
+    """Legend text saying why the energy-envelope theory is not drawn (`theory` from
+    :func:`_envelope`): eps outside its range, or no play it covers; None for a force without
+    a random part (no wall-free sigma_x), where it has nothing to say."""
+    if theory is not None:
+        return rf"energy-envelope theory: no $\delta \geq$ {_num(ENVELOPE_DELTA_MIN)} to draw"
+    if float(events.attrs.get("linear_sigma_x", 0.0)) > 0.0 and float(
             _attr(events, "eps")) < ENVELOPE_EPS_MIN:
         return (rf"energy-envelope theory ($\varepsilon \to 1$) not drawn:{sep}"
                 rf"$\varepsilon$ = {_num(_attr(events, 'eps'))} is outside its range "
                 rf"$\varepsilon \geq$ {_num(ENVELOPE_EPS_MIN)} (docs/model.md 7.2)")
-    return rf"energy-envelope theory: no $\delta \geq$ {_num(ENVELOPE_DELTA_MIN)} to draw"
+    return None
 
 
 def _envelope_note(fig, theory, drawn, how, events=None):
     """Add the energy-envelope entry to fig07's legend (below the axes): the curves drawn
     (`theory`, when `drawn`), or why there are none."""
     legend = fig.legends[0] if fig.legends else None
-    if legend is None:
+    absent = None if drawn else _envelope_absent(events, theory, "\n")
+    if legend is None or not (drawn or absent):
         return
     entry = (Line2D([], [], color="0.3", ls=theory["ls"], lw=ENVELOPE_DENSITY_LW, alpha=0.4,
                     label=_envelope_label(theory, "density of $\\varepsilon V$", "\n")
                     + f"\n{how}")
              if drawn else
-             Line2D([], [], ls="none", label=_envelope_absent(events, theory, "\n")))
+             Line2D([], [], ls="none", label=absent))
     handles = list(legend.legend_handles) + [entry]
     labels = [t.get_text() for t in legend.get_texts()] + [entry.get_label()]
     title = legend.get_title().get_text()
