@@ -163,7 +163,8 @@ def truncated_gaussian_pdf(x, sigma_x: float, delta: float):
 
 #: Points of the grid in the impact velocity u = sqrt(2 H - delta^2) on which the
 #: energy-envelope integrals are taken (Simpson's rule; the inner integral J(u) by the
-#: trapezoidal rule): relative error ~1e-9 at eps = 1, ~1e-7 below.
+#: trapezoidal rule): relative error ~1e-12 at eps = 1, ~5e-7 below (measured against
+#: 16 and 64 times finer grids).
 ENVELOPE_NODES = 4097
 #: The grid ends at this many sigma = sqrt(S0 / (4 zeta)) of u: the density there is below
 #: exp(-12^2 / 2) ~ 5e-32 of its peak.
@@ -349,8 +350,7 @@ def envelope_energy_pdf(H, delta: float, *, eps: float, zeta: float, S0: float):
     Z = z_low + _simpson(T * weight * u, u)
     H = np.asarray(H, dtype=float)
     d = float(delta)
-    with np.errstate(invalid="ignore"):
-        v = np.sqrt(np.maximum(2.0 * H - d * d, 0.0))
+    v = np.sqrt(np.maximum(2.0 * H - d * d, 0.0))
     above = np.interp(v, u, T * weight, right=0.0)
     below = 2.0 * np.pi * np.exp(-np.maximum(H, 0.0) / s2)
     p = np.where(2.0 * H >= d * d, above, np.where(d > 0.0, below, 0.0)) / Z
