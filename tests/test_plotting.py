@@ -12,6 +12,7 @@ import os
 import numpy as np
 import pytest
 import xarray as xr
+from matplotlib.colors import same_color
 from matplotlib.figure import Figure
 
 from helpers import assert_figure
@@ -261,6 +262,68 @@ def test_fig09_draws_rice_asymptotes_of_the_wall_free_response(data):
     assert not [ln for ax in plotting.fig09(events).axes for ln in ax.get_lines()
                 if ln.get_gid() == "rice"]
 
+
+
+def _envelope_lines(fig):
+    return [[ln for ln in ax.get_lines() if ln.get_gid() == "envelope"] for ax in fig.axes]
+
+
+def test_fig09_envelope_theory_only_where_it_applies_unless_asked(data):
+    """The energy-envelope curves (gid "envelope") are those of `stats.energy_envelope` at
+    S0 = 4 zeta sigma_x^2, on delta >= 0 only; at the fixture's eps = 0.5 (outside the range
+    eps >= 0.8) they are left out with a note, drawn dash-dotted and labelled on request."""
+    events = data["events"]
+    eps, zeta = float(events.attrs["eps"]), float(events.attrs["zeta"])
+    assert eps < stats.ENVELOPE_EPS_MIN
+    fig = plotting.fig09(events)
+    assert _envelope_lines(fig) == [[], []]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert any("not drawn" in s and "outside its range" in s for s in labels)
+    assert not [s for s in [t.get_text() for t in plotting.fig09(events, envelope="never")
+                            .legends[0].get_texts()] if "energy-envelope" in s]
+    s0 = 4 * zeta * float(events.attrs["linear_sigma_x"]) ** 2
+    for attrs, style in (({}, "-."), ({"eps": 0.9}, "-")):
+        ev = events.copy()
+        ev.attrs.update(attrs)
+        fig = plotting.fig09(ev, envelope="always" if not attrs else "auto")
+        (v_line,), (z_line,) = _envelope_lines(fig)
+        d = np.asarray(v_line.get_xdata(), dtype=float)
+        assert d.min() == pytest.approx(stats.ENVELOPE_DELTA_MIN)
+        assert d.max() == pytest.approx(float(ev["delta"].max()))
+        th = stats.energy_envelope(d, eps=float(ev.attrs["eps"]), zeta=zeta, S0=s0)
+        np.testing.assert_allclose(v_line.get_ydata(), th.v_after_mean, rtol=1e-12)
+        np.testing.assert_allclose(z_line.get_ydata(), th.interval_mean, rtol=1e-12)
+        assert v_line.get_linestyle() == style
+        label = [t.get_text() for t in fig.legends[0].get_texts() if "energy-envelope" in
+                 t.get_text()][0]
+        assert "white noise at $\\omega = 1$" in label and "\\varepsilon \\to 1" in label
+        assert ("OUTSIDE its range" in label) == (not attrs)
+    silent = events.copy()
+    silent.attrs.update(linear_sigma_x=0.0, eps=0.9)   # no random force: nothing to say
+    assert not [t for t in plotting.fig09(silent).legends[0].get_texts()
+                if "energy-envelope" in t.get_text()]
+    with pytest.raises(ValueError, match="envelope"):
+        plotting.fig09(events, envelope="yes")
+
+
+def test_fig07_envelope_densities_for_the_plays_it_covers(data):
+    events = data["events"].copy()
+    events.attrs["eps"] = 0.9
+    fig = plotting.fig07(events, density_delta=DENSITY_DELTA)
+    drawn = _envelope_lines(fig)
+    deltas = [2.0, 0.5, 0.0]                       # the density deltas >= 0, largest first
+    assert [len(lines) for lines in drawn] == [len(deltas)] * 2
+    s0 = 4 * 0.05 * float(events.attrs["linear_sigma_x"]) ** 2
+    data_colors = [ln.get_color() for ln in _data_lines(fig.axes[0])
+                   if ln.get_gid() != "envelope"]
+    for k, (line, d) in enumerate(zip(drawn[0], deltas)):
+        w, p = (np.asarray(v, dtype=float) for v in line.get_data())
+        expected = stats.envelope_v_after_pdf(w, d, eps=0.9, zeta=0.05, S0=s0)
+        np.testing.assert_allclose(p[np.isfinite(p)], expected[np.isfinite(p)], rtol=1e-12)
+        assert same_color(line.get_color(), data_colors[k])   # its delta curve's colour
+    assert any("energy-envelope" in s for s in _legend_texts(fig.axes[0]))
+    events.attrs["eps"] = 0.5
+    assert _envelope_lines(plotting.fig07(events, density_delta=DENSITY_DELTA)) == [[], []]
 
 def test_events_store_batch_lag1_and_no_ratio_statistics_without_harmonic(data):
     events, harmonic = data["events"], data["events_h"]

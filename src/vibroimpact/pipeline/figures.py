@@ -45,7 +45,7 @@ FIGURES = {
                   shows="the PSD of the acceleration a(tau) for several plays delta, with the "
                         "wall-free response |H|^2 S_f"),
     "fig07": dict(draw="random:fig07",
-                  owner="study", reads=("events",), options=("density_delta",),
+                  owner="study", reads=("events",), options=("density_delta", "envelope"),
                   shows="the probability density of the velocity after impact for several "
                         "plays delta"),
     "fig08": dict(draw="random:fig08",
@@ -53,7 +53,7 @@ FIGURES = {
                   shows="the probability density of the interval between impacts for several "
                         "plays delta"),
     "fig09": dict(draw="random:fig09",
-                  owner="study", reads=("events",),
+                  owner="study", reads=("events",), options=("envelope",),
                   shows="the mean velocity after impact and the mean interval against delta, "
                         "with batch-means confidence bars, down to the play beyond which no "
                         "impact occurs"),

@@ -8,9 +8,11 @@ from matplotlib.patches import Patch
 from vibroimpact.plotting._common import (
     CONFIDENCE, FEW_IMPACTS, SPECTRUM_BETA_MAX, STOP_BAND_LEVEL, _attr, _density_figure,
     _events_params, _figure, _header, _headroom, _num, _padded, _panel_tag, _psd_label, _require,
-    _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label, no_collision_text,
-    note_on_axes, t_quantile)
-from vibroimpact.stats.theory import upcrossing_rate
+    _density_deltas, _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label,
+    family_styles, no_collision_text, note_on_axes, t_quantile)
+from vibroimpact.stats.theory import (
+    ENVELOPE_DELTA_MIN, ENVELOPE_EPS_MIN, energy_envelope, envelope_v_after_pdf,
+    upcrossing_rate)
 
 #: fig05 draws the PSD of the piecewise-linear force as its own line when it differs from the
 #: target of the samples by more than this fraction of the target's peak on the axis shown.
@@ -143,7 +145,7 @@ def fig06(spectra, beta_max=SPECTRUM_BETA_MAX):
 
 
 @_styled
-def fig07(events, density_delta=None):
+def fig07(events, density_delta=None, envelope="auto"):
     """Fig. 7: probability density of the velocity after impact, one curve per density delta.
 
     Parameters
@@ -153,16 +155,45 @@ def fig07(events, density_delta=None):
     density_delta : sequence of float, optional
         Deltas to draw (the dataset's nearest values; config key ``density_delta``); default
         the largest seven of the dataset.
+    envelope : {"auto", "always", "never"}
+        The energy-envelope theory's density (`vibroimpact.stats.envelope_v_after_pdf`):
+        drawn where it applies, also outside it (dash-dotted, labelled so), or never; at
+        delta >= `ENVELOPE_DELTA_MIN` only. See :func:`fig09`.
 
     Returns
     -------
     matplotlib.figure.Figure
         (a) log and (b) linear density axes, one line per (distinct) density delta with a
-        shaded 95 % band; sparse bins merged (`MIN_BIN_COUNT`).
+        shaded 95 % band; sparse bins merged (`MIN_BIN_COUNT`). The theory, when drawn, is a
+        thin line of its delta's colour (gid ``"envelope"``).
     """
-    fig, _ = _density_figure(events, 0, "v_after_density",
-                             "Fig. 7  Probability density of the velocity after impact",
-                             _events_params(events, 0), density_delta, linear=True)
+    fig, axes = _density_figure(events, 0, "v_after_density",
+                                "Fig. 7  Probability density of the velocity after impact",
+                                _events_params(events, 0), density_delta, linear=True)
+    theory = _envelope(events, envelope)
+    if theory is None:
+        if envelope == "auto":
+            _envelope_note(fig, None, False, "", events)
+        return fig
+    ds = events.isel(inv_beta=0)
+    index = _density_deltas(events, density_delta)
+    w = np.linspace(*axes[0].get_xlim(), 400)[1:]
+    low, top = axes[0].get_ylim()
+    drawn = False
+    for style, k in zip(family_styles(len(index)), index):
+        delta = float(ds["delta"][k])
+        if delta < ENVELOPE_DELTA_MIN:
+            continue
+        p = envelope_v_after_pdf(w, delta, eps=theory["eps"], zeta=theory["zeta"],
+                                 S0=theory["S0"])
+        for ax in axes:
+            (line,) = ax.plot(w, np.where(p > 0.0, p, np.nan), color=style["color"],
+                              ls=theory["ls"], lw=ENVELOPE_DENSITY_LW, alpha=0.4, zorder=1)
+            line.set_gid("envelope")
+        drawn = True
+    axes[0].set_ylim(low, top)      # the theory's far tail does not stretch the log axis
+    _envelope_note(fig, theory, drawn, "wide pale lines, each in its $\\delta$'s colour",
+                   events)
     return fig
 
 
@@ -211,7 +242,7 @@ RICE_TO_SIGMA = 30.0
 
 
 @_styled
-def fig09(events):
+def fig09(events, envelope="auto"):
     """Fig. 9: mean velocity after impact and mean interval against delta, 95 % bars.
 
     Parameters
@@ -221,6 +252,13 @@ def fig09(events):
         ``v_after_stderr``, ``interval_mean``, ``interval_stderr``, ``n_collisions``,
         ``n_batches``; attributes ``record_length`` and, to draw Rice's asymptotes,
         ``linear_sigma_x`` and ``linear_sigma_v``.
+    envelope : {"auto", "always", "never"}
+        The energy-envelope averaging (`vibroimpact.stats.energy_envelope`, docs/model.md
+        section 7.2): ``"auto"`` draws it where it applies (eps >= `ENVELOPE_EPS_MIN`,
+        delta >= `ENVELOPE_DELTA_MIN`) and otherwise says in the legend that it is not
+        drawn; ``"always"`` draws it at every delta >= `ENVELOPE_DELTA_MIN` also for a
+        smaller eps, dash-dotted and labelled as outside its range; ``"never"`` leaves it
+        out. Its white-noise level at the resonance is ``S0 = 4 zeta sigma_x^2``.
 
     Returns
     -------
@@ -233,7 +271,8 @@ def fig09(events):
         impact ``eps sigma_v sqrt(pi/2)`` and the mean interval ``1/nu+(delta)``, with the
         record length, beyond which no interval can be measured. The plays with no
         collision in the record are shaded (gid ``"no_collision"``), from
-        :func:`critical_delta` on: a property of this record, not a threshold.
+        :func:`critical_delta` on: a property of this record, not a threshold. The
+        energy-envelope theory (gid ``"envelope"``): (a) ``eps <V>``, (b) ``1 / nu``.
     """
     fig, axes = _figure(2)
     fig.set_figheight(FIG09_HEIGHT)
@@ -262,6 +301,14 @@ def fig09(events):
         eps = float(_attr(ds, "eps"))
         asymptotes = (np.full_like(d_rice, eps * sigma_v * np.sqrt(np.pi / 2.0)),
                       1.0 / upcrossing_rate(d_rice, sigma_x, sigma_v))
+    theory = _envelope(events, envelope)
+    if theory is not None:
+        lo = max(ENVELOPE_DELTA_MIN, delta.min())
+        d_env = np.linspace(lo, delta.max(), 200) if lo < delta.max() else np.empty(0)
+        if d_env.size:
+            th = energy_envelope(d_env, eps=theory["eps"], zeta=theory["zeta"],
+                                 S0=theory["S0"])
+            envelope_curves = (th.v_after_mean, th.interval_mean)
     few_any = False
     for k, (ax, name, color) in enumerate(zip(axes, ("v_after", "interval"), ("C0", "C1"))):
         mean = np.asarray(ds[f"{name}_mean"], dtype=float)
@@ -276,6 +323,10 @@ def fig09(events):
         if rice:
             (line,) = ax.plot(d_rice, asymptotes[k], color="0.25", ls="--", lw=1.1)
             line.set_gid("rice")
+        if theory is not None and d_env.size:
+            (line,) = ax.plot(d_env, envelope_curves[k], color=ENVELOPE_COLOR,
+                              ls=theory["ls"], lw=1.2)
+            line.set_gid("envelope")
         if np.isfinite(d_c):
             span = ax.axvspan(d_c, delta.max(), color="0.85", lw=0, zorder=0)
             span.set_gid("no_collision")
@@ -309,6 +360,12 @@ def fig09(events):
                                   r"e^{-\delta^2/2\sigma_x^2}$ "
                                   rf"($\sigma_x$ = {_num(sigma_x)}, $\sigma_v$ = {_num(sigma_v)}: "
                                   "wall-free response)"))
+    if theory is not None and d_env.size:
+        marks.append(Line2D([], [], color=ENVELOPE_COLOR, ls=theory["ls"], lw=1.2,
+                            label=_envelope_label(theory, r"(a) $\varepsilon\langle V\rangle$, "
+                                                          r"(b) $1/\nu$")))
+    elif envelope != "never" and _envelope_absent(events, theory):
+        marks.append(Line2D([], [], ls="none", label=_envelope_absent(events, theory)))
     if record is not None:
         marks.append(Line2D([], [], color="0.45", ls=":", lw=1.0,
                             label=f"(b) record length {float(record):.3g}: no longer "
@@ -324,3 +381,75 @@ def fig09(events):
     _header(fig, "Fig. 9  Mean velocity after impact and mean interval between collisions",
             _events_params(events, 0))
     return fig
+
+
+#: Colour of the energy-envelope theory in fig09 (fig07 draws it in each delta's colour).
+ENVELOPE_COLOR = "C2"
+#: Its line style where it applies, and where it is drawn outside its range.
+ENVELOPE_LS, ENVELOPE_OUTSIDE_LS = "-", "-."
+#: Width of fig07's theory densities: wide and pale (alpha 0.4), behind the measured ones.
+ENVELOPE_DENSITY_LW = 3.0
+_ENVELOPE_MODES = ("auto", "always", "never")
+
+
+def _envelope(events, envelope):
+    """What fig07 and fig09 need to draw the energy-envelope theory, or None when it is not
+    drawn: ``eps``, ``zeta``, ``S0 = 4 zeta sigma_x^2``, whether eps is in its range
+    (``inside``), its line style."""
+    if envelope not in _ENVELOPE_MODES:
+        raise ValueError(f"envelope must be one of {_ENVELOPE_MODES}, got {envelope!r}")
+    sigma_x = events.attrs.get("linear_sigma_x")
+    if envelope == "never" or sigma_x is None or not float(sigma_x) > 0.0:
+        return None
+    eps, zeta = float(_attr(events, "eps")), float(_attr(events, "zeta"))
+    inside = eps >= ENVELOPE_EPS_MIN
+    if envelope == "auto" and not inside:
+        return None
+    return dict(eps=eps, zeta=zeta, S0=4.0 * zeta * float(sigma_x) ** 2, inside=inside,
+                ls=ENVELOPE_LS if inside else ENVELOPE_OUTSIDE_LS)
+
+
+def _envelope_label(theory, what, sep=" "):
+    """Legend text of the energy-envelope curves: what they are and under which assumptions
+    (`sep` between its parts: a newline for a narrow legend column)."""
+    text = (rf"energy-envelope averaging,{sep}$\varepsilon \to 1$, white noise at $\omega = 1$ "
+            rf"($S_f(1) = 4\zeta\sigma_x^2$ = {_num(theory['S0'])}):{sep}{what}, "
+            rf"$\delta \geq$ {_num(ENVELOPE_DELTA_MIN)}")
+    if not theory["inside"]:
+        text += (";\n" rf"OUTSIDE its range ($\varepsilon$ = {_num(theory['eps'])} < "
+                 rf"{_num(ENVELOPE_EPS_MIN)}): for orientation only")
+    return text
+
+
+def _envelope_absent(events, theory, sep=" "):
+    """Legend text saying why the energy-envelope theory is not drawn (`theory` from
+    :func:`_envelope`): eps outside its range, or no play it covers; None for a force without
+    a random part (no wall-free sigma_x), where it has nothing to say."""
+    if theory is not None:
+        return rf"energy-envelope theory: no $\delta \geq$ {_num(ENVELOPE_DELTA_MIN)} to draw"
+    if float(events.attrs.get("linear_sigma_x", 0.0)) > 0.0 and float(
+            _attr(events, "eps")) < ENVELOPE_EPS_MIN:
+        return (rf"energy-envelope theory ($\varepsilon \to 1$) not drawn:{sep}"
+                rf"$\varepsilon$ = {_num(_attr(events, 'eps'))} is outside its range "
+                rf"$\varepsilon \geq$ {_num(ENVELOPE_EPS_MIN)} (docs/model.md 7.2)")
+    return None
+
+
+def _envelope_note(fig, theory, drawn, how, events=None):
+    """Add the energy-envelope entry to fig07's legend (below the axes): the curves drawn
+    (`theory`, when `drawn`), or why there are none."""
+    legend = fig.legends[0] if fig.legends else None
+    absent = None if drawn else _envelope_absent(events, theory, "\n")
+    if legend is None or not (drawn or absent):
+        return
+    entry = (Line2D([], [], color="0.3", ls=theory["ls"], lw=ENVELOPE_DENSITY_LW, alpha=0.4,
+                    label=_envelope_label(theory, "density of $\\varepsilon V$", "\n")
+                    + f"\n{how}")
+             if drawn else
+             Line2D([], [], ls="none", label=absent))
+    handles = list(legend.legend_handles) + [entry]
+    labels = [t.get_text() for t in legend.get_texts()] + [entry.get_label()]
+    title = legend.get_title().get_text()
+    legend.remove()
+    fig.legend(handles, labels, loc="outside lower center", ncols=2, title=title,
+               title_fontsize=7.5, fontsize=7.5)

@@ -440,3 +440,91 @@ def main(argv=None):
 
 if __name__ == "__main__":
     main()
+
+
+#: A residual of the self-audit fails beyond this many of its batch-means standard errors.
+#: The residual of an exact record is a boundary term, typically 1/sqrt(B) of its standard
+#: error (docs/model.md, section 7.1), so 3 is far out for every cell of a sweep.
+AUDIT_SIGMAS = 3.0
+#: Sweeps with more cells than this are summarised: the largest ratios, then the worst cells.
+AUDIT_ROWS = 12
+#: How many of the worst cells the summary (and a failed verdict) lists.
+AUDIT_WORST = 5
+#: The identities of the self-audit: (name, residual variable, its scale, how the scale reads).
+_IDENTITIES = (("power", "power_residual", "power_input", "<f v>"),
+               ("virial", "virial_residual", "virial_scale", "<v^2>"))
+
+
+def identity_audit(events):
+    """The events dataset's self-audit: the power-balance and virial residuals of every cell
+    (docs/model.md, section 7.1) against their batch-means standard errors.
+
+    Returns a verdict (Markdown: whether every ``|residual| <= AUDIT_SIGMAS`` standard
+    errors, or which cells fail) and a table: per cell (``delta``, with ``1/beta_f`` when
+    the dataset has several), for each identity the residual, its standard error, their
+    ratio and the residual relative to its scale (``<f v>``, ``<v^2>``). Beyond `AUDIT_ROWS`
+    cells, the `AUDIT_WORST` cells with the largest ratio. A dataset without residuals (older
+    than the audit, or not an events dataset) gives a note.
+    """
+    import pandas as pd
+    from IPython.display import Markdown, display
+
+    if events is None or "power_residual" not in events:
+        return Markdown("*This study's events dataset carries no identity residuals.*")
+    table = {}
+    for name, var, scale, _ in _IDENTITIES:
+        residual = events[var].to_series()
+        stderr = events[f"{var}_stderr"].to_series()
+        table[(name, "residual")] = residual
+        table[(name, "s.e.")] = stderr
+        with np.errstate(divide="ignore", invalid="ignore"):
+            table[(name, "residual / s.e.")] = residual / stderr
+            table[(name, "residual / scale")] = residual / events[scale].to_series().abs()
+    frame = pd.DataFrame(table)
+    if frame.index.get_level_values("inv_beta").nunique() == 1:
+        frame.index = frame.index.droplevel("inv_beta")
+    ratios = frame.xs("residual / s.e.", axis=1, level=1).abs()
+    worst = ratios.max(axis=1)
+    display(Markdown(_audit_verdict(ratios)))
+    shown = frame
+    if len(frame) > AUDIT_ROWS:
+        shown = frame.loc[worst.sort_values(ascending=False).index[:AUDIT_WORST]]
+        display(Markdown(f"The {AUDIT_WORST} of {len(frame)} cells with the largest "
+                         "|residual| / s.e.:"))
+    formats = {c: "{:.2f}" if c[1] == "residual / s.e." else "{:.2e}" for c in frame.columns}
+    # class names of its own: a report's findings table is read by its "data" cells
+    names = {"data": "audit", "row_heading": "audit_cell", "col_heading": "audit_column"}
+    return (shown.style.format(formats).format_index("{:.4g}", axis=0)
+            .set_table_styles([], css_class_names=names))
+
+
+def _audit_verdict(ratios):
+    """One line: every residual within `AUDIT_SIGMAS` standard errors, or the failures."""
+    values = ratios.to_numpy()
+    if not np.isfinite(values).all():
+        bad = ratios.columns[~np.isfinite(values).all(axis=0)].tolist()
+        return (f"**Self-audit: cannot decide** ({', '.join(bad)}: a standard error of 0 or "
+                "NaN; too few batches?).")
+    entries = [(float(r), name, _cell_text(ratios.index, cell))
+               for cell, row in ratios.iterrows() for name, r in row.items()]
+    fails = [e for e in entries if e[0] > AUDIT_SIGMAS]
+    if not fails:
+        r, name, where = max(entries)
+        return (f"**Self-audit passed:** all {len(entries)} residuals (power balance and "
+                f"virial, {len(ratios)} cells) within {AUDIT_SIGMAS:g} standard errors; the "
+                f"largest, {r:.2f} s.e., is the {name} at {where}.")
+    fails.sort(key=lambda e: -e[0])
+    listed = "; ".join(f"{name} at {where} ({r:.1f} s.e.)"
+                       for r, name, where in fails[:AUDIT_WORST])
+    if len(fails) > AUDIT_WORST:
+        listed += f"; and {len(fails) - AUDIT_WORST} more"
+    return (f"**Self-audit FAILED:** {len(fails)} of {len(entries)} residuals beyond "
+            f"{AUDIT_SIGMAS:g} standard errors: {listed}. The impact record disagrees with "
+            "the motion there (docs/model.md, section 7.1).")
+
+
+def _cell_text(index, cell):
+    """``delta = 0.5`` (or ``1/beta_f = 1.1, delta = 0.5``) for a cell of the audit table."""
+    cell = cell if isinstance(cell, tuple) else (cell,)
+    names = ["1/beta_f" if n == "inv_beta" else n for n in index.names]
+    return ", ".join(f"{n} = {float(v):.4g}" for n, v in zip(names, cell))

@@ -11,7 +11,8 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
 - `residence`: residence times in the motions and the rates of switching between them;
 - `escape`: the Arrhenius fit of residence times against the noise level;
-- `theory`: the wall-free linear response, elastic impacts under white noise;
+- `theory`: the wall-free linear response, elastic impacts under white noise, and the
+  energy-envelope averaging for eps near 1;
 - `identities`: the power balance and the virial of a stationary record (a self-audit).
 
 Every public name is re-exported here lazily (``vibroimpact.stats.density``), so a job that
@@ -40,7 +41,10 @@ _WHERE = {
     "EscapeFit": "escape", "escape_fit": "escape",
     "linear_response_std": "theory", "elastic_impact_rate": "theory",
     "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
-    "truncated_gaussian_pdf": "theory",
+    "truncated_gaussian_pdf": "theory", "EnvelopeTheory": "theory",
+    "energy_envelope": "theory", "envelope_v_after_pdf": "theory",
+    "envelope_energy_pdf": "theory",
+    "ENVELOPE_EPS_MIN": "theory", "ENVELOPE_DELTA_MIN": "theory",
     "flight_moments": "identities", "identity_residuals": "identities",
     "IdentityResiduals": "identities",
 }
