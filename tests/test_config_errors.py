@@ -277,7 +277,7 @@ CASES = [
     _c("figure_option_not_applicable", R + ("figures",),
        ["fig03", "fig04", "fig05", "fig06", "fig07", "fig08",
         {"name": "fig09", "density_delta": [0.0]}],
-       "studies.random.figures[6].density_delta", "not an option of fig09; allowed: only name"),
+       "studies.random.figures[6].density_delta", "not an option of fig09; allowed: name, envelope"),
     _c("figure_listed_twice", R + ((APPEND, "figures", "fig07"),), None,
        "studies.random.figures[7]", "each figure once"),
     _c("figure_unknown_fig02", R + ("figures",),
