@@ -38,8 +38,8 @@ wildcard_constraints:
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
     # figNN or fig15_vs_fig16 of the figure table, -k: k-th value of a listed parameter (not a
     # sweep.png, nor the validation figures)
-    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov)(-[0-9]+)?",
-    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov",
+    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence)(-[0-9]+)?",
+    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence",
 
 
 STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}

@@ -87,6 +87,12 @@ FIGURES = {
                            harmonic=True,
                            shows="the probability contours of Fig. 15 over the stable domains "
                                  "of Fig. 16, with the agreement measures of each motion"),
+    "residence": dict(draw="maps:residence",
+                      owner="study", reads=("map",), harmonic=True,
+                      shows="the mean residence time (forcing periods) in each impact motion "
+                            "and in no listed motion, over the (1/beta_f, delta) plane of "
+                            "Fig. 15 under sin(beta_f tau) + r(tau); hatched cells hold few "
+                            "complete stretches"),
     "fig16": dict(draw="orbits:fig16",
                   owner="orbits", reads=("orbits", "boundaries"),
                   shows="the domains over the (1/beta_f, delta) plane of stable periodic "
@@ -254,7 +260,7 @@ def caption(kind, name, entry, target):
     number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
     what = FIGURES[fig]["shows"]
     title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
-             "lyapunov": "Lyapunov exponents"}.get(fig, f"Fig. {number}")
+             "lyapunov": "Lyapunov exponents", "residence": "Residence times"}.get(fig, f"Fig. {number}")
     parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
     if kind == "study":
         if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:
