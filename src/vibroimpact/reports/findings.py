@@ -433,9 +433,11 @@ def _predictors_text(predictors, motion):
     shown = {n: c for n, c in found.items() if c is not None and np.isfinite(c.rho)}
     if not shown:
         return ""
-    parts = [f"{n} {c.rho:+.2f} [{c.low:+.2f}, {c.high:+.2f}]" for n, c in shown.items()]
-    text = f"; inside the domain ({next(iter(shown.values())).n_cells} cells) rho with " + (
-        ", ".join(parts))
+    cells = next(iter(shown.values())).n_cells
+    parts = [f"{n} {c.rho:+.2f} [{c.low:+.2f}, {c.high:+.2f}]"
+             + (f" ({c.n_cells} cells)" if c.n_cells != cells else "")
+             for n, c in shown.items()]
+    text = f"; inside the domain ({cells} cells) rho with " + ", ".join(parts)
     free = {n: c for n, c in shown.items() if n != "residence" and _resolved(c)}
     if free:
         best = max(free, key=lambda n: abs(free[n].rho))
