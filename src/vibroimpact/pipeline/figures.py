@@ -260,7 +260,8 @@ def caption(kind, name, entry, target):
     number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
     what = FIGURES[fig]["shows"]
     title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
-             "lyapunov": "Lyapunov exponents", "residence": "Residence times"}.get(fig, f"Fig. {number}")
+             "lyapunov": "Lyapunov exponents",
+             "residence": "Residence times"}.get(fig, f"Fig. {number}")
     parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
     if kind == "study":
         if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:
