@@ -83,7 +83,7 @@ def test_the_harmonic_reports_show_what_predicts_p_and_whether_it_is_markov(buil
             table["stable domain: rho [95 %]"])
         assert any(cells[(r, 2)] for r in range(3, 9)), "no basin or Lyapunov correlation"
         text = html.read_text()
-        assert "markov_value" in text and "the bookkeeping, Markov or not" in text
+        assert "markov_value" in text and "(the bookkeeping, Markov or not)" in text
 
 
 def test_a_changed_dataset_changes_the_table(built, tmp_path):

@@ -50,7 +50,9 @@ PREDICTORS = {
 }
 #: The bootstrap's seed and number of resamples (module docstring).
 SEED = 19741974
-N_RESAMPLES = 2000
+N_RESAMPLES = 1000
+#: Resamples ranked at a time (memory: a few of (chunk, cells) float arrays).
+_CHUNK = 100
 #: Fewest cells a rank correlation is computed on.
 MIN_CELLS = 5
 
@@ -143,8 +145,12 @@ def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95):
     if n < MIN_CELLS or np.unique(x).size < 2 or np.unique(p).size < 2:
         return np.nan, np.nan, np.nan, n
     rho = float(_pearson_rows(_ranks(x), _ranks(p)))
-    idx = np.random.default_rng(seed).integers(0, n, size=(n_resamples, n))
-    boot = _pearson_rows(_ranks(x[idx]), _ranks(p[idx]))
+    rng = np.random.default_rng(seed)
+    boot = []
+    for start in range(0, n_resamples, _CHUNK):
+        idx = rng.integers(0, n, size=(min(_CHUNK, n_resamples - start), n))
+        boot.append(_pearson_rows(_ranks(x[idx]), _ranks(p[idx])))
+    boot = np.concatenate(boot)
     boot = boot[np.isfinite(boot)]
     tail = 50.0 * (1.0 - level)
     low, high = (np.percentile(boot, [tail, 100.0 - tail]) if boot.size
