@@ -516,7 +516,7 @@ FEW_STRETCHES_STYLE = dict(facecolor="none", edgecolor="0.35", hatch="xxx", line
 #: Marker of the cells where the state occurs only in the stretches cut by the record's ends
 #: (the one it starts in, the one it ends in): seen, not measured; a motion held through the
 #: whole record is one.
-ONLY_CUT_STYLE = dict(marker="^", color="#d55e00", markersize=5, linestyle="none")
+ONLY_CUT_STYLE = dict(facecolor="#f4c7a1", edgecolor="none", linewidth=0.0)
 
 
 @_styled
@@ -538,7 +538,7 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
         One panel per state, whole cells coloured by the mean length of the complete stretches
         in forcing periods on one logarithmic scale for all panels; hatched cells
         (gid ``"few_stretches"``) hold fewer than `min_stretches` complete stretches.
-        A triangle (gid ``"only_cut"``) marks a cell where the state occurs only in the
+        A pale orange cell (gid ``"only_cut"``) is one where the state occurs only in the
         stretches cut by the record's ends (``n_censored`` > 0, no complete stretch): seen,
         but not measured; a motion held through the whole record (P near 1) is one.
     """
@@ -570,8 +570,8 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
             ax.add_collection(PatchCollection(cell_rectangles(x, y, few), gid="few_stretches",
                                               **FEW_STRETCHES_STYLE), autolim=False)
         if cut is not None and cut[k].any():
-            i, j = np.nonzero(cut[k])
-            ax.plot(x[i], y[j], gid="only_cut", **ONLY_CUT_STYLE)
+            ax.add_collection(PatchCollection(cell_rectangles(x, y, cut[k]), gid="only_cut",
+                                              **ONLY_CUT_STYLE), autolim=False)
         ax.set_title("none" if name == "none" else f"({name})")
     _finish_axes(axes, motion_map)
     for ax in axes:                       # cells drawn whole: the extent is the cells' edges
@@ -586,8 +586,8 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
                       label=f"fewer than {min_stretches} complete stretches (blank: none)")]
                if few_any else [])
     if cut is not None and cut.any():
-        handles.append(Line2D([], [], **ONLY_CUT_STYLE,
-                              label="only in the stretch the record starts or ends in (no "
-                                    "complete stretch; e.g. held throughout)"))
+        handles.append(Patch(**ONLY_CUT_STYLE,
+                             label="only in the stretch the record starts or ends in (no "
+                                   "complete stretch; e.g. held throughout)"))
     return _finish_figure(fig, motion_map, handles, "Mean residence time in each impact motion "
                           "under harmonic plus random force")
