@@ -233,8 +233,10 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
     edit("config/test.yaml", _set(("orbits", "harmonic", "attractors", "n_starts"), 4))
     jobs = scheduled(repo)
-    # (the test config copies neither to a paper target, and no study report shows them)
-    assert set(jobs) == ATTRACTOR_RULES | {"draw_figure", "orbits_report", "all"}
+    # (the test config copies neither to a paper target; the study reports that show the
+    # map over this entry read the basins and exponents as predictors of the probabilities)
+    assert set(jobs) == ATTRACTOR_RULES | {"draw_figure", "orbits_report", "study_report",
+                                           "all"}
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
         "basins.png", "lyapunov.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())

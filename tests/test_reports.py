@@ -56,6 +56,36 @@ def test_the_tables_are_the_findings_of_the_datasets(built):
     assert sorted(harmonic) == [5, 6, 7, 8] and "n/a" not in harmonic.values()
 
 
+def _predictor_cells(html):
+    """The predictors table of a report's HTML: ``{(row, col): text}``."""
+    cells = re.findall(r'<td class="predictor_value row(\d+) col(\d+)"[^>]*>([^<]*)</td>',
+                       Path(html).read_text())
+    return {(int(r), int(c)): text.strip() for r, c, text in cells}
+
+
+def test_the_harmonic_reports_show_what_predicts_p_and_whether_it_is_markov(built):
+    """Both harmonic reports show the predictors table (4 predictors x 3 motions, the basins
+    and exponents of the test config's attractors on the map's grid) with the correlations
+    `reports.predictors` computes, and the Markov table with the bookkeeping check."""
+    from vibroimpact.reports import predictors
+
+    root = built / "results"
+    expected = predictors.predictor_correlations(
+        *(xr.load_dataset(root / p) for p in (
+            "datasets/motion_map_map.nc", "orbits/harmonic.nc", "orbits/harmonic_basins.nc",
+            "orbits/harmonic_lyapunov.nc")))
+    table = predictors.predictors_table(expected)
+    for study in ("harmonic", "motion_map"):
+        html = root / "reports" / study / "harmonic_random.html"
+        cells = _predictor_cells(html)
+        assert max(r for r, _ in cells) + 1 == len(table) == 12
+        assert [cells[(r, 0)] for r in range(len(table))] == list(
+            table["stable domain: rho [95 %]"])
+        assert any(cells[(r, 2)] for r in range(3, 9)), "no basin or Lyapunov correlation"
+        text = html.read_text()
+        assert "markov_value" in text and "(the bookkeeping, Markov or not)" in text
+
+
 def test_a_changed_dataset_changes_the_table(built, tmp_path):
     """Finding 2 on the test config holds; with the mean velocities reversed the rebuilt
     report says it does not (only the report and the figures of that dataset rerun)."""

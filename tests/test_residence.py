@@ -120,3 +120,67 @@ def test_bad_input_is_refused():
         stats.residence_statistics([0.0, 1.0], [2], 2)
     with pytest.raises(ValueError, match="non-decreasing"):
         stats.residence_statistics([0.0, 1.0, 0.5], [0, 1], 2)
+
+
+# --- is the sequence Markov? (stats.markov_residence_check, stats.jump_chain_independence) ---
+
+def _markov_chain(rates, total, seed):
+    """A continuous-time Markov chain with off-diagonal ``rates``: exponential stays of mean
+    1 / (row sum), the next state drawn by the row's rates, independent of the past."""
+    rng = np.random.default_rng(seed)
+    rates = np.asarray(rates, dtype=float)
+    out = rates.sum(axis=1)
+    t, state, edges, states = 0.0, 0, [0.0], []
+    while t < total:
+        t += rng.exponential(1.0 / out[state])
+        edges.append(min(t, total))
+        states.append(state)
+        state = rng.choice(len(out), p=rates[state] / out[state])
+    return np.array(edges), np.array(states)
+
+
+def test_a_simulated_markov_chain_passes_both_checks():
+    """Three states, unequal rates: every state's stretches have CV 1 within 2/sqrt(n), and
+    the next state does not depend on the previous one (p > 0.01; seeded)."""
+    rates = [[0.0, 0.3, 0.1], [0.05, 0.0, 0.05], [0.5, 0.2, 0.0]]
+    edges, states = _markov_chain(rates, 30_000.0, 11)
+    r = stats.residence_statistics(edges, states, 3)
+    check = stats.markov_residence_check(r.mean, r.stderr, r.n_stretches)
+    assert (r.n_stretches > 300).all()
+    assert check.markov.tolist() == [1.0, 1.0, 1.0], check
+    assert (np.abs(check.cv - 1.0) <= 2 / np.sqrt(r.n_stretches)).all()
+    statistic, dof, p = stats.jump_chain_independence(states, 3)
+    assert dof == 3 and p > 0.01, (statistic, p)
+
+
+def test_a_fixed_length_sequence_fails():
+    """Every stretch as long as the others: CV 0, many standard deviations below 1; a cycle
+    A B A C A B ...: from A the next state is set by the previous one."""
+    states = np.tile([0, 1, 0, 2], 100)
+    edges = np.arange(states.size + 1, dtype=float) * 3.0
+    r = stats.residence_statistics(edges, states, 3)
+    check = stats.markov_residence_check(r.mean, r.stderr, r.n_stretches)
+    np.testing.assert_allclose(check.cv, 0.0, atol=1e-12)
+    assert check.markov.tolist() == [0.0, 0.0, 0.0]
+    statistic, dof, p = stats.jump_chain_independence(states, 3)
+    assert dof == 1 and p < 1e-10
+
+
+def test_stays_in_whole_units_are_markov_when_geometric():
+    """A motion group that repeats with probability 1/2 whatever came before: a geometric
+    number of units (mean 2 units, CV sqrt(1/2)). Markov in units of its step; judged in
+    continuous time (unit 0) it would look too regular. Too few stretches: not judged."""
+    rng = np.random.default_rng(5)
+    stays = rng.geometric(0.5, 2000).astype(float)
+    mean, sd, n = stays.mean(), stays.std(ddof=1), stays.size
+    stepped = stats.markov_residence_check(mean, sd / np.sqrt(n), n, unit=1.0)
+    assert stepped.cv_markov == pytest.approx(np.sqrt(1 - 1 / mean))
+    assert stepped.markov == 1.0 and abs(stepped.z) < 2
+    assert stats.markov_residence_check(mean, sd / np.sqrt(n), n).markov == 0.0
+    few = stats.markov_residence_check(mean, sd / np.sqrt(9), 9, unit=1.0)
+    assert np.isnan(few.markov)
+
+
+def test_two_states_carry_no_jump_chain_information():
+    statistic, dof, p = stats.jump_chain_independence([0, 1, 0, 1, 1, 0], 2)
+    assert dof == 0 and np.isnan(p)

@@ -1,5 +1,6 @@
 """The `residence` map (`plotting.maps.residence`): not in the figure table yet."""
 import numpy as np
+import pytest
 import xarray as xr
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
@@ -50,3 +51,23 @@ def test_a_map_without_any_complete_stretch_says_so():
     FigureCanvasAgg(fig).draw()
     notes = [t.get_text() for ax in fig.axes for t in ax.texts if t.get_gid() == "note"]
     assert notes == ["no complete stretch of any motion"]
+
+
+def test_a_state_seen_only_in_cut_stretches_is_marked_not_left_blank():
+    """A motion held through the whole record has no complete stretch: no mean, but a pale
+    cell, so that it does not read as a motion that never occurs."""
+    t = np.full((4, 3, 2), 3.0)
+    n = np.full((4, 3, 2), 20)
+    t[0, 1, 1], n[0, 1, 1] = np.nan, 0          # held throughout: one stretch, cut twice
+    t[1, 2, 0], n[1, 2, 0] = np.nan, 0          # never occurs
+    ds = _map(t, n)
+    censored = np.zeros((4, 3, 2), int)
+    censored[0, 1, 1] = 1
+    ds["n_censored"] = (("state", "inv_beta", "delta"), censored)
+    fig = residence(ds)
+    FigureCanvasAgg(fig).draw()
+    panels = [ax for ax in fig.axes if ax.get_title()]
+    marks = [[c for c in ax.collections if c.get_gid() == "only_cut"] for ax in panels]
+    assert [len(m) for m in marks] == [1, 0, 0, 0]
+    (cell,) = marks[0][0].get_paths()
+    assert cell.get_extents().bounds == pytest.approx((0.75, 0.5, 0.5, 1.0))

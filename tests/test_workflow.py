@@ -88,6 +88,25 @@ def test_a_users_study_is_built_alone_with_the_papers_noise(workdir, tmp_path):
     assert "results/figures/mine/fig09.png" in snakemake(workdir, "-n", config=str(mine)).stdout
 
 
+def test_the_harmonic_reports_read_the_basins_and_exponents_of_the_map_s_orbits(workdir):
+    """The map's study draws Fig. 15 over orbits entry `harmonic`, which has attractors: both
+    harmonic reports read its basins and Lyapunov exponents (the predictors of P); the
+    random-force report does not."""
+    targets = [f"results/reports/{s}/harmonic_random.html" for s in ("harmonic", "motion_map")]
+    jobs = scheduled_jobs(workdir, *targets, "results/reports/random/random_force.html")
+    reports = {next(iter(j["output"])).split("/")[2]: j["input"] for j in jobs
+               if j["rule"] == "study_report"}
+    for study in ("harmonic", "motion_map"):
+        assert {"results/orbits/harmonic_basins.nc", "results/orbits/harmonic_lyapunov.nc",
+                "results/figures/motion_map/residence.png"} <= reports[study], study
+    assert not any("orbits" in p for p in reports["random"])
+
+
+def test_residence_needs_only_the_map(workdir):
+    assert scheduled_rules(workdir, "results/figures/residence.png") == {
+        "generate_noise", "simulate_map", "aggregate_map", "draw_figure", "copy_paper_figure"}
+
+
 def test_fig07_records_no_spectra(workdir):
     rules = scheduled_rules(workdir, "results/figures/fig07.png")
     assert "simulate_events" in rules
@@ -330,6 +349,34 @@ def test_finding7_velocity_after_impact_narrow_where_11_dominates(harmonic):
         return np.sqrt(((v - mean) ** 2 * d).sum() / d.sum()) / mean
 
     assert spread(1.0) < 0.5 * min(spread(0.25), spread(0.0), spread(-0.5))
+
+
+@pytest.mark.workflow
+def test_the_switching_rates_imply_the_stored_probabilities(built):
+    """The stationary distribution of each cell's switching rates against the fractions of
+    time it stores (per motion the probability plus its stick variant: the states merge the
+    two; "none" the rest): within one standard error in every cell. This holds Markov or not
+    (the switches into and out of a state differ by at most one: `stats.residence`), so it
+    checks the bookkeeping; where the sequence is Markov is the CV check's
+    (`reports.switching.markov_summary`), which the report shows. Measured on the test
+    config: 45 of 45 cells, largest |pi - fraction| 0.018 (0.79 standard errors); every
+    judged motion cell (29, 17, 11) close to Markov. On the default map every cell with 10
+    switches or more is within (4138 cells, largest deviation 0.011); 79 cells with at most 7
+    switches are not: there the one unbalanced switch at the record's end weighs."""
+    from vibroimpact.reports import switching
+
+    m = xr.load_dataset(built / "results" / "datasets" / "motion_map_map.nc")
+    check = switching.stationary_check(m)
+    # the identity's end term is one switch: measured 45 of 45 cells within, whatever their
+    # switches; held where the switches are many (the default map: every such cell)
+    many = check["n_switches"] >= m.attrs["min_switches"]
+    assert many.sum() >= 10
+    assert check["within"].all(axis=-1)[many].all(), np.argwhere(~check["within"].all(-1))
+    np.testing.assert_allclose(check["fraction"].sum(axis=-1), 1.0, atol=1e-12)
+    summary = switching.markov_summary(m)
+    judged = summary.loc[["(1/1)", "(2/1)", "(1/2)"]]
+    assert (judged["close to Markov"] + judged["too regular"] + judged["too irregular"]
+            > 0).all()
 
 
 @pytest.mark.workflow

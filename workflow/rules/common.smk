@@ -39,8 +39,8 @@ wildcard_constraints:
     owner="(orbits/)?[A-Za-z][A-Za-z0-9_]*",
     # figNN or fig15_vs_fig16 of the figure table, -k: k-th value of a listed parameter (not a
     # sweep.png, nor the validation figures)
-    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|escape_vs_noise)(-[0-9]+)?",
-    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|escape_vs_noise",
+    fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence|escape_vs_noise)(-[0-9]+)?",
+    paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence|escape_vs_noise",
 
 
 STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}
@@ -267,9 +267,23 @@ def _study_datasets(name):
     return out
 
 
+def _attractor_datasets(name):
+    """``{basins, lyapunov: path}`` of the orbits entry study ``name`` draws Fig. 15 over
+    (``fig15_vs_fig16``), when that entry has an ``attractors`` block: the harmonic report's
+    noise-free predictors of the probabilities; {} otherwise."""
+    entry = config["studies"][name]
+    if "fig15_vs_fig16" not in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
+        return {}
+    orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
+    if not config["orbits"][orbits].get("attractors"):
+        return {}
+    return {kind: _DATASETS[kind].format(name=orbits) for kind in ("basins", "lyapunov")}
+
+
 def study_report_inputs(wildcards):
     """The notebook, the datasets and the figures of a study and of its ``report_with``, and
-    the study's noise record (its provenance row, whether or not a figure draws it)."""
+    the study's noise record (its provenance row, whether or not a figure draws it); with a
+    map over an orbits entry that has attractors, their basins and Lyapunov datasets."""
     entry = config["studies"][wildcards.study]
     kind = arguments.study_report_kind(entry)
     if wildcards.report != kind:
@@ -280,7 +294,7 @@ def study_report_inputs(wildcards):
     }
     shown = []
     for name in [wildcards.study, *entry.get("report_with", [])]:
-        for dataset, path in _study_datasets(name).items():
+        for dataset, path in {**_study_datasets(name), **_attractor_datasets(name)}.items():
             inputs.setdefault(dataset, path)
         shown += [
             f"results/figures/{name}/{f}.png"

@@ -87,6 +87,12 @@ FIGURES = {
                            harmonic=True,
                            shows="the probability contours of Fig. 15 over the stable domains "
                                  "of Fig. 16, with the agreement measures of each motion"),
+    "residence": dict(draw="maps:residence",
+                      owner="study", reads=("map",), harmonic=True,
+                      shows="the mean residence time (forcing periods) in each impact motion "
+                            "and in no listed motion, over the (1/beta_f, delta) plane of "
+                            "Fig. 15 under sin(beta_f tau) + r(tau); hatched cells hold few "
+                            "complete stretches"),
     "fig16": dict(draw="orbits:fig16",
                   owner="orbits", reads=("orbits", "boundaries"),
                   shows="the domains over the (1/beta_f, delta) plane of stable periodic "
@@ -261,6 +267,7 @@ def caption(kind, name, entry, target):
     what = FIGURES[fig]["shows"]
     title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
              "lyapunov": "Lyapunov exponents",
+             "residence": "Residence times",
              "escape_vs_noise": "Escape against noise level"}.get(fig, f"Fig. {number}")
     parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
     if kind == "study":

@@ -16,7 +16,7 @@ Datasets and the figures that read them (docs/figures.md)::
     results/traces/{study}.nc           fig03, fig10           (random, harmonic)
     results/datasets/{study}_spectra.nc fig06, fig11, fig12    (random, harmonic)
     results/datasets/{study}_events.nc  fig07, fig08, fig09, fig13, fig14
-    results/datasets/{study}_map.nc     fig15, fig15_vs_fig16  (harmonic)
+    results/datasets/{study}_map.nc     fig15, fig15_vs_fig16, residence  (harmonic)
     results/datasets/{study}_escape.nc  escape_vs_noise        (harmonic)
     results/orbits/{name}.nc            fig16, fig15_vs_fig16  (orbits), basins (attractors)
     results/orbits/{name}_boundaries.nc fig16                  (orbits)
@@ -34,7 +34,7 @@ from vibroimpact.plotting._common import (LABELS, MIN_BIN_COUNT, STYLE_FILE, axi
 from vibroimpact.plotting.attractors import basins, lyapunov
 from vibroimpact.plotting.escape import escape_vs_noise
 from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
-from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement
+from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement, residence
 from vibroimpact.plotting.orbits import fig16
 from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fig06, fig07,
                                          fig08, fig09)
@@ -45,5 +45,6 @@ __all__ = [
     "bin_counts", "family_styles", "merge_sparse_bins",
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
     "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
-    "map_agreement", "basins", "lyapunov", "work_precision", "stress", "escape_vs_noise",
+    "map_agreement", "basins", "lyapunov", "work_precision", "stress", "residence",
+    "escape_vs_noise",
 ]

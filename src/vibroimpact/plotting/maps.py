@@ -513,6 +513,10 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
 RESIDENCE_MIN_STRETCHES = 5
 #: Look of the cells with fewer complete stretches (their mean is a few samples, or none).
 FEW_STRETCHES_STYLE = dict(facecolor="none", edgecolor="0.35", hatch="xxx", linewidth=0.0)
+#: Marker of the cells where the state occurs only in the stretches cut by the record's ends
+#: (the one it starts in, the one it ends in): seen, not measured; a motion held through the
+#: whole record is one.
+ONLY_CUT_STYLE = dict(facecolor="#f4c7a1", edgecolor="none", linewidth=0.0)
 
 
 @_styled
@@ -534,6 +538,9 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
         One panel per state, whole cells coloured by the mean length of the complete stretches
         in forcing periods on one logarithmic scale for all panels; hatched cells
         (gid ``"few_stretches"``) hold fewer than `min_stretches` complete stretches.
+        A pale orange cell (gid ``"only_cut"``) is one where the state occurs only in the
+        stretches cut by the record's ends (``n_censored`` > 0, no complete stretch): seen,
+        but not measured; a motion held through the whole record (P near 1) is one.
     """
     from matplotlib.colors import LogNorm
 
@@ -551,7 +558,9 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
     axes = fig.subplots(1, len(states), sharex=True, sharey=True, squeeze=False).ravel()
     mesh = None
     few_any = False
-    for ax, name, ts, ns, ok in zip(axes, states, t, n, shown):
+    cut = ((n == 0) & (motion_map["n_censored"].transpose("state", "inv_beta", "delta").values
+                       > 0) if "n_censored" in motion_map else None)
+    for k, (ax, name, ts, ns, ok) in enumerate(zip(axes, states, t, n, shown)):
         if ok.any():
             mesh = ax.pcolormesh(xe, ye, np.ma.masked_where(~ok, ts).T, norm=norm,
                                  cmap="viridis", gid="residence")
@@ -560,6 +569,9 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
             few_any = True
             ax.add_collection(PatchCollection(cell_rectangles(x, y, few), gid="few_stretches",
                                               **FEW_STRETCHES_STYLE), autolim=False)
+        if cut is not None and cut[k].any():
+            ax.add_collection(PatchCollection(cell_rectangles(x, y, cut[k]), gid="only_cut",
+                                              **ONLY_CUT_STYLE), autolim=False)
         ax.set_title("none" if name == "none" else f"({name})")
     _finish_axes(axes, motion_map)
     for ax in axes:                       # cells drawn whole: the extent is the cells' edges
@@ -573,5 +585,9 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
     handles = ([Patch(**{**FEW_STRETCHES_STYLE, "linewidth": 0.7},
                       label=f"fewer than {min_stretches} complete stretches (blank: none)")]
                if few_any else [])
+    if cut is not None and cut.any():
+        handles.append(Patch(**ONLY_CUT_STYLE,
+                             label="only in the stretch the record starts or ends in (no "
+                                   "complete stretch; e.g. held throughout)"))
     return _finish_figure(fig, motion_map, handles, "Mean residence time in each impact motion "
                           "under harmonic plus random force")

@@ -14,7 +14,8 @@ __all__ = ["DENSITY_INV_BETA", "REPORT_PARAMETERS", "nearest", "notebook_paramet
 REPORT_PARAMETERS = {
     "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
     "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
-                        "figures", "amplitude", "inv_beta", "density_delta"),
+                        "basins", "lyapunov", "figures", "amplitude", "inv_beta",
+                        "density_delta"),
     "periodic_motions": ("name", "orbits", "boundaries", "basins", "lyapunov", "map",
                          "figures"),
     "performance": ("work_precision", "figures"),

@@ -414,40 +414,83 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     return _finding(7, measured, holds)
 
 
-def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5):
-    """Fig. 15 against Fig. 16, from :func:`vibroimpact.plotting.maps.map_agreement`.
+def _predictor(predictors, name, motion):
+    """The stable-domain correlation of predictor ``name`` with P of ``motion`` (or None)."""
+    return next((c for c in predictors or () if c.predictor == name and c.motion == motion
+                 and c.where == "domain"), None)
+
+
+def _resolved(c):
+    """A correlation computed, with its 95 % interval clear of 0."""
+    return c is not None and np.isfinite(c.rho) and (c.low > 0 or c.high < 0)
+
+
+def _predictors_text(predictors, motion):
+    """The noise-free predictors of ``motion``'s P in its stable domain, and which ranks P
+    best (:mod:`vibroimpact.reports.predictors`)."""
+    found = {name: _predictor(predictors, name, motion)
+             for name in ("S", "basin", "lyapunov", "residence")}
+    shown = {n: c for n, c in found.items() if c is not None and np.isfinite(c.rho)}
+    if not shown:
+        return ""
+    cells = next(iter(shown.values())).n_cells
+    parts = [f"{n} {c.rho:+.2f} [{c.low:+.2f}, {c.high:+.2f}]"
+             + (f" ({c.n_cells} cells)" if c.n_cells != cells else "")
+             for n, c in shown.items()]
+    text = f"; inside the domain ({cells} cells) rho with " + ", ".join(parts)
+    free = {n: c for n, c in shown.items() if n != "residence" and _resolved(c)}
+    if free:
+        best = max(free, key=lambda n: abs(free[n].rho))
+        text += f"; best noise-free predictor {best}"
+    return text
+
+
+def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5, predictors=None):
+    """Fig. 15 against Fig. 16, from :func:`vibroimpact.plotting.maps.map_agreement` and, when
+    given, the predictors of P (:func:`vibroimpact.reports.predictors.predictor_correlations`).
 
     Where: of the cells where a motion has probability >= 50 %, at least ``inside`` lie in
     its stable domain (motions with fewer than ``min_cells`` such cells are not judged). How
     strongly: Spearman's rank correlation of probability and S inside the domain at least
-    ``correlation``. Both: ``yes``; where only: ``partly``.
+    ``correlation`` and, with ``predictors``, its 95 % bootstrap interval clear of 0. Both:
+    ``yes``; where only: ``partly``; not where: ``no``. ``measured`` also gives the other
+    predictors' correlations inside the domain (basin fraction, Lyapunov exponent, residence
+    time) and the noise-free one that ranks P best: the claim names S, the data may favour
+    another.
     """
     judged = {m: a for m, a in agreement.items() if a["n_dominant"] >= min_cells}
     if not judged:
         return not_available(8, f"no motion has {min_cells} cells with probability >= 50 %")
     parts = [f"({m}) {a['n_dominant']} cells >= 50 %: {100 * a['dominant_inside']:.0f} % inside, "
              f"domain covered {100 * a['domain_covered']:.0f} %, rank correlation with S "
-             f"{a['rank_correlation']:.2f}" for m, a in judged.items()]
+             f"{a['rank_correlation']:.2f}" + _predictors_text(predictors, m)
+             for m, a in judged.items()]
     where = all(a["dominant_inside"] >= inside for a in judged.values())
-    strongly = all(np.isfinite(a["rank_correlation"]) and a["rank_correlation"] >= correlation
-                   for a in judged.values())
+
+    def strong(m, a):
+        if not (np.isfinite(a["rank_correlation"]) and a["rank_correlation"] >= correlation):
+            return False
+        return predictors is None or _resolved(_predictor(predictors, "S", m))
+
+    strongly = all(strong(m, a) for m, a in judged.items())
     return _finding(8, "; ".join(parts), "yes" if where and strongly else (
         "partly" if where else "no"))
 
 
 def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, inv_beta=1.1,
-                    density_delta=None):
+                    density_delta=None, predictors=None):
     """Findings 5-8 of a harmonic-plus-random study; those whose datasets are missing are
     ``n/a``. ``agreement`` is :func:`vibroimpact.plotting.maps.map_agreement` of its map with
     an orbits map; ``density_delta``, the plays Fig. 14 draws, are those finding 7 reads
-    (default: every play with impacts)."""
+    (default: every play with impacts); ``predictors`` the correlations finding 8 also reads
+    (:func:`vibroimpact.reports.predictors.predictor_correlations`)."""
     found = [finding5(spectra, amplitude, events=events) if spectra is not None else
              not_available(5, "this study draws no spectrum of a(tau) (Fig. 12)")]
     missing = "this study has no impact densities (Figs. 13, 14)"
     found.append(finding6(events, inv_beta) if events is not None else not_available(6, missing))
     found.append(finding7(events, inv_beta, deltas=density_delta) if events is not None else
                  not_available(7, missing))
-    found.append(finding8(agreement) if agreement is not None else
+    found.append(finding8(agreement, predictors=predictors) if agreement is not None else
                  not_available(8, "this study has no probability map compared with an orbits "
                                   "map (fig15_vs_fig16)"))
     return found

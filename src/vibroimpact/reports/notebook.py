@@ -528,3 +528,53 @@ def _cell_text(index, cell):
     cell = cell if isinstance(cell, tuple) else (cell,)
     names = ["1/beta_f" if n == "inv_beta" else n for n in index.names]
     return ", ".join(f"{n} = {float(v):.4g}" for n, v in zip(names, cell))
+
+
+# --- what predicts P, and is the switching Markov (the harmonic report) ----------------------
+
+def _styled(table, names, caption=None):
+    """A table left-aligned and wrapped, with CSS classes of its own (``names``: the findings
+    table's cells are read by their default classes)."""
+    wrapped = [{"selector": "td", "props": "text-align: left; white-space: normal"}]
+    styler = table.style.set_table_styles(wrapped, css_class_names=names)
+    return styler.set_caption(caption) if caption else styler
+
+
+def predictors(motion_map, orbits=None, basins=None, lyapunov=None):
+    """The rank correlations of each candidate predictor with each motion's P
+    (:func:`vibroimpact.reports.predictors.predictor_correlations`), or None without a map."""
+    if motion_map is None:
+        return None
+    from vibroimpact.reports.predictors import predictor_correlations
+
+    return predictor_correlations(motion_map, orbits, basins, lyapunov)
+
+
+def show_predictors(correlations):
+    """The predictors table (a row per predictor and motion: Spearman's rho with P and its
+    95 % bootstrap interval, in the stable domain and over the plane, and the cells)."""
+    from IPython.display import Markdown
+
+    if correlations is None:
+        return Markdown("*This study has no probability map (Fig. 15).*")
+    from vibroimpact.reports.predictors import predictors_table
+
+    names = {"data": "predictor_value", "row_heading": "predictor_name",
+             "col_heading": "predictor_column"}
+    return _styled(predictors_table(correlations), names)
+
+
+def markov_summary(motion_map):
+    """Per state of the map: are its residence times those of a Markov chain
+    (:func:`vibroimpact.reports.switching.markov_summary`), with the bookkeeping check of the
+    switching rates as the caption."""
+    from IPython.display import Markdown
+
+    if motion_map is None or "residence_time" not in motion_map:
+        return Markdown("*This study has no map with residence times.*")
+    from vibroimpact.reports.switching import markov_summary as summary
+
+    table = summary(motion_map)
+    names = {"data": "markov_value", "row_heading": "markov_state",
+             "col_heading": "markov_column"}
+    return _styled(table, names, table.attrs["note"])

@@ -39,6 +39,8 @@ _WHERE = {
     "ResidenceStatistics": "residence", "label_pieces": "residence",
     "residence_statistics": "residence", "stationary_distribution": "residence",
     "EscapeFit": "escape", "escape_fit": "escape",
+    "MarkovCheck": "residence", "markov_residence_check": "residence",
+    "jump_chain_independence": "residence",
     "linear_response_std": "theory", "elastic_impact_rate": "theory",
     "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory", "EnvelopeTheory": "theory",

@@ -1,0 +1,282 @@
+"""What predicts the probability of a motion under noise (Fig. 15)? Rank correlations of P
+with the candidates, cell by cell over the map's (1/beta_f, delta) plane.
+
+The paper's conclusion 5 (finding 8) names one predictor: the degree of stability S of the
+periodic motion under the harmonic force alone (Fig. 16). The datasets offer three more:
+
+- ``S``: Fig. 16's degree of stability (%), read at the orbit map's cell nearest to each map
+  cell (its grid is finer; as `plotting.maps.map_agreement`); 0 outside the stable domain
+  (S = 100 (1 - |lambda|) is 0 at its edge);
+- ``basin``: the share of starting states that settle on a stable orbit of the type without
+  noise (``results/orbits/{orbits}_basins.nc``, `fraction`);
+- ``lyapunov``: the largest Lyapunov exponent of the cell's starts without noise
+  (``{orbits}_lyapunov.nc``; -inf where every start sticks, ranked lowest), one per cell;
+- ``residence``: the mean residence time of the motion in the noisy record itself (the map's
+  ``residence_time``, in forcing periods; 0 where the motion never occurs, left out where it
+  has no complete stretch). Not a noise-free predictor: P is the motion's share of the time,
+  which is its mean residence time times its number of visits over the record, so the
+  residence time predicts P almost by construction. Its row says how much of P is "how long
+  the motion holds once reached" against "how often it is reached"; the three others say how
+  much the noise-free dynamics foretell.
+
+Each is correlated with P (the map's ``probability``: the motion with free flights, as Figs. 15
+and 16 compare) inside the motion's stable domain (Fig. 16's ``n_stable > 0``; without an
+orbit map, the basins dataset's ``n_stable``) and over the whole plane. The basins and
+exponents are simulated on the orbits entry's ``attractors`` grid, which the config sets to
+the map's grid so that they compare cell for cell; a different grid is refused
+(:func:`on_map_grid`), never interpolated (a share of starts or an exponent between two
+cells is not the value of either).
+
+**Interval.** Spearman's rho with a 95 % percentile bootstrap interval: the cells resampled
+with replacement (pairs kept) ``N_RESAMPLES`` times from ``numpy.random.default_rng(SEED)``;
+resamples without spread in either variable are dropped. Neighbouring cells are correlated
+(P and the predictors vary smoothly over the plane), so the cells are fewer independent
+pieces of evidence than their number and the interval is narrower than it should be: read
+it as a lower bound on the uncertainty.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["PREDICTORS", "SEED", "N_RESAMPLES", "MIN_CELLS", "Correlation", "on_map_grid",
+           "rank_correlation", "predictor_correlations", "predictors_table"]
+
+#: The candidates, in the table's order, with what each is.
+PREDICTORS = {
+    "S": "degree of stability S (Fig. 16, no noise)",
+    "basin": "basin fraction (no noise)",
+    "lyapunov": "largest Lyapunov exponent (no noise)",
+    "residence": "mean residence time (the noisy record itself)",
+}
+#: The bootstrap's seed and number of resamples (module docstring).
+SEED = 19741974
+N_RESAMPLES = 1000
+#: Resamples ranked at a time (memory: a few of (chunk, cells) float arrays).
+_CHUNK = 100
+#: Fewest cells a rank correlation is computed on.
+MIN_CELLS = 5
+
+
+@dataclass(frozen=True)
+class Correlation:
+    """Spearman's rho of one predictor with P of one motion over one set of cells.
+
+    ``where`` is ``"domain"`` (the motion's stable domain) or ``"plane"`` (every cell);
+    ``rho``, ``low``, ``high`` are NaN when not computed, and ``note`` then says why (the
+    dataset is missing, its grid differs, too few cells, no spread).
+    """
+
+    predictor: str
+    motion: str
+    where: str
+    rho: float
+    low: float
+    high: float
+    n_cells: int
+    note: str = ""
+
+
+def _grid_text(values):
+    values = np.asarray(values, dtype=float)
+    if values.size < 2:
+        return ", ".join(f"{v:.4g}" for v in values)
+    return f"{values[0]:.4g} to {values[-1]:.4g} ({values.size} values)"
+
+
+def on_map_grid(ds, motion_map, name):
+    """``ds`` (a basins or Lyapunov dataset) with the map's (inv_beta, delta) coordinates.
+
+    Raises
+    ------
+    ValueError
+        When its grid is not the map's (both must list the same values, to 1e-9): the
+        message gives both grids and the config key that sets them.
+    """
+    same = all(ds.sizes[d] == motion_map.sizes[d]
+               and np.allclose(ds[d].values, motion_map[d].values, rtol=0.0, atol=1e-9)
+               for d in ("inv_beta", "delta"))
+    if not same:
+        raise ValueError(
+            f"the {name} grid (1/beta_f {_grid_text(ds.inv_beta)}, delta "
+            f"{_grid_text(ds.delta)}) is not the map's (1/beta_f "
+            f"{_grid_text(motion_map.inv_beta)}, delta {_grid_text(motion_map.delta)}): set "
+            f"the orbits entry's attractors grid to the study's to compare them cell for cell")
+    return ds.assign_coords(inv_beta=motion_map.inv_beta.values,
+                            delta=motion_map.delta.values)
+
+
+def _ranks(a):
+    from scipy.stats import rankdata
+
+    return rankdata(a, axis=-1)
+
+
+def _pearson_rows(a, b):
+    a = a - a.mean(axis=-1, keepdims=True)
+    b = b - b.mean(axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return (a * b).sum(axis=-1) / np.sqrt((a * a).sum(axis=-1) * (b * b).sum(axis=-1))
+
+
+def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95):
+    """Spearman's rho of ``x`` and ``p`` with a bootstrap percentile interval.
+
+    Parameters
+    ----------
+    x, p : array_like, shape (n,)
+        Paired values (cells); pairs with a NaN are left out (-inf and inf are ranked).
+    seed : int
+        Of ``numpy.random.default_rng``: the resampled cells.
+    n_resamples : int
+    level : float
+        Confidence level of the interval.
+
+    Returns
+    -------
+    rho, low, high : float
+        NaN when fewer than `MIN_CELLS` pairs or no spread in either variable.
+    n : int
+        The pairs used.
+    """
+    x, p = np.asarray(x, dtype=float).ravel(), np.asarray(p, dtype=float).ravel()
+    keep = ~(np.isnan(x) | np.isnan(p))
+    x, p = x[keep], p[keep]
+    n = int(x.size)
+    if n < MIN_CELLS or np.unique(x).size < 2 or np.unique(p).size < 2:
+        return np.nan, np.nan, np.nan, n
+    rho = float(_pearson_rows(_ranks(x), _ranks(p)))
+    rng = np.random.default_rng(seed)
+    boot = []
+    for start in range(0, n_resamples, _CHUNK):
+        idx = rng.integers(0, n, size=(min(_CHUNK, n_resamples - start), n))
+        boot.append(_pearson_rows(_ranks(x[idx]), _ranks(p[idx])))
+    boot = np.concatenate(boot)
+    boot = boot[np.isfinite(boot)]
+    tail = 50.0 * (1.0 - level)
+    low, high = (np.percentile(boot, [tail, 100.0 - tail]) if boot.size
+                 else (np.nan, np.nan))
+    return rho, float(min(low, rho)), float(max(high, rho)), n
+
+
+def _stable_domain(motion_map, orbits, basins, motion):
+    """(stable, S) on the map's grid: Fig. 16's nearest cell, or the basins' n_stable."""
+    if orbits is not None and motion in orbits["type"].values:
+        o = orbits.sel(type=motion)
+        near = o.sel(inv_beta=motion_map.inv_beta, delta=motion_map.delta, method="nearest")
+        # map cells beyond the orbit map's plane (more than half a step out) are unknown
+        inside = np.ones((motion_map.sizes["inv_beta"], motion_map.sizes["delta"]), bool)
+        for axis, d in enumerate(("inv_beta", "delta")):
+            grid = o[d].values
+            half = 0.5 * (np.diff(grid).max() if grid.size > 1 else 0.0) + 1e-9
+            out = np.abs(near[d].values - motion_map[d].values) > half
+            inside &= ~np.expand_dims(out, 1 - axis)
+        stable = (near["n_stable"].values > 0) & inside
+        S = np.where(stable, near["S"].values, np.where(inside, 0.0, np.nan))
+        return stable, S
+    if basins is not None and motion in basins["motion"].values:
+        return basins["n_stable"].sel(motion=motion).values > 0, None
+    return None, None
+
+
+def _fields(motion_map, motion, orbits, basins, lyapunov, errors):
+    """``{predictor: array on the map's grid or a reason string}`` for one motion."""
+    stable, S = _stable_domain(motion_map, orbits, basins, motion)
+    out = {"S": S if S is not None else
+           "no orbit map (the study draws no fig15_vs_fig16)" if orbits is None else
+           f"the orbit map has no type {motion}"}
+    for name, ds in (("basin", basins), ("lyapunov", lyapunov)):
+        if name in errors:
+            out[name] = errors[name]
+        elif ds is None:
+            out[name] = ("no attractors dataset (the orbits entry fig15_vs_fig16 names has no "
+                         "attractors block)")
+        elif name == "basin":
+            out[name] = (ds["fraction"].sel(motion=motion).values
+                         if motion in ds["motion"].values else f"no basin of {motion}")
+        else:
+            out[name] = ds["lyapunov"].values
+    if "residence_time" in motion_map and motion in motion_map["state"].values:
+        r = motion_map.sel(state=motion)
+        seen = (r["n_stretches"].values + r["n_censored"].values) > 0
+        out["residence"] = np.where(seen, r["residence_time"].values, 0.0)
+    else:
+        out["residence"] = "the map stores no residence times"
+    return stable, out
+
+
+def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, seed=SEED,
+                           n_resamples=N_RESAMPLES):
+    """Spearman's rho of each predictor with each motion's P, in its stable domain and over
+    the plane (module docstring).
+
+    Parameters
+    ----------
+    motion_map : xarray.Dataset
+        ``results/datasets/{study}_map.nc``.
+    orbits, basins, lyapunov : xarray.Dataset or None
+        Fig. 16's orbit map, the basins and the Lyapunov datasets of the same system (None:
+        not provided; its rows say so). A basins or Lyapunov dataset on another grid than the
+        map's is not used (its rows give :func:`on_map_grid`'s reason).
+    seed, n_resamples : int
+        Of the bootstrap (:func:`rank_correlation`).
+
+    Returns
+    -------
+    list of Correlation
+        Per predictor (the order of `PREDICTORS`), per motion of the map, domain then plane.
+    """
+    errors = {}
+    aligned = {}
+    for name, ds in (("basin", basins), ("lyapunov", lyapunov)):
+        try:
+            aligned[name] = None if ds is None else on_map_grid(ds, motion_map, name)
+        except ValueError as error:
+            errors[name], aligned[name] = f"not used: {error}", None
+    out = []
+    motions = [str(m) for m in motion_map["motion"].values]
+    fields = {m: _fields(motion_map, m, orbits, aligned["basin"], aligned["lyapunov"], errors)
+              for m in motions}
+    for predictor in PREDICTORS:
+        for m in motions:
+            stable, values = fields[m]
+            x = values[predictor]
+            p = motion_map["probability"].sel(motion=m).values
+            for where in ("domain", "plane"):
+                if isinstance(x, str):
+                    out.append(Correlation(predictor, m, where, np.nan, np.nan, np.nan, 0, x))
+                    continue
+                if where == "domain" and stable is None:
+                    out.append(Correlation(predictor, m, where, np.nan, np.nan, np.nan, 0,
+                                           "no stable domain (no orbit map or basins)"))
+                    continue
+                cells = stable if where == "domain" else np.ones(p.shape, bool)
+                rho, low, high, n = rank_correlation(x[cells], p[cells], seed, n_resamples)
+                note = ("" if np.isfinite(rho) else
+                        f"fewer than {MIN_CELLS} cells" if n < MIN_CELLS else "no spread")
+                out.append(Correlation(predictor, m, where, rho, low, high, n, note))
+    return out
+
+
+def _rho_text(c):
+    if not np.isfinite(c.rho):
+        return ""
+    return f"{c.rho:+.2f} [{c.low:+.2f}, {c.high:+.2f}]"
+
+
+def predictors_table(correlations):
+    """The correlations as a table (pandas DataFrame): a row per predictor and motion, rho
+    with its 95 % interval and the number of cells in the stable domain and over the plane,
+    and why a value is missing."""
+    import pandas as pd
+
+    rows = {}
+    for c in correlations:
+        row = rows.setdefault((PREDICTORS[c.predictor], f"({c.motion})"), {})
+        label = "stable domain" if c.where == "domain" else "whole plane"
+        row[f"{label}: rho [95 %]"] = _rho_text(c)
+        row[f"{label}: cells"] = c.n_cells
+        if c.note and c.note not in row.get("note", ""):
+            row["note"] = "; ".join(filter(None, [row.get("note", ""), f"{label}: {c.note}"]))
+    table = pd.DataFrame.from_dict(rows, orient="index").fillna("")
+    table.index.names = ["predictor", "motion"]
+    return table
