@@ -1,7 +1,8 @@
 """Cost of the events cells' self-audit: the compiled kernel against the numpy reference.
 
 For one seeded band-limited record (rms 0.5, beta_c 4, dt = 0.1; zeta = 0.05, eps = 0.5, the
-random study's force) and each delta, prints CPU ns per sample step of
+random study's force), at four delta and once with A sin(tau / 1.1) added, prints CPU ns per
+sample step of
 
 1. the simulation alone: `simulate_chunks` with the state recorded at every sample, as an
    events cell runs it (the peer);
@@ -34,7 +35,10 @@ from vibroimpact.pipeline import cells
 
 SPEC = noise.NoiseSpec(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0)
 ZETA, EPS, TRANSIENT, BATCHES = 0.05, 0.5, 200.0, 20
-DELTAS = (3.0, 0.5, 0.0, -0.5)
+#: (delta, amplitude of sin(beta_f tau)): the random study's cells, then one with the harmonic
+#: force of the harmonic study (its sine costs the kernel a sin and a cos a step)
+CELLS = ((3.0, 0.0), (0.5, 0.0), (0.0, 0.0), (-0.5, 0.0), (0.0, 1.0))
+BETA_F = 1 / 1.1
 SEED = 19740072
 
 
@@ -83,13 +87,13 @@ def main():
     print(f"\n== Self-audit of an events cell: {n:.3g} steps, zeta = {ZETA}, eps = {EPS}, "
           f"band-limited rms {SPEC.rms} dt {SPEC.dt}; CPU ns per step, best of "
           f"{args.repeats} ==")
-    print(f"{'delta':>6} {'impacts':>8} {'simulate':>9} {'numpy':>8} {'kernel':>8} "
+    print(f"{'delta':>6} {'A':>4} {'impacts':>8} {'simulate':>9} {'numpy':>8} {'kernel':>8} "
           f"{'numpy/sim':>10} {'kernel/sim':>11} {'numpy/kernel':>13} {'max rel diff':>13}")
-    for delta in DELTAS:
-        params = dict(zeta=ZETA, eps=EPS, delta=delta, amplitude=0.0, beta_f=1.0)
-
-        simulation = lambda delta=delta: list(simulate_chunks(
-            ZETA, EPS, delta, noise=record, dt=SPEC.dt, record_every=1))
+    for delta, amplitude in CELLS:
+        params = dict(zeta=ZETA, eps=EPS, delta=delta, amplitude=amplitude, beta_f=BETA_F)
+        simulation = lambda delta=delta, amplitude=amplitude: list(simulate_chunks(
+            ZETA, EPS, delta, noise=record, dt=SPEC.dt, amplitude=amplitude, beta=BETA_F,
+            record_every=1))
         sim_s, chunk_list = cpu_best(simulation, args.repeats)
         chunks = dict(params=params, chunks=chunk_list)
         np_s, ref = cpu_best(lambda c=chunks: run_audit(record, c, numpy_moments), args.repeats)
@@ -99,8 +103,9 @@ def main():
         diff = np.max(np.abs(got - ref).max(axis=1) / np.where(scale > 0, scale, 1.0))
         impacts = sum(c.impact_time.size for c in chunk_list)
         ns = lambda s: s / n * 1e9
-        print(f"{delta:>6g} {impacts:>8d} {ns(sim_s):>9.1f} {ns(np_s):>8.1f} {ns(k_s):>8.1f} "
-              f"{np_s / sim_s:>10.2f} {k_s / sim_s:>11.2f} {np_s / k_s:>13.1f} {diff:>13.1e}")
+        print(f"{delta:>6g} {amplitude:>4g} {impacts:>8d} {ns(sim_s):>9.1f} {ns(np_s):>8.1f} "
+              f"{ns(k_s):>8.1f} {np_s / sim_s:>10.2f} {k_s / sim_s:>11.2f} "
+              f"{np_s / k_s:>13.1f} {diff:>13.1e}")
     print("simulate: simulate_chunks with record_every=1 (the events cell's simulation, "
           "statistics aside); numpy / kernel: the audit on its chunks; max rel diff: "
           "max |kernel - numpy| / max |numpy| over each row of the integrals")
