@@ -224,16 +224,21 @@ class _IdentityRecord:
     The window runs over whole force steps, from sample ``ceil(transient / dt)`` to sample
     ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. Each chunk
     brings the state at its samples (``record_every=1``) and its impacts and sticking
-    phases; :func:`vibroimpact.stats.flight_moments` integrates its steps exactly.
+    phases; :func:`vibroimpact.impact.audit.audit_moments` (the compiled
+    :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly.
     """
 
     def __init__(self, noise, dt, transient, t_end, n_batches, **params):
+        from vibroimpact.impact.audit import audit_moments
+        self.audit_moments = audit_moments
         self.noise, self.dt, self.params = noise, dt, params
         self.k_start = int(math.ceil(transient / dt - 1e-9))
         self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
         self.n_batches = n_batches
         n = self.k_stop - self.k_start
-        self.steps = np.bincount((np.arange(n) * n_batches) // max(n, 1), minlength=n_batches)
+        # the first sample of each batch of _batch, and the window's end
+        self.bounds = self.k_start + (np.arange(n_batches + 1) * n + n_batches - 1) // n_batches
+        self.steps = np.diff(self.bounds)
         self.moments = np.zeros((len(stats.identities.MOMENTS), n_batches))
         self.sum_u = np.zeros(n_batches)
         self.sum_u2 = np.zeros(n_batches)
@@ -252,11 +257,11 @@ class _IdentityRecord:
             r = np.asarray(self.noise[lo : hi + 1], dtype=float)
             start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
                                                 chunk.stuck_since, chunk.t_end)
-            self.moments += stats.flight_moments(
-                lo, self.params["delta"] - chunk.a[keep], chunk.v[keep], r, self.dt,
+            self.moments += self.audit_moments(
+                lo, chunk.a[keep], chunk.v[keep], r, self.dt,
                 **self.params, impact_time=chunk.impact_time,
                 impact_velocity=chunk.impact_velocity, stick_start=start, stick_end=end,
-                batch=self._batch(np.arange(lo, hi)), n_batches=self.n_batches)
+                batch_bounds=self.bounds)
         step = chunk.impact_step
         hit = (step >= self.k_start) & (step < self.k_stop)
         u, b = chunk.impact_velocity[hit], self._batch(step[hit])

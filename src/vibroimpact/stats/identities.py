@@ -192,20 +192,21 @@ def _resting(t, s0, s1):
     return (j >= 0) & (t < s1[np.maximum(j, 0)])
 
 
-def _whole_step_forms(k, x0, v0, r0, r1, dt, zeta, A, beta):
-    """Quadratic forms of the integrals of v^2, x^2, f v, x f over whole free steps.
+def step_forms(dt, zeta, amplitude=0.0, beta_f=1.0):
+    """The matrices of the integrals of v^2, x^2, f v, x f over a whole free step.
 
     On a whole step x, v and f at the fixed nodes are linear in
-    ``z = (r0, b, y0, y0', sin psi, cos psi)`` (``b`` the slope, ``y`` the free response,
-    ``psi = beta k h``), so each integral is ``z^T M z`` with M computed once.
+    ``z = (r0, b, y0, y0', sin psi, cos psi)`` (``r0`` the force sample at the step's start,
+    ``b`` the slope, ``y`` the free response, ``psi = beta_f k h``), so each integral is
+    ``z^T M z`` with M the same for every step.
 
     Returns
     -------
-    M : ndarray, shape (4, m, m)
-        The symmetric matrices, in the order v^2, x^2, f v, x f.
-    z : ndarray, shape (m, n)
-        ``m = 6``, or 4 without a harmonic force (no ``sin psi, cos psi``).
+    ndarray, shape (4, m, m)
+        The symmetric matrices, in the order v^2, x^2, f v, x f; ``m = 6``, or 4 without a
+        harmonic force (no ``sin psi, cos psi``).
     """
+    A, beta = amplitude, beta_f
     wd = np.sqrt(1.0 - zeta * zeta)
     sig = 0.5 * dt * (1.0 + _XI)
     w = 0.5 * dt * _W
@@ -220,9 +221,17 @@ def _whole_step_forms(k, x0, v0, r0, r1, dt, zeta, A, beta):
     c = np.array([one, sig, zero, zero, A * np.cos(beta * sig), A * np.sin(beta * sig)])  # f
     form = lambda g, h: 0.5 * ((g * w) @ h.T + (h * w) @ g.T)
     M = np.stack([form(b, b), form(a, a), form(c, b), form(a, c)])
+    return M if A != 0.0 else M[:, :4, :4]
+
+
+def _whole_step_forms(k, x0, v0, r0, r1, dt, zeta, A, beta):
+    """The matrices of :func:`step_forms` and the vectors ``z``, shape (m, n), of whole steps."""
+    M = step_forms(dt, zeta, A, beta)
     slope = (r1 - r0) / dt
     if A == 0.0:
-        return M[:, :4, :4], np.array([r0, slope, x0 - r0 + 2.0 * zeta * slope, v0 - slope])
+        return M, np.array([r0, slope, x0 - r0 + 2.0 * zeta * slope, v0 - slope])
+    q = A / np.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
+    phi = np.arctan2(2.0 * zeta * beta, 1.0 - beta * beta)
     psi = beta * (k * dt)
     sin_psi, cos_psi = np.sin(psi), np.cos(psi)
     sin_pa = sin_psi * np.cos(phi) - cos_psi * np.sin(phi)

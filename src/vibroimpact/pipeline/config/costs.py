@@ -14,10 +14,12 @@ __all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simula
 # --- CPU seconds -----------------------------------------------------------------------------
 JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
-#: The self-audit of an events cell (`stats.flight_moments`: exact integrals over every step),
-#: per step on top of NS_PER_STEP: 100-250 ns CPU measured across the delta sweep on a
-#: shared 2-core node under load (~400 ns at the densest impacts, delta = -0.5, eps = 0.5).
-NS_PER_AUDIT_STEP = 150.0
+#: The self-audit of an events cell (`impact.audit.audit_moments`: exact integrals over every
+#: step), per step on top of NS_PER_STEP. CPU ns measured by benchmarks/bench_audit.py (1e6
+#: steps, zeta 0.05, eps 0.5, band-limited rms 0.5, dt 0.1; shared 2-core node under load):
+#: 5-10 for delta >= 1, ~20 at 0.5, ~40 at 0, 80-105 at -0.5, ~26 at -1 (0.3-0.85 x the
+#: simulation's own cost); a mean over the sweep's cells, most of them beyond delta = 1.
+NS_PER_AUDIT_STEP = 25.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 US_PER_START = 360.0       # one start of the attractor map, settled or run to its cap
@@ -43,9 +45,9 @@ BASE_MEM_MB = 600
 #: estimates.
 NOISE_MEM_MB = BASE_MEM_MB + 200
 #: A simulate job: the simulator's chunk buffers (~100 MB at the default chunk of 2**20
-#: samples) and the events cell's self-audit on a chunk (~110 MB more measured), besides the
-#: noise record held in memory (8 bytes a sample).
-SIMULATE_BUFFERS_MB = 300
+#: samples; the events cell's self-audit adds none measured, its kernel walks the chunk),
+#: besides the noise record held in memory (8 bytes a sample).
+SIMULATE_BUFFERS_MB = 200
 
 
 def record_steps(n_samples, dt, t_end=None):
