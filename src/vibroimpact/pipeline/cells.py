@@ -12,6 +12,7 @@ import numpy as np
 
 from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
+from vibroimpact.impact.audit import audit_moments
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
 log = logging.getLogger("vibroimpact")
@@ -229,8 +230,6 @@ class _IdentityRecord:
     """
 
     def __init__(self, noise, dt, transient, t_end, n_batches, **params):
-        from vibroimpact.impact.audit import audit_moments
-        self.audit_moments = audit_moments
         self.noise, self.dt, self.params = noise, dt, params
         self.k_start = int(math.ceil(transient / dt - 1e-9))
         self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
@@ -257,7 +256,7 @@ class _IdentityRecord:
             r = np.asarray(self.noise[lo : hi + 1], dtype=float)
             start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
                                                 chunk.stuck_since, chunk.t_end)
-            self.moments += self.audit_moments(
+            self.moments += audit_moments(
                 lo, chunk.a[keep], chunk.v[keep], r, self.dt,
                 **self.params, impact_time=chunk.impact_time,
                 impact_velocity=chunk.impact_velocity, stick_start=start, stick_end=end,
