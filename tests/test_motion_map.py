@@ -195,12 +195,16 @@ def test_the_map_dataset_stores_residence_and_rates_beside_the_probabilities(tmp
     assert ds["motion"].values.tolist() == states[:3]
     assert ds["probability"].dims == ("motion", "inv_beta", "delta")
     for name in ("residence_time", "residence_time_stderr", "n_stretches", "n_censored"):
-        assert ds[name].dims == ("state", "inv_beta", "delta"), name
+        assert ds[name].dims == ("motion", "inv_beta", "delta"), name
+        assert ds[f"{name}_none"].dims == ("inv_beta", "delta"), name
         assert ds[name].attrs["long_name"], name
+        assert ds[f"{name}_none"].attrs["long_name"], name
+        assert stats.by_state(ds)[name].dims == ("state", "inv_beta", "delta")
+    assert stats.by_state(ds)["state"].values.tolist() == states
     for name in ("switch_rate", "switch_count"):
         assert ds[name].dims == ("from_motion", "to_motion", "inv_beta", "delta"), name
         assert ds[name].attrs["long_name"], name
-    for dim in ("state", "from_motion", "to_motion"):
+    for dim in ("from_motion", "to_motion"):
         assert ds[dim].values.tolist() == states
     from vibroimpact.pipeline import io
 
@@ -209,9 +213,13 @@ def test_the_map_dataset_stores_residence_and_rates_beside_the_probabilities(tmp
                            transient=200.0, target_stderr=0.05, min_time=500.0,
                            max_periods=300, min_switches=10, motions=MOTIONS)
     got = ds.sel(inv_beta=2.0, delta=1.0)
-    np.testing.assert_array_equal(got["residence_time"].values, cell["residence_time"])
+    stay = stats.by_state(ds).sel(inv_beta=2.0, delta=1.0)
+    np.testing.assert_array_equal(stay["residence_time"].values, cell["residence_time"])
+    np.testing.assert_array_equal(got["residence_time"].values, cell["residence_time"][:-1])
+    assert got["residence_time_none"].values == cell["residence_time"][-1] or np.isnan(
+        cell["residence_time"][-1])
     np.testing.assert_array_equal(got["switch_rate"].values, cell["switch_rate"])
-    np.testing.assert_array_equal(got["n_stretches"].values, cell["n_stretches"])
+    np.testing.assert_array_equal(stay["n_stretches"].values, cell["n_stretches"])
     np.testing.assert_array_equal(got["probability"].values, cell["probability"])
     assert cell["n_stretches"].sum() > 0
 

@@ -18,6 +18,12 @@ def _plane(seed):
     return np.random.default_rng(seed).random((INV_BETA.size, DELTA.size))
 
 
+def _stored(name, values):
+    """``values`` over (state, inv_beta, delta) as the map stores them: the motions over
+    `motion`, "none" under ``<name>_none``."""
+    return {name: (("motion", *PLANE), values[:-1]), f"{name}_none": (PLANE, values[-1])}
+
+
 def motion_map(p11, seed=0):
     """A map whose (1/1) probability is ``p11`` (the others small and random), with
     residence times and switching of a two-state record in every cell."""
@@ -35,13 +41,12 @@ def motion_map(p11, seed=0):
              probability_stderr=(("motion", *PLANE), np.full(p.shape, 0.01)),
              stick_probability=(("motion", *PLANE), np.zeros(p.shape)),
              stick_probability_stderr=(("motion", *PLANE), np.zeros(p.shape)),
-             residence_time=(("state", *PLANE), t),
-             residence_time_stderr=(("state", *PLANE), t / np.sqrt(n)),
-             n_stretches=(("state", *PLANE), n), n_censored=(("state", *PLANE), n * 0 + 2),
+             **_stored("residence_time", t), **_stored("residence_time_stderr", t / np.sqrt(n)),
+             **_stored("n_stretches", n), **_stored("n_censored", n * 0 + 2),
              switch_rate=(("from_motion", "to_motion", *PLANE), rate),
              switch_count=(("from_motion", "to_motion", *PLANE),
                            np.where(np.nan_to_num(rate) > 0, 50, 0))),
-        coords=dict(motion=MOTIONS, state=STATES, from_motion=STATES, to_motion=STATES,
+        coords=dict(motion=MOTIONS, from_motion=STATES, to_motion=STATES,
                     inv_beta=INV_BETA, delta=DELTA))
 
 

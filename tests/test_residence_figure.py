@@ -13,14 +13,23 @@ ATTRS = dict(zeta=0.05, eps=0.5, amplitude=1.0, noise_kind="band_limited", noise
              min_time=500.0, max_periods=500, min_switches=10)
 
 
+PLANE = ("inv_beta", "delta")
+
+
+def _stored(name, values):
+    """``values`` over (state, inv_beta, delta) as the map stores them: the motions over
+    `motion`, "none" under ``<name>_none``."""
+    return {name: (("motion", *PLANE), values[:-1]), f"{name}_none": (PLANE, values[-1])}
+
+
 def _map(t, n):
-    plane = ("inv_beta", "delta")
     shape = t.shape[1:]
     return xr.Dataset(
-        dict(residence_time=(("state", *plane), t), n_stretches=(("state", *plane), n),
-             reached=(plane, np.ones(shape, np.int8)), simulated_time=(plane, np.full(shape, 1e3)),
-             n_collisions=(plane, np.full(shape, 100))),
-        coords=dict(state=STATES, inv_beta=[0.5, 1.0, 1.5], delta=[0.0, 1.0]), attrs=ATTRS)
+        dict(**_stored("residence_time", t), **_stored("n_stretches", n),
+             reached=(PLANE, np.ones(shape, np.int8)), simulated_time=(PLANE, np.full(shape, 1e3)),
+             n_collisions=(PLANE, np.full(shape, 100))),
+        coords=dict(motion=STATES[:-1], inv_beta=[0.5, 1.0, 1.5], delta=[0.0, 1.0]),
+        attrs=ATTRS)
 
 
 def test_one_log_scale_panel_per_state_with_few_stretches_hatched():
@@ -63,7 +72,7 @@ def test_a_state_seen_only_in_cut_stretches_is_marked_not_left_blank():
     ds = _map(t, n)
     censored = np.zeros((4, 3, 2), int)
     censored[0, 1, 1] = 1
-    ds["n_censored"] = (("state", "inv_beta", "delta"), censored)
+    ds = ds.assign(_stored("n_censored", censored))
     fig = residence(ds)
     FigureCanvasAgg(fig).draw()
     panels = [ax for ax in fig.axes if ax.get_title()]

@@ -78,6 +78,12 @@ META = {
     "n_stretches": ("complete stretches of the motion (both ends inside the record)", "1"),
     "n_censored": ("stretches of the motion cut by the record's start or end (not in the "
                    "mean)", "1"),
+    "residence_time_none": ("mean residence time in no listed motion (runs of unclassified "
+                            "intervals), in forcing periods", "1"),
+    "residence_time_stderr_none": ("standard error of residence_time_none, in forcing periods",
+                                   "1"),
+    "n_stretches_none": ("complete stretches of no listed motion", "1"),
+    "n_censored_none": ("stretches of no listed motion cut by the record's start or end", "1"),
     "switch_rate": ("switches from from_motion to to_motion per forcing period spent in "
                     "from_motion (NaN: from_motion never seen)", "1"),
     "switch_count": ("switches from from_motion to to_motion in the record", "1"),
@@ -176,6 +182,9 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
+#: The map's residence statistics: over `motion` for the listed motions, and for "none" (time
+#: in no listed motion) under the same name with ``_none`` (docs/datasets.md).
+RESIDENCE_VARIABLES = ("residence_time", "residence_time_stderr", "n_stretches", "n_censored")
 _MAP_SCALARS = ("n_switches", "few_switches", "reached", "n_collisions", "collision_rate",
                 "n_impacts_resolved", "v_after_mean", "simulated_time", "record_end", "n_checks",
                 "cpu_time")
@@ -196,21 +205,23 @@ def map_tile(cells, results, motions, attrs):
                                  np.stack([r["stick_probability"] for r in results]))
     data["stick_probability_stderr"] = (("cell", "motion"),
                                         np.stack([r["stick_stderr"] for r in results]))
-    for name in ("residence_time", "residence_time_stderr", "n_stretches", "n_censored"):
-        data[name] = (("cell", "state"), np.stack([r[name] for r in results]))
+    for name in RESIDENCE_VARIABLES:     # the motions' over `motion`, "none"'s apart
+        values = np.stack([r[name] for r in results])
+        data[name] = (("cell", "motion"), values[:, :-1])
+        data[f"{name}_none"] = ("cell", values[:, -1])
     for name in ("switch_rate", "switch_count"):
         data[name] = (("cell", "from_motion", "to_motion"),
                       np.stack([r[name] for r in results]))
     states = _motion_names(motions) + ["none"]
-    coords = dict(_cell_coords(cells), motion=_motion_names(motions), state=states,
-                  from_motion=states, to_motion=states)
+    coords = dict(_cell_coords(cells), motion=_motion_names(motions), from_motion=states,
+                  to_motion=states)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
 def aggregate_map(tiles, study, attrs):
     """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
     ds = _to_grid(tiles, study.inv_beta, study.delta).transpose(
-        "motion", "state", "from_motion", "to_motion", "inv_beta", "delta", missing_dims="ignore")
+        "motion", "from_motion", "to_motion", "inv_beta", "delta", missing_dims="ignore")
     ds.attrs = dict(attrs)
     return _annotate(ds)
 

@@ -544,11 +544,14 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
     """
     from matplotlib.colors import LogNorm
 
-    states = [str(s) for s in motion_map["state"].values]
+    from vibroimpact.stats.residence import by_state
+
+    stay = by_state(motion_map)
+    states = [str(s) for s in stay["state"].values]
     x, y = _grid(motion_map)
     xe, ye = cell_edges(x), cell_edges(y)
-    t = motion_map["residence_time"].transpose("state", "inv_beta", "delta").values
-    n = motion_map["n_stretches"].transpose("state", "inv_beta", "delta").values
+    t = stay["residence_time"].values
+    n = stay["n_stretches"].values
     shown = np.isfinite(t) & (t > 0)
     norm = (LogNorm(vmin=float(t[shown].min()), vmax=max(float(t[shown].max()),
                                                           1.01 * float(t[shown].min())))
@@ -558,8 +561,8 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
     axes = fig.subplots(1, len(states), sharex=True, sharey=True, squeeze=False).ravel()
     mesh = None
     few_any = False
-    cut = ((n == 0) & (motion_map["n_censored"].transpose("state", "inv_beta", "delta").values
-                       > 0) if "n_censored" in motion_map else None)
+    cut = ((n == 0) & (stay["n_censored"].values > 0) if "n_censored" in stay
+           else np.zeros(n.shape, bool))
     for k, (ax, name, ts, ns, ok) in enumerate(zip(axes, states, t, n, shown)):
         if ok.any():
             mesh = ax.pcolormesh(xe, ye, np.ma.masked_where(~ok, ts).T, norm=norm,
@@ -569,7 +572,7 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
             few_any = True
             ax.add_collection(PatchCollection(cell_rectangles(x, y, few), gid="few_stretches",
                                               **FEW_STRETCHES_STYLE), autolim=False)
-        if cut is not None and cut[k].any():
+        if cut[k].any():
             ax.add_collection(PatchCollection(cell_rectangles(x, y, cut[k]), gid="only_cut",
                                               **ONLY_CUT_STYLE), autolim=False)
         ax.set_title("none" if name == "none" else f"({name})")

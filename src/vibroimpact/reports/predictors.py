@@ -195,8 +195,8 @@ def _fields(motion_map, motion, orbits, basins, lyapunov, errors):
                          if motion in ds["motion"].values else f"no basin of {motion}")
         else:
             out[name] = ds["lyapunov"].values
-    if "residence_time" in motion_map and motion in motion_map["state"].values:
-        r = motion_map.sel(state=motion)
+    if "residence_time" in motion_map and motion in motion_map["motion"].values:
+        r = motion_map.sel(motion=motion)
         seen = (r["n_stretches"].values + r["n_censored"].values) > 0
         out["residence"] = np.where(seen, r["residence_time"].values, 0.0)
     else:

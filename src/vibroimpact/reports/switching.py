@@ -72,9 +72,10 @@ def markov_cells(motion_map):
     """
     from vibroimpact import stats
 
+    stay = stats.by_state(motion_map)
     out = {}
-    for state in (str(s) for s in motion_map["state"].values):
-        r = motion_map.sel(state=state).transpose(*_PLANE, ...)
+    for state in (str(s) for s in stay["state"].values):
+        r = stay.sel(state=state).transpose(*_PLANE, ...)
         out[state] = stats.markov_residence_check(
             r["residence_time"].values, r["residence_time_stderr"].values,
             r["n_stretches"].values, unit=_unit(state))
@@ -104,11 +105,12 @@ def markov_summary(motion_map):
     """
     import pandas as pd
 
-    from vibroimpact.stats.residence import MARKOV_MIN_STRETCHES
+    from vibroimpact.stats.residence import MARKOV_MIN_STRETCHES, by_state
 
+    stretches = by_state(motion_map)["n_stretches"]
     rows = {}
     for state, check in markov_cells(motion_map).items():
-        n = motion_map["n_stretches"].sel(state=state).transpose(*_PLANE).values
+        n = stretches.sel(state=state).transpose(*_PLANE).values
         enough = (n >= MARKOV_MIN_STRETCHES) & np.isfinite(check.cv)
         judged = np.isfinite(check.markov)
         regular = judged & (check.markov == 0.0) & (check.z < 0)

@@ -11,7 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-__all__ = ["ResidenceStatistics", "label_pieces", "residence_statistics",
+__all__ = ["ResidenceStatistics", "label_pieces", "residence_statistics", "by_state",
            "stationary_distribution", "MarkovCheck", "markov_residence_check",
            "jump_chain_independence"]
 
@@ -311,3 +311,30 @@ def jump_chain_independence(states, n_states: int):
         dof += (table.shape[0] - 1) * (table.shape[1] - 1)
     p_value = float(chi2.sf(statistic, dof)) if dof else np.nan
     return statistic, dof, p_value
+
+
+def by_state(motion_map):
+    """The residence statistics of a map dataset over one dimension ``state``: its motions,
+    then "none".
+
+    The map stores them as a probability map does, over ``motion`` (``residence_time``,
+    ``residence_time_stderr``, ``n_stretches``, ``n_censored``), with "none" (time in no
+    listed motion) under the same names plus ``_none`` (docs/datasets.md). The one function
+    of this package on an xarray Dataset: the figure and the reports read the four states
+    alike.
+
+    Returns
+    -------
+    xarray.Dataset
+        Those of the four variables the map holds, over ``("state", "inv_beta", "delta")``,
+        states named as the map's motions ("1/1", ...) then "none".
+    """
+    import xarray as xr
+
+    names = ("residence_time", "residence_time_stderr", "n_stretches", "n_censored")
+    parts = {}
+    for name in (n for n in names if n in motion_map):
+        motions = motion_map[name].rename(motion="state")
+        none = motion_map[f"{name}_none"].expand_dims(state=["none"])
+        parts[name] = xr.concat([motions, none], dim="state")
+    return xr.Dataset(parts).transpose("state", "inv_beta", "delta")
