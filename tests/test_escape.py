@@ -41,6 +41,17 @@ def test_fit_recovers_a_known_slope_exactly_from_exact_data():
     assert fit.slope_hi - fit.slope == pytest.approx(1.959964 * fit.slope_stderr, rel=1e-6)
 
 
+def test_fit_whose_scatter_sets_the_error_uses_students_t_on_its_few_levels():
+    """ln T curved: chi2_red > 1, the error scaled by sqrt(chi2_red) and the interval
+    Student's t with K - 2 = 2 degrees of freedom (4.303), not the normal 1.96."""
+    x = 1.0 / np.array([0.15, 0.18, 0.22, 0.29]) ** 2
+    t = 3.0 * np.exp(0.16 * x - 0.001 * x ** 2)
+    fit = stats.escape_fit(x, t, 0.01 * t, np.full(4, 100))
+    assert fit.chi2_red > 1.0
+    assert fit.slope_hi - fit.slope == pytest.approx(4.302653 * fit.slope_stderr, rel=1e-6)
+    assert fit.slope - fit.slope_lo == pytest.approx(4.302653 * fit.slope_stderr, rel=1e-6)
+
+
 def test_fit_covers_the_slope_of_noisy_data_at_its_confidence():
     """500 synthetic data sets of 5 levels, each ln T off by its stated error: the 95 %
     interval holds the true slope in 95 % of them (binomial 3 sigma: +-3 %), chi2_red ~ 1."""

@@ -13,11 +13,12 @@ from typing import NamedTuple
 
 import numpy as np
 
+from vibroimpact.stats.events import t_quantile
+
 __all__ = ["EscapeFit", "escape_fit", "FIT_CONFIDENCE"]
 
-#: Confidence of the slope's interval, and its normal quantile (see `escape_fit`).
+#: Confidence of the slope's interval (see `escape_fit`).
 FIT_CONFIDENCE = 0.95
-_Z = 1.959963984540054
 
 
 class EscapeFit(NamedTuple):
@@ -62,9 +63,12 @@ def escape_fit(inv_rms2, time, time_stderr, n_stretches, min_stretches=20, allow
     ``1 / s^2``. The slope's standard error comes from the weighted normal equations and is
     multiplied by ``sqrt(chi2_red)`` when the points scatter more than their errors allow
     (``chi2_red > 1``, the Particle Data Group's scale factor: a curved ``ln T`` shows as a
-    wide interval rather than a falsely precise slope). The interval is ``slope +- 1.96
-    stderr``. ``chi2_red`` itself says whether ``ln T`` is linear in ``1 / rms^2`` over the
-    levels used: about 1 when it is.
+    wide interval rather than a falsely precise slope). The interval is ``slope +- q
+    stderr``: with the errors as given, ``q`` is the normal quantile (1.96); when the scatter
+    sets the error (``chi2_red > 1``), it is estimated from the ``K - 2`` residual degrees of
+    freedom of a few levels, and ``q`` is Student's t quantile with ``K - 2`` degrees of
+    freedom (4.30 for K = 4). ``chi2_red`` itself says whether ``ln T`` is linear in
+    ``1 / rms^2`` over the levels used: about 1 when it is.
     """
     x = np.asarray(inv_rms2, dtype=float)
     t = np.asarray(time, dtype=float)
@@ -85,5 +89,8 @@ def escape_fit(inv_rms2, time, time_stderr, n_stretches, min_stretches=20, allow
     chi2_red = chi2 / (k - 2) if k > 2 else float("nan")
     scale = max(1.0, chi2_red) if k > 2 else 1.0
     se = float(np.sqrt(cov[1, 1] * scale))
-    return EscapeFit(float(slope), se, float(slope - _Z * se), float(slope + _Z * se),
+    # t_quantile(B) has B - 1 degrees of freedom: K - 1 of them gives K - 2
+    q = float(t_quantile(k - 1, FIT_CONFIDENCE) if scale > 1.0
+              else t_quantile(2**30, FIT_CONFIDENCE))
+    return EscapeFit(float(slope), se, float(slope - q * se), float(slope + q * se),
                      float(intercept), chi2_red, k, used)
