@@ -215,10 +215,12 @@ def make_plan(config, own=None, *, results="results"):
             block = entry["escape"]
             levels, cells = len(block["rms"]), len(block["cells"])
             states = len(entry["motions"]) + 1
+            cpu = costs.escape_cpu_s(entry, float(noise["dt"]))
             _add(row, levels * cells, levels + 1,
-                 2 * levels * cells * states * 40 + cells * states * 60,
-                 costs.escape_cpu_s(entry, float(noise["dt"])))
-            parts.append(f"escape {_n(cells, 'cell')} x {_n(levels, 'noise level')}")
+                 2 * levels * cells * states * 40 + cells * states * 60, cpu)
+            cpu += (levels + 1) * JOB_START_S + FIGURE_S     # its jobs' start-up, its figure
+            parts.append(f"escape {_n(cells, 'cell')} x {_n(levels, 'noise level')} "
+                         f"(~{cpu:.0f} CPU-s with its figure)")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
             _add(row, 0, 1, 40 * steps, 0.0)
