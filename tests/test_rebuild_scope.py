@@ -33,6 +33,7 @@ ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits", "trace_boundaries"}
 # the basins and Lyapunov exponents run the simulator's kernel against the orbit solver's
 ATTRACTOR_RULES = {"solve_attractor_tile", "aggregate_attractors"}
 MAP_RULES = {"simulate_map", "aggregate_map"}
+ESCAPE_RULES = {"simulate_escape", "aggregate_escape"}
 
 
 def _git(repo, *args):
@@ -196,8 +197,8 @@ def test_figure_only_key_reruns_only_that_figure(repo, edit):
 def test_simulator_edit_reruns_the_studies_and_downstream(repo, edit):
     edit("src/vibroimpact/impact/kernels.py", _append_code)    # uncommitted
     jobs = scheduled(repo)
-    assert set(jobs) == (STUDY_RULES | MAP_RULES | ATTRACTOR_RULES | FIGURE_RULES | REPORT_RULES
-                         | VALIDATION_RULES)
+    assert set(jobs) == (STUDY_RULES | MAP_RULES | ESCAPE_RULES | ATTRACTOR_RULES | FIGURE_RULES
+                         | REPORT_RULES | VALIDATION_RULES)
     assert "fig16.png" not in {Path(p).name for p in jobs["draw_figure"]}
     assert {"basins.png", "lyapunov.png"} <= {Path(p).name for p in jobs["draw_figure"]}
 
