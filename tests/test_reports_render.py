@@ -20,6 +20,7 @@ from types import SimpleNamespace
 import nbformat
 import numpy as np
 import pytest
+import yaml
 import xarray as xr
 
 from helpers import ROOT, make_workdir
@@ -289,8 +290,9 @@ def test_snakemake_report_has_each_figure_once_and_no_docutils_error(built):
     assert "system-message" not in text and "System Message" not in text
     assert fetched(text) == []
     pngs = sorted((built / "results" / "figures").rglob("*.png"))
-    copies = [p for p in pngs if p.parent.name == "figures" and p.stem.startswith("fig")]
-    assert len(copies) >= 15
+    paper_figures = yaml.safe_load((built / "config" / "test.yaml").read_text())["paper_figures"]
+    copies = [p for p in pngs if p.parent.name == "figures" and p.stem in paper_figures]
+    assert len(copies) == len(paper_figures) >= 15
     for png in pngs:
         assert text.count(base64.b64encode(png.read_bytes()).decode()) == 1, png
     categories = json.loads(re.search(r"var categories = (\{.*?\});\n", text)[1])
