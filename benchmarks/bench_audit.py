@@ -57,9 +57,12 @@ def run_audit(record, chunks, moments):
     dt = SPEC.dt
     rec = cells._IdentityRecord(record, dt, TRANSIENT, (record.size - 1) * dt, BATCHES,
                                 **chunks["params"])
-    rec.audit_moments = moments
-    for chunk in chunks["chunks"]:
-        rec.add(chunk)
+    compiled, cells.audit_moments = cells.audit_moments, moments    # what `add` calls
+    try:
+        for chunk in chunks["chunks"]:
+            rec.add(chunk)
+    finally:
+        cells.audit_moments = compiled
     return rec.moments
 
 
