@@ -68,5 +68,21 @@ def test_a_wrong_residual_fails_by_name_and_a_long_sweep_shows_its_worst_cells(e
     assert np.isfinite(table.data.to_numpy()).all()
 
 
+def test_a_residual_below_the_numerical_floor_passes_and_is_named(events):
+    """Beyond 3 s.e. but within AUDIT_FLOOR of its scale (the mass resting on the wall, its
+    batch errors below the accuracy of the closed-form chatter tails): passed, and said."""
+    low = events.copy(deep=True)
+    scale = abs(float(low["virial_scale"][0, 0]))
+    low["virial_residual"][0, 0] = 0.5 * nb.AUDIT_FLOOR * scale
+    low["virial_residual_stderr"][0, 0] = 0.01 * nb.AUDIT_FLOOR * scale
+    (verdict,), _ = _audit(low)
+    assert verdict.startswith("**Self-audit passed:**")
+    assert "1 more beyond 3 s.e. but within 1e-07 of their scale" in verdict
+    assert "virial at delta = -0.5: 50.0 s.e., 5.0e-08 of its scale" in verdict
+    low["virial_residual"][0, 0] = 2 * nb.AUDIT_FLOOR * scale
+    (verdict,), _ = _audit(low)
+    assert "FAILED" in verdict and "virial at delta = -0.5 (200.0 s.e.)" in verdict
+
+
 def test_no_residuals_no_table():
     assert "no identity residuals" in nb.identity_audit(None).data
