@@ -19,7 +19,9 @@ KIND_OF_REASON = {1: "fold", 2: "grazing", 3: "period_doubling"}
 SHORTEST_RUN = 4
 N_STARTS = 64
 MOTIONS = ["1/1", "2/1", "1/2", "1/3", "3/1", "other"]
-CLASSES = ["listed", "periodic_other", "sticking", "chaotic", "undecided"]
+CLASSES = ["listed", "periodic_other", "sticking", "chaotic", "undecided", "wall_free"]
+#: Above this play the synthetic "other" starts take the wall-free response (no impact).
+WALL_FREE_DELTA = 2.2
 BOX = "phase in [0, 2pi), x0 = delta - g, g in [0, 4], v0 in [-4, 4]"
 CONFIDENCE = 0.95
 
@@ -145,10 +147,14 @@ def basins(orbits, inv_beta=None, delta=None, seed=0):
     total = weight.sum(axis=0)
     chaotic = 3.0 * np.exp(-((ib - 0.6) ** 2 / 0.05 + (d - 0.3) ** 2 / 0.3)) * (total == 0)
     free = 1.0 - stick
-    # a coexisting motion of another type (e.g. without impact) draws starts everywhere
+    # a coexisting motion of another type draws starts everywhere: an impact motion, or
+    # above delta = WALL_FREE_DELTA the wall-free linear response
     other = 0.25 + 0.5 * np.exp(-(d - 1.0) ** 2) + (total == 0)
+    wall_free = np.where(d > WALL_FREE_DELTA, other, 0.0)
+    other = other - wall_free
     p = np.concatenate([free * weight[:-1],
-                        np.stack([other * free, stick, chaotic * free, 0.01 * free])])
+                        np.stack([other * free, stick, chaotic * free, 0.01 * free,
+                                  wall_free * free])])
     p /= p.sum(axis=0, keepdims=True)
     counts = np.empty((p.shape[0], *shape), int)
     for i in range(shape[0]):
@@ -188,18 +194,22 @@ def lyapunov(basins_ds, seed=0):
                     [0.05 + 0.1 * cf[3], 0.002 * rng.standard_normal(cell_class.shape)],
                     -zeta - 0.3 * cf[0])
     lam = np.where(cf[2] == 1.0, -np.inf, lam)
-    impact_rate = np.where(d > 2.2, 0.0, 0.15 * (2.2 - d) / 3.7)
+    impact_rate = np.where(d > WALL_FREE_DELTA, 0.0, 0.15 * (WALL_FREE_DELTA - d) / 3.7)
     lam = np.where(impact_rate == 0.0, -zeta, lam)
+    # where some starts are chaotic, their positive exponent is the cell's largest
+    lyapunov_class = np.where((cf[3] > 0) & (cell_class != 3), 3, cell_class).astype("int8")
+    lam = np.where((cf[3] > 0) & (cell_class != 3), 0.05 + 0.1 * cf[3], lam)
     stderr = np.where(np.isin(cell_class, (3, 4)), 0.004, np.nan)
     dims = ("inv_beta", "delta")
     ds = xr.Dataset(
         {"lyapunov": (dims, lam), "lyapunov_stderr": (dims, stderr),
          "cell_class": (dims, cell_class), "impact_rate": (dims, impact_rate),
+         "lyapunov_class": (dims, lyapunov_class),
          "class_fraction": basins_ds["class_fraction"]},
         coords={k: basins_ds[k] for k in ("inv_beta", "delta", "class")},
         attrs=dict(zeta=basins_ds.attrs["zeta"], eps=basins_ds.attrs["eps"]))
-    ds["cell_class"].attrs.update(
-        flag_values=np.arange(5, dtype="int8"),
-        flag_meanings="listed_periodic periodic_other sticking chaotic undecided")
+    for name in ("cell_class", "lyapunov_class"):
+        ds[name].attrs.update(flag_values=np.arange(len(CLASSES), dtype="int8"),
+                              flag_meanings=" ".join(CLASSES))
     ds["lyapunov"].attrs.update(long_name="largest Lyapunov exponent", units="1")
     return ds

@@ -21,6 +21,8 @@ from vibroimpact import plotting
 from vibroimpact.plotting.attractors import CLASSES, NAN_COLOR, STICK_COLOR
 from vibroimpact.plotting.orbits import BOUNDARY_KINDS, _kind_style
 
+CLASSES_LIST = list(CLASSES)
+
 ROOT = Path(__file__).resolve().parents[1]
 #: The last commit before fig16 took `boundaries`: fig16(orbits) must draw what it drew.
 BEFORE_BOUNDARIES = "b1ccd6b"
@@ -319,3 +321,55 @@ def test_lyapunov_refuses_unknown_classes(data):
     ds["cell_class"].attrs["flag_meanings"] = "periodic chaotic"
     with pytest.raises(ValueError, match="flag_meanings"):
         plotting.lyapunov(ds)
+
+
+def test_lyapunov_marks_where_a_coexisting_motion_holds_the_largest_exponent(data):
+    ds = data["lyapunov"]
+    code = ds["cell_class"].values
+    owner = ds["lyapunov_class"].values
+    other = np.isfinite(ds["lyapunov"].values) & (owner != code)
+    assert other.any() and (code == CLASSES_LIST.index("wall_free")).any()
+    fig = plotting.lyapunov(ds)
+    ax = fig.axes[0]
+    x, y = ds["inv_beta"].values, ds["delta"].values
+    drawn = set()
+    for k, name in enumerate(CLASSES_LIST):
+        lines = [ln for ln in ax.lines if ln.get_gid() == f"owner-{name}"]
+        here = other & (owner == k)
+        assert len(lines) == int(here.any()), name
+        for ln in lines:
+            assert matplotlib.colors.same_color(ln.get_color(), CLASSES[name][0])
+            xy = set(zip(ln.get_xdata(), ln.get_ydata()))
+            i, j = np.nonzero(here)
+            assert xy == set(zip(x[i], y[j]))
+            drawn |= xy
+    assert len(drawn) == other.sum()
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any(t.startswith("largest exponent from a coexisting motion of fewer starts: "
+                            "chaotic") for t in labels)
+
+
+def test_lyapunov_colour_bar_ticks_both_ends_evenly(lyapunov_figure):
+    (values,) = _gid(lyapunov_figure.axes[0], "lyapunov")
+    bar = values.colorbar
+    ticks = np.asarray(bar.get_ticks())
+    norm = values.norm
+    assert ticks[0] == norm.vmin and ticks[-1] == norm.vmax and 0.0 in ticks
+    # two slopes, each half ticked at 0, half its end and its end: evenly spaced on the bar
+    np.testing.assert_allclose(norm(ticks), [0.0, 0.25, 0.5, 0.75, 1.0], atol=1e-12)
+    labels = [t.get_text() for t in bar.ax.get_yticklabels()]
+    assert all(labels) and labels[0].startswith(("-", "\N{MINUS SIGN}"))
+
+
+def test_lyapunov_draws_a_dataset_of_five_classes(data):
+    # written before the wall-free class: codes 0-4 keep their meanings
+    ds = data["lyapunov"].copy(deep=True).drop_vars("lyapunov_class")
+    five = CLASSES_LIST[:5]
+    ds = ds.isel({"class": slice(0, 5)})
+    ds["cell_class"] = ds["cell_class"].where(ds["cell_class"] < 5, 1).astype("int8")
+    ds["cell_class"].attrs.update(flag_values=np.arange(5, dtype="int8"),
+                                  flag_meanings=" ".join(five))
+    fig = plotting.lyapunov(ds)
+    labels = [t.get_text() for t in _panel(fig, "(b) what the starts settle to")
+              .get_legend().get_texts()]
+    assert not any(t.startswith(CLASSES["wall_free"][1]) for t in labels)

@@ -217,7 +217,80 @@ def test_whole_plane_exponents_and_bookkeeping():
     # "sticking", not periodic within the cap)
     late = np.isnan(outf[:, ak.F_SETTLE]) & ~unsettled
     assert np.all(cls[late] == ak.STICKING) and late.sum() < 0.01 * cls.size
-    # sticking: exponents -inf; impact-free settled motions: both -zeta
+    # sticking: exponents -inf; the wall-free response: both -zeta, and only where the
+    # linear steady response stays off the wall; every other periodic motion impacts
     assert np.all(outf[cls == ak.STICKING, ak.F_LYAP1] == -np.inf)
-    free = (cls == ak.PERIODIC_OTHER) & (outi[:, ak.I_PERIOD_M] == 0)
+    free = cls == ak.WALL_FREE
     assert free.any() and np.all(outf[free, ak.F_LYAP1] == -ZETA)
+    b, d = np.divmod(raw["cell_of"], delta.size)
+    assert np.all(_steady_amplitude(inv_beta[b[free]]) < delta[d[free]])
+    assert np.all(outi[cls == ak.PERIODIC_OTHER, ak.I_PERIOD_M] > 0)
+
+
+def _steady_amplitude(inv_beta):
+    """q(beta) of the linear steady response q sin(beta tau - phi) (MODEL.md)."""
+    beta = 1.0 / np.asarray(inv_beta, dtype=float)
+    return 1.0 / np.hypot(1.0 - beta ** 2, 2.0 * ZETA * beta)
+
+
+def test_wall_free_response_is_its_own_class():
+    # q(beta) from the closed form: 1/beta = 0.5 -> q = 0.33, 2.5 -> 1.19, 1.0 -> 10 (the
+    # resonance); delta = 1.5 and 3 clear the first and the last, delta = 0.2 none
+    inv_beta = np.array([0.5, 1.0, 2.5])
+    delta = np.array([0.2, 1.5, 3.0])
+    q = _steady_amplitude(inv_beta)
+    r = attractor_map(inv_beta, delta, ZETA, EPS, n_starts=16)
+    free = A.CLASSES.index("wall_free")
+    cls = r["class_start"]
+    clear = q[:, None] < delta[None, :]         # (nb, nd): the response misses the wall
+    assert clear.sum() == 4
+    # a wall-free start only where the closed form clears the wall, and there both of its
+    # exponents are -zeta (tolerance 0: a free flight's tangent map is the damped propagator,
+    # whose exponents are -zeta exactly), no collision, not a listed motion
+    on = cls == free
+    assert not np.any(on & ~clear[None])
+    assert np.all(r["lyapunov_start"][on] == -ZETA)
+    assert np.all(r["lyapunov_second_start"][on] == -ZETA)
+    assert np.all(r["motion_start"][on] == len(r["motions"]) - 1)
+    # cells that clear the wall and where no start impacts: the wall-free class, exponent
+    # -zeta, with the largest exponent's owner the wall-free response itself
+    quiet = clear & (r["impact_rate"] == 0.0)
+    assert quiet.sum() == 4
+    assert np.all(r["class_count"][free][quiet] == 16)
+    assert np.all(r["cell_class"][quiet] == free)
+    assert np.all(r["lyapunov"][quiet] == -ZETA) and np.all(r["lyapunov_class"][quiet] == free)
+    # and it is no longer counted as a periodic impact motion of another type
+    assert np.all(r["class_count"][A.CLASSES.index("periodic_other")][quiet] == 0)
+    assert not np.any(r["class_count"][free][~clear])
+
+
+def test_wall_free_start_converges_to_the_linear_response_in_the_simulator():
+    # independent of the kernel's settling test: the public simulator from a start that the
+    # map calls wall-free makes no impact after the settle time, and its distance from
+    # q sin(beta tau - phi) shrinks like exp(-zeta tau) (the exponent -zeta)
+    inv_beta, delta = 2.5, 3.0
+    beta = 1.0 / inv_beta
+    q = float(_steady_amplitude(inv_beta))
+    phi = math.atan2(2.0 * ZETA * beta, 1.0 - beta ** 2)
+    x0, v0 = delta - 0.5, 3.0
+    outf, outi, _ = A._starts_at_cell(inv_beta, delta, ZETA, EPS, [0.0], [x0], [v0])
+    assert outi[0, ak.I_CLASS] == ak.WALL_FREE
+    settle = outf[0, ak.F_SETTLE]
+    dt = ak.start_step(beta, 0.0)[0]
+    res = vibroimpact.simulate(ZETA, EPS, delta, amplitude=1.0, beta=beta, x0=x0, v0=v0,
+                               t_end=settle + 200.0, dt=dt, record_every=1)
+    assert res.n_impacts >= 1 and np.all(res.impact_time < settle)
+    t = np.asarray(res.grid_time)
+    x = delta - np.asarray(res.a)
+    v = np.asarray(res.v)
+    # the free part w = x - q sin(beta t - phi) and its envelope sqrt(w^2 + ((w' + zeta w)
+    # / omega_d)^2), which decays exactly like exp(-zeta t) between impacts
+    w = x - q * np.sin(beta * t - phi)
+    wv = v - q * beta * np.cos(beta * t - phi)
+    env = np.hypot(w, (wv + ZETA * w) / math.sqrt(1.0 - ZETA ** 2))
+    after = t > settle
+    slope = np.polyfit(t[after], np.log(env[after]), 1)[0]
+    # a straight line in log: the slope is -zeta to the round-off of x (env falls from
+    # delta - q to 1e-4 of it over the 200 time units)
+    assert slope == pytest.approx(-ZETA, abs=1e-6)
+    assert np.max(q + env[after]) < delta

@@ -55,8 +55,8 @@ def _fake_attractor_result(rows, deltas, n_starts, rng):
     nb, nd = rows.size, deltas.size
     motion = rng.integers(0, 3, size=(n_starts, nb, nd))
     count = np.stack([(motion == k).sum(axis=0) for k in range(3)])
-    classes = rng.integers(0, 5, size=(n_starts, nb, nd))
-    class_count = np.stack([(classes == k).sum(axis=0) for k in range(5)])
+    classes = rng.integers(0, 6, size=(n_starts, nb, nd)).astype(np.int8)
+    class_count = np.stack([(classes == k).sum(axis=0) for k in range(6)])
     lyap = rng.normal(size=(n_starts, nb, nd))
     return dict(
         inv_beta=rows, delta=deltas, motions=types + ["other"], count=count,
@@ -65,7 +65,9 @@ def _fake_attractor_result(rows, deltas, n_starts, rng):
         n_stable=rng.integers(0, 2, size=(2, nb, nd)),
         stick_count=rng.integers(0, 2, size=(2, nb, nd)),
         class_count=class_count, cell_class=np.argmax(class_count, axis=0).astype(np.int8),
-        lyapunov=lyap.max(axis=0), lyapunov_start=lyap, lyapunov_second_start=lyap - 1.0,
+        lyapunov=lyap.max(axis=0), lyapunov_start=lyap, class_start=classes,
+        lyapunov_class=np.take_along_axis(classes, lyap.argmax(axis=0)[None], axis=0)[0],
+        lyapunov_second_start=lyap - 1.0,
         lyapunov_stderr=np.full((nb, nd), np.nan), impact_rate=rng.random((nb, nd)),
         settle_time=rng.random((n_starts, nb, nd)), motion_start=motion)
 
@@ -99,7 +101,10 @@ def test_attractor_tiles_join_into_the_basins_and_lyapunov_datasets(tmp_path, or
     np.testing.assert_allclose(basins["class_fraction"].sum("class").values, 1.0)
     np.testing.assert_array_equal(lyap["lyapunov"].values, whole["lyapunov"])
     np.testing.assert_array_equal(lyap["cell_class"].values, whole["cell_class"])
-    assert lyap["cell_class"].attrs["flag_meanings"].split() == list(datasets.ATTRACTOR_CLASSES)
+    np.testing.assert_array_equal(lyap["class_start"].values, whole["class_start"])
+    np.testing.assert_array_equal(lyap["lyapunov_class"].values, whole["lyapunov_class"])
+    for name in ("cell_class", "lyapunov_class", "class_start"):
+        assert lyap[name].attrs["flag_meanings"].split() == list(datasets.ATTRACTOR_CLASSES)
     for ds in (basins, lyap):
         for name in ds.data_vars:
             assert "long_name" in ds[name].attrs, name
@@ -153,5 +158,5 @@ def test_the_class_names_are_one_list():
     from vibroimpact.plotting import attractors as drawn
 
     assert tuple(CLASSES) == datasets.ATTRACTOR_CLASSES == tuple(drawn.CLASSES)
-    assert [ak.LISTED, ak.PERIODIC_OTHER, ak.STICKING, ak.CHAOTIC, ak.UNDECIDED] == list(
-        range(len(CLASSES)))
+    assert [ak.LISTED, ak.PERIODIC_OTHER, ak.STICKING, ak.CHAOTIC, ak.UNDECIDED,
+            ak.WALL_FREE] == list(range(len(CLASSES)))

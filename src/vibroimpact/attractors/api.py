@@ -3,7 +3,8 @@
 For every cell ``(1/beta, delta)`` of a grid, :func:`attractor_map` runs ``n_starts`` starting
 states without noise until each settles on a periodic motion or reaches a time cap, and tells
 which motion it settled on (a stable (m/n) orbit of :func:`vibroimpact.periodic_orbits`, an
-impact-stick motion, another periodic motion) together with its Lyapunov exponents. Kernels:
+impact-stick motion, another periodic impact motion, the wall-free linear response) together
+with its Lyapunov exponents. Kernels:
 :mod:`vibroimpact.attractors.kernels`.
 """
 from __future__ import annotations
@@ -20,8 +21,13 @@ from vibroimpact.attractors import kernels as ak
 
 __all__ = ["attractor_map", "CLASSES", "DEFAULT_TYPES"]
 
-#: The classes of a start (``class_count``, ``cell_class``).
-CLASSES = ("listed", "periodic_other", "sticking", "chaotic", "undecided")
+#: The classes of a start (``class_count``, ``cell_class``, ``class_start``), by code 0-5:
+#: a stable solver orbit of a listed type; another periodic impact motion; sticking (at rest
+#: on the wall, or an impact-stick motion); chaotic; undecided; the wall-free response (the
+#: linear steady response ``q sin(beta tau - phi)`` with ``q < delta``, no impact). The
+#: wall-free class came last so that the codes 0-4 of datasets written before it keep their
+#: meaning.
+CLASSES = ("listed", "periodic_other", "sticking", "chaotic", "undecided", "wall_free")
 DEFAULT_TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))
 #: Default cap on a start's run (dimensionless time): ~64 natural periods, 5.5 times the
 #: time ln(1e6)/zeta = 276 that damping alone needs at zeta = 0.05 and match_tol = 1e-6.
@@ -172,10 +178,13 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         - ``fraction``, ``fraction_lo``, ``fraction_hi`` (n_types + 1, nb, nd): ``count /
           n_starts`` and its Clopper-Pearson 95 % interval;
         - ``n_stable`` int (n_types, nb, nd): stable admissible solver orbits;
-        - ``class_count`` int (5, nb, nd) and ``cell_class`` int8 (nb, nd), the most frequent
+        - ``class_count`` int (6, nb, nd) and ``cell_class`` int8 (nb, nd), the most frequent
           class (the first of a tie);
         - ``lyapunov`` (nb, nd): the largest exponent over the cell's starts (``-inf`` when
-          every start sticks); ``lyapunov_start``, ``lyapunov_second_start`` (n_starts, nb,
+          every start sticks); ``lyapunov_class`` int8 (nb, nd): the class of the start it
+          belongs to (the first such start; -1 where no start has an exponent), which differs
+          from ``cell_class`` where a minority attractor coexists with a larger exponent;
+          ``lyapunov_start``, ``lyapunov_second_start`` (n_starts, nb,
           nd): both exponents of every start; ``lyapunov_stderr`` (nb, nd): the largest
           standard error among the unsettled starts (NaN where all settled);
         - ``impact_rate`` (nb, nd): mean collisions per unit time over the starts' final
@@ -198,8 +207,9 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     **Settling**, tested once per forcing period, in this order:
 
     1. no impact can happen again: the free response's amplitude plus the steady one, ``q``,
-       is below ``delta`` (class "periodic_other", the impact-free motion; both exponents
-       ``-zeta``);
+       is below ``delta`` (class "wall_free": the motion tends to the linear steady response
+       ``q sin(beta tau - phi)``, which never reaches the wall; both exponents ``-zeta``,
+       exactly, since the tangent map of a free flight is the damped propagator);
     2. on the wall (resting or sliding) for 4 forcing periods without an impact (class
        "sticking");
     3. the last 3 m impacts follow a stable admissible solver orbit of a listed (m/n) type
@@ -211,7 +221,7 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
        in its period it is an impact-stick motion, class "sticking", with m' collisions
        (impacts grouped as in :func:`vibroimpact.stats.group_collisions`) per k periods; if
        (m'/k) is a listed type it is counted in ``stick_count``. Otherwise class
-       "periodic_other".
+       "periodic_other" (a periodic impact motion of another type).
 
     ``settle_time`` is the start of the window that proved it (the first impact of the
     3 returns). Unsettled at ``max_time``: "chaotic" or "undecided" (below), or "sticking"
@@ -286,6 +296,10 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
                            f"{inv_beta[ib]:g}, delta = {delta[d]:g} "
                            f"({int(np.count_nonzero(status))} starts in all)")
     lyap1 = to_s(outf[:, ak.F_LYAP1])
+    ranked = np.where(np.isnan(lyap1), -np.inf, lyap1)
+    owner = np.argmax(ranked, axis=0)           # first start holding the largest exponent
+    lyap_class = np.where(np.isnan(lyap1).all(axis=0), -1,
+                          np.take_along_axis(cls, owner[None], axis=0)[0]).astype(np.int8)
     lyap2 = to_s(outf[:, ak.F_LYAP2])
     stderr = to_s(outf[:, ak.F_STDERR])
     with warnings.catch_warnings():
@@ -303,7 +317,8 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         "n_stable": raw["n_stable"],
         "class_count": class_count,
         "cell_class": np.argmax(class_count, axis=0).astype(np.int8),
-        "lyapunov": lyap, "lyapunov_start": lyap1, "lyapunov_second_start": lyap2,
+        "lyapunov": lyap, "lyapunov_class": lyap_class, "lyapunov_start": lyap1,
+        "lyapunov_second_start": lyap2,
         "lyapunov_stderr": lyap_se, "impact_rate": rate,
         "settle_time": to_s(outf[:, ak.F_SETTLE]),
         "motion_start": motion, "class_start": cls,

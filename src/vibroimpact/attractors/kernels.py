@@ -79,8 +79,8 @@ CAPACITY = 2 * STEP_HEADROOM + COMPACT
 #: "Chaotic": the largest exponent exceeds this many standard errors (batch means, 7 dof).
 CHAOS_SIGMAS = 3.0
 
-# classes (attractors.CLASSES)
-LISTED, PERIODIC_OTHER, STICKING, CHAOTIC, UNDECIDED = 0, 1, 2, 3, 4
+# classes (attractors.CLASSES); the wall-free response came last, so codes 0-4 kept their meaning
+LISTED, PERIODIC_OTHER, STICKING, CHAOTIC, UNDECIDED, WALL_FREE = 0, 1, 2, 3, 4, 5
 # per-start float results
 (F_SETTLE, F_LYAP1, F_LYAP2, F_STDERR, F_RATE, F_IMPACTS, F_WINDOW, F_STEP, F_T0) = range(9)
 N_F = 9
@@ -595,6 +595,7 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
             last_k, last_s = k, 0.0
         mode = int(state[S_MODE])
         # (a) no impact ever again: the free response has decayed below the wall's margin
+        # and the motion tends to the linear steady response q sin(beta tau - phi), q < delta
         if mode == FREE:
             w = state[S_W]
             c2 = (state[S_WV] + zeta * w) / omega
@@ -603,7 +604,7 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                 outf[F_LYAP1] = -zeta
                 outf[F_LYAP2] = -zeta
                 outf[F_RATE] = 0.0
-                outi[I_CLASS] = PERIODIC_OTHER
+                outi[I_CLASS] = WALL_FREE
                 outi[I_PERIOD_P] = 1
                 return
         # (b) resting or sliding on the wall for REPEATS + 1 periods without an impact

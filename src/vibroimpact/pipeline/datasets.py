@@ -392,7 +392,8 @@ def boundaries_dataset(curves_by_type, attrs):
 
 
 #: Classes of a start of the attractor map (`vibroimpact.attractor_map`).
-ATTRACTOR_CLASSES = ("listed", "periodic_other", "sticking", "chaotic", "undecided")
+ATTRACTOR_CLASSES = ("listed", "periodic_other", "sticking", "chaotic", "undecided",
+                     "wall_free")
 
 ATTRACTOR_META = {
     "fraction": ("share of the starts that settle on a stable periodic motion of this type "
@@ -409,6 +410,8 @@ ATTRACTOR_META = {
     "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle",
                         "1/tau"),
     "cell_class": ("the most frequent class of the cell's starts", "1"),
+    "lyapunov_class": ("class of the start whose exponent is the cell's largest", "1"),
+    "class_start": ("class of each start (flag_meanings)", "1"),
     "impact_rate": ("collisions per unit time, mean over the cell's starts", "1/tau"),
     "lyapunov_start": ("largest Lyapunov exponent of each start", "1/tau"),
     "motion_start": ("what each start settles on: index into motion", "1"),
@@ -435,8 +438,10 @@ def attractor_tile_dataset(result, attrs):
     for name in ("lyapunov", "lyapunov_stderr", "impact_rate"):
         data[name] = (plane, result[name])
     data["cell_class"] = (plane, result["cell_class"].astype(np.int8))
+    data["lyapunov_class"] = (plane, result["lyapunov_class"].astype(np.int8))
     for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
         data[name] = (("start", *plane), result[name])
+    data["class_start"] = (("start", *plane), result["class_start"].astype(np.int8))
     return xr.Dataset(data, coords=coords, attrs=dict(attrs))
 
 
@@ -477,17 +482,19 @@ def basins_dataset(tiles):
 
 def lyapunov_dataset(tiles):
     """The Lyapunov dataset (``results/orbits/<name>_lyapunov.nc``) of the joined attractor
-    tiles: ``lyapunov``, ``lyapunov_stderr``, ``cell_class`` (CF flags), ``impact_rate`` over
-    ``(inv_beta, delta)``, ``class_fraction`` and each start's exponent."""
+    tiles: ``lyapunov``, ``lyapunov_stderr``, ``cell_class`` and ``lyapunov_class`` (CF
+    flags), ``impact_rate`` over ``(inv_beta, delta)``, ``class_fraction`` and each start's
+    exponents and class (``class_start``, CF flags)."""
     n_starts = int(tiles.attrs["n_starts"])
     ds = xr.Dataset(
         {name: tiles[name] for name in ("lyapunov", "lyapunov_stderr", "cell_class",
-                                        "impact_rate", "lyapunov_start",
-                                        "lyapunov_second_start", "settle_time")},
+                                        "lyapunov_class", "impact_rate", "lyapunov_start",
+                                        "lyapunov_second_start", "settle_time", "class_start")},
         attrs=dict(tiles.attrs))
     ds["class_fraction"] = tiles["class_count"] / n_starts
-    ds["cell_class"].attrs.update(flag_values=np.arange(len(ATTRACTOR_CLASSES), dtype=np.int8),
-                                  flag_meanings=" ".join(ATTRACTOR_CLASSES))
+    for name in ("cell_class", "lyapunov_class", "class_start"):
+        ds[name].attrs.update(flag_values=np.arange(len(ATTRACTOR_CLASSES), dtype=np.int8),
+                              flag_meanings=" ".join(ATTRACTOR_CLASSES))
     return _described(ds)
 
 

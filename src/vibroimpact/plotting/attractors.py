@@ -15,6 +15,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
+from matplotlib.ticker import FormatStrFormatter
 
 from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
                                           axis_label)
@@ -40,13 +41,15 @@ STRAY_COLOR = "#CC79A7"
 STICK_LEVEL = 10
 STICK_LINE_COLOR = "#009E73"
 #: The classes of a cell's starts (a dataset's ``class`` coordinate and ``cell_class``
-#: codes 0-4): colour and words.
+#: codes 0-5, `vibroimpact.attractors.CLASSES`): colour and words. The wall-free response is
+#: the linear steady response q sin(beta tau - phi), q < delta, that never reaches the wall.
 CLASSES = {
     "listed": ("#0072B2", "periodic, of a type of Fig. 16"),
-    "periodic_other": ("#56B4E9", "periodic, of another type"),
+    "periodic_other": ("#56B4E9", "periodic impact motion of another type"),
     "sticking": ("#8C6D31", "sticking to the wall"),
     "chaotic": ("#D55E00", "chaotic"),
     "undecided": ("0.72", "undecided"),
+    "wall_free": ("#C9E4B4", r"wall-free response ($q < \delta$, no impact)"),
 }
 #: Colour of the cells with an exponent of -inf (every start sticks) and of those without a
 #: value (NaN).
@@ -59,9 +62,15 @@ MIXED_SHARE = 0.5
 MIXED_HATCH = "////"
 #: Lyapunov colour map: diverging, centred at 0 (stable blue, chaotic red); each side ends at
 #: this quantile of its exponents' magnitudes, so that a few outlying cells (a finite-time
-#: estimate) do not wash out the rest; beyond it the end colour, an arrow on the colour bar.
+#: estimate) do not wash out the rest, rounded up to a value of `LYAPUNOV_ENDS` (times a
+#: power of ten); beyond it the end colour, an arrow on the colour bar. Each half of the bar
+#: has its own scale, ticked at 0, half its end and its end (evenly spaced on the bar).
 LYAPUNOV_CMAP = "RdBu_r"
 LYAPUNOV_QUANTILE = 0.99
+LYAPUNOV_ENDS = (1.0, 1.2, 1.6, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
+#: Where the start holding a cell's largest exponent is not of the cell's class (a coexisting
+#: attractor of fewer starts sets the colour of panel (a)): a marker in that class's colour.
+OWNER_MARKER = dict(marker="D", ms=2.6, mec="k", mew=0.35, ls="none")
 
 
 def _grid(ds):
@@ -249,29 +258,44 @@ def _starts_text(basins):
     return text
 
 
-def _class_names(ds):
-    """The classes of codes 0..4 (`CLASSES`), checked against ``cell_class``'s
-    ``flag_meanings`` when it has them."""
-    meanings = ds["cell_class"].attrs.get("flag_meanings")
-    if meanings is not None and len(str(meanings).split()) != len(CLASSES):
-        raise ValueError(f"cell_class has the flag_meanings {meanings!r}; this figure knows "
-                         f"{len(CLASSES)} classes, codes 0-{len(CLASSES) - 1}: {list(CLASSES)}")
-    return list(CLASSES), [words for _, words in CLASSES.values()]
+def _class_names(ds, name="cell_class"):
+    """The classes of the codes of ``ds[name]``: its ``flag_meanings`` in order when it has
+    them (each one of `CLASSES`; a dataset written before the wall-free class has codes 0-4),
+    else `CLASSES` in order."""
+    meanings = ds[name].attrs.get("flag_meanings")
+    names = list(CLASSES) if meanings is None else str(meanings).split()
+    unknown = [n for n in names if n not in CLASSES]
+    if unknown:
+        raise ValueError(f"{name} has the flag_meanings {meanings!r}; this figure knows the "
+                         f"classes {list(CLASSES)}, not {unknown}")
+    return names, [CLASSES[n][1] for n in names]
+
+
+def _nice_end(value):
+    """The smallest of `LYAPUNOV_ENDS` times a power of ten that is >= `value` (> 0)."""
+    power = 10.0 ** np.floor(np.log10(value))
+    for step in LYAPUNOV_ENDS:
+        if step * power >= value * (1.0 - 1e-12):
+            return step * power
+    return 10.0 * power
 
 
 def _lyapunov_norm(finite):
     """Diverging norm centred at 0 from the finite exponents, each side ending at the
-    `LYAPUNOV_QUANTILE` of its magnitudes, and the colour bar's ``extend``."""
-    ends, beyond = [], []
+    `LYAPUNOV_QUANTILE` of its magnitudes rounded up (`_nice_end`), the colour bar's
+    ``extend`` and its ticks (each side's end, half of it, 0)."""
+    ends, sides = [], []
     for side in (-finite[finite < 0.0], finite[finite > 0.0]):
-        end = float(np.quantile(side, LYAPUNOV_QUANTILE)) if side.size else 0.0
-        ends.append(end)
-        beyond.append(bool(side.size) and float(side.max()) > end)
+        ends.append(float(np.quantile(side, LYAPUNOV_QUANTILE)) if side.size else 0.0)
+        sides.append(side)
     floor = 0.05 * max(*ends, 1e-12)        # a side without values keeps a sliver of colour
-    norm = TwoSlopeNorm(vcenter=0.0, vmin=-max(ends[0], floor), vmax=max(ends[1], floor))
+    ends = [_nice_end(max(end, floor)) for end in ends]
+    beyond = [bool(side.size) and float(side.max()) > end for side, end in zip(sides, ends)]
+    norm = TwoSlopeNorm(vcenter=0.0, vmin=-ends[0], vmax=ends[1])
     extend = {(False, False): "neither", (True, False): "min", (False, True): "max",
               (True, True): "both"}[tuple(beyond)]
-    return norm, extend
+    ticks = [-ends[0], -0.5 * ends[0], 0.0, 0.5 * ends[1], ends[1]]
+    return norm, extend, ticks
 
 
 @_styled
@@ -282,15 +306,20 @@ def lyapunov(lyapunov):
     ----------
     lyapunov : xarray.Dataset
         ``results/orbits/{name}_lyapunov.nc``: ``lyapunov`` (per unit time tau; -inf where
-        every start sticks), ``lyapunov_stderr``, ``cell_class`` (int, codes 0-4),
-        ``impact_rate`` over ``(inv_beta, delta)``, ``class_fraction`` over ``(class,
-        inv_beta, delta)``; global attributes ``zeta``, ``eps``.
+        every start sticks), ``lyapunov_stderr``, ``cell_class`` (int, codes of its
+        ``flag_meanings``, `CLASSES`), ``impact_rate`` over ``(inv_beta, delta)``,
+        ``class_fraction`` over ``(class, inv_beta, delta)``; optionally ``lyapunov_class``
+        (the class of the start holding the largest exponent); global attributes ``zeta``,
+        ``eps``.
 
     Returns
     -------
     matplotlib.figure.Figure
         (a) The exponent on a diverging map centred at 0 (`LYAPUNOV_CMAP`, each side
-        scaled to its own range up to `LYAPUNOV_QUANTILE`: red chaotic, blue settling),
+        scaled to its own range up to `LYAPUNOV_QUANTILE`, rounded up: red chaotic, blue
+        settling; the bar ticked at both ends, their halves and 0), a diamond in the class's
+        colour where the largest exponent belongs to a start of another class than the
+        cell's (``lyapunov_class``: a coexisting motion of fewer starts),
         cells of -inf in the sticking colour (`STICK_COLOR`), cells without a value grey; a
         dot where the exponent lies within `SIGN_STDERRS` standard errors of 0 (its sign
         unresolved); the edge of the region where no start impacts (``impact_rate`` 0: the
@@ -317,7 +346,7 @@ def lyapunov(lyapunov):
                         cmap=ListedColormap([STICK_COLOR]), rasterized=True, gid="sticking")
         handles_l.append(Patch(facecolor=STICK_COLOR, edgecolor="0.6",
                                label=r"every start sticks: $-\infty$"))
-    norm, extend = _lyapunov_norm(lam[finite])
+    norm, extend, ticks = _lyapunov_norm(lam[finite])
     shaded = ax_l.pcolormesh(xe, ye, np.ma.masked_where(~finite, np.where(finite, lam, 0.0)).T,
                              cmap=LYAPUNOV_CMAP, norm=norm, rasterized=True, gid="lyapunov")
     if "lyapunov_stderr" in lyapunov:
@@ -342,12 +371,31 @@ def lyapunov(lyapunov):
             handles_l.append(Line2D([], [], color="0.2", lw=0.9,
                                     label=r"edge of no impact (wall-free response, "
                                           r"$-\zeta$)"))
-    fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend=extend,
-                 label=r"largest Lyapunov exponent (per unit $\tau$)")
-    ax_l.set_title("(a) largest Lyapunov exponent")
-
     names, words = _class_names(lyapunov)
     code = np.asarray(lyapunov["cell_class"].values).astype(int)
+    if "lyapunov_class" in lyapunov:
+        # the start holding the cell's largest exponent settled elsewhere than most starts:
+        # the colour of (a) is that coexisting attractor's exponent
+        own_names, _ = _class_names(lyapunov, "lyapunov_class")
+        owner = np.asarray(lyapunov["lyapunov_class"].values).astype(int)
+        for k, name in enumerate(own_names):
+            here = finite & (owner == k) & (np.array(names)[np.clip(code, 0, len(names) - 1)]
+                                            != name)
+            if here.any():
+                i, j = np.nonzero(here)
+                ax_l.plot(x[i], y[j], color=CLASSES[name][0], gid=f"owner-{name}",
+                          **OWNER_MARKER)
+                handles_l.append(Line2D([], [], color=CLASSES[name][0], **OWNER_MARKER,
+                                        label=f"largest exponent from a coexisting motion "
+                                              f"of fewer starts: {CLASSES[name][1]} "
+                                              f"({int(here.sum())} cells)"))
+    bar = fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend=extend, ticks=ticks,
+                       format=FormatStrFormatter("%.3g"),
+                       label="largest Lyapunov exponent (per unit $\\tau$)\n"
+                             "each half of the bar to its own scale")
+    bar.minorticks_off()
+    ax_l.set_title("(a) largest Lyapunov exponent")
+
     colors = [CLASSES[n][0] for n in names]
     ax_c.pcolormesh(xe, ye, code.T, cmap=ListedColormap(colors), vmin=-0.5,
                     vmax=len(names) - 0.5, rasterized=True, gid="cell-class")
