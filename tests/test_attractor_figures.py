@@ -345,8 +345,7 @@ def test_lyapunov_marks_where_a_coexisting_motion_holds_the_largest_exponent(dat
             drawn |= xy
     assert len(drawn) == other.sum()
     labels = [t.get_text() for t in ax.get_legend().get_texts()]
-    assert any(t.startswith("largest exponent from a coexisting motion of fewer starts: "
-                            "chaotic") for t in labels)
+    assert any(t.startswith("largest from fewer starts: chaotic (") for t in labels)
 
 
 def test_lyapunov_colour_bar_ticks_both_ends_evenly(lyapunov_figure):
@@ -373,3 +372,90 @@ def test_lyapunov_draws_a_dataset_of_five_classes(data):
     labels = [t.get_text() for t in _panel(fig, "(b) what the starts settle to")
               .get_legend().get_texts()]
     assert not any(t.startswith(CLASSES["wall_free"][1]) for t in labels)
+
+
+# --------------------------------------------------------------------------------------------
+# The periodic-motions report's tables
+# --------------------------------------------------------------------------------------------
+
+def _four_cells():
+    """2 x 2 cells of 4 starts: (0, 0) three listed starts at -0.1 and a chaotic one at
+    +0.5; (0, 1) every start sticks; (1, 0) every start on the wall-free response; (1, 1)
+    three sticking starts and one periodic impact motion of another type at -0.2."""
+    code = {n: k for k, n in enumerate(CLASSES_LIST)}
+    cls = np.empty((4, 2, 2), np.int8)
+    lam = np.empty((4, 2, 2))
+    cls[:, 0, 0], lam[:, 0, 0] = [code["listed"]] * 3 + [code["chaotic"]], [-0.1] * 3 + [0.5]
+    cls[:, 0, 1], lam[:, 0, 1] = code["sticking"], -np.inf
+    cls[:, 1, 0], lam[:, 1, 0] = code["wall_free"], -0.05
+    cls[:, 1, 1] = [code["sticking"]] * 3 + [code["periodic_other"]]
+    lam[:, 1, 1] = [-np.inf] * 3 + [-0.2]
+    counts = np.stack([(cls == k).sum(axis=0) for k in range(len(CLASSES_LIST))])
+    flags = dict(flag_meanings=" ".join(CLASSES_LIST))
+    plane = ("inv_beta", "delta")
+    ds = xr.Dataset(
+        {"lyapunov": (plane, lam.max(axis=0)),
+         "cell_class": (plane, np.argmax(counts, axis=0).astype(np.int8), flags),
+         "lyapunov_class": (plane, np.take_along_axis(cls, lam.argmax(axis=0)[None], 0)[0],
+                            flags),
+         "lyapunov_start": (("start", *plane), lam),
+         "class_start": (("start", *plane), cls, flags),
+         "class_fraction": (("class", *plane), counts / 4.0)},
+        coords={"inv_beta": [1.0, 2.0], "delta": [0.0, 1.0], "class": CLASSES_LIST})
+    basins = xr.Dataset(
+        {"n_stable": (("motion", *plane), np.array([[[1, 0], [0, 0]], [[0, 0], [0, 0]]])),
+         "fraction": (("motion", *plane), np.array([[[0.75, 0], [0, 0]],
+                                                    [[0.25, 1], [1, 1]]])),
+         "fraction_lo": (("motion", *plane), np.zeros((2, 2, 2))),
+         "fraction_hi": (("motion", *plane), np.ones((2, 2, 2))),
+         "class_fraction": ds["class_fraction"]},
+        coords={"motion": ["1/1", "other"], "inv_beta": [1.0, 2.0], "delta": [0.0, 1.0],
+                "class": CLASSES_LIST})
+    return ds, basins
+
+
+def test_lyapunov_table_gives_each_class_its_own_exponent_and_counts_minus_infinity():
+    from vibroimpact.reports.notebook import lyapunov_summary
+
+    ds, basins = _four_cells()
+    table = lyapunov_summary(ds, basins)
+    own = table["exponent of its own starts, range"]
+    # the listed cell: its own starts' -0.1, not the chaotic start's +0.5
+    assert own["listed"] == "-0.1 .. -0.1"
+    assert table.loc["listed", "cells whose largest exponent is another class's"] == (
+        "1: chaotic x1 (0.5 .. 0.5)")
+    assert own["sticking"] == "-inf (all 2 cells)"
+    assert table.loc["sticking", "cells whose largest exponent is another class's"] == (
+        "1: periodic other x1 (-0.2 .. -0.2)")
+    assert own["wall free"] == "-0.05 .. -0.05" and table.loc["wall free", "cells"] == 1
+    assert table.loc["listed", "starts in the class, min - median (%)"] == "75 - 75"
+    # a dataset without the per-start classes: the cells' largest exponent, -inf counted
+    old = lyapunov_summary(ds.drop_vars(["class_start", "lyapunov_class"]), basins)
+    assert old.loc["sticking", "largest exponent, range"] == "-0.2 .. -0.2; -inf in 1 cells"
+
+
+def test_basin_table_names_the_wall_free_response():
+    from vibroimpact.reports.notebook import basin_summary
+
+    _, basins = _four_cells()
+    row = basin_summary(basins).loc["of other: wall-free response (every cell)"]
+    assert row["basin min - max (%)"] == "0 - 100"
+    assert row["cells where every start settles on it"] == 1
+
+
+def test_boundary_table_one_column_per_pair_of_kinds():
+    from vibroimpact.reports.notebook import boundary_summary
+
+    edges = xr.Dataset(
+        {"curve": ("point", np.array([0, 0, 1, 1])),
+         "kind": ("curve", np.array(["grazing", "fold"])),
+         "type": ("curve", np.array(["1/1", "1/1"])),
+         "codim2_type": ("codim2", np.array(["1/1", "1/1", "1/1", "2/1"])),
+         "codim2_kinds": ("codim2", np.array(["fold+grazing", "fold+grazing",
+                                              "grazing+period_doubling", "fold+grazing"]))})
+    table = boundary_summary(edges)
+    assert table.loc["(1/1)", "codim-2: fold + grazing"] == "2"
+    assert table.loc["(1/1)", "codim-2: grazing + period_doubling"] == "1"
+    assert table.loc["(2/1)", "codim-2: grazing + period_doubling"] == ""
+    # every cell short enough for pandas' default column width (50 characters)
+    assert max(len(str(v)) for v in table.values.ravel()) < 50

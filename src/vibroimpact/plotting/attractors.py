@@ -49,8 +49,12 @@ CLASSES = {
     "sticking": ("#8C6D31", "sticking to the wall"),
     "chaotic": ("#D55E00", "chaotic"),
     "undecided": ("0.72", "undecided"),
-    "wall_free": ("#C9E4B4", r"wall-free response ($q < \delta$, no impact)"),
+    "wall_free": ("#C9E4B4", r"wall-free response ($q < \delta$)"),
 }
+#: Short names of the classes (legend of the markers of panel (a)).
+CLASS_SHORT = {"listed": "a Fig. 16 type", "periodic_other": "another periodic",
+               "sticking": "sticking", "chaotic": "chaotic", "undecided": "undecided",
+               "wall_free": "wall-free"}
 #: Colour of the cells with an exponent of -inf (every start sticks) and of those without a
 #: value (NaN).
 STICK_COLOR = CLASSES["sticking"][0]
@@ -70,7 +74,7 @@ LYAPUNOV_QUANTILE = 0.99
 LYAPUNOV_ENDS = (1.0, 1.2, 1.6, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0, 10.0)
 #: Where the start holding a cell's largest exponent is not of the cell's class (a coexisting
 #: attractor of fewer starts sets the colour of panel (a)): a marker in that class's colour.
-OWNER_MARKER = dict(marker="D", ms=2.6, mec="k", mew=0.35, ls="none")
+OWNER_MARKER = dict(marker="D", ms=2.2, mec="k", mew=0.3, ls="none")
 
 
 def _grid(ds):
@@ -329,7 +333,7 @@ def lyapunov(lyapunov):
     """
     x, y = _grid(lyapunov)
     xe, ye = cell_edges(x), cell_edges(y)
-    fig = Figure(figsize=(10.0, 5.2))
+    fig = Figure(figsize=(10.0, 6.4))
     FigureCanvasAgg(fig)
     ax_l, ax_c = fig.subplots(1, 2, sharex=True, sharey=True)
     lam = np.asarray(lyapunov["lyapunov"].values, dtype=float)
@@ -386,9 +390,8 @@ def lyapunov(lyapunov):
                 ax_l.plot(x[i], y[j], color=CLASSES[name][0], gid=f"owner-{name}",
                           **OWNER_MARKER)
                 handles_l.append(Line2D([], [], color=CLASSES[name][0], **OWNER_MARKER,
-                                        label=f"largest exponent from a coexisting motion "
-                                              f"of fewer starts: {CLASSES[name][1]} "
-                                              f"({int(here.sum())} cells)"))
+                                        label=f"largest from fewer starts: "
+                                              f"{CLASS_SHORT[name]} ({int(here.sum())} cells)"))
     bar = fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend=extend, ticks=ticks,
                        format=FormatStrFormatter("%.3g"),
                        label="largest Lyapunov exponent (per unit $\\tau$)\n"
@@ -400,7 +403,7 @@ def lyapunov(lyapunov):
     ax_c.pcolormesh(xe, ye, code.T, cmap=ListedColormap(colors), vmin=-0.5,
                     vmax=len(names) - 0.5, rasterized=True, gid="cell-class")
     handles_c = [Patch(facecolor=c, edgecolor="0.6",
-                       label=f"{w} ({100.0 * np.mean(code == k):.2g} % of cells)")
+                       label=f"{w} ({100.0 * np.mean(code == k):.2g} %)")
                  for k, (c, w) in enumerate(zip(colors, words)) if (code == k).any()]
     if "class_fraction" in lyapunov:
         cf = np.asarray(lyapunov["class_fraction"].sel({"class": names}).values, dtype=float)
@@ -419,8 +422,8 @@ def lyapunov(lyapunov):
     below = dict(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=7)
     if handles_l:
         ax_l.legend(handles=handles_l, **below)
-    ax_c.legend(handles=handles_c, ncols=2, title="class of the cell", title_fontsize=7,
-                **below)
+    ax_c.legend(handles=handles_c, ncols=2, title="class of the cell (share of the cells)",
+                title_fontsize=7, **below)
     n = lyapunov.attrs.get("n_starts")
     starts = "" if n is None else f";  {int(n)} starts per cell, the largest exponent of them"
     _header(fig, "Largest Lyapunov exponent and the motion the starts settle to",

@@ -11,6 +11,7 @@ from the network (nbconvert's template would load require.js, MathJax and mermai
 """
 from pathlib import Path
 import re
+import warnings
 
 import numpy as np
 
@@ -208,7 +209,8 @@ def orbit_domains(orbits):
 
 def boundary_summary(boundaries):
     """Per motion type: the exact edge curves of its stable domain by kind (curves, points),
-    and the codimension-two points where two kinds meet."""
+    and the codimension-two points where two kinds meet, one column per pair of kinds (a
+    single joined column was cut by the table's width)."""
     import pandas as pd
 
     rows = {}
@@ -218,6 +220,7 @@ def boundary_summary(boundaries):
     points = np.bincount(boundaries["curve"].values, minlength=curve_kind.size)
     c2_type = boundaries["codim2_type"].values.astype(str)
     c2_kinds = boundaries["codim2_kinds"].values.astype(str)
+    pairs = sorted(set(c2_kinds.tolist()))
     for name in dict.fromkeys(curve_type.tolist() + c2_type.tolist()):
         row = {}
         for kind in kinds:
@@ -225,8 +228,9 @@ def boundary_summary(boundaries):
             row[kind] = (f"{int(sel.sum())} ({int(points[sel].sum())} points)"
                          if sel.any() else "")
         here = c2_kinds[c2_type == name]
-        row["codimension-two points"] = ", ".join(
-            f"{k} x{int((here == k).sum())}" for k in sorted(set(here.tolist()))) or ""
+        for pair in pairs:
+            n = int((here == pair).sum())
+            row[f"codim-2: {pair.replace('+', ' + ')}"] = str(n) if n else ""
         rows[f"({name})"] = row
     return pd.DataFrame.from_dict(rows, orient="index")
 
@@ -257,33 +261,77 @@ def basin_summary(basins):
             if f.size else "",
         }
     other = basins["fraction"].values[n_types]
-    rows["other (every cell)"] = dict.fromkeys(next(iter(rows.values())), "") | {
+    blank = dict.fromkeys(next(iter(rows.values())), "")
+    rows["other (every cell)"] = blank | {
         "basin median (%)": f"{100 * np.median(other):.1f}",
         "basin min - max (%)": f"{100 * other.min():.0f} - {100 * other.max():.0f}"}
+    if "class_fraction" in basins and "wall_free" in basins["class"].values:
+        # the linear steady response that never reaches the wall: a motion of its own
+        free = basins["class_fraction"].sel({"class": "wall_free"}).values
+        rows["of other: wall-free response (every cell)"] = blank | {
+            "basin median (%)": f"{100 * np.median(free):.1f}",
+            "basin min - max (%)": f"{100 * free.min():.0f} - {100 * free.max():.0f}",
+            "cells where every start settles on it": int((free == 1.0).sum())}
     return pd.DataFrame.from_dict(rows, orient="index")
+
+
+def _exponent_range(values):
+    """``"a .. b"`` of the finite values, with the cells at -inf counted (never dropped)."""
+    finite = values[np.isfinite(values)]
+    n_inf = int(np.isneginf(values).sum())
+    parts = [f"{finite.min():.3g} .. {finite.max():.3g}"] if finite.size else []
+    if n_inf:
+        parts.append(f"-inf in {n_inf} cells" if finite.size else
+                     f"-inf (all {n_inf} cells)")
+    return "; ".join(parts)
 
 
 def lyapunov_summary(lyapunov, basins):
     """How the plane divides by what its starts settle on (the cell's most frequent class),
     over all cells and over the cells where the solver finds no stable listed motion (the
-    paper's D, V, X, U), with the largest exponent's range in each class."""
+    paper's D, V, X, U), with the range of the exponent of the class's own starts (per cell
+    the largest over the starts of the cell's class; -inf cells counted), the share of the
+    cell's starts in its class, and the cells whose largest exponent over all starts belongs
+    to a start of another class (a coexisting motion of fewer starts: the colour of the
+    Lyapunov figure there) with that exponent's range."""
     import pandas as pd
 
     n_types = basins.sizes["motion"] - 1
     none_stable = (basins["n_stable"].values[:n_types] > 0).sum(axis=0) == 0
     cls = lyapunov["cell_class"].values
     lam = lyapunov["lyapunov"].values
+    names = lyapunov["cell_class"].attrs["flag_meanings"].split()
+    per_start = "class_start" in lyapunov and "lyapunov_start" in lyapunov
+    if per_start:
+        starts = lyapunov["class_start"].values
+        own = np.where(starts == cls[None], lyapunov["lyapunov_start"].values, np.nan)
+        with np.errstate(invalid="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)       # cells without own start
+            own = np.nanmax(own, axis=0)
+    share = (lyapunov["class_fraction"].sel({"class": names}).values
+             if "class_fraction" in lyapunov else None)
+    owner = lyapunov["lyapunov_class"].values if "lyapunov_class" in lyapunov else None
     rows = {}
-    for code, name in enumerate(lyapunov["cell_class"].attrs["flag_meanings"].split()):
+    for code, name in enumerate(names):
         sel = cls == code
-        finite = lam[sel & np.isfinite(lam)]
-        rows[name.replace("_", " ")] = {
-            "cells": int(sel.sum()),
-            "of them with no stable listed orbit": int((sel & none_stable).sum()),
-            "largest exponent, range": (f"{finite.min():.3g} .. {finite.max():.3g}"
-                                        if finite.size else
-                                        "-inf" if np.isneginf(lam[sel]).any() else ""),
-        }
+        row = {"cells": int(sel.sum()),
+               "of them with no stable listed orbit": int((sel & none_stable).sum())}
+        if per_start:
+            row["exponent of its own starts, range"] = _exponent_range(own[sel])
+        else:
+            row["largest exponent, range"] = _exponent_range(lam[sel])
+        if share is not None:
+            s = share[code][sel]
+            row["starts in the class, min - median (%)"] = (
+                f"{100 * s.min():.0f} - {100 * np.median(s):.0f}" if s.size else "")
+        if owner is not None:
+            other = sel & (owner != code) & np.isfinite(lam)
+            row["cells whose largest exponent is another class's"] = (
+                f"{int(other.sum())}: " + ", ".join(
+                    f"{names[k].replace('_', ' ')} x{int((owner[other] == k).sum())}"
+                    for k in sorted(set(owner[other].tolist())))
+                + f" ({_exponent_range(lam[other])})" if other.any() else "0")
+        rows[name.replace("_", " ")] = row
     return pd.DataFrame.from_dict(rows, orient="index")
 
 
