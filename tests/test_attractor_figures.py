@@ -422,11 +422,15 @@ def test_lyapunov_table_gives_each_class_its_own_exponent_and_counts_minus_infin
     own = table["exponent of its own starts, range"]
     # the listed cell: its own starts' -0.1, not the chaotic start's +0.5
     assert own["listed"] == "-0.1 .. -0.1"
-    assert table.loc["listed", "cells whose largest exponent is another class's"] == (
-        "1: chaotic x1 (0.5 .. 0.5)")
+    assert table.loc["listed", "cells where another class holds the largest exponent"] == (
+        "1: chaotic 1")
+    assert table.loc["listed", "that exponent, range"] == "0.5 .. 0.5"
     assert own["sticking"] == "-inf (all 2 cells)"
-    assert table.loc["sticking", "cells whose largest exponent is another class's"] == (
-        "1: periodic other x1 (-0.2 .. -0.2)")
+    assert table.loc["sticking", "cells where another class holds the largest exponent"] == (
+        "1: periodic other 1")
+    assert table.loc["sticking", "that exponent, range"] == "-0.2 .. -0.2"
+    # every entry short enough for pandas' default column width (50 characters)
+    assert max(len(str(v)) for v in table.values.ravel()) < 50
     assert own["wall free"] == "-0.05 .. -0.05" and table.loc["wall free", "cells"] == 1
     assert table.loc["listed", "starts in the class, min - median (%)"] == "75 - 75"
     # a dataset without the per-start classes: the cells' largest exponent, -inf counted

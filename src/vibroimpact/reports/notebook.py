@@ -326,11 +326,12 @@ def lyapunov_summary(lyapunov, basins):
                 f"{100 * s.min():.0f} - {100 * np.median(s):.0f}" if s.size else "")
         if owner is not None:
             other = sel & (owner != code) & np.isfinite(lam)
-            row["cells whose largest exponent is another class's"] = (
-                f"{int(other.sum())}: " + ", ".join(
-                    f"{names[k].replace('_', ' ')} x{int((owner[other] == k).sum())}"
-                    for k in sorted(set(owner[other].tolist())))
-                + f" ({_exponent_range(lam[other])})" if other.any() else "0")
+            by = sorted(((int((owner[other] == k).sum()), names[k].replace("_", " "))
+                         for k in set(owner[other].tolist())), reverse=True)
+            row["cells where another class holds the largest exponent"] = (
+                f"{int(other.sum())}: " + ", ".join(f"{name} {n}" for n, name in by)
+                if other.any() else "0")
+            row["that exponent, range"] = _exponent_range(lam[other])
         rows[name.replace("_", " ")] = row
     return pd.DataFrame.from_dict(rows, orient="index")
 
