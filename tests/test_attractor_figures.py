@@ -190,6 +190,23 @@ def test_basins_one_panel_per_motion(data, basin_figure):
     assert titles == [f"({m})" for m in motions] + ["other: none of these types"]
 
 
+def test_basins_outline_the_wall_free_response_in_the_other_panel(data, basin_figure):
+    from vibroimpact.plotting.attractors import WALL_FREE_SHARE, cell_outline
+
+    ds = data["basins"]
+    free = ds["class_fraction"].sel({"class": "wall_free"}).values >= WALL_FREE_SHARE
+    assert free.any() and not free.all()
+    (line,) = _gid(_panel(basin_figure, "other: none of these types"), "wall-free")
+    expected = cell_outline(ds["inv_beta"].values, ds["delta"].values, free)
+    assert len(line.get_segments()) == len(expected)
+    for ax in basin_figure.axes:
+        if ax.get_title() != "other: none of these types":
+            assert not _gid(ax, "wall-free")
+    labels = [t.get_text() for t in basin_figure.legends[0].get_texts()]
+    assert sum("wall-free response" in t for t in labels) == 1
+    assert "wall-free response" in basin_figure.legends[0].get_title().get_text()
+
+
 def test_basins_leave_cells_without_a_stable_orbit_blank(data, basin_figure):
     ds = data["basins"]
     for name in ("1/1", "1/2", "1/3"):

@@ -37,6 +37,10 @@ BASIN_CMAP_SPAN = (0.12, 1.0)
 NO_ORBIT_COLOR = "0.9"
 DOMAIN_COLOR = "#D55E00"
 STRAY_COLOR = "#CC79A7"
+#: The "other" panel outlines the cells where at least this share of the starts settles on
+#: the wall-free response (the linear response that never reaches the wall), in this colour.
+WALL_FREE_SHARE = 0.5
+WALL_FREE_LINE_COLOR = "#F0E442"
 #: Share (%) of starts on a type's impact-stick variant drawn as a dashed line, its colour.
 STICK_LEVEL = 10
 STICK_LINE_COLOR = "#009E73"
@@ -158,7 +162,8 @@ def basins(basins, orbits=None):
         dashed line where `STICK_LEVEL` % of the starts settle on the type's impact-stick
         variant; with `orbits`, Fig. 16's stable domain outlined. A last panel gives the
         share that settles on none of them ("other"); the legend's title says what those
-        starts do over the whole map (``class_fraction``).
+        starts do over the whole map (``class_fraction``), and the "other" panel outlines
+        the cells where `WALL_FREE_SHARE` of the starts settle on the wall-free response.
 
     Notes
     -----
@@ -178,7 +183,7 @@ def basins(basins, orbits=None):
     x, y = _grid(basins)
     xe, ye = cell_edges(x), cell_edges(y)
     cmap, norm = _basin_colormap()
-    shown = dict(no_orbit=False, stray=False, stick=False, domain=False)
+    shown = dict(no_orbit=False, stray=False, stick=False, domain=False, wall_free=False)
     shaded = None
     for ax, name in zip(axes, panels):
         sel = basins.sel(motion=name)
@@ -218,6 +223,17 @@ def basins(basins, orbits=None):
                 colors=DOMAIN_COLOR, linewidths=1.1, capstyle="projecting",
                 gid="stable-domain"), autolim=False)
             shown["domain"] |= bool(stable.any())
+        if (name == "other" and "class_fraction" in basins
+                and "wall_free" in basins["class"].values):
+            # the wall-free response, a motion of its own among "other"
+            free = np.asarray(basins["class_fraction"].sel({"class": "wall_free"}).values,
+                              dtype=float) >= WALL_FREE_SHARE
+            if free.any():
+                ax.add_collection(LineCollection(cell_outline(x, y, free),
+                                                 colors=WALL_FREE_LINE_COLOR, linewidths=1.6,
+                                                 capstyle="projecting", gid="wall-free"),
+                                  autolim=False)
+                shown["wall_free"] = True
         ax.set_title("other: none of these types" if name == "other" else f"({name})")
     for ax in axes[len(panels):]:
         ax.set_visible(False)
@@ -235,6 +251,10 @@ def basins(basins, orbits=None):
     if shown["domain"]:
         handles.append(Line2D([], [], color=DOMAIN_COLOR, lw=1.1,
                               label="stable domain of Fig. 16 (cell edges of its map)"))
+    if shown["wall_free"]:
+        handles.append(Line2D([], [], color=WALL_FREE_LINE_COLOR, lw=1.6,
+                              label=f"other: >= {100 * WALL_FREE_SHARE:.0f} % of starts on the "
+                                    r"wall-free response ($q < \delta$, no impact)"))
     if shown["stick"]:
         handles.append(Line2D([], [], color=STICK_LINE_COLOR, lw=1.2, ls="--",
                               label=f"{STICK_LEVEL} % of starts on the type's impact-stick "
