@@ -15,7 +15,7 @@ from matplotlib.colors import BoundaryNorm, ListedColormap, TwoSlopeNorm
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
-from matplotlib.ticker import FormatStrFormatter
+from matplotlib.ticker import FuncFormatter
 
 from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
                                           axis_label)
@@ -295,6 +295,11 @@ def _class_names(ds, name="cell_class"):
     return names, [CLASSES[n][1] for n in names]
 
 
+def _tick_text(value, _pos=None):
+    """A colour-bar tick: 3 significant digits, a true minus sign."""
+    return f"{value:.3g}".replace("-", "\N{MINUS SIGN}")
+
+
 def _nice_end(value):
     """The smallest of `LYAPUNOV_ENDS` times a power of ten that is >= `value` (> 0)."""
     power = 10.0 ** np.floor(np.log10(value))
@@ -413,7 +418,7 @@ def lyapunov(lyapunov):
                                         label=f"largest from fewer starts: "
                                               f"{CLASS_SHORT[name]} ({int(here.sum())} cells)"))
     bar = fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend=extend, ticks=ticks,
-                       format=FormatStrFormatter("%.3g"),
+                       format=FuncFormatter(_tick_text),
                        label="largest Lyapunov exponent (per unit $\\tau$)\n"
                              "each half of the bar to its own scale")
     bar.minorticks_off()
