@@ -225,6 +225,9 @@ def test_whole_plane_exponents_and_bookkeeping():
     b, d = np.divmod(raw["cell_of"], delta.size)
     assert np.all(_steady_amplitude(inv_beta[b[free]]) < delta[d[free]])
     assert np.all(outi[cls == ak.PERIODIC_OTHER, ak.I_PERIOD_M] > 0)
+    # and conversely: a start that ends without impacts and off the wall is wall-free
+    quiet = (outf[:, ak.F_RATE] == 0.0) & (cls != ak.STICKING)
+    assert np.all(cls[quiet] == ak.WALL_FREE)
 
 
 def _steady_amplitude(inv_beta):
