@@ -508,6 +508,11 @@ CASES = [
         """, "studies.mine.n_batches = 20", "a record (t_end - transient) of at least"),
     _c("motions_of_one_ratio", H + ("motions",), [[1, 1], [2, 2]], "studies.harmonic.motions",
        "(2/2) has z_j/z = 1 like (1/1)"),
+    _c("n_samples_written_as_a_float", N + ("n_samples",), 4.0e5,
+       "noises.random_input.n_samples = 400000.0",
+       "a number with a dot or an exponent, not an integer; write 400000"),
+    _own("tile_size_written_as_a_float", OWN + "    tile_size: 2.0\n", "studies.mine.tile_size",
+         "not an integer; write 2; allowed: an integer >= 1"),
     _c("delta_list_repeats_a_tiny_value", R + ("delta",), [1e-7, 2e-7, 1.00000000001e-7],
        "studies.random.delta", "1e-07 listed more than once"),
 ]

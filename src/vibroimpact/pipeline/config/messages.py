@@ -222,6 +222,10 @@ class _Words:
         that failed, else the one at ``parts``), saying when a number was read as text."""
         node = node if node is not None else self.at(parts)
         problem = _read_as_text(value, integer=node.get("type") == "integer")
+        if (node.get("type") == "integer" and isinstance(value, float) and math.isfinite(value)
+                and value.is_integer()):
+            problem = (f"a number with a dot or an exponent, not an integer; write "
+                       f"{int(value)}")
         return (f"{_path(parts)} = {_short(value)}: {problem or 'not allowed'}; "
                 f"allowed: {self.describe(parts, node)}")
 
@@ -312,8 +316,13 @@ def _filling_validator(schema):
         if validator.is_type(instance, "string") and not re.fullmatch(pattern, instance):
             yield jsonschema.ValidationError(f"{instance!r} does not match {pattern!r} whole")
 
+    # an integer is an int: JSON Schema 2020-12 counts 1.0 as one, which would reach
+    # range(), file names and SeedSequence as a float
+    types = base.TYPE_CHECKER.redefine(
+        "integer", lambda _, value: isinstance(value, int) and not isinstance(value, bool))
     return jsonschema.validators.extend(
-        base, {"properties": set_defaults, "pattern": whole_pattern})(schema)
+        base, {"properties": set_defaults, "pattern": whole_pattern},
+        type_checker=types)(schema)
 
 
 def _nonfinite(value, parts=()):
