@@ -255,10 +255,13 @@ def main(argv=None):
     root = Path(args.directory).resolve()
     for name in args.configfile:
         if Path(name).suffix.lower() not in CONFIG_SUFFIXES and not Path(name).is_file():
+            others = " ".join(f for f in args.configfile if f != name)
+            hint = (f": give targets before it, e.g. run {name}"
+                    + (f" --configfile {others}" if others else "")
+                    if args.command == "run" else "")
             return _fail(f"--configfile {name}: no such config file; every name after "
                          f"--configfile is one (several are layered in order, as Snakemake "
-                         f"takes them): give targets before it, e.g. run {name} --configfile "
-                         f"{' '.join(f for f in args.configfile if f != name)}")
+                         f"takes them){hint}")
     try:
         _, plan = config.load(root=root, user_files=args.configfile)
     except config.ConfigError as err:
