@@ -609,12 +609,14 @@ def _no_job_ran(work):
 #: real `snakemake` command (each ~3-5 s of start-up; every case goes through Snakemake's API
 #: in this process): the schema (a non-finite number, an unknown key, a number YAML reads as
 #: text), a cross-field check, a figure's block, a sweep's combination, the plan's limits,
-#: the strict reading of the file (a key given twice, nested aliases), the layering on the
-#: paper's config, and the cases Snakemake's own loader refuses first (the entry point).
+#: the strict reading of the file (a key given twice, nested aliases, YAML 1.1 octal, a name
+#: YAML reads as a boolean), the layering on the paper's config, and the cases Snakemake's
+#: own loader refuses first (the entry point).
 COMMAND_CASES = ("zeta_nan", "unknown_study_key", "n_samples_exponent_string",
                  "transient_beyond_record", "fig03_without_trace",
                  "sweep_rms_beyond_float_range", "tiny_max_cells", "key_given_twice",
-                 "nested_aliases", "collision_without_replace", "empty_file", "only_comments")
+                 "nested_aliases", "collision_without_replace", "empty_file", "only_comments",
+                 "seed_octal", "study_named_yes")
 assert {c.id for c in CASES} >= set(COMMAND_CASES)
 assert {c.id for c in CASES if not c.snakemake} <= set(COMMAND_CASES)
 
