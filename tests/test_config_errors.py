@@ -513,6 +513,10 @@ CASES = [
        "a number with a dot or an exponent, not an integer; write 400000"),
     _own("tile_size_written_as_a_float", OWN + "    tile_size: 2.0\n", "studies.mine.tile_size",
          "not an integer; write 2; allowed: an integer >= 1"),
+    _own("density_play_between_tiny_plays",
+         OWN.replace("delta: [0.0, 1.0]", "delta: [1.0e-7, 2.0e-7, 3.0e-7]\n    rms: 1.0e-7\n"
+                     "    density_delta: [1.5e-7]"),
+         "studies.mine.density_delta[0] = 1.5e-07", "not on the delta grid"),
     _c("delta_list_repeats_a_tiny_value", R + ("delta",), [1e-7, 2e-7, 1.00000000001e-7],
        "studies.random.delta", "1e-07 listed more than once"),
 ]
