@@ -397,6 +397,128 @@ CASES = [
             trace: {delta: 0.0, t_end: 2000.0}
             figures: [fig03]
         """, "studies.my_trace.trace.t_end", "0 < t_end <= 1000"),
+    # --- names YAML reads as something else than text, or that do not match whole ------------
+    _own("study_named_yes", OWN.replace("  mine:", "  yes:"), "bad.yaml:3:3",
+         "the key 'yes' is read by YAML as the boolean true, not as a name"),
+    _own("study_named_123", OWN.replace("  mine:", "  123:"), "bad.yaml:3:3",
+         "read by YAML as the integer 123"),
+    _own("study_named_tilde", OWN.replace("  mine:", "  ~:"), "bad.yaml:3:3",
+         "read by YAML as null"),
+    _own("study_named_a_date", OWN.replace("  mine:", "  2024-01-01:"), "bad.yaml:3:3",
+         "read by YAML as a date"),
+    _own("orbits_named_by_an_integer", OWN + "orbits:\n  5: {}\n", "bad.yaml:10:3",
+         "read by YAML as the integer 5"),
+    _own("study_name_ending_in_a_newline", OWN.replace("  mine:", '  "s1\\n":'), "studies",
+         "the name 's1\\n' is not allowed"),
+    _own("figure_name_ending_in_a_newline", OWN.replace("[fig09]", '["fig09\\n"]'),
+         "studies.mine.figures[0]", '"fig09\\n": not allowed; allowed: a string matching'),
+    _own("paper_figure_name_ending_in_a_newline",
+         OWN + 'paper_figures:\n  "fig09\\n": mine\n', "paper_figures",
+         "the name 'fig09\\n' is not allowed; allowed: a string matching"),
+    # --- YAML 1.1 readings the README does not allow -----------------------------------------
+    _own("two_merge_keys", """
+        paper: false
+        base: &base {noise: random_input, zeta: 0.05}
+        more: &more {eps: 0.5}
+        studies:
+          mine:
+            <<: *base
+            <<: *more
+            delta: [0.0, 1.0]
+            figures: [fig09]
+        """, "bad.yaml:8:5", "a second `<<:` merge key in one mapping (the first on line 7)"),
+    _own("seed_octal", OWN + "    seed: 010\n", "bad.yaml:9:11",
+         "010 is read by YAML 1.1 as 8, a number in octal (the leading 0); write 10"),
+    _own("n_batches_octal", OWN + "    n_batches: 010\n", "bad.yaml:9:16",
+         "read by YAML 1.1 as 8, a number in octal"),
+    _own("transient_base_60", OWN + "    transient: 3:20\n", "bad.yaml:9:16",
+         "3:20 is read by YAML 1.1 as 200, a number in base 60"),
+    _own("leading_zero_not_octal", OWN + "    n_batches: 08\n", "studies.mine.n_batches = 08",
+         "YAML 1.1 reads an integer with a leading 0 as octal, and 8, 9 are no octal digits; "
+         "write 8"),
+    _own("fullwidth_digits", OWN + "    n_batches: １２\n", "studies.mine.n_batches",
+         "its digits are not ASCII (U+FF11 FULLWIDTH DIGIT ONE, U+FF12 FULLWIDTH DIGIT TWO); "
+         "write 12"),
+    _own("zero_width_space_in_a_key", OWN + "    n_\u200bbatches: 10\n",
+         'studies.mine."n_\\u200bbatches": unknown key', "U+200B ZERO WIDTH SPACE"),
+    _own("no_break_space_in_a_key", OWN + "    n_batches\u00a0: 10\n",
+         'studies.mine."n_batches\\xa0": unknown key', "U+00A0 NO-BREAK SPACE"),
+    # --- grids, records and motions the README's rules refuse --------------------------------
+    _own("grid_step_not_dividing_the_range",
+         OWN.replace("delta: [0.0, 1.0]", "delta: {start: 0, stop: 1, step: 0.3}"),
+         "studies.mine.delta.stop = 1: not start + a whole number of steps 0.3",
+         "a stop on the grid, e.g. 0.9 or 1.2"),
+    _own("lowpass2_record_shorter_than_its_correlation", """
+        paper: false
+        noises:
+          slow:
+            kind: lowpass2
+            rms: 0.5
+            dt: 0.1
+            beta_c: 2.0
+            zeta_f: 1.0e-12
+            n_samples: 200001
+            seed: 3
+        studies:
+          mine:
+            noise: slow
+            zeta: 0.05
+            eps: 0.5
+            delta: [0.0, 1.0]
+            figures: [fig09]
+        """, "noises.slow.n_samples", "n_samples dt >= 100 tau_c = 5e+13"),
+    _own("thousand_batches_over_ten_samples", """
+        paper: false
+        noises:
+          short:
+            kind: white
+            rms: 0.5
+            dt: 0.1
+            n_samples: 16
+            nperseg: 16
+            seed: 3
+        studies:
+          mine:
+            noise: short
+            zeta: 0.05
+            eps: 0.5
+            delta: [0.0, 1.0]
+            transient: 0.5
+            n_batches: 1000
+            figures: [fig09]
+        """, "studies.mine.n_batches = 1000", "n_batches x 6.283 = 6283"),
+    _own("record_of_nanoseconds", """
+        paper: false
+        noises:
+          brief:
+            kind: white
+            rms: 0.5
+            dt: 2.5e-10
+            n_samples: 16
+            nperseg: 16
+            seed: 3
+        studies:
+          mine:
+            noise: brief
+            zeta: 0.05
+            eps: 0.5
+            delta: [0.0, 1.0]
+            transient: 0.0
+            figures: [fig09]
+        """, "studies.mine.n_batches = 20", "a record (t_end - transient) of at least"),
+    _c("motions_of_one_ratio", H + ("motions",), [[1, 1], [2, 2]], "studies.harmonic.motions",
+       "(2/2) has z_j/z = 1 like (1/1)"),
+    _c("n_samples_written_as_a_float", N + ("n_samples",), 4.0e5,
+       "noises.random_input.n_samples = 400000.0",
+       "a number with a dot or an exponent, not an integer; write 400000"),
+    _own("tile_size_written_as_a_float", OWN + "    tile_size: 2.0\n", "studies.mine.tile_size",
+         "not an integer; write 2; allowed: an integer >= 1"),
+    _own("density_play_between_tiny_plays",
+         OWN.replace("delta: [0.0, 1.0]", "delta: [1.0e-7, 2.0e-7, 3.0e-7]\n    rms: 1.0e-7\n"
+                     "    density_delta: [1.5e-7]"),
+         "studies.mine.density_delta[0] = 1.5e-07", "not on the delta grid"),
+    _c("delta_list_repeats_a_tiny_value", R + ("delta",), [1e-7, 2e-7, 1.00000000001e-7],
+       "studies.random.delta", "1e-07 listed more than once"),
 ]
 
 assert len({c.id for c in CASES}) == len(CASES), "case ids must be distinct"
@@ -491,12 +613,14 @@ def _no_job_ran(work):
 #: real `snakemake` command (each ~3-5 s of start-up; every case goes through Snakemake's API
 #: in this process): the schema (a non-finite number, an unknown key, a number YAML reads as
 #: text), a cross-field check, a figure's block, a sweep's combination, the plan's limits,
-#: the strict reading of the file (a key given twice, nested aliases), the layering on the
-#: paper's config, and the cases Snakemake's own loader refuses first (the entry point).
+#: the strict reading of the file (a key given twice, nested aliases, YAML 1.1 octal, a name
+#: YAML reads as a boolean), the layering on the paper's config, and the cases Snakemake's
+#: own loader refuses first (the entry point).
 COMMAND_CASES = ("zeta_nan", "unknown_study_key", "n_samples_exponent_string",
                  "transient_beyond_record", "fig03_without_trace",
                  "sweep_rms_beyond_float_range", "tiny_max_cells", "key_given_twice",
-                 "nested_aliases", "collision_without_replace", "empty_file", "only_comments")
+                 "nested_aliases", "collision_without_replace", "empty_file", "only_comments",
+                 "seed_octal", "study_named_yes")
 assert {c.id for c in CASES} >= set(COMMAND_CASES)
 assert {c.id for c in CASES if not c.snakemake} <= set(COMMAND_CASES)
 
@@ -558,3 +682,182 @@ def test_plan_reports_yaml_syntax_error(copy_dir):
     assert f"broken.yaml:{_broken_mark()}" in out.stderr
     assert out.stderr.startswith("error: ")
     _no_job_ran(copy_dir)
+
+
+# --- legitimate studies and readings that must build ------------------------------------------
+
+def _own_study(**keys):
+    """OWN as a dict, its study `mine` with ``keys`` set."""
+    user = yaml.safe_load(OWN)
+    user["studies"]["mine"].update(keys)
+    return user
+
+
+@pytest.mark.parametrize("delta", [{"start": 1.0e-12, "stop": 5.0e-12, "step": 1.0e-12},
+                                   [1.0e-12, 2.0e-12, 3.0e-12, 4.0e-12, 5.0e-12]])
+def test_a_study_at_a_tiny_scale_keeps_its_plays_distinct(delta):
+    """The README's scaling argument (the model is linear between impacts: plays and force
+    divided by one factor): plays 1e-12 ... 5e-12 with rms 1e-12 are five distinct cells,
+    rounded at 1e-10 of their scale (10 decimals of a grid of scale >= 1), not to 0."""
+    from vibroimpact.pipeline.study import grid_values
+
+    config, plan = configuration.load(_own_study(delta=delta, rms=1.0e-12), root=ROOT)
+    values = grid_values(config["studies"]["mine"]["delta"])
+    assert values.tolist() == pytest.approx([1e-12, 2e-12, 3e-12, 4e-12, 5e-12], rel=1e-9)
+    assert plan.cells == 5
+
+
+def test_a_tiny_forcing_period_is_named_by_its_value():
+    """inv_beta from 2e-11 (beyond dt/(2 pi): refused), named 2e-11 and not rounded to 0."""
+    user = _own_study(amplitude=1.0e-12, rms=1.0e-12, delta=[0.0, 1.0e-12],
+                      inv_beta={"start": 2.0e-11, "stop": 4.0e-11, "step": 1.0e-11})
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.load(user, root=ROOT)
+    text = str(info.value)
+    assert "inv_beta = 2.0e-11" in text and "1/beta_f = 0" not in text, text
+
+
+@pytest.mark.parametrize("delta", [[1.0e-7, 2.0e-7, 3.0e-7],
+                                   {"start": 1.0e-7, "stop": 3.0e-7, "step": 1.0e-7}])
+def test_small_values_listed_once_are_not_duplicates(delta):
+    """Duplicates are values equal at the grid's rounding relative to their scale (1e-10 of
+    it): 1e-7, 2e-7, 3e-7 are three plays in either form, as are density plays on them."""
+    config, plan = configuration.load(
+        _own_study(delta=delta, rms=1.0e-7, density_delta=[3.0e-7, 2.0e-7]), root=ROOT)
+    assert plan.cells == 3
+
+
+def test_default_grids_are_bit_identical_to_the_ten_decimal_rounding():
+    """The grids of config/config.yaml and config/test.yaml (every {start, stop, step}, all of
+    scale >= 1) are what the former rounding to 10 decimals gave, bit for bit."""
+    import numpy as np
+
+    from vibroimpact.pipeline.study import grid_size, grid_values
+
+    found = []
+
+    def walk(value):
+        if isinstance(value, dict):
+            if set(value) == {"start", "stop", "step"}:
+                old = np.round(float(value["start"])
+                               + float(value["step"]) * np.arange(grid_size(value)), 10)
+                assert grid_values(value).tobytes() == old.tobytes(), value
+                found.append(value)
+            for item in value.values():
+                walk(item)
+
+    for name in ("config.yaml", "test.yaml"):
+        walk(yaml.safe_load((ROOT / "config" / name).read_text()))
+    assert len(found) == 14
+
+
+def test_a_json_config_is_read_as_json(tmp_path):
+    """Snakemake reads a config file as JSON first: 5e-2 is a number there, not YAML 1.1
+    text; a key given twice in a JSON object is refused like YAML's."""
+    import json
+
+    path = tmp_path / "mine.json"
+    path.write_text(json.dumps(_own_study(zeta=0.05)).replace("0.05", "5e-2"))
+    assert "5e-2" in path.read_text()
+    config, _ = configuration.load(root=ROOT, user_files=[path])
+    assert config["studies"]["mine"]["zeta"] == 0.05
+    path.write_text('{"paper": false, "paper": true}')
+    with pytest.raises(configuration.ConfigError, match="JSON: the key 'paper' is given twice"):
+        configuration.read_yaml(path)
+
+
+@pytest.mark.parametrize("text, value", [("0", 0), ("00", 0), ("007", 7), ("0x10", 16),
+                                         ("1_000", 1000), ("0.05", 0.05), ("1.0e+6", 1.0e6)])
+def test_unambiguous_numbers_read_as_before(tmp_path, text, value):
+    """Only a leading 0 that changes the value (octal) and colons (base 60) are refused."""
+    path = tmp_path / "n.yaml"
+    path.write_text(f"x: {text}\n")
+    assert configuration.read_yaml(path) == {"x": value}
+
+
+def test_a_non_text_key_in_a_given_dict_is_one_line():
+    """A config given as a dict (Snakemake's) with an integer orbits key: one line, not a
+    traceback from sorting names."""
+    user = _own_study()
+    user["orbits"] = {5: {}}
+    with pytest.raises(configuration.ConfigError) as info:
+        configuration.load(user, root=ROOT)
+    assert str(info.value) == ("orbits: the key 5 is an integer, not a name (YAML reads yes:, "
+                               "123:, ~: so); allowed: text: quote it, or rename it")
+
+
+def test_several_files_after_one_configfile(tmp_path, capsys):
+    """`python -m vibroimpact plan --configfile a.yaml b.yaml` layers both, as Snakemake
+    takes them (`make CONFIG="a.yaml b.yaml"` passes this); a target after them is named."""
+    from vibroimpact.pipeline import cli
+
+    (tmp_path / "a.yaml").write_text(OWN)
+    (tmp_path / "b.yaml").write_text(OWN.replace("paper: false\n", "").replace("mine:", "more:"))
+    a, b = str(tmp_path / "a.yaml"), str(tmp_path / "b.yaml")
+    assert cli.main(["plan", "--directory", str(ROOT), "--configfile", a, b]) == 0
+    out = capsys.readouterr().out
+    assert "studies.mine" in out and "studies.more" in out
+    code = cli.main(["plan", "--directory", str(ROOT), "--configfile", a,
+                     "results/figures/fig09.png"])
+    assert code == 2
+    assert ("--configfile results/figures/fig09.png: no such config file; every name after "
+            "--configfile is one") in capsys.readouterr().err
+    code = cli.main(["run", "--directory", str(ROOT), "--configfile", a,
+                     "results/figures/fig09.png"])
+    assert code == 2
+    assert (f"give targets before it, e.g. run results/figures/fig09.png --configfile {a}"
+            in capsys.readouterr().err)
+
+
+#: Two studies on one short record: plastic impact (eps = 0) with Figs. 7, 9 and its report,
+#: and the scale 1e-12 of the README's argument beside the same study at scale 0.5.
+SCALED = textwrap.dedent("""\
+    paper: false
+    noises:
+      short_input: {kind: band_limited, rms: 0.5, dt: 0.1, beta_c: 4.0, n_samples: 200001,
+                    seed: 11}
+    studies:
+      plastic:
+        noise: short_input
+        zeta: 0.05
+        eps: 0
+        delta: [-0.5, 0, 0.5]
+        density_delta: [0.5, 0.0, -0.5]
+        figures: [fig07, fig09]
+      tiny:
+        noise: short_input
+        zeta: 0.05
+        eps: 0.5
+        rms: 1.0e-12
+        delta: {start: 1.0e-12, stop: 5.0e-12, step: 1.0e-12}
+        figures: [fig09]
+      scaled:
+        noise: short_input
+        zeta: 0.05
+        eps: 0.5
+        delta: {start: 0.5, stop: 2.5, step: 0.5}
+        figures: [fig09]
+    """)
+
+
+@pytest.mark.workflow
+def test_plastic_and_tiny_studies_build(tmp_path):
+    """eps = 0 builds its figures and report (finding 2: n/a, not a division by 0); the study
+    at scale 1e-12 is the study at scale 0.5 divided by 5e11 (the model is linear between
+    impacts, and the record is the same seed scaled): the same collisions at every play and
+    means within 1e-12 relative (measured 2e-15), so its five plays stayed apart."""
+    import xarray as xr
+
+    work = make_workdir(tmp_path)
+    (work / "mine.yaml").write_text(SCALED)
+    out = subprocess.run([SNAKEMAKE, "--cores", "1", "--configfile", "mine.yaml"], cwd=work,
+                         capture_output=True, text=True, timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    report = (work / "results" / "reports" / "plastic" / "random_force.html").read_text()
+    assert "eps = 0: plastic impact" in report
+    with (xr.open_dataset(work / "results" / "datasets" / "tiny_events.nc") as tiny,
+          xr.open_dataset(work / "results" / "datasets" / "scaled_events.nc") as scaled):
+        assert tiny.n_collisions.values.tolist() == scaled.n_collisions.values.tolist()
+        for name, factor in (("v_after_mean", 2e-12), ("interval_mean", 1.0)):
+            ratio = tiny[name].values / (factor * scaled[name].values)
+            assert abs(ratio - 1.0).max() < 1e-12, (name, ratio)

@@ -130,3 +130,15 @@ def test_finding4_tells_the_reach_of_a_record_from_a_threshold():
     assert found.holds == "partly" and "expects 1 " in found.measured
     threshold = reach.assign_attrs(record_length=100.0 / nu)   # 100 expected, none seen
     assert findings.finding4(threshold).holds == "yes"
+
+
+def test_finding2_with_plastic_impact_is_not_available():
+    """eps = 0 (allowed: plastic impact): every mean velocity after impact is 0; finding 2
+    (velocities fall as delta decreases) has nothing to compare, not a division by 0."""
+    result = findings.finding2(random_events(v=np.zeros(DELTA.size)))
+    assert result.holds == "n/a"
+    assert "eps = 0" in result.measured
+    # a play whose mean is 0 among positive ones: the slope comparison is skipped, the
+    # monotonicity still decides
+    v = np.array([0.0, 0.03, 0.12, 0.3, 0.45, 0.6, 0.7])
+    assert findings.finding2(random_events(v=v)).holds == "yes"

@@ -41,9 +41,10 @@ def _parser():
                        ("run", "check, prepare and build (extra arguments go to snakemake)"),
                        ("report", "write Snakemake's report of the build (after run)")):
         p = sub.add_parser(name, help=text, description=text)
-        p.add_argument("--configfile", action="append", default=[], metavar="FILE",
-                       help="your config file, layered on config/config.yaml (README); "
-                            "repeat for several")
+        p.add_argument("--configfile", action="extend", nargs="+", default=[], metavar="FILE",
+                       help="your config files, layered on config/config.yaml in order "
+                            "(README): several after one --configfile, as Snakemake takes "
+                            "them, or the option repeated; targets go before it")
         if name == "report":
             p.add_argument("--output", default=REPORT, metavar="FILE",
                            help=f"the report, relative to the project directory (default "
@@ -56,6 +57,10 @@ def _parser():
                        help="also print the schema validator's full output on a config error")
     return parser
 
+
+#: Endings of a config file (Snakemake reads JSON or YAML); a name after --configfile with
+#: none of them that is no file is a target given in the wrong place.
+CONFIG_SUFFIXES = (".yaml", ".yml", ".json")
 
 #: Where ``report`` writes Snakemake's report (README, "Reports").
 REPORT = "results/report.html"
@@ -248,6 +253,15 @@ def main(argv=None):
     if args.verbose:
         os.environ[config.VERBOSE_ENV] = "1"
     root = Path(args.directory).resolve()
+    for name in args.configfile:
+        if Path(name).suffix.lower() not in CONFIG_SUFFIXES and not Path(name).is_file():
+            others = " ".join(f for f in args.configfile if f != name)
+            hint = (f": give targets before it, e.g. run {name}"
+                    + (f" --configfile {others}" if others else "")
+                    if args.command == "run" else "")
+            return _fail(f"--configfile {name}: no such config file; every name after "
+                         f"--configfile is one (several are layered in order, as Snakemake "
+                         f"takes them){hint}")
     try:
         _, plan = config.load(root=root, user_files=args.configfile)
     except config.ConfigError as err:

@@ -9,9 +9,20 @@ import math
 
 import numpy as np
 
-#: Decimals kept when a grid is given as start/stop/step (so 0.1 * 3 is 0.3, not
-#: 0.30000000000000004).
+#: Significant decimals kept when a grid is given as start/stop/step (so 0.1 * 3 is 0.3, not
+#: 0.30000000000000004), relative to the grid's scale: 10 decimals for a grid of scale >= 1,
+#: more for a smaller one (1e-12 ... 5e-12 keeps 22), so no two values merge (`grid_decimals`).
 GRID_DECIMALS = 10
+
+
+def grid_decimals(scale):
+    """Decimals a grid of values up to ``scale`` (its largest magnitude, or its step) is
+    rounded to: `GRID_DECIMALS` for ``scale >= 1``, and as many more as ``scale`` has
+    leading zeros below 1 (rounding at 1e-10 of the scale)."""
+    scale = abs(float(scale))
+    if not scale > 0.0 or not math.isfinite(scale):
+        return GRID_DECIMALS
+    return GRID_DECIMALS - min(0, math.floor(math.log10(scale)))
 
 
 #: The keys of a study entry each kind of job reads (the workflow passes exactly these to the
@@ -73,7 +84,8 @@ def grid_values(spec):
     """
     if isinstance(spec, dict):
         start, step = float(spec["start"]), float(spec["step"])
-        return np.round(start + step * np.arange(grid_size(spec)), GRID_DECIMALS)
+        scale = max(abs(start), abs(float(spec["stop"])), step)
+        return np.round(start + step * np.arange(grid_size(spec)), grid_decimals(scale))
     values = np.asarray([float(v) for v in spec], dtype=float)
     if values.size == 0 or not np.all(np.isfinite(values)):
         raise ValueError(f"grid must hold at least one finite value, got {spec!r}")

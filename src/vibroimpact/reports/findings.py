@@ -165,9 +165,13 @@ def finding2(events):
     measured = (f"mean velocity after impact {v[-1]:.3g} at delta = {d[-1]:.3g} down to "
                 f"{v[0]:.3g} at delta = {d[0]:.3g}"
                 f"{', increasing throughout' if _increasing(v) else ', not monotone'}")
+    if not np.any(v > 0.0):
+        # eps = 0 (plastic impact): the mass leaves the wall at rest after every impact
+        return not_available(2, "the mean velocity after impact is 0 at every play (eps = 0: "
+                                "plastic impact)")
     marked = True
-    if d[0] < 0 and 0.0 in d and d[-1] >= -d[0]:
-        at = lambda x: float(ev.v_after_mean.sel(delta=x, method="nearest"))
+    at = lambda x: float(ev.v_after_mean.sel(delta=x, method="nearest"))
+    if d[0] < 0 and 0.0 in d and d[-1] >= -d[0] and min(at(d[0]), at(0.0), at(-d[0])) > 0.0:
         slope_neg = np.log(at(0.0) / at(d[0])) / -d[0]
         slope_pos = np.log(at(-d[0]) / at(0.0)) / -d[0]
         marked = slope_neg > slope_pos

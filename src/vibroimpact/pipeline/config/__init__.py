@@ -24,7 +24,8 @@ from pathlib import Path
 from vibroimpact.pipeline.config.checks import check
 from vibroimpact.pipeline.config.layering import (SECTIONS, check_size, compose, deep_merge,
                                                   read_yaml)
-from vibroimpact.pipeline.config.messages import VERBOSE_ENV, ConfigError, validate
+from vibroimpact.pipeline.config.messages import (VERBOSE_ENV, ConfigError, non_text_keys,
+                                                  validate)
 from vibroimpact.pipeline.config.messages import _short  # noqa: F401 (how a value is shown)
 from vibroimpact.pipeline.config.plan import Plan, make_plan
 from vibroimpact.pipeline.config.sweeps import (SWEEP_KEYS, Sweeps, drawn_sweeps,
@@ -58,6 +59,9 @@ def load(user=None, *, root=".", user_files=()):
             user = deep_merge(user, read_yaml(path))
     else:
         check_size(user or {}, "the config given with --configfile")
+    keys = non_text_keys(user or {})
+    if keys:        # before anything sorts or looks up the names
+        raise ConfigError(keys)
     schema = read_yaml(root / "config" / "schema.yaml", user=False)
     paper = read_yaml(root / "config" / "config.yaml", user=False)
     config, own = compose(paper, user or {})

@@ -9,6 +9,7 @@ before it raises, one or two lines each.
 Loads no kernel, numba or scipy: the solver's and the generator's limits come from
 `vibroimpact._limits`.
 """
+from fractions import Fraction
 import math
 
 import numpy as np
@@ -16,8 +17,8 @@ import numpy as np
 from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time, cutoff
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
-from vibroimpact.pipeline.study import (escape_samples, grid_size, grid_values, map_cap_steps,
-                                        noise_record)
+from vibroimpact.pipeline.study import (escape_samples, grid_decimals, grid_size, grid_values,
+                                        map_cap_steps, noise_record)
 
 __all__ = ["GRID_RTOL", "check"]
 
@@ -26,7 +27,10 @@ GRID_RTOL = 1e-6
 
 
 def _on_grid(value, grid):
-    return bool(np.any(np.abs(grid - value) <= GRID_RTOL * max(1.0, abs(value))))
+    """Whether ``value`` is a value of ``grid`` within `GRID_RTOL` of the larger of its own
+    magnitude and the grid's (a grid of plays 1e-7 ... 3e-7 tells 1.5e-7 from 2e-7)."""
+    scale = max(abs(value), float(np.max(np.abs(grid))))
+    return bool(np.any(np.abs(grid - value) <= GRID_RTOL * scale))
 
 
 def _grid_text(grid):
@@ -36,10 +40,12 @@ def _grid_text(grid):
 
 
 def _repeated(values):
-    """The values of a list given more than once (equal within `GRID_RTOL`), ascending."""
-    v = np.sort(np.asarray(values, dtype=float))
-    close = np.diff(v) <= GRID_RTOL * np.maximum(1.0, np.abs(v[1:]))
-    return sorted(set(v[1:][close].tolist()))
+    """The values of a list given more than once: equal once rounded as a grid of their
+    scale is (`vibroimpact.pipeline.study.grid_decimals`: 10 significant decimals of the
+    largest magnitude), ascending."""
+    v = np.asarray(values, dtype=float)
+    v = np.sort(np.round(v, grid_decimals(np.max(np.abs(v)))))
+    return sorted(set(v[1:][np.diff(v) == 0.0].tolist()))
 
 
 def _distinct(problems, where, values):
@@ -67,6 +73,8 @@ def _grid(problems, where, spec, limit, positive=False):
         return None
     if isinstance(spec, list) and not _distinct(problems, where, spec):
         return None
+    if isinstance(spec, dict) and not _stop_on_grid(problems, where, spec, n):
+        return None
     values = grid_values(spec)
     if positive and np.any(values <= 0.0):
         bad = float(values[values <= 0.0][0])
@@ -76,6 +84,22 @@ def _grid(problems, where, spec, limit, positive=False):
                      "values > 0")
         return None
     return values
+
+
+def _stop_on_grid(problems, where, spec, n):
+    """Record a ``{start, stop, step}`` whose stop is not start + a whole number of steps
+    (the grid would end before it, dropping the stop the README says is included), naming
+    the nearest stops; True when it is on the grid (within 1e-6 of a step)."""
+    start, stop, step = (float(spec[k]) for k in ("start", "stop", "step"))
+    if (stop - start) / step - (n - 1) <= 1e-6:
+        return True
+    decimals = grid_decimals(max(abs(start), abs(stop), step))
+    below, above = (round(start + k * step, decimals) for k in (n - 1, n))
+    problems.add(f"{where}.stop", spec["stop"], f"not start + a whole number of steps "
+                 f"{_num(step)}: the grid would end at {_num(below)}",
+                 f"a stop on the grid, e.g. {_num(below)} or {_num(above)}, or a step that "
+                 f"divides stop - start = {_num(stop - start)}")
+    return False
 
 
 def _check_noises(config, problems):
@@ -101,11 +125,46 @@ def _check_noises(config, problems):
         if int(entry["nperseg"]) > int(entry["n_samples"]):
             problems.add(f"{where}.nperseg", entry["nperseg"], "longer than the record",
                          f"16 <= nperseg <= n_samples = {entry['n_samples']}")
+        if ok and kind == "lowpass2":
+            _check_correlation_time(where, entry, problems)
         if ok and beta_c is not None:
             try:        # the generator's own limits (the FIR length), without loading it
                 cutoff(kind, float(beta_c), dt)
             except ValueError as err:
                 problems.add(where, None, str(err), "see config/schema.yaml, noises")
+
+
+#: Correlation times a lowpass2 record must span: the sample variance of a record T long
+#: has a relative s.d. of about sqrt(c tau_c / T) (c = 1 for a lightly damped filter, whose
+#: correlation rho^2 integrates to tau_c/2 on each side; 2 for an overdamped one), so 100
+#: correlation times put it within ~10-15 % of rms^2.
+RECORD_CORRELATION_TIMES = 100
+
+
+def correlation_time(beta_c, zeta_f):
+    """Decay time of the correlation of a lowpass2 noise: 1/|Re p| of its slower pole,
+    ``1/(zeta_f beta_c)`` for ``zeta_f <= 1``, ``(zeta_f + sqrt(zeta_f^2 - 1))/beta_c``
+    above."""
+    if zeta_f <= 1.0:
+        return 1.0 / (zeta_f * beta_c)
+    return (zeta_f + math.sqrt(zeta_f * zeta_f - 1.0)) / beta_c
+
+
+def _check_correlation_time(where, entry, problems):
+    """Record a lowpass2 record short against its correlation time: one slowly varying
+    sinusoid whose variance is not rms^2, under titles that say rms."""
+    tau_c = correlation_time(float(entry["beta_c"]), float(entry["zeta_f"]))
+    length = int(entry["n_samples"]) * float(entry["dt"])
+    if length >= RECORD_CORRELATION_TIMES * tau_c:
+        return
+    need = RECORD_CORRELATION_TIMES * tau_c
+    problems.add(f"{where}.n_samples", entry["n_samples"],
+                 f"a record of {length:.3g} time units, {length / tau_c:.3g} correlation "
+                 f"times of this noise (tau_c = {tau_c:.3g}: 1/(zeta_f beta_c), the decay of "
+                 f"its correlation): its variance would not be rms^2",
+                 f"n_samples dt >= {RECORD_CORRELATION_TIMES} tau_c = {need:.4g} (n_samples "
+                 f">= {math.ceil(need / float(entry['dt'])):,}; the sample variance then "
+                 f"within ~10-15 % of rms^2, 1 s.d.), or a larger zeta_f or beta_c")
 
 
 def _check_figures(config, section, name, entry, problems, grids):
@@ -249,6 +308,8 @@ def _check_study(config, name, entry, problems, limits, unforced):
     elif transient >= end:
         problems.add(f"{where}.transient", transient, "leaves no record for the statistics "
                      f"(t_end = {end:.6g})", f"0 <= transient < {end:.6g}")
+    if t_end is None or t_end <= tau * (1 + 1e-9):
+        _check_batches(where, entry, end - transient, dt, problems)
     uses = {r for f in entry["figures"] for r in figures.FIGURES[
         f if isinstance(f, str) else f["name"]]["reads"]}
     spectra = entry.get("spectra")
@@ -303,6 +364,15 @@ def _check_study(config, name, entry, problems, limits, unforced):
     if len(set(motions)) != len(motions):
         problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
                      "distinct [m, n] pairs")
+    else:
+        ratios = {}
+        for m, n_ in motions:
+            first = ratios.setdefault(Fraction(n_, m), (m, n_))
+            if first != (m, n_):
+                problems.add(f"{where}.motions", entry["motions"],
+                             f"({m}/{n_}) has z_j/z = {_num(n_ / m)} like ({first[0]}/"
+                             f"{first[1]}): the classification on z_j/z cannot tell them apart",
+                             "[m, n] pairs of distinct n/m")
     if "map" in uses and harmonic and grids["inv_beta"] is not None:
         spec = entry["map"]
         try:        # the cap of the longest forcing period (the job's own check, at parse time)
@@ -321,6 +391,30 @@ def _check_study(config, name, entry, problems, limits, unforced):
     if all(g is not None for g in grids.values()):
         _check_figures(config, "studies", name, entry, problems, grids)
     return grids
+
+
+#: Shortest batch of the batch-means standard errors: a natural period 2 pi (time units),
+#: the motion's own time scale (shorter batches are not near independent); and 2 samples.
+MIN_BATCH_TIME = 2 * math.pi
+
+
+def _check_batches(where, entry, length, dt, problems):
+    """Record a statistics record (transient to t_end, ``length``) too short for its
+    ``n_batches`` batches, each at least `MIN_BATCH_TIME` and 2 samples long."""
+    if length <= 0.0:
+        return          # reported as the transient's
+    shortest = max(MIN_BATCH_TIME, 2 * dt)
+    n_batches = int(entry["n_batches"])
+    if length >= n_batches * shortest:
+        return
+    fits = int(length // shortest)
+    allowed_ = (f"n_batches <= {fits}, or " if fits >= 2 else "") + (
+        f"a record (t_end - transient) of at least n_batches x {shortest:.4g} = "
+        f"{n_batches * shortest:.4g}")
+    problems.add(f"{where}.n_batches", n_batches, f"batches of {length / n_batches:.3g} time "
+                 f"units ({length / dt / n_batches:.3g} samples) over the statistics record of "
+                 f"{length:.3g} (transient to t_end), shorter than a natural period 2 pi or 2 "
+                 f"samples", allowed_)
 
 
 #: Samples of one escape record, held in memory by its job (8 bytes each: 400 MB).

@@ -9,7 +9,9 @@
   name, e.g. a noise record or an orbits map).
 """
 import copy
+import json
 from pathlib import Path
+import re
 
 import yaml
 
@@ -26,16 +28,49 @@ SECTIONS = ("noises", "studies", "orbits", "paper_figures")
 MAX_VALUES = 1_000_000
 
 
+#: Plain scalars YAML 1.1 reads otherwise than a reader of the file would: a leading 0 makes
+#: an integer octal (``010`` is 8), colons make a number base 60 (``3:20`` is 200).
+_OCTAL = re.compile(r"[-+]?0[0-7_]+")
+_BASE60 = re.compile(r"[-+]?[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?")
+#: What a key YAML reads as something else than text is read as.
+_KINDS = {bool: "the boolean", int: "the integer", float: "the number"}
+
+
+def _kind(value):
+    if value is None:
+        return "null (no value)"
+    for cls, text in _KINDS.items():
+        if type(value) is cls:
+            return f"{text} {_short(value)}"
+    return f"a {type(value).__name__} ({_short(value)})"
+
+
 class _StrictLoader(yaml.SafeLoader):
-    """``yaml.SafeLoader`` that refuses a key given twice in one mapping (PyYAML keeps the
-    last silently), naming both lines."""
+    """``yaml.SafeLoader`` that refuses what PyYAML reads silently otherwise than meant: a
+    key given twice in one mapping (PyYAML keeps the last), two ``<<:`` merge keys in one
+    mapping (the second wins), a key that is not text (``yes:`` a boolean, ``123:`` an
+    integer, ``~:`` null, ``2024-01-01:`` a date), an integer with a leading 0 (YAML 1.1
+    octal: ``010`` is 8) and a number with colons (base 60: ``3:20`` is 200), naming the
+    lines."""
 
     def construct_mapping(self, node, deep=False):
-        seen = {}
+        seen, merge = {}, None
         for key_node, _ in node.value:
             if key_node.tag == "tag:yaml.org,2002:merge":
+                if merge is not None:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"a second `<<:` merge key in one mapping (the first on "
+                        f"line {merge + 1}); YAML keeps one silently: merge both in one, "
+                        f"<<: [*first, *second] (the first listed wins a key both give)",
+                        key_node.start_mark)
+                merge = key_node.start_mark.line
                 continue
             key = self.construct_object(key_node, deep=True)
+            if not isinstance(key, str) and isinstance(key_node, yaml.ScalarNode):
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"the key {key_node.value!r} is read by YAML as "
+                    f"{_kind(key)}, not as a name; keys are text: quote it "
+                    f"(\"{key_node.value}\") or rename it", key_node.start_mark)
             try:
                 first = seen.get(key)
             except TypeError:
@@ -47,6 +82,48 @@ class _StrictLoader(yaml.SafeLoader):
                     key_node.start_mark)
             seen[key] = key_node.start_mark.line
         return super().construct_mapping(node, deep=deep)
+
+    def construct_yaml_int(self, node):
+        value = super().construct_yaml_int(node)
+        text = node.value
+        if _BASE60.fullmatch(text):
+            self._misread(node, value, "base 60 (each colon: sixties, as on a clock)")
+        if _OCTAL.fullmatch(text) and value != int(text.replace("_", ""), 10):
+            self._misread(node, value, "octal (the leading 0)")
+        return value
+
+    def construct_yaml_float(self, node):
+        value = super().construct_yaml_float(node)
+        if _BASE60.fullmatch(node.value):
+            self._misread(node, value, "base 60 (each colon: sixties, as on a clock)")
+        return value
+
+    @staticmethod
+    def _misread(node, value, rule):
+        digits = node.value.replace("_", "")
+        if ":" in digits:
+            fix = f"{_short(value)} if that is meant, or the number meant without colons"
+        else:
+            sign = digits[0] if digits[0] in "+-" else ""
+            fix = f"{sign}{digits.lstrip('+-').lstrip('0') or '0'} without the leading 0"
+        raise yaml.constructor.ConstructorError(
+            None, None, f"{node.value} is read by YAML 1.1 as {_short(value)}, a number "
+            f"in {rule}; write {fix} (or quote it for text)", node.start_mark)
+
+
+_StrictLoader.add_constructor("tag:yaml.org,2002:int", _StrictLoader.construct_yaml_int)
+_StrictLoader.add_constructor("tag:yaml.org,2002:float", _StrictLoader.construct_yaml_float)
+
+
+def _json_object(pairs):
+    """A JSON object, refusing a key given twice (``json`` keeps the last silently)."""
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise ValueError(f"the key {key!r} is given twice in one object; JSON readers "
+                             f"keep one silently: delete or rename the other")
+        out[key] = value
+    return out
 
 
 def expanded_size(value, limit=MAX_VALUES):
@@ -81,8 +158,12 @@ def check_size(value, where):
                           f"with aliases used a few times")
 
 
+_NOT_JSON = object()
+
+
 def read_yaml(path, *, user=True):
-    """The mapping in a YAML config file.
+    """The mapping in a config file: JSON if it reads as JSON (as Snakemake reads it), else
+    YAML read strictly (`_StrictLoader`).
 
     A syntax error or a key given twice names the file, line and column; an empty file, a
     file that holds no mapping or whose aliases expand beyond `MAX_VALUES` names the file.
@@ -98,7 +179,15 @@ def read_yaml(path, *, user=True):
         raise ConfigError(f"{path}:{line}: not UTF-8 text (byte 0x{err.object[err.start]:02x}); "
                           f"allowed: a YAML file saved as UTF-8") from None
     try:
-        data = yaml.load(text, Loader=_StrictLoader)
+        # JSON first, as Snakemake reads a config file (YAML 1.1 would read 5e-2 as text)
+        data = json.loads(text, object_pairs_hook=_json_object)
+    except json.JSONDecodeError:
+        data = _NOT_JSON
+    except ValueError as err:
+        raise ConfigError(f"{path}: JSON: {err}") from None
+    try:
+        if data is _NOT_JSON:
+            data = yaml.load(text, Loader=_StrictLoader)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
         where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)

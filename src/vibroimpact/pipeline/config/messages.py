@@ -12,10 +12,11 @@ import copy
 import math
 import os
 import re
+import unicodedata
 
 import yaml
 
-__all__ = ["ConfigError", "VERBOSE_ENV", "validate"]
+__all__ = ["ConfigError", "VERBOSE_ENV", "validate", "non_text_keys"]
 
 #: Environment variable asking for the full schema validator output after the short one.
 VERBOSE_ENV = "VIBROIMPACT_VERBOSE"
@@ -45,7 +46,7 @@ def _path(parts):
     """``studies.random.delta[2]`` of the key path ``["studies", "random", "delta", 2]``."""
     text = ""
     for p in parts:
-        text += f"[{p}]" if isinstance(p, int) else (f".{p}" if text else str(p))
+        text += f"[{p}]" if isinstance(p, int) else (f".{_key(p)}" if text else _key(p))
     return text or "<top level>"
 
 
@@ -55,15 +56,19 @@ def _num(x):
 
 def _short(value):
     """``value`` as YAML on one line, cut to 60 characters."""
+    if isinstance(value, str) and _invisible(value):
+        return _key(value)
     text = yaml.safe_dump(value, default_flow_style=True, width=10**6).strip()
     text = text.removesuffix("...").strip()
     return text if len(text) <= 60 else text[:57] + "..."
 
 
 def _read_as_text(value, integer=False):
-    """Why a value that reads as a number is text (``1.0e6``: YAML 1.1 wants ``1.0e+6``),
-    with how to write it (``integer``: as the integer, ``4e5`` -> 400000); None for any other
-    value."""
+    """Why a value that reads as a number is text, with how to write it (``integer``: as
+    the integer, ``4e5`` -> 400000); None for any other value. The causes: quotes (the text
+    YAML would read as a number unquoted), YAML 1.1's exponent rule (``1.0e6``: it wants
+    ``1.0e+6``), a leading 0 (``08``: not octal, so text), digits that are not ASCII
+    (fullwidth ``１２``)."""
     if not isinstance(value, str):
         return None
     try:
@@ -72,16 +77,47 @@ def _read_as_text(value, integer=False):
         return None
     if not math.isfinite(number):
         return None
-    exponent = re.fullmatch(r"\s*([-+]?[0-9_]*\.?[0-9_]*)[eE]([-+]?)([0-9]+)\s*", value)
-    if exponent is None:
+    plain = f"{int(number)}" if integer and number.is_integer() else _num(number)
+    odd = sorted({c for c in value if c.isdigit() and c not in "0123456789"})
+    if odd:
+        names = ", ".join(f"U+{ord(c):04X} {unicodedata.name(c, '?')}" for c in odd)
+        return (f"read as the text {value!r}: its digits are not ASCII ({names}); write "
+                f"{plain} in ASCII digits")
+    try:
+        unquoted = yaml.safe_load(value)
+    except yaml.YAMLError:
+        unquoted = value
+    if isinstance(unquoted, (int, float)) and not isinstance(unquoted, bool):
         return f"read as the text {value!r} (it is quoted); write the number without quotes"
-    mantissa, sign, digits = exponent.groups()
-    if integer and number.is_integer():
-        fix = f"{int(number)}"
-    else:
-        fix = f"{mantissa if '.' in mantissa else mantissa + '.0'}e{sign or '+'}{digits}"
-    return (f"read as the text {value!r}: YAML 1.1 reads a number with an exponent only "
-            f"with a dot and a signed exponent; write {fix}")
+    exponent = re.fullmatch(r"\s*([-+]?[0-9_]*\.?[0-9_]*)[eE]([-+]?)([0-9]+)\s*", value)
+    if exponent is not None:
+        mantissa, sign, digits = exponent.groups()
+        if integer and number.is_integer():
+            fix = f"{int(number)}"
+        else:
+            fix = f"{mantissa if '.' in mantissa else mantissa + '.0'}e{sign or '+'}{digits}"
+        return (f"read as the text {value!r}: YAML 1.1 reads a number with an exponent only "
+                f"with a dot and a signed exponent; write {fix}")
+    if re.fullmatch(r"[-+]?0[0-9_]+", value.strip()):
+        return (f"read as the text {value!r}: YAML 1.1 reads an integer with a leading 0 as "
+                f"octal, and 8, 9 are no octal digits; write {plain} without the leading 0")
+    return f"read as the text {value!r}, not as a number; write {plain}"
+
+
+def _invisible(name):
+    """The characters of ``name`` that do not print (a zero-width or no-break space), in
+    words, or ''."""
+    odd = sorted({c for c in str(name) if not c.isprintable()})
+    return ", ".join(f"U+{ord(c):04X} {unicodedata.name(c, 'control character')}"
+                     for c in odd)
+
+
+def _key(part):
+    """A key of a path as it is written, or quoted with escapes when it holds a character
+    that does not print (``"n\\u200bbatches"``), so two names that print alike differ."""
+    if isinstance(part, str) and _invisible(part):
+        return '"' + part.encode("unicode_escape").decode("ascii") + '"'
+    return str(part)
 
 
 def _scalar(node):
@@ -186,6 +222,10 @@ class _Words:
         that failed, else the one at ``parts``), saying when a number was read as text."""
         node = node if node is not None else self.at(parts)
         problem = _read_as_text(value, integer=node.get("type") == "integer")
+        if (node.get("type") == "integer" and isinstance(value, float) and math.isfinite(value)
+                and value.is_integer()):
+            problem = (f"a number with a dot or an exponent, not an integer; write "
+                       f"{int(value)}")
         return (f"{_path(parts)} = {_short(value)}: {problem or 'not allowed'}; "
                 f"allowed: {self.describe(parts, node)}")
 
@@ -209,8 +249,14 @@ class _Words:
         if kind == "additionalProperties":
             known = list(error.schema.get("properties", {}))
             extra = [k for k in error.instance if k not in known]
-            return [f"{_path(parts + [k])}: unknown key; allowed keys here: {', '.join(known)}"
+            return [f"{_path(parts + [k])}: unknown key"
+                    + (f" (it holds {_invisible(k)}, which does not print)" if _invisible(k)
+                       else "") + f"; allowed keys here: {', '.join(known)}"
                     for k in extra]
+        names = self.resolve(self.at(parts).get("propertyNames", {}))
+        if "propertyNames" in error.schema_path and names.get("description"):
+            return [f"{_path(parts)}: the name {error.instance!r} is not allowed; allowed: "
+                    f"{self.describe(parts, names)}"]
         if "propertyNames" in error.schema_path:
             return [f"{_path(parts)}: the name {error.instance!r} is not allowed; allowed: "
                     f"letters, digits and _, starting with a letter, at most 120 characters "
@@ -264,7 +310,19 @@ def _filling_validator(schema):
                     instance[name] = copy.deepcopy(sub["default"])
         yield from properties(validator, props, instance, schema_)
 
-    return jsonschema.validators.extend(base, {"properties": set_defaults})(schema)
+    def whole_pattern(validator, pattern, instance, schema_):
+        # JSON Schema's `pattern` is a search, and Python's `$` matches before a final
+        # newline: "s1\n" would pass ^[A-Za-z][A-Za-z0-9_]*$; a name must match whole
+        if validator.is_type(instance, "string") and not re.fullmatch(pattern, instance):
+            yield jsonschema.ValidationError(f"{instance!r} does not match {pattern!r} whole")
+
+    # an integer is an int: JSON Schema 2020-12 counts 1.0 as one, which would reach
+    # range(), file names and SeedSequence as a float
+    types = base.TYPE_CHECKER.redefine(
+        "integer", lambda _, value: isinstance(value, int) and not isinstance(value, bool))
+    return jsonschema.validators.extend(
+        base, {"properties": set_defaults, "pattern": whole_pattern},
+        type_checker=types)(schema)
 
 
 def _nonfinite(value, parts=()):
@@ -280,6 +338,26 @@ def _nonfinite(value, parts=()):
             yield from _nonfinite(v, (*parts, i))
 
 
+def non_text_keys(value, parts=()):
+    """A line for each key of ``value`` that is not text (what YAML reads ``yes:``, ``123:``,
+    ``~:`` as, in a config given as a dict; `read_yaml` refuses them with their line)."""
+    lines = []
+    if isinstance(value, dict):
+        for k, v in value.items():
+            if not isinstance(k, str):
+                kind = {bool: "a boolean", int: "an integer", float: "a number"}.get(
+                    type(k), "null" if k is None else f"a {type(k).__name__}")
+                lines.append(f"{_path(list(parts))}: the key {k!r} is {kind}, not a name "
+                             f"(YAML reads yes:, 123:, ~: so); allowed: text: quote it, or "
+                             f"rename it")
+            else:
+                lines += non_text_keys(v, (*parts, k))
+    elif isinstance(value, list):
+        for i, v in enumerate(value):
+            lines += non_text_keys(v, (*parts, i))
+    return lines
+
+
 def validate(config, schema):
     """Check ``config`` against the JSON Schema ``schema``, filling defaults in place.
 
@@ -290,7 +368,8 @@ def validate(config, schema):
         ``VIBROIMPACT_VERBOSE=1``).
     """
     words = _Words(schema)
-    problems = [words.nonfinite(p, v) for p, v in _nonfinite(config)]
+    problems = non_text_keys(config)
+    problems += [words.nonfinite(p, v) for p, v in _nonfinite(config)]
     if problems:
         raise ConfigError(problems)
     errors = sorted(_filling_validator(schema).iter_errors(config),
