@@ -431,8 +431,10 @@ def _response_spectra(spectra, i_beta, title, params, beta_max, lin_label):
     ax.set_xlim(0.0, float(ds["beta"].max()))
     ax.set_xlabel(axis_label(ds["beta"]))
     ax.set_ylabel(_psd_label(ds["S_a"]))
-    ax.legend(loc="upper right", ncols=1 if deltas.size < 7 else 2, fontsize=7.5,
-              title=_welch_text(full, harmonic), title_fontsize=7)
+    # below the axes: inside, it hid the resonance peaks and the harmonics of the forcing
+    fig.set_figheight(fig.get_figheight() * 1.3)
+    fig.legend(loc="outside lower center", ncols=2, fontsize=7.5,
+               title=_welch_text(full, harmonic), title_fontsize=7)
     _header(fig, title, params)
     return fig
 
@@ -619,11 +621,14 @@ def _drawn_density(cell, var, band):
     return np.array(xs), np.array(ys), None if band is None else np.array(ses)
 
 
-def _density_figure(events, i_beta, var, title, params, density_delta=None, linear=False):
+def _density_figure(events, i_beta, var, title, params, density_delta=None, linear=False,
+                    zoom=None):
     """One density curve per density delta at inv_beta index `i_beta`, with a confidence band.
 
     Panel (a) has a log density axis (the tails matter as much as the bulk); with `linear`,
-    panel (b) draws the same curves on a linear axis, where the spread of the bulk reads.
+    panel (b) draws the same curves on a linear axis, where the spread of the bulk reads;
+    with `zoom` (a value of x), panel (a) shows every drawn bin and panel (b) the same
+    curves, log too, on ``[0, zoom]``, where the bulk reads.
     Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`). The band
     is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile of B - 1
     dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number of
@@ -634,7 +639,9 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     -------
     (Figure, list of Axes)
     """
-    fig, axes = _figure(2 if linear else 1, height_ratios=(1.3, 1.0) if linear else None)
+    two = linear or zoom is not None
+    fig, axes = _figure(2 if two else 1, sharex=zoom is None,
+                        height_ratios=(1.3, 1.0) if two else None)
     ds = events.isel(inv_beta=i_beta)
     index = _density_deltas(events, density_delta)
     x = _require(ds, var, "this figure").dims[-1]
@@ -665,11 +672,13 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
             top = max(top, float(np.nanmax(y)))
             low = min(low, float(np.nanmin(y)))
     ax_log = axes[0]
-    ax_log.set_yscale("log")
-    if top > 0.0:
-        ax_log.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
-    else:
-        ax_log.set_ylim(DENSITY_DECADES, 1.0)
+    for ax in axes if zoom is not None else axes[:1]:
+        ax.set_yscale("log")
+        if top > 0.0:
+            ax.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
+        else:
+            ax.set_ylim(DENSITY_DECADES, 1.0)
+    if top <= 0.0:
         drawn = ds.isel(delta=index)
         empty = (no_collision_text(drawn, where=r"in this record at any $\delta$ drawn")
                  if int(drawn["n_collisions"].sum()) == 0 else
@@ -677,7 +686,7 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
                  "too few collisions for a density")
         for ax in axes:
             note_on_axes(ax, empty)
-    for ax in axes[1:]:
+    for ax in axes[1:] if linear else ():
         ax.set_ylim(0.0, 1.08 * top if top > 0.0 else 1.0)
     for ax in axes:
         ax.set_xlim(edges[0], x_end if x_end > edges[0] else edges[-1])
@@ -686,6 +695,11 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     if linear:
         _panel_tag(axes[0], "(a) log scale")
         _panel_tag(axes[1], "(b) linear scale")
+    if zoom is not None:
+        axes[1].set_xlim(edges[0], min(float(zoom), axes[0].get_xlim()[1]))
+        axes[0].set_xlabel(axis_label(ds[x]))
+        _panel_tag(axes[0], "(a) every bin drawn")
+        _panel_tag(axes[1], f"(b) the bulk, up to {_num(axes[1].get_xlim()[1])}")
     rule = (f"bins with < {MIN_BIN_COUNT} values merged with their neighbours (plateaus), "
             "runs still below not drawn")
     title_text = rule
@@ -695,9 +709,9 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
                   else "t of B - 1 dof")
         title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
                       f"({100 * CONFIDENCE:g} %, {t_text})\n{rule}")
-    if len(index) > LEGEND_INSIDE or linear:
+    if len(index) > LEGEND_INSIDE or two:
         # a legend this tall would hide the curves' peaks: below the axes instead
-        fig.set_figheight(fig.get_figheight() * (1.2 if linear else 1.3))
+        fig.set_figheight(fig.get_figheight() * (1.2 if two else 1.3))
         fig.legend(loc="outside lower center", ncols=2, title=title_text, title_fontsize=7.5,
                    fontsize=7.5)
     else:
