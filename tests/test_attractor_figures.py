@@ -206,7 +206,9 @@ def test_basins_leave_cells_without_a_stable_orbit_blank(data, basin_figure):
 
 def test_basins_print_the_starts_and_the_interval(data, basin_figure):
     title = basin_figure.get_suptitle()
-    assert "64 starts per cell" in title and data["basins"].attrs["box"] in title
+    # the box as stored, its plain names in the paper's symbols (plotting.symbols)
+    assert "64 starts per cell" in title and plotting.symbols(data["basins"].attrs["box"]) in title
+    assert "$x_0$" in title and " x0 " not in title
     assert "Clopper-Pearson" in title
     assert "\\n" not in title                 # line breaks, not escaped ones
     legend = basin_figure.legends[0].get_title().get_text()

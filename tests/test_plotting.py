@@ -237,6 +237,35 @@ def test_fig13_pair_label_points_off_its_axis(data):
         assert "leftarrow" in label.get_text() and "rightarrow" in label.get_text()
 
 
+def test_headers_define_only_the_collision_quantities_drawn(data):
+    """Issue 33: the header of Figs. 7-9, 13, 14 defined z_j on figures that do not draw it."""
+    v_def, z_def = (plotting.COLLISION_QUANTITIES[k] for k in ("v_after", "interval"))
+    events, harmonic = data["events"], data["events_h"]
+    for fig, drawn in ((plotting.fig07(events, density_delta=DENSITY_DELTA), v_def),
+                       (plotting.fig08(events, density_delta=DENSITY_DELTA), z_def),
+                       (plotting.fig13(harmonic, inv_beta=1.1), z_def),
+                       (plotting.fig14(harmonic, inv_beta=1.1), v_def)):
+        title = _title(fig)
+        assert drawn in title and ({v_def, z_def} - {drawn}).pop() not in title, title
+        assert "per collision" in title
+    title = _title(plotting.fig09(events))
+    assert v_def in title and z_def in title
+
+
+@pytest.mark.parametrize("plain, shown", [
+    ("forcing phase in [0, 2 pi), x0 = delta - g with g in [0, 4], v0 in [-4, 4]",
+     r"forcing phase in [0, $2\pi$), $x_0$ = $\delta$ - g with g in [0, 4], $v_0$ in [-4, 4]"),
+    ("|mu-mu_ind|/max(1,|mu_ind|) over tol(d)",
+     r"|$\mu$-$\mu_{\rm ind}$|/max(1,|$\mu_{\rm ind}$|) over tol(d)"),
+    ("contact edges, a(tau) and x' at samples", r"contact edges, $a(\tau)$ and $x'$ at samples"),
+    (r"$\delta$ = 2, a delta; epsilon, mu", r"$\delta$ = 2, a $\delta$; epsilon, $\mu$"),
+    ("max(replay |dx|,|du|; -min a)", "max(replay |dx|,|du|; -min a)"),
+])
+def test_symbols_write_plain_names_as_the_papers_symbols(plain, shown):
+    """Only whole names outside mathtext change, each once (2 pi is not 2 then pi)."""
+    assert plotting.symbols(plain) == shown
+
+
 def test_density_delta_without_impacts_keeps_its_line(data):
     ax = plotting.fig07(data["events"], density_delta=[6.0, 0.0]).axes[0]
     assert len(_data_lines(ax)) == 2
@@ -533,7 +562,7 @@ def test_missing_parameter_attribute_is_named(data):
 def test_style_is_scoped_to_the_figure_functions(data):
     import matplotlib
     before = dict(matplotlib.rcParams)
-    fig = plotting.fig06(data["spectra"])
+    fig = plotting.fig04(data["noise"])       # one panel, legend inside: the style's size
     assert tuple(fig.get_size_inches()) == (6.5, 4.5)
     assert dict(matplotlib.rcParams) == before
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import re
 from pathlib import Path
 
 import matplotlib
@@ -189,10 +190,42 @@ def _headroom(ax):
 #: Characters of a parameter line above which it is broken at its "; " separators.
 HEADER_WIDTH = 90
 
+#: Plain-ASCII names that text stored with the data uses (a basins box, a stress family's
+#: error measure), and the paper's symbols a header shows for them (`symbols`); the longer
+#: name first where one contains another.
+SYMBOLS = (
+    (r"\b2 pi\b", r"$2\pi$"),
+    (r"\bpi\b", r"$\pi$"),
+    (r"\bdelta\b", r"$\delta$"),
+    (r"\bx0\b", r"$x_0$"),
+    (r"\bv0\b", r"$v_0$"),
+    (r"\ba\(tau\)", r"$a(\tau)$"),
+    (r"\bx'", r"$x'$"),
+    (r"\bmu_ind\b", r"$\mu_{\rm ind}$"),
+    (r"\bmu\b", r"$\mu$"),
+)
+#: One pass over a text: a name matched is replaced once, never inside a symbol put there.
+_SYMBOLS_RE = re.compile("|".join(f"({pattern})" for pattern, _ in SYMBOLS))
+
+
+def symbols(text):
+    r"""`text` with the plain names of `SYMBOLS` written as the paper's symbols (mathtext).
+
+    Only the parts outside ``$...$`` change, so a text already in mathtext stays as it is:
+    ``"forcing phase in [0, 2 pi), x0 = delta - g"`` becomes
+    ``"forcing phase in [0, $2\pi$), $x_0$ = $\delta$ - g"``.
+    """
+    parts = str(text).split("$")
+    for k in range(0, len(parts), 2):          # even parts lie outside math
+        parts[k] = _SYMBOLS_RE.sub(lambda m: SYMBOLS[m.lastindex - 1][1], parts[k])
+    return "$".join(parts)
+
 
 def _header(fig, title, params):
+    """The figure's title and its parameter lines (plain names as symbols, `symbols`),
+    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`)."""
     lines = []
-    for line in params.split("\n"):
+    for line in symbols(params).split("\n"):
         while len(line) > HEADER_WIDTH and ";  " in line[:HEADER_WIDTH + 10]:
             cut = line.rfind(";  ", 0, HEADER_WIDTH + 10)
             lines.append(line[:cut + 1])
@@ -729,18 +762,24 @@ def _require_harmonic(events, figure):
 
 #: What an impact statistic counts, printed on every figure of one (docs/figures.md).
 COLLISION_NOTE = (r"per collision (an impact after a free flight, with its chatter and "
-                  r"sticking);  "
-                  r"$\varepsilon u_{j-0}$: its first rebound, $z_j$: first impact to first impact")
+                  r"sticking)")
+#: How each collision statistic is read off a collision; a figure defines those it draws.
+COLLISION_QUANTITIES = {"v_after": r"$\varepsilon u_{j-0}$: its first rebound",
+                        "interval": r"$z_j$: first impact to first impact"}
 
 
-def _events_params(events, i_beta):
+def _events_params(events, i_beta, drawn=tuple(COLLISION_QUANTITIES)):
     """Parameter line of an events/spectra dataset at inv_beta index `i_beta`; an events
-    dataset (collision statistics) adds `COLLISION_NOTE` on a line of its own."""
+    dataset (collision statistics) adds `COLLISION_NOTE` on a line of its own, with the
+    definitions of the quantities `drawn` (keys of `COLLISION_QUANTITIES`) only."""
     inv_beta = float(events["inv_beta"][i_beta])
     harmonic = float(_attr(events, "amplitude")) != 0.0
     line = f"{_system_text(events)};  " + _forcing_text(
         events, inv_beta=inv_beta if harmonic else None)
-    return line + (f"\n{COLLISION_NOTE}" if "n_collisions" in events else "")
+    if "n_collisions" not in events:
+        return line
+    return line + "\n" + ";  ".join([COLLISION_NOTE]
+                                    + [COLLISION_QUANTITIES[name] for name in drawn])
 
 
 # --------------------------------------------------------------------------------------------

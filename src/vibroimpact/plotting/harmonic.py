@@ -133,7 +133,7 @@ def fig13(events, inv_beta, density_delta=None):
     fig, axes = _density_figure(
         events, i, "ratio_density",
         r"Fig. 13  Probability density of $z_j/z$, the interval over the forcing period",
-        _events_params(events, i), density_delta, linear=True)
+        _events_params(events, i, ("interval",)), density_delta, linear=True)
     marks = ((0.5, "-.", PAIR_LABEL, "center"), (1.0, ":", " (1/1)", "left"),
              (2.0, ":", " (1/2)", "left"))
     for ax in axes:
@@ -160,5 +160,6 @@ def fig14(events, inv_beta, density_delta=None):
     i = _nearest(events["inv_beta"], inv_beta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",
-                             _events_params(events, i), density_delta, linear=True)
+                             _events_params(events, i, ("v_after",)), density_delta,
+                             linear=True)
     return fig

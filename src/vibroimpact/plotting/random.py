@@ -169,7 +169,8 @@ def fig07(events, density_delta=None, envelope="auto"):
     """
     fig, axes = _density_figure(events, 0, "v_after_density",
                                 "Fig. 7  Probability density of the velocity after impact",
-                                _events_params(events, 0), density_delta, linear=True)
+                                _events_params(events, 0, ("v_after",)), density_delta,
+                                linear=True)
     theory = _envelope(events, envelope)
     if theory is None:
         if envelope == "auto":
@@ -223,7 +224,8 @@ def fig08(events, density_delta=None, zoom=FIG08_ZOOM):
     """
     fig, _ = _density_figure(events, 0, "interval_density",
                              "Fig. 8  Probability density of the interval between collisions",
-                             _events_params(events, 0), density_delta, zoom=zoom)
+                             _events_params(events, 0, ("interval",)), density_delta,
+                             zoom=zoom)
     return fig
 
 
