@@ -95,11 +95,44 @@ def test_fig16_draws_one_line_per_curve_styled_by_kind(data, fig16_curves):
         reference = Line2D([], [], **_kind_style(str(kind)))
         for drawn in (line, over):
             np.testing.assert_array_equal(drawn.get_xydata(), points)
-            assert drawn._unscaled_dash_pattern == reference._unscaled_dash_pattern, kind
+            # the dashes (on (a) every other type's shifted by half a period: _overview_style)
+            assert drawn._unscaled_dash_pattern[1] == reference._unscaled_dash_pattern[1], kind
+        assert line._unscaled_dash_pattern == reference._unscaled_dash_pattern
         assert matplotlib.colors.same_color(line.get_color(), "k")
         assert matplotlib.colors.same_color(over.get_color(), colors[name])
     for ax in fig16_curves.axes:
         assert not _gid(ax, "stable-edge"), "no cell-edge line beside the curves"
+
+
+def test_fig16_overview_shifts_every_other_types_dashes(data, fig16_curves):
+    """Issue 33: the (2/1) and (3/1) grazing edges coincide below 1/beta = 1; in phase, the
+    later dashes hid the earlier. Shifted by half a period, both colours show in turn."""
+    types = [str(t) for t in data["orbits"]["type"].values]
+    b = data["boundaries"]
+    for c, (kind, name) in enumerate(zip(b["kind"].values, b["type"].values)):
+        (over,) = _gid(fig16_curves.axes[0], f"overview-boundary-{c}")
+        offset, dashes = over._unscaled_dash_pattern
+        if dashes is None:
+            continue                            # solid: nothing to shift
+        expected = 0.5 * sum(dashes) if types.index(str(name)) % 2 else 0.0
+        assert offset == pytest.approx(expected + _kind_style(str(kind))["ls"][0]), (kind, name)
+
+
+def test_fig16_writes_no_region_word_over_a_codim2_marker(data, fig16_curves):
+    """Issue 33: the "unstable" label covered the codimension-two markers of (1/2)."""
+    fig16_curves.canvas.draw()
+    renderer = fig16_curves.canvas.get_renderer()
+    checked = 0
+    for ax in fig16_curves.axes[1:]:
+        marks = ax.transData.transform(np.vstack(
+            [line.get_xydata() for line in _gid(ax, "codim2")] or [np.empty((0, 2))]))
+        for text in ax.texts:
+            if not str(text.get_gid()).startswith("reason-"):
+                continue
+            box = text.get_window_extent(renderer)
+            checked += len(marks)
+            assert not any(box.contains(*xy) for xy in marks), text.get_text()
+    assert checked, "the fixture has words and markers on one panel"
 
 
 def test_fig16_marks_every_codim2_point_on_its_panel(data, fig16_curves):
