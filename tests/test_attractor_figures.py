@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from matplotlib.lines import Line2D
+from matplotlib.text import Text
 
 import attractor_data
 from vibroimpact import plotting
@@ -129,10 +130,32 @@ def test_fig16_writes_no_region_word_over_a_codim2_marker(data, fig16_curves):
         for text in ax.texts:
             if not str(text.get_gid()).startswith("reason-"):
                 continue
-            box = text.get_window_extent(renderer)
+            box = Text.get_window_extent(text, renderer)    # the word, not its leader
             checked += len(marks)
             assert not any(box.contains(*xy) for xy in marks), text.get_text()
     assert checked, "the fixture has words and markers on one panel"
+
+
+def test_fig16_moves_a_region_word_off_a_codim2_marker(data, fig16_curves):
+    """A marker put where a word was written pushes the word elsewhere."""
+    word = next(t for ax in fig16_curves.axes[1:] for t in ax.texts
+                if str(t.get_gid()).startswith("reason-"))
+    name = word.axes.get_title().strip("()")
+    x, y = word.get_position()
+    b = data["boundaries"]
+    extra = {"codim2_inv_beta": [x], "codim2_delta": [y], "codim2_type": [name],
+             "codim2_kinds": ["fold+grazing"]}
+    moved = b.drop_dims("codim2").assign(
+        {k: ("codim2", np.concatenate([b[k].values, np.array(v, dtype=b[k].dtype)]))
+         for k, v in extra.items()})
+    fig = plotting.fig16(data["orbits"], moved)
+    ax = _panel(fig, f"({name})")
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    mark = ax.transData.transform([[x, y]])[0]
+    words = [t for t in ax.texts if t.get_gid() == word.get_gid()]
+    # the word's own box (an Annotation's extent would include its leader)
+    assert words and not any(Text.get_window_extent(t, renderer).contains(*mark) for t in words)
 
 
 def test_fig16_marks_every_codim2_point_on_its_panel(data, fig16_curves):
