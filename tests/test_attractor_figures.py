@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from matplotlib.lines import Line2D
+from matplotlib.text import Text
 
 import attractor_data
 from vibroimpact import plotting
@@ -97,11 +98,66 @@ def test_fig16_draws_one_line_per_curve_styled_by_kind(data, fig16_curves):
         reference = Line2D([], [], **_kind_style(str(kind)))
         for drawn in (line, over):
             np.testing.assert_array_equal(drawn.get_xydata(), points)
-            assert drawn._unscaled_dash_pattern == reference._unscaled_dash_pattern, kind
+            # the dashes (on (a) every other type's shifted by half a period: _overview_style)
+            assert drawn._unscaled_dash_pattern[1] == reference._unscaled_dash_pattern[1], kind
+        assert line._unscaled_dash_pattern == reference._unscaled_dash_pattern
         assert matplotlib.colors.same_color(line.get_color(), "k")
         assert matplotlib.colors.same_color(over.get_color(), colors[name])
     for ax in fig16_curves.axes:
         assert not _gid(ax, "stable-edge"), "no cell-edge line beside the curves"
+
+
+def test_fig16_overview_shifts_every_other_types_dashes(data, fig16_curves):
+    """Issue 33: the (2/1) and (3/1) grazing edges coincide below 1/beta = 1; in phase, the
+    later dashes hid the earlier. Shifted by half a period, both colours show in turn."""
+    types = [str(t) for t in data["orbits"]["type"].values]
+    b = data["boundaries"]
+    for c, (kind, name) in enumerate(zip(b["kind"].values, b["type"].values)):
+        (over,) = _gid(fig16_curves.axes[0], f"overview-boundary-{c}")
+        offset, dashes = over._unscaled_dash_pattern
+        if dashes is None:
+            continue                            # solid: nothing to shift
+        expected = 0.5 * sum(dashes) if types.index(str(name)) % 2 else 0.0
+        assert offset == pytest.approx(expected + _kind_style(str(kind))["ls"][0]), (kind, name)
+
+
+def test_fig16_writes_no_region_word_over_a_codim2_marker(data, fig16_curves):
+    """Issue 33: the "unstable" label covered the codimension-two markers of (1/2)."""
+    fig16_curves.canvas.draw()
+    renderer = fig16_curves.canvas.get_renderer()
+    checked = 0
+    for ax in fig16_curves.axes[1:]:
+        marks = ax.transData.transform(np.vstack(
+            [line.get_xydata() for line in _gid(ax, "codim2")] or [np.empty((0, 2))]))
+        for text in ax.texts:
+            if not str(text.get_gid()).startswith("reason-"):
+                continue
+            box = Text.get_window_extent(text, renderer)    # the word, not its leader
+            checked += len(marks)
+            assert not any(box.contains(*xy) for xy in marks), text.get_text()
+    assert checked, "the fixture has words and markers on one panel"
+
+
+def test_fig16_moves_a_region_word_off_a_codim2_marker(data, fig16_curves):
+    """A marker put where a word was written pushes the word elsewhere."""
+    word = next(t for ax in fig16_curves.axes[1:] for t in ax.texts
+                if str(t.get_gid()).startswith("reason-"))
+    name = word.axes.get_title().strip("()")
+    x, y = word.get_position()
+    b = data["boundaries"]
+    extra = {"codim2_inv_beta": [x], "codim2_delta": [y], "codim2_type": [name],
+             "codim2_kinds": ["fold+grazing"]}
+    moved = b.drop_dims("codim2").assign(
+        {k: ("codim2", np.concatenate([b[k].values, np.array(v, dtype=b[k].dtype)]))
+         for k, v in extra.items()})
+    fig = plotting.fig16(data["orbits"], moved)
+    ax = _panel(fig, f"({name})")
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    mark = ax.transData.transform([[x, y]])[0]
+    words = [t for t in ax.texts if t.get_gid() == word.get_gid()]
+    # the word's own box (an Annotation's extent would include its leader)
+    assert words and not any(Text.get_window_extent(t, renderer).contains(*mark) for t in words)
 
 
 def test_fig16_marks_every_codim2_point_on_its_panel(data, fig16_curves):
@@ -225,7 +281,9 @@ def test_basins_leave_cells_without_a_stable_orbit_blank(data, basin_figure):
 
 def test_basins_print_the_starts_and_the_interval(data, basin_figure):
     title = basin_figure.get_suptitle()
-    assert "64 starts per cell" in title and data["basins"].attrs["box"] in title
+    # the box as stored, its plain names in the paper's symbols (plotting.symbols)
+    assert "64 starts per cell" in title and plotting.symbols(data["basins"].attrs["box"]) in title
+    assert "$x_0$" in title and " x0 " not in title
     assert "Clopper-Pearson" in title
     assert "\\n" not in title                 # line breaks, not escaped ones
     legend = basin_figure.legends[0].get_title().get_text()

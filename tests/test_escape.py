@@ -306,8 +306,43 @@ def test_the_figure_draws_points_excluded_points_and_fits():
     excluded = [c for c in first.containers if c.lines[0].get_gid() == "excluded_points"]
     assert excluded                               # rms 0.4 and the weak (1/1) level
     legend = " ".join(t.get_text() for t in first.get_legend().get_texts())
-    assert "(1/1): $\\Delta$ = 0.16 [" in legend
+    # to the decimal of the interval's second significant digit (half-width 0.015)
+    assert "(1/1): $\\Delta$ = 0.160 [0.145, 0.175]" in legend
+    assert "-0.0000" not in legend
     assert "(1/1) 90 % at rms 0.15" in first.get_title()
+
+
+def test_the_bars_are_95_percent_intervals_as_delta_is():
+    """Issue 33: +-1 s.e. bars sat beside 95 % intervals of Delta; now both are 95 %."""
+    from vibroimpact.stats.events import t_quantile
+
+    ds = _synthetic(n_weak=(5, 3000))
+    fig = plotting_escape(ds)
+    first = [ax for ax in fig.axes if ax.get_visible() and ax.get_ylabel()][0]
+    (points,) = [c for c in first.containers if c.lines[0].get_gid() == "fitted_points"
+                 and c.get_label().startswith("(1/1)")]
+    cell = ds.isel(cell=0)
+    used = cell["fit_used"].values[:, 0].astype(bool)
+    t, se = cell["residence_time"].values[used, 0], cell["residence_time_stderr"].values[used, 0]
+    half = t_quantile(cell["n_stretches"].values[used, 0], 0.95) * se
+    segments = points.lines[2][0].get_segments()
+    np.testing.assert_allclose([s[1][1] - s[0][1] for s in segments],
+                               np.minimum(half, 0.999 * t) + half, rtol=1e-12)
+    labels = " ".join(t.get_text() for t in fig.legends[0].get_texts())
+    assert "95 %" in labels and "1 s.e." not in labels
+
+
+@pytest.mark.parametrize("value, lo, hi, text", [
+    (0.163, 0.146, 0.18, "0.163 [0.146, 0.180]"),
+    (0.00409, -0.000194, 0.00836, "0.0041 [-0.0002, 0.0084]"),
+    (-0.0000004, -0.0081, 0.0081, "0.0000 [-0.0081, 0.0081]"),
+    (12.3456, 10.0, 14.0, "12.3 [10.0, 14.0]"),
+    (0.16, 0.16, 0.16, "0.16 [0.16, 0.16]"),
+])
+def test_delta_is_printed_to_its_interval(value, lo, hi, text):
+    from vibroimpact.plotting.escape import _interval_text
+
+    assert _interval_text(value, lo, hi) == text
 
 
 def test_a_figure_without_a_usable_state_says_so():

@@ -4,6 +4,7 @@ The datasets are small and laid out by hand so that each feature sits where the 
 a probability map with a cliff (0 to 100 % within one cell), a smooth hill and flagged cells;
 an orbit map with a stable band, a stable domain one cell wide, and regions of every reason.
 """
+import matplotlib.colors
 import numpy as np
 import pytest
 import xarray as xr
@@ -12,7 +13,7 @@ from matplotlib.text import Text
 
 from vibroimpact import plotting
 from vibroimpact.plotting.maps import (CLIFF_LEVEL, FEW_SWITCHES_STYLE, MAP_TEXT_SIZE,
-                                       cell_edges)
+                                       TYPE_COLORS, cell_edges)
 from vibroimpact.plotting.orbits import REASONS
 
 INV_BETA = np.round(np.arange(0.2, 3.001, 0.1), 10)
@@ -180,3 +181,27 @@ def test_no_config_keys_on_the_figure(figures, name):
         assert not any(key in t for t in texts), key
     assert any(r"$1/\beta" in ax.get_xlabel() for ax in fig.axes)
     assert any(r"$\delta$" in ax.get_ylabel() for ax in fig.axes)
+
+
+def test_type_colours_tell_the_first_five_motions_apart():
+    """Issue 33: (2/1) in vermillion and (3/1) in orange read as one hue in Fig. 16. Every
+    two of the first five differ by 30 degrees of hue or 0.4 of HSV value."""
+    hsv = matplotlib.colors.rgb_to_hsv([matplotlib.colors.to_rgb(c) for c in TYPE_COLORS[:5]])
+    for a in range(5):
+        for b in range(a):
+            hue = abs(hsv[a, 0] - hsv[b, 0]) * 360.0
+            assert min(hue, 360.0 - hue) >= 30.0 or abs(hsv[a, 2] - hsv[b, 2]) >= 0.4, (a, b)
+
+
+def test_fig15_two_panels_a_row_its_colour_bar_beside_them(figures):
+    """Issue 33: four panels in a row left the labels tiny at a page's width, the colour bar
+    far from the panels, and the record's length without a unit."""
+    fig = figures["fig15"]
+    fig.canvas.draw()
+    panels = [ax for ax in fig.axes if ax.get_visible() and ax.get_title()]
+    (bar,) = [ax for ax in fig.axes if ax.get_label() == "<colorbar>"]
+    assert fig.get_figwidth() <= 10.0 and len({ax.get_position().x0 for ax in panels}) <= 2
+    right = max(ax.get_position().x1 for ax in panels)
+    assert 0.0 < bar.get_position().x0 - right < 0.06       # figure fraction
+    assert "time units" in fig.get_suptitle()
+

@@ -193,6 +193,79 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
     assert ax.figure.axes[-1].get_xlabel() == axis_label(events[var])
 
 
+def test_fig08_panel_a_shows_every_drawn_interval_and_b_the_bulk(data):
+    """Issue 33: the axis ended at 20 and hid the long waits of the smallest plays."""
+    fig = plotting.fig08(data["events"], density_delta=DENSITY_DELTA, zoom=4.0)
+    ax_all, ax_bulk = fig.axes
+    assert ax_all.get_yscale() == ax_bulk.get_yscale() == "log"
+    last = max(np.nanmax(ln.get_xdata()) for ln in _data_lines(ax_all))
+    assert ax_all.get_xlim()[1] >= last            # no drawn point beyond the axis
+    assert last > 4.0                              # the fixture's tails reach past the zoom
+    assert ax_bulk.get_xlim()[1] == pytest.approx(4.0)
+    # the same curves in both panels
+    for a, b in zip(_data_lines(ax_all), _data_lines(ax_bulk)):
+        np.testing.assert_array_equal(a.get_xdata(), b.get_xdata())
+
+
+def _overlaps_data(fig, ax):
+    """Whether a figure legend's box covers any drawn data point of `ax` (display space)."""
+    fig.canvas.draw()
+    box = (fig.legends[0] if fig.legends else ax.get_legend()).get_window_extent()
+    for line in _data_lines(ax):
+        xy = ax.transData.transform(np.column_stack([line.get_xdata(), line.get_ydata()]))
+        xy = xy[np.isfinite(xy).all(axis=1)]
+        inside = ((xy[:, 0] > box.x0) & (xy[:, 0] < box.x1)
+                  & (xy[:, 1] > box.y0) & (xy[:, 1] < box.y1))
+        if inside.any():
+            return True
+    return False
+
+
+def test_fig12_legend_covers_no_spectrum(data):
+    """Issue 33: the legend hid the delta = 2 peak and the tops of the harmonics' lines."""
+    fig = plotting.fig12(data["spectra_h"], inv_beta=1.1)
+    assert not _overlaps_data(fig, fig.axes[0])
+
+
+def test_fig13_pair_label_points_off_its_axis(data):
+    """The (2/1) intervals lie in pairs on both sides of z_j/z = 1/2, none on it: the label
+    is centred on the line and points both ways, not written as if a peak stood there."""
+    fig = plotting.fig13(data["events_h"], inv_beta=1.1, density_delta=DENSITY_DELTA)
+    for ax in fig.axes:
+        (label,) = [t for t in ax.texts if "(2/1)" in t.get_text()]
+        assert label.get_position()[0] == 0.5 and label.get_horizontalalignment() == "center"
+        assert "leftarrow" in label.get_text() and "rightarrow" in label.get_text()
+
+
+def test_headers_define_only_the_collision_quantities_drawn(data):
+    """Issue 33: the header of Figs. 7-9, 13, 14 defined z_j on figures that do not draw it."""
+    v_def, z_def = (plotting.COLLISION_QUANTITIES[k] for k in ("v_after", "interval"))
+    events, harmonic = data["events"], data["events_h"]
+    for fig, drawn in ((plotting.fig07(events, density_delta=DENSITY_DELTA), v_def),
+                       (plotting.fig08(events, density_delta=DENSITY_DELTA), z_def),
+                       (plotting.fig13(harmonic, inv_beta=1.1), z_def),
+                       (plotting.fig14(harmonic, inv_beta=1.1), v_def)):
+        title = _title(fig)
+        assert drawn in title and ({v_def, z_def} - {drawn}).pop() not in title, title
+        assert "per collision" in title
+    title = _title(plotting.fig09(events))
+    assert v_def in title and z_def in title
+
+
+@pytest.mark.parametrize("plain, shown", [
+    ("forcing phase in [0, 2 pi), x0 = delta - g with g in [0, 4], v0 in [-4, 4]",
+     r"forcing phase in [0, $2\pi$), $x_0$ = $\delta$ - g with g in [0, 4], $v_0$ in [-4, 4]"),
+    ("|mu-mu_ind|/max(1,|mu_ind|) over tol(d)",
+     r"|$\mu$-$\mu_{\rm ind}$|/max(1,|$\mu_{\rm ind}$|) over tol(d)"),
+    ("contact edges, a(tau) and x' at samples", r"contact edges, $a(\tau)$ and $x'$ at samples"),
+    (r"$\delta$ = 2, a delta; epsilon, mu", r"$\delta$ = 2, a $\delta$; epsilon, $\mu$"),
+    ("max(replay |dx|,|du|; -min a)", "max(replay |dx|,|du|; -min a)"),
+])
+def test_symbols_write_plain_names_as_the_papers_symbols(plain, shown):
+    """Only whole names outside mathtext change, each once (2 pi is not 2 then pi)."""
+    assert plotting.symbols(plain) == shown
+
+
 def test_density_delta_without_impacts_keeps_its_line(data):
     ax = plotting.fig07(data["events"], density_delta=[6.0, 0.0]).axes[0]
     assert len(_data_lines(ax)) == 2
@@ -489,7 +562,7 @@ def test_missing_parameter_attribute_is_named(data):
 def test_style_is_scoped_to_the_figure_functions(data):
     import matplotlib
     before = dict(matplotlib.rcParams)
-    fig = plotting.fig06(data["spectra"])
+    fig = plotting.fig04(data["noise"])       # one panel, legend inside: the style's size
     assert tuple(fig.get_size_inches()) == (6.5, 4.5)
     assert dict(matplotlib.rcParams) == before
 

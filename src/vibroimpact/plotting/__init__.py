@@ -4,7 +4,8 @@ Every function takes already opened :class:`xarray.Dataset` objects laid out as 
 ``docs/datasets.md`` and returns a Figure; none of them touches a file. :func:`save` is the
 only writer (the workflow's figure rule calls it). Axis labels come from one vocabulary in
 the paper's symbols, `LABELS` (a variable outside it is labelled by its ``long_name`` and
-``units``); every density figure follows one sparse-bin rule (`MIN_BIN_COUNT`,
+``units``), and headers write the plain names of text stored with the data as symbols
+(:func:`symbols`); every density figure follows one sparse-bin rule (`MIN_BIN_COUNT`,
 :func:`merge_sparse_bins`) and draws a family of curves with colour, line style and marker
 (:func:`family_styles`); the look comes from the one style file
 ``vibroimpact.mplstyle``, applied by :func:`style`. Every figure prints the parameters it
@@ -28,9 +29,10 @@ Datasets and the figures that read them (docs/figures.md)::
 Plotting never imports the simulator or the orbit solver; it may use small helpers of
 `vibroimpact.stats`.
 """
-from vibroimpact.plotting._common import (LABELS, MIN_BIN_COUNT, STYLE_FILE, axis_label,
-                                          bin_counts, family_styles, merge_sparse_bins, save,
-                                          style)
+from vibroimpact.plotting._common import (COLLISION_QUANTITIES, LABELS, MIN_BIN_COUNT,
+                                          STYLE_FILE, SYMBOLS, axis_label, bin_counts,
+                                          family_styles, merge_sparse_bins, save, style,
+                                          symbols)
 from vibroimpact.plotting.attractors import basins, lyapunov
 from vibroimpact.plotting.escape import escape_vs_noise
 from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
@@ -42,7 +44,8 @@ from vibroimpact.plotting.validation import stress, work_precision
 
 __all__ = [
     "STYLE_FILE", "style", "axis_label", "critical_delta", "save", "LABELS", "MIN_BIN_COUNT",
-    "bin_counts", "family_styles", "merge_sparse_bins",
+    "bin_counts", "family_styles", "merge_sparse_bins", "SYMBOLS", "symbols",
+    "COLLISION_QUANTITIES",
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
     "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
     "map_agreement", "basins", "lyapunov", "work_precision", "stress", "residence",

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import re
 from pathlib import Path
 
 import matplotlib
@@ -189,10 +190,42 @@ def _headroom(ax):
 #: Characters of a parameter line above which it is broken at its "; " separators.
 HEADER_WIDTH = 90
 
+#: Plain-ASCII names that text stored with the data uses (a basins box, a stress family's
+#: error measure), and the paper's symbols a header shows for them (`symbols`); the longer
+#: name first where one contains another.
+SYMBOLS = (
+    (r"\b2 pi\b", r"$2\pi$"),
+    (r"\bpi\b", r"$\pi$"),
+    (r"\bdelta\b", r"$\delta$"),
+    (r"\bx0\b", r"$x_0$"),
+    (r"\bv0\b", r"$v_0$"),
+    (r"\ba\(tau\)", r"$a(\tau)$"),
+    (r"\bx'", r"$x'$"),
+    (r"\bmu_ind\b", r"$\mu_{\rm ind}$"),
+    (r"\bmu\b", r"$\mu$"),
+)
+#: One pass over a text: a name matched is replaced once, never inside a symbol put there.
+_SYMBOLS_RE = re.compile("|".join(f"({pattern})" for pattern, _ in SYMBOLS))
+
+
+def symbols(text):
+    r"""`text` with the plain names of `SYMBOLS` written as the paper's symbols (mathtext).
+
+    Only the parts outside ``$...$`` change, so a text already in mathtext stays as it is:
+    ``"forcing phase in [0, 2 pi), x0 = delta - g"`` becomes
+    ``"forcing phase in [0, $2\pi$), $x_0$ = $\delta$ - g"``.
+    """
+    parts = str(text).split("$")
+    for k in range(0, len(parts), 2):          # even parts lie outside math
+        parts[k] = _SYMBOLS_RE.sub(lambda m: SYMBOLS[m.lastindex - 1][1], parts[k])
+    return "$".join(parts)
+
 
 def _header(fig, title, params):
+    """The figure's title and its parameter lines (plain names as symbols, `symbols`),
+    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`)."""
     lines = []
-    for line in params.split("\n"):
+    for line in symbols(params).split("\n"):
         while len(line) > HEADER_WIDTH and ";  " in line[:HEADER_WIDTH + 10]:
             cut = line.rfind(";  ", 0, HEADER_WIDTH + 10)
             lines.append(line[:cut + 1])
@@ -431,8 +464,10 @@ def _response_spectra(spectra, i_beta, title, params, beta_max, lin_label):
     ax.set_xlim(0.0, float(ds["beta"].max()))
     ax.set_xlabel(axis_label(ds["beta"]))
     ax.set_ylabel(_psd_label(ds["S_a"]))
-    ax.legend(loc="upper right", ncols=1 if deltas.size < 7 else 2, fontsize=7.5,
-              title=_welch_text(full, harmonic), title_fontsize=7)
+    # below the axes: inside, it hid the resonance peaks and the harmonics of the forcing
+    fig.set_figheight(fig.get_figheight() * 1.3)
+    fig.legend(loc="outside lower center", ncols=2, fontsize=7.5,
+               title=_welch_text(full, harmonic), title_fontsize=7)
     _header(fig, title, params)
     return fig
 
@@ -619,11 +654,14 @@ def _drawn_density(cell, var, band):
     return np.array(xs), np.array(ys), None if band is None else np.array(ses)
 
 
-def _density_figure(events, i_beta, var, title, params, density_delta=None, linear=False):
+def _density_figure(events, i_beta, var, title, params, density_delta=None, linear=False,
+                    zoom=None):
     """One density curve per density delta at inv_beta index `i_beta`, with a confidence band.
 
     Panel (a) has a log density axis (the tails matter as much as the bulk); with `linear`,
-    panel (b) draws the same curves on a linear axis, where the spread of the bulk reads.
+    panel (b) draws the same curves on a linear axis, where the spread of the bulk reads;
+    with `zoom` (a value of x), panel (a) shows every drawn bin and panel (b) the same
+    curves, log too, on ``[0, zoom]``, where the bulk reads.
     Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`). The band
     is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile of B - 1
     dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number of
@@ -634,7 +672,9 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     -------
     (Figure, list of Axes)
     """
-    fig, axes = _figure(2 if linear else 1, height_ratios=(1.3, 1.0) if linear else None)
+    two = linear or zoom is not None
+    fig, axes = _figure(2 if two else 1, sharex=zoom is None,
+                        height_ratios=(1.3, 1.0) if two else None)
     ds = events.isel(inv_beta=i_beta)
     index = _density_deltas(events, density_delta)
     x = _require(ds, var, "this figure").dims[-1]
@@ -665,11 +705,13 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
             top = max(top, float(np.nanmax(y)))
             low = min(low, float(np.nanmin(y)))
     ax_log = axes[0]
-    ax_log.set_yscale("log")
-    if top > 0.0:
-        ax_log.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
-    else:
-        ax_log.set_ylim(DENSITY_DECADES, 1.0)
+    for ax in axes if zoom is not None else axes[:1]:
+        ax.set_yscale("log")
+        if top > 0.0:
+            ax.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
+        else:
+            ax.set_ylim(DENSITY_DECADES, 1.0)
+    if top <= 0.0:
         drawn = ds.isel(delta=index)
         empty = (no_collision_text(drawn, where=r"in this record at any $\delta$ drawn")
                  if int(drawn["n_collisions"].sum()) == 0 else
@@ -677,7 +719,7 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
                  "too few collisions for a density")
         for ax in axes:
             note_on_axes(ax, empty)
-    for ax in axes[1:]:
+    for ax in axes[1:] if linear else ():
         ax.set_ylim(0.0, 1.08 * top if top > 0.0 else 1.0)
     for ax in axes:
         ax.set_xlim(edges[0], x_end if x_end > edges[0] else edges[-1])
@@ -686,6 +728,11 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     if linear:
         _panel_tag(axes[0], "(a) log scale")
         _panel_tag(axes[1], "(b) linear scale")
+    if zoom is not None:
+        axes[1].set_xlim(edges[0], min(float(zoom), axes[0].get_xlim()[1]))
+        axes[0].set_xlabel(axis_label(ds[x]))
+        _panel_tag(axes[0], "(a) every bin drawn")
+        _panel_tag(axes[1], f"(b) the bulk, up to {_num(axes[1].get_xlim()[1])}")
     rule = (f"bins with < {MIN_BIN_COUNT} values merged with their neighbours (plateaus), "
             "runs still below not drawn")
     title_text = rule
@@ -695,9 +742,9 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
                   else "t of B - 1 dof")
         title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
                       f"({100 * CONFIDENCE:g} %, {t_text})\n{rule}")
-    if len(index) > LEGEND_INSIDE or linear:
+    if len(index) > LEGEND_INSIDE or two:
         # a legend this tall would hide the curves' peaks: below the axes instead
-        fig.set_figheight(fig.get_figheight() * (1.2 if linear else 1.3))
+        fig.set_figheight(fig.get_figheight() * (1.2 if two else 1.3))
         fig.legend(loc="outside lower center", ncols=2, title=title_text, title_fontsize=7.5,
                    fontsize=7.5)
     else:
@@ -715,18 +762,24 @@ def _require_harmonic(events, figure):
 
 #: What an impact statistic counts, printed on every figure of one (docs/figures.md).
 COLLISION_NOTE = (r"per collision (an impact after a free flight, with its chatter and "
-                  r"sticking);  "
-                  r"$\varepsilon u_{j-0}$: its first rebound, $z_j$: first impact to first impact")
+                  r"sticking)")
+#: How each collision statistic is read off a collision; a figure defines those it draws.
+COLLISION_QUANTITIES = {"v_after": r"$\varepsilon u_{j-0}$: its first rebound",
+                        "interval": r"$z_j$: first impact to first impact"}
 
 
-def _events_params(events, i_beta):
+def _events_params(events, i_beta, drawn=tuple(COLLISION_QUANTITIES)):
     """Parameter line of an events/spectra dataset at inv_beta index `i_beta`; an events
-    dataset (collision statistics) adds `COLLISION_NOTE` on a line of its own."""
+    dataset (collision statistics) adds `COLLISION_NOTE` on a line of its own, with the
+    definitions of the quantities `drawn` (keys of `COLLISION_QUANTITIES`) only."""
     inv_beta = float(events["inv_beta"][i_beta])
     harmonic = float(_attr(events, "amplitude")) != 0.0
     line = f"{_system_text(events)};  " + _forcing_text(
         events, inv_beta=inv_beta if harmonic else None)
-    return line + (f"\n{COLLISION_NOTE}" if "n_collisions" in events else "")
+    if "n_collisions" not in events:
+        return line
+    return line + "\n" + ";  ".join([COLLISION_NOTE]
+                                    + [COLLISION_QUANTITIES[name] for name in drawn])
 
 
 # --------------------------------------------------------------------------------------------

@@ -17,6 +17,7 @@ from matplotlib.ticker import FuncFormatter
 from vibroimpact.plotting._common import (CONFIDENCE, _attr, _header, _num, _spectrum_parts,
                                           _styled, _system_text, note_on_axes)
 from vibroimpact.plotting.maps import TYPE_COLORS
+from vibroimpact.stats.events import t_quantile
 
 __all__ = ["escape_vs_noise"]
 
@@ -32,10 +33,23 @@ def _state_label(name):
     return "none" if name == "none" else f"({name})"
 
 
+def _interval_text(value, lo, hi):
+    """``0.163 [0.146, 0.180]``: the value and its interval to the decimal of the interval's
+    second significant digit (half its width), no more; 3 significant digits when the
+    interval has no width."""
+    half = 0.5 * (float(hi) - float(lo))
+    if not (np.isfinite(half) and half > 0.0):
+        return f"{value:.3g} [{lo:.3g}, {hi:.3g}]"
+    decimals = max(0, 1 - int(np.floor(np.log10(half))))
+    # + 0.0 turns the -0.0 of a value that rounds to zero into 0.0
+    value, lo, hi = (round(float(v), decimals) + 0.0 for v in (value, lo, hi))
+    return f"{value:.{decimals}f} [{lo:.{decimals}f}, {hi:.{decimals}f}]"
+
+
 def _fit_text(cell, k):
-    """``Delta = 0.163 [0.156, 0.171]``, with chi^2/dof when there is one."""
-    text = (rf"$\Delta$ = {cell['slope'].values[k]:.3g} "
-            rf"[{cell['slope_lo'].values[k]:.3g}, {cell['slope_hi'].values[k]:.3g}]")
+    """``Delta = 0.163 [0.146, 0.180]``, with chi^2/dof when there is one."""
+    text = r"$\Delta$ = " + _interval_text(cell["slope"].values[k], cell["slope_lo"].values[k],
+                                           cell["slope_hi"].values[k])
     chi2 = float(cell["chi2_red"].values[k])
     return text + (rf", $\chi^2/\nu$ = {chi2:.2g}" if np.isfinite(chi2) else "")
 
@@ -56,7 +70,10 @@ def _panel(ax, cell, states, min_stretches, x_line, home):
         drawn = True
         color = NONE_COLOR if name == "none" else TYPE_COLORS[k % len(TYPE_COLORS)]
         marker = STATE_MARKERS[k % len(STATE_MARKERS)]
-        err = np.where(np.isfinite(e), e, 0.0)
+        # the same confidence as Delta's interval: +-t s.e. of a mean of n stretches, the
+        # lower end kept above 0 on the log axis
+        half = np.nan_to_num(t_quantile(n, CONFIDENCE) * e)
+        err = np.vstack([np.minimum(half, 0.999 * np.nan_to_num(t)), half])
         label = _state_label(name)
         fitted = np.isfinite(cell["slope"].values[k])
         if fitted:
@@ -64,7 +81,7 @@ def _panel(ax, cell, states, min_stretches, x_line, home):
         for mask, face, gid in ((shown & used, color, "fitted_points"),
                                 (shown & ~used, "white", "excluded_points")):
             if mask.any():
-                ax.errorbar(x[mask], t[mask], yerr=err[mask], fmt=marker, color=color,
+                ax.errorbar(x[mask], t[mask], yerr=err[:, mask], fmt=marker, color=color,
                             markerfacecolor=face, markersize=5, capsize=2, linestyle="none",
                             gid=gid, label=label if gid == "fitted_points" or not fitted
                             and not (shown & used).any() else None)
@@ -91,10 +108,12 @@ def escape_vs_noise(escape):
     Returns
     -------
     matplotlib.figure.Figure
-        Per cell: the residence times (forcing periods, log axis) with +-1 standard error
-        bars, filled where the level is in the fit (gid ``"fitted_points"``), open where it
-        is not (``"excluded_points"``: fewer than ``min_stretches`` complete stretches, or
-        rms above ``fit_max_rms``, whose levels lie in a grey band); the fitted lines
+        Per cell: the residence times (forcing periods, log axis) with `CONFIDENCE` bars
+        (+-t standard errors of the mean of the n complete stretches, t of n - 1 dof, as
+        Delta's interval), filled where the level is in the fit (gid ``"fitted_points"``),
+        open where it is not (``"excluded_points"``: fewer than ``min_stretches`` complete
+        stretches, or rms above ``fit_max_rms``, whose levels lie in a grey band); the fitted
+        lines
         (``"fit"``) with Delta, its 95 % interval and chi^2 per degree of freedom in the
         legend. A state with fewer than ``min_stretches`` complete stretches at every level
         is not drawn.
@@ -142,7 +161,8 @@ def escape_vs_noise(escape):
         top_axis.set_xticklabels([_num(v) for v in escape["rms"].values], fontsize=7)
         top_axis.set_xlabel(r"rms$_r$", fontsize=8)
     handles = [Line2D([], [], marker="o", color="0.3", linestyle="none",
-                      label="in the fit (bars: $\\pm$1 s.e. of the mean)"),
+                      label=f"in the fit (bars: {100 * CONFIDENCE:g} %, $\\pm$t s.e. of the "
+                            "mean of n stretches, t of n - 1 d.o.f.)"),
                Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
                       linestyle="none",
                       label=f"not in the fit (fewer than {min_stretches} complete stretches"

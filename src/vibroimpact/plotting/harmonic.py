@@ -119,7 +119,8 @@ def fig13(events, inv_beta, density_delta=None):
     -------
     matplotlib.figure.Figure
         (a) log and (b) linear density axes: one line per density delta, a dash-dot line at
-        z_j/z = 1/2 (the symmetry axis of the (2/1) motion) and dotted marks at 1 ((1/1)
+        z_j/z = 1/2, the mirror axis of the (2/1) motion's pairs of intervals (no (2/1)
+        interval lies on it: its label points to both sides), and dotted marks at 1 ((1/1)
         motion) and 2 ((1/2) motion).
 
     Raises
@@ -132,14 +133,20 @@ def fig13(events, inv_beta, density_delta=None):
     fig, axes = _density_figure(
         events, i, "ratio_density",
         r"Fig. 13  Probability density of $z_j/z$, the interval over the forcing period",
-        _events_params(events, i), density_delta, linear=True)
-    marks = ((0.5, "-.", "(2/1)"), (1.0, ":", "(1/1)"), (2.0, ":", "(1/2)"))
+        _events_params(events, i, ("interval",)), density_delta, linear=True)
+    marks = ((0.5, "-.", PAIR_LABEL, "center"), (1.0, ":", " (1/1)", "left"),
+             (2.0, ":", " (1/2)", "left"))
     for ax in axes:
-        for x, ls, motion in marks:
+        for x, ls, text, ha in marks:
             ax.axvline(x, color="0.3", ls=ls, lw=1.0)
-            ax.text(x, 0.97, f" {motion}", transform=ax.get_xaxis_transform(), ha="left",
-                    va="top", fontsize=8, color="0.3")
+            ax.text(x, 0.97, text, transform=ax.get_xaxis_transform(), ha=ha, va="top",
+                    fontsize=8, color="0.3")
     return fig
+
+
+#: fig13's label on z_j/z = 1/2: the (2/1) motion's intervals lie on both sides of it, in
+#: pairs that add up to one forcing period (z_j + z_{j+1} = z), none on it.
+PAIR_LABEL = r"$\leftarrow$ (2/1): pairs $z_j + z_{j+1} = z$ $\rightarrow$"
 
 
 @_styled
@@ -153,5 +160,6 @@ def fig14(events, inv_beta, density_delta=None):
     i = _nearest(events["inv_beta"], inv_beta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",
-                             _events_params(events, i), density_delta, linear=True)
+                             _events_params(events, i, ("v_after",)), density_delta,
+                             linear=True)
     return fig

@@ -34,8 +34,9 @@ COMPARISON_LEVELS = (20, 50, 80)
 #: Contour levels of the degree of stability S (%).
 S_LEVELS = (5, 10, 20, 30, 40, 50, 60, 70, 80, 90)
 #: One colour per motion type: the Okabe-Ito qualitative palette, which readers with the
-#: common colour-vision deficiencies can also tell apart (black last).
-TYPE_COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#000000")
+#: common colour-vision deficiencies can also tell apart; black fifth, orange last: the (3/1)
+#: motion in orange beside (2/1) in vermillion read as one hue in Fig. 16.
+TYPE_COLORS = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#000000", "#56B4E9", "#E69F00")
 #: Font size (pt) of contour labels and of the words written in a map's regions.
 MAP_TEXT_SIZE = 7.5
 #: A contour label keeps this distance (fraction of the panel's width and height) from the
@@ -303,7 +304,8 @@ def _map_text(ds):
             "each cell from rest over one noise record, "
             rf"to s.e. $\leq$ {100 * float(_attr(ds, 'target_stderr')):.3g} pp "
             rf"({100 * reached:.1f} % of cells) or {int(_attr(ds, 'max_periods'))} periods;  "
-            rf"record {t.min():.0f}-{t.max():.0f} (median {np.median(t):.0f})")
+            rf"records of {t.min():,.0f} to {t.max():,.0f} time units $\tau$ "
+            rf"(median {np.median(t):,.0f})")
 
 
 def _grid(ds):
@@ -340,6 +342,10 @@ def _finish_axes(axes, ds):
             note_on_axes(ax, no_collision_text(ds, where="in any cell\nof this map"))
 
 
+#: Panels per row of fig15.
+FIG15_COLUMNS = 2
+
+
 @_styled
 def fig15(motion_map, levels=PROBABILITY_LEVELS):
     """Fig. 15: probability (%) of each impact motion over the (1/beta, delta) plane.
@@ -371,9 +377,15 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         panels.append((" + ".join(f"({m})" for m in motions) + " with sticking",
                        motion_map["stick_probability"].sum("motion").values))
     x, y = _grid(motion_map)
-    fig = Figure(figsize=(4.0 * len(panels) + 1.0, 4.4))
+    # two panels a row: at a page's width four in a row left the labels tiny
+    ncols = min(len(panels), FIG15_COLUMNS)
+    nrows = -(-len(panels) // ncols)
+    fig = Figure(figsize=(4.2 * ncols + 1.3, 3.6 * nrows + 2.0))
     FigureCanvasAgg(fig)
-    axes = fig.subplots(1, len(panels), sharex=True, sharey=True, squeeze=False).ravel()
+    grid = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
+    for ax in grid[len(panels):]:
+        ax.set_visible(False)
+    axes = grid[:len(panels)]
     few = motion_map["few_switches"].values.astype(bool)
     short = ~motion_map["reached"].values.astype(bool)
     fill_levels = [0.0, *levels, 100.0]
@@ -392,7 +404,11 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
             ax.plot(x[i], y[j], ls="none", marker=".", ms=1.5, color="C3")
         ax.set_title(title, fontsize=9 if len(title) > 12 else None)
     _finish_axes(axes, motion_map)
-    fig.colorbar(shaded, ax=axes.tolist(), label="probability of the motion (%)", shrink=0.85)
+    for ax in grid[len(panels) - ncols:len(panels)]:
+        ax.xaxis.set_tick_params(labelbottom=True)      # under a hidden panel's place too
+        ax.set_xlabel(axis_label(motion_map["inv_beta"]))
+    fig.colorbar(shaded, ax=grid.tolist(), label="probability of the motion (%)",
+                 shrink=0.6, pad=0.02, aspect=30)
     handles = [few_switches_handle(motion_map)] if few.any() else []
     if has_cliff:
         handles.append(_cliff_handle(1.0))

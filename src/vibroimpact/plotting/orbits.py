@@ -9,8 +9,8 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
-from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
-                                          axis_label)
+from vibroimpact.plotting._common import (_attr, _header, _nearest, _same_system, _styled,
+                                          _system_text, axis_label)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -101,17 +101,35 @@ def _box_cells(ax, word, shape):
     return tuple(int(np.ceil(c)) // 2 * 2 + 1 for c in cells)
 
 
+def _marker_cells(ax, x, y):
+    """Cells of the grid (x, y) that the codimension-two markers of `ax` cover (gid
+    ``"codim2"``), with `WORD_MARGIN` around them: no word may be written over a marker."""
+    taken = np.zeros((x.size, y.size), bool)
+    axes_box = ax.get_window_extent(ax.figure.canvas.get_renderer())
+    reach = (0.5 * CODIM2_STYLE["ms"] + WORD_MARGIN) * ax.figure.dpi / 72.0
+    di = int(np.ceil(reach / axes_box.width * x.size))
+    dj = int(np.ceil(reach / axes_box.height * y.size))
+    for line in ax.get_lines():
+        if line.get_gid() != "codim2":
+            continue
+        for px, py in zip(line.get_xdata(), line.get_ydata()):
+            i, j = _nearest(x, px), _nearest(y, py)
+            taken[max(i - di, 0):i + di + 1, max(j - dj, 0):j + dj + 1] = True
+    return taken
+
+
 def _name_regions(ax, x, y, reason, stable):
     """Write each reason's words in its sizable regions (with a leader to those too thin).
 
     A word goes where its box fits inside the region (on two lines if it must), as deep
     inside as it can; a region too thin for it gets the word on the nearest free cells (no
-    stable domain, no other word) within `LEADER_LENGTH`, with a line to the region's
-    deepest point that crosses no stable domain. The texts have gid ``reason-<code>``.
+    stable domain, no other word, no codimension-two marker: `_marker_cells`) within
+    `LEADER_LENGTH`, with a line to the region's deepest point that crosses no stable
+    domain. The texts have gid ``reason-<code>``.
     """
     from scipy import ndimage   # scipy in fig16's job only, not in every job importing plotting
 
-    taken = stable.copy()
+    taken = stable | _marker_cells(ax, x, y)
     scale = np.array([1.0 / x.size, 1.0 / y.size])        # a cell, as a share of the panel
     for code in (3, 2, 1):       # the thin unstable regions first: they need space near them
         word = REASONS[code][1]
@@ -206,6 +224,17 @@ def _kind_style(kind):
     return dict(ls=BOUNDARY_KINDS[kind][0], lw=BOUNDARY_WIDTH)
 
 
+def _overview_style(style, k):
+    """A boundary's style (`_kind_style`) on the overview (a), for the `k`-th type: wider
+    (`OVERVIEW_WIDTH`), and a dashed pattern shifted by half its period for every other
+    type, so where two types' edges of one kind coincide both colours show in turn."""
+    ls = style["ls"]
+    if isinstance(ls, tuple) and k % 2:
+        offset, pattern = ls
+        ls = (offset + 0.5 * sum(pattern), pattern)
+    return dict(style, ls=ls, lw=style["lw"] * OVERVIEW_WIDTH / BOUNDARY_WIDTH)
+
+
 def _draw_boundaries(overview, panels, boundaries):
     """Boundary curves and codimension-two points of each type on its panel and on (a).
 
@@ -215,6 +244,7 @@ def _draw_boundaries(overview, panels, boundaries):
     Returns the kinds drawn and whether a codimension-two point was.
     """
     drawn = set()
+    order = {name: k for k, name in enumerate(panels)}
     for c, name, kind, xy in boundary_curves(boundaries):
         if name not in panels:
             continue
@@ -222,7 +252,7 @@ def _draw_boundaries(overview, panels, boundaries):
         style = _kind_style(kind)
         ax.plot(xy[:, 0], xy[:, 1], color="k", gid=f"boundary-{c}", **style)
         overview.plot(xy[:, 0], xy[:, 1], color=color, gid=f"overview-boundary-{c}",
-                      **dict(style, lw=style["lw"] * OVERVIEW_WIDTH / BOUNDARY_WIDTH))
+                      **_overview_style(style, order[name]))
         drawn.add(kind)
     types = np.array([str(t) for t in boundaries["codim2_type"].values])
     x = np.asarray(boundaries["codim2_inv_beta"].values, dtype=float)

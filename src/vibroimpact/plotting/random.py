@@ -169,7 +169,8 @@ def fig07(events, density_delta=None, envelope="auto"):
     """
     fig, axes = _density_figure(events, 0, "v_after_density",
                                 "Fig. 7  Probability density of the velocity after impact",
-                                _events_params(events, 0), density_delta, linear=True)
+                                _events_params(events, 0, ("v_after",)), density_delta,
+                                linear=True)
     theory = _envelope(events, envelope)
     if theory is None:
         if envelope == "auto":
@@ -197,12 +198,34 @@ def fig07(events, density_delta=None, envelope="auto"):
     return fig
 
 
+#: Upper end of fig08's panel (b), the bulk of the intervals (panel (a) shows every bin).
+FIG08_ZOOM = 20.0
+
+
 @_styled
-def fig08(events, density_delta=None):
-    """Fig. 8: probability density of the interval between collisions (as fig07)."""
+def fig08(events, density_delta=None, zoom=FIG08_ZOOM):
+    """Fig. 8: probability density of the interval between collisions (as fig07).
+
+    Parameters
+    ----------
+    events : xarray.Dataset
+        As for :func:`fig07`.
+    density_delta : sequence of float, optional
+        As for :func:`fig07`.
+    zoom : float, optional
+        Upper end of panel (b).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Two log-density axes: (a) up to the last drawn bin, so the long waits of the
+        smallest plays (the tail that grows again as delta falls below about -0.2) are
+        seen whole; (b) the bulk, ``0 <= z_j <= zoom``.
+    """
     fig, _ = _density_figure(events, 0, "interval_density",
                              "Fig. 8  Probability density of the interval between collisions",
-                             _events_params(events, 0), density_delta)
+                             _events_params(events, 0, ("interval",)), density_delta,
+                             zoom=zoom)
     return fig
 
 
