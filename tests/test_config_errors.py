@@ -358,6 +358,19 @@ CASES = [
             delta: [0.0, 1.0]
             figures: [fig09]
         """, "studies.random", "replace: [studies.random]"),
+    _own("validation_block_without_replace", """
+        paper: false
+        validation:
+          build: true
+          work_precision:
+            solvers: [RK45]
+            repeats: 1
+        """, "validation.work_precision", "replace: [validation]"),
+    _own("validation_block_differs_with_the_paper_built", """
+        validation:
+          stress:
+            seed: 7
+        """, "validation.stress", "would overwrite its results"),
     _own("replace_names_no_entry", """
         paper: false
         replace: [studies.random]

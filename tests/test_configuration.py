@@ -76,6 +76,28 @@ def test_an_identical_entry_needs_no_replace():
     assert plan.drawn["studies"] == {"random"}
 
 
+def test_a_users_validation_block_is_the_papers_unless_replaced():
+    """`validation` follows the rule of `studies`: a block that differs from the paper's
+    would overwrite results/validation/work_precision.nc, its figure and report; refused
+    unless replaced. `validation.build` is the user's own (whether rule all builds it)."""
+    one_run = {"solvers": ["RK45"], "repeats": 1}
+    user = dict(MINE, validation={"build": True, "work_precision": one_run})
+    with pytest.raises(configuration.ConfigError, match=r"validation\.work_precision: .* "
+                       r"would overwrite its results"):
+        configuration.load(user, root=ROOT)
+    config, _ = configuration.load(dict(user, validation={"build": True}), root=ROOT)
+    assert config["validation"]["build"] is True               # the paper's runs, unchanged
+    paper = configuration.load(root=ROOT)[0]["validation"]
+    assert {k: v for k, v in config["validation"].items() if k != "build"} == {
+        k: v for k, v in paper.items() if k != "build"}
+    same = dict(MINE, validation={"work_precision": PAPER["validation"]["work_precision"]})
+    configuration.load(same, root=ROOT)                        # identical: no replace needed
+    config, _ = configuration.load(dict(user, replace=["validation"]), root=ROOT)
+    assert config["validation"]["work_precision"]["solvers"] == ["RK45"]
+    assert config["validation"]["work_precision"]["delta"] == (   # replaced whole: defaults
+        [1.0, 0.0, -0.5])
+
+
 # --- the plan ---------------------------------------------------------------------------------
 
 def test_plan_of_the_paper_config():
