@@ -1,6 +1,7 @@
 """Config layering, the plan and its limits, and the fault-recovery helpers (fast)."""
 import os
 from pathlib import Path
+import shutil
 import signal
 import socket
 import subprocess
@@ -96,6 +97,33 @@ def test_a_users_validation_block_is_the_papers_unless_replaced():
     assert config["validation"]["work_precision"]["solvers"] == ["RK45"]
     assert config["validation"]["work_precision"]["delta"] == (   # replaced whole: defaults
         [1.0, 0.0, -0.5])
+
+
+def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(tmp_path):
+    """`make stale`: an earlier config's figure of the same study (fig13-9), a dataset the
+    study no longer needs, are listed and removed; the current outputs (their PDF and
+    notebook twins), another study of a similar name and, with `paper: false`, the paper's
+    outputs are not."""
+    from vibroimpact.pipeline import stale, targets
+
+    config, plan = configuration.load(root=ROOT)
+    current = targets.needed_files(config, plan.drawn)
+    twins = {p[:-4] + ".pdf" for p in current if p.endswith(".png")}
+    twins |= {p[:-5] + ext for p in current if p.endswith(".html")
+              for ext in (".ipynb", ".summary.html")}
+    old = ["results/figures/harmonic/fig13-9.png", "results/figures/harmonic/fig13-9.pdf",
+           "results/datasets/harmonic_map.nc", "results/reports/random/harmonic_random.html"]
+    other = ["results/datasets/harmonic_two_events.nc", "results/figures/elsewhere/fig09.png"]
+    for rel in [*current, *twins, *old, *other]:
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).touch()
+    assert stale.stale_files(config, plan.drawn, tmp_path) == sorted(old)
+    mine, mine_plan = configuration.load(MINE, root=ROOT)
+    assert stale.stale_files(mine, mine_plan.drawn, tmp_path) == []    # the paper's: not its
+    shutil.copytree(ROOT / "config", tmp_path / "config")
+    assert stale.main(["--directory", str(tmp_path), "--delete"]) == 0
+    assert not any((tmp_path / rel).exists() for rel in old)
+    assert all((tmp_path / rel).exists() for rel in [*current, *twins, *other])
 
 
 # --- the plan ---------------------------------------------------------------------------------
