@@ -126,6 +126,31 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
     assert all((tmp_path / rel).exists() for rel in [*current, *twins, *other])
 
 
+def test_the_readme_quotes_the_current_plan_and_figure_table():
+    """The README's generated blocks (benchmarks/readme_numbers.py --write README.md) are
+    those of this tree: the plan of the default config, and the table of which figure an
+    entry may list and what it needs. A change to either fails here until the script is
+    re-run; the build's own numbers name their build's commit and are not checked."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_numbers",
+                                                  ROOT / "benchmarks" / "readme_numbers.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    readme = (ROOT / "README.md").read_text()
+
+    def block(name):
+        marker = f"<!-- readme_numbers:{name} -->"
+        start = readme.index(marker) + len(marker)
+        return readme[start:readme.index(f"<!-- /readme_numbers:{name} -->")]
+
+    _, plan = configuration.load(root=ROOT)
+    assert block("plan").endswith(f"`benchmarks/readme_numbers.py`): {plan.summary(2)}")
+    assert block("figures") == module.figures_text()
+    for fig in figures.FIGURES:
+        assert f"| `{fig}` |" in block("figures")
+
+
 # --- the plan ---------------------------------------------------------------------------------
 
 def test_plan_of_the_paper_config():
