@@ -10,6 +10,7 @@ names}`` of the entries whose figures ``rule all`` draws. Paths are relative to 
 directory; no Snakemake, no numerics.
 """
 from vibroimpact.pipeline import figures
+from vibroimpact.pipeline.config.sweeps import sweep_figures
 from vibroimpact.reports.arguments import study_report_kind
 
 __all__ = ["DATASETS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
@@ -172,8 +173,7 @@ def sweep_inputs(config, sweep):
 
 def sweep_targets(config, drawn):
     """The side-by-side figure of every sweep whose studies are all drawn."""
-    return [f"results/figures/{name}/sweep.png" for name, sweep in
-            sorted(config.get("sweeps", {}).items()) if set(sweep["studies"]) <= drawn["studies"]]
+    return sweep_figures(config, drawn)
 
 
 def validation_targets():
