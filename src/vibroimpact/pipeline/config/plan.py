@@ -1,6 +1,8 @@
 """The plan of a build: cells, jobs, output bytes and CPU time per config entry.
 
-:func:`make_plan` costs every output of ``rule all`` with the one cost model
+:func:`make_plan` costs every job that ``rule all`` runs (its targets and every file they
+need, `vibroimpact.pipeline.targets.needed_files`: the jobs a dry run on a fresh copy
+schedules) with the one cost model
 (`vibroimpact.pipeline.config.costs`) before anything runs; :meth:`Plan.format` is what
 ``python -m vibroimpact plan`` prints and :meth:`Plan.refuse_beyond_limits` refuses a build
 beyond the config's ``limits``.
@@ -72,7 +74,8 @@ class Plan:
                 f"(~{_time(self.cpu_s / max(cores, 1))} on {_n(cores, 'core')})")
 
     def format(self, cores=2):
-        lines = ["vibroimpact plan (every output of `rule all`, whether or not already built):"]
+        lines = ["vibroimpact plan (every job of `rule all` and of what it needs, whether or "
+                 "not already built):"]
         width = max([len(r.key) for r in self.rows] + [10])
         lines.append(f"  {'entry':<{width}}  {'jobs':>4}  {'outputs':>8}  {'CPU':>8}  what")
         for r in self.rows:
