@@ -18,7 +18,7 @@ SLOW_WORKERS ?= -n 2
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
 
-.PHONY: all plan report test test-fast test-slow bench lint clean
+.PHONY: all plan report stale clean-stale test test-fast test-slow bench lint clean
 # checks the config, prints the plan, recovers from a killed run, then runs Snakemake; then
 # writes Snakemake's report of the build, whole or not at all
 all: $(STAMP)
@@ -30,6 +30,14 @@ report: $(STAMP)
 
 plan: $(STAMP)
 	$(BIN)/python -m vibroimpact plan --cores $(CORES) $(CONFIG_ARGS)
+
+# outputs of the config's entries that it no longer builds (an earlier config's figures of the
+# same study ...): `stale` lists them, `clean-stale` removes them (README, "Outputs")
+stale: $(STAMP)
+	$(BIN)/python -m vibroimpact.pipeline.stale $(CONFIG_ARGS)
+
+clean-stale: $(STAMP)
+	$(BIN)/python -m vibroimpact.pipeline.stale --delete $(CONFIG_ARGS)
 
 $(STAMP): environment.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)

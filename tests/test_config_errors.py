@@ -358,6 +358,34 @@ CASES = [
             delta: [0.0, 1.0]
             figures: [fig09]
         """, "studies.random", "replace: [studies.random]"),
+    _own("validation_block_without_replace", """
+        paper: false
+        validation:
+          build: true
+          work_precision:
+            solvers: [RK45]
+            repeats: 1
+        """, "validation.work_precision", "replace: [validation]"),
+    _own("validation_block_differs_with_the_paper_built", """
+        validation:
+          stress:
+            seed: 7
+        """, "validation.stress", "would overwrite its results"),
+    _own("report_with_the_papers_map_beyond_max_jobs", """
+        paper: false
+        limits: {max_jobs: 20}
+        studies:
+          mine:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+            report_with: [motion_map]
+        """, "limits.max_jobs", "this build has 30 jobs"),
     _own("replace_names_no_entry", """
         paper: false
         replace: [studies.random]

@@ -1,6 +1,7 @@
 """Config layering, the plan and its limits, and the fault-recovery helpers (fast)."""
 import os
 from pathlib import Path
+import shutil
 import signal
 import socket
 import subprocess
@@ -74,6 +75,80 @@ def test_an_identical_entry_needs_no_replace():
     user = {"paper": False, "studies": {"random": PAPER["studies"]["random"]}}
     _, plan = configuration.load(user, root=ROOT)
     assert plan.drawn["studies"] == {"random"}
+
+
+def test_a_users_validation_block_is_the_papers_unless_replaced():
+    """`validation` follows the rule of `studies`: a block that differs from the paper's
+    would overwrite results/validation/work_precision.nc, its figure and report; refused
+    unless replaced. `validation.build` is the user's own (whether rule all builds it)."""
+    one_run = {"solvers": ["RK45"], "repeats": 1}
+    user = dict(MINE, validation={"build": True, "work_precision": one_run})
+    with pytest.raises(configuration.ConfigError, match=r"validation\.work_precision: .* "
+                       r"would overwrite its results"):
+        configuration.load(user, root=ROOT)
+    config, _ = configuration.load(dict(user, validation={"build": True}), root=ROOT)
+    assert config["validation"]["build"] is True               # the paper's runs, unchanged
+    paper = configuration.load(root=ROOT)[0]["validation"]
+    assert {k: v for k, v in config["validation"].items() if k != "build"} == {
+        k: v for k, v in paper.items() if k != "build"}
+    same = dict(MINE, validation={"work_precision": PAPER["validation"]["work_precision"]})
+    configuration.load(same, root=ROOT)                        # identical: no replace needed
+    config, _ = configuration.load(dict(user, replace=["validation"]), root=ROOT)
+    assert config["validation"]["work_precision"]["solvers"] == ["RK45"]
+    assert config["validation"]["work_precision"]["delta"] == (   # replaced whole: defaults
+        [1.0, 0.0, -0.5])
+
+
+def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(tmp_path):
+    """`make stale`: an earlier config's figure of the same study (fig13-9), a dataset the
+    study no longer needs, are listed and removed; the current outputs (their PDF and
+    notebook twins), another study of a similar name and, with `paper: false`, the paper's
+    outputs are not."""
+    from vibroimpact.pipeline import stale, targets
+
+    config, plan = configuration.load(root=ROOT)
+    current = targets.needed_files(config, plan.drawn)
+    twins = {p[:-4] + ".pdf" for p in current if p.endswith(".png")}
+    twins |= {p[:-5] + ext for p in current if p.endswith(".html")
+              for ext in (".ipynb", ".summary.html")}
+    old = ["results/figures/harmonic/fig13-9.png", "results/figures/harmonic/fig13-9.pdf",
+           "results/datasets/harmonic_map.nc", "results/reports/random/harmonic_random.html"]
+    other = ["results/datasets/harmonic_two_events.nc", "results/figures/elsewhere/fig09.png"]
+    for rel in [*current, *twins, *old, *other]:
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).touch()
+    assert stale.stale_files(config, plan.drawn, tmp_path) == sorted(old)
+    mine, mine_plan = configuration.load(MINE, root=ROOT)
+    assert stale.stale_files(mine, mine_plan.drawn, tmp_path) == []    # the paper's: not its
+    shutil.copytree(ROOT / "config", tmp_path / "config")
+    assert stale.main(["--directory", str(tmp_path), "--delete"]) == 0
+    assert not any((tmp_path / rel).exists() for rel in old)
+    assert all((tmp_path / rel).exists() for rel in [*current, *twins, *other])
+
+
+def test_the_readme_quotes_the_current_plan_and_figure_table():
+    """The README's generated blocks (benchmarks/readme_numbers.py --write README.md) are
+    those of this tree: the plan of the default config, and the table of which figure an
+    entry may list and what it needs. A change to either fails here until the script is
+    re-run; the build's own numbers name their build's commit and are not checked."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_numbers",
+                                                  ROOT / "benchmarks" / "readme_numbers.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    readme = (ROOT / "README.md").read_text()
+
+    def block(name):
+        marker = f"<!-- readme_numbers:{name} -->"
+        start = readme.index(marker) + len(marker)
+        return readme[start:readme.index(f"<!-- /readme_numbers:{name} -->")]
+
+    _, plan = configuration.load(root=ROOT)
+    assert block("plan").endswith(f"`benchmarks/readme_numbers.py`): {plan.summary(2)}")
+    assert block("figures") == module.figures_text()
+    for fig in figures.FIGURES:
+        assert f"| `{fig}` |" in block("figures")
 
 
 # --- the plan ---------------------------------------------------------------------------------

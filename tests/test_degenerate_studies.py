@@ -210,14 +210,17 @@ STUDIES = {
 }
 
 
+#: The user's file of these studies (test_workflow.py dry-runs it against the plan too).
+CONFIG = dict(paper=False, noises=dict(
+    zero=dict(kind="band_limited", rms=0.0, dt=0.1, beta_c=4.0, n_samples=3001, seed=1),
+    tiny=dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=16, nperseg=16,
+              seed=2)), studies=STUDIES)
+
+
 @pytest.mark.workflow
 def test_degenerate_studies_build_every_figure_and_report(tmp_path):
     workdir = make_workdir(tmp_path / "wf")
-    config = dict(paper=False, noises=dict(
-        zero=dict(kind="band_limited", rms=0.0, dt=0.1, beta_c=4.0, n_samples=3001, seed=1),
-        tiny=dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=16, nperseg=16,
-                  seed=2)), studies=STUDIES)
-    (workdir / "degenerate.yaml").write_text(yaml.safe_dump(config))
+    (workdir / "degenerate.yaml").write_text(yaml.safe_dump(CONFIG))
     snakemake(workdir, config="degenerate.yaml")
     results = Path(workdir) / "results"
     for name, study in STUDIES.items():

@@ -66,13 +66,47 @@ def test_fig15_vs_fig16_runs_the_map_and_the_orbits(workdir):
         "aggregate_orbits", "draw_figure", "copy_paper_figure"}
 
 
-def test_the_plan_counts_the_jobs_of_a_dry_run(workdir):
+#: The user's files of the suite that build (each dry-run on a fresh copy, against the plan):
+#: {id: YAML text}; None is the paper's config alone (`make`).
+MINE = ("paper: false\nstudies:\n  mine:\n    noise: harmonic_input\n"
+        "    zeta: 0.1\n    eps: 0.8\n    delta: [0.0, 1.0]\n    figures: [fig09]\n")
+#: Issue 34: a study whose report shows the paper's motion map (its map, escape runs, orbit
+#: and attractor tiles are built for the report, though `rule all` draws none of its figures).
+REPORT_WITH = ("paper: false\nstudies:\n  mine:\n    noise: harmonic_input\n    zeta: 0.05\n"
+               "    eps: 0.5\n    amplitude: 1.0\n    inv_beta: [1.1]\n    delta: [0.0, 1.0]\n"
+               "    transient: 100.0\n    figures: [fig13]\n    report_with: [motion_map]\n")
+
+
+def _suite_configs():
+    from test_degenerate_studies import CONFIG as DEGENERATE
+    from test_sweeps import WORKFLOW as SWEEPS
+
+    return {"paper": None, "test": (ROOT / "config" / "test.yaml").read_text(), "mine": MINE,
+            "report_with_the_papers_map": REPORT_WITH,
+            "paper_true_with_mine": MINE.replace("paper: false", "paper: true"),
+            "mine_with_the_papers_validation": MINE + "validation:\n  build: true\n",
+            "degenerate": yaml.safe_dump(DEGENERATE), "sweeps": SWEEPS}
+
+
+@pytest.mark.parametrize("name", sorted(_suite_configs()))
+def test_the_plan_counts_every_job_of_the_dry_run(workdir, name):
+    """The plan is the contract: on a fresh copy (nothing built) it counts exactly the jobs
+    Snakemake's dry run schedules, for every config of the suite that builds, and its summary
+    is the one the dry run prints (the limits are checked against it)."""
     from vibroimpact.pipeline import config as configuration
 
-    _, plan = configuration.load(root=workdir, user_files=[workdir / "config" / "test.yaml"])
-    out = snakemake(workdir, "-n", "--quiet", "rules")
+    text = _suite_configs()[name]
+    files = []
+    if text is not None:
+        (workdir / f"plan_{name}.yaml").write_text(text)
+        files = [workdir / f"plan_{name}.yaml"]
+    _, plan = configuration.load(root=workdir, user_files=files)
+    cmd = [SNAKEMAKE, "-n", "--quiet", "rules", "--cores", "2"]
+    cmd += ["--configfile", str(files[0])] if files else []
+    out = subprocess.run(cmd, cwd=workdir, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stdout[-2000:] + out.stderr[-2000:]
     total = next(int(l.split()[1]) for l in out.stdout.splitlines() if l.startswith("total"))
-    assert total == plan.jobs + 1           # + the target rule `all`
+    assert total == plan.jobs + 1, (name, job_table(out.stdout), plan.format())  # + `all`
     assert f"vibroimpact plan: {plan.summary(2)}" in out.stdout + out.stderr
 
 

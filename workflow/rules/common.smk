@@ -13,7 +13,7 @@ import shlex
 import sys
 from types import SimpleNamespace
 
-from vibroimpact.pipeline import figures
+from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.provenance import code_digest
 from vibroimpact.pipeline.study import (
@@ -134,31 +134,12 @@ def _owner(wildcards):
 
 
 # Where each dataset a figure can read lives ({name}: the owner; {noise}: its noise record).
-_DATASETS = {
-    "noise": "results/noise/{noise}.nc",
-    "trace": "results/traces/{name}.nc",
-    "spectra": "results/datasets/{name}_spectra.nc",
-    "events": "results/datasets/{name}_events.nc",
-    "map": "results/datasets/{name}_map.nc",
-    "escape": "results/datasets/{name}_escape.nc",
-    "orbits": "results/orbits/{name}.nc",
-    "boundaries": "results/orbits/{name}_boundaries.nc",
-    "basins": "results/orbits/{name}_basins.nc",
-    "lyapunov": "results/orbits/{name}_lyapunov.nc",
-}
+_DATASETS = targets.DATASETS
 
 
 def figure_inputs(wildcards):
     """The datasets figure ``{fig}`` of ``{owner}`` draws, from the table FIGURES."""
-    kind, name, entry = _owner(wildcards)
-    fig, _ = figures.figure_variant(wildcards.fig)
-    if figures.FIGURES.get(fig, {}).get("owner") != kind:
-        raise ValueError(f"{wildcards.owner}: no figure {fig!r} for a {kind} entry")
-    names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
-    return [
-        _DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
-        for d in figures.FIGURES[fig]["reads"]
-    ]
+    return targets.figure_inputs(config, wildcards.owner, wildcards.fig)
 
 
 def figure_options(wildcards):
@@ -183,16 +164,7 @@ def figure_captions():
 
 def paper_figure_source(wildcards):
     """The PNG and PDF of the figure that ``paper_figures[{paper_fig}]`` names."""
-    if wildcards.paper_fig not in config.get("paper_figures", {}):
-        raise ValueError(
-            f"paper_figures: {wildcards.paper_fig} is not listed; listed: "
-            f"{sorted(config.get('paper_figures', {}))}"
-        )
-    name = config["paper_figures"][wildcards.paper_fig]
-    section = "orbits" if figures.FIGURES[wildcards.paper_fig]["owner"] == "orbits" else "studies"
-    owner = f"orbits/{name}" if section == "orbits" else name
-    target = figures.paper_target(config[section][name], wildcards.paper_fig)
-    return {ext: f"results/figures/{owner}/{target}.{ext}" for ext in ("png", "pdf")}
+    return targets.paper_figure_source(config, wildcards.paper_fig)
 
 
 def _paper_figure_of(wildcards):
@@ -231,7 +203,7 @@ def _sweep(wildcards):
 
 def sweep_inputs(wildcards):
     """The events datasets of the studies of sweep ``{sweep}``, in its order."""
-    return [_DATASETS["events"].format(name=study) for study in _sweep(wildcards)["studies"]]
+    return targets.sweep_inputs(config, wildcards.sweep)
 
 
 def sweep_labels(wildcards):
@@ -242,10 +214,7 @@ def sweep_labels(wildcards):
 # --- validation (validation.smk) ------------------------------------------------------------
 
 # Each validation figure and the dataset it draws.
-VALIDATION_FIGURES = {
-    "work_precision": "results/validation/work_precision.nc",
-    "stress": "results/validation/stress_sample.nc",
-}
+VALIDATION_FIGURES = targets.VALIDATION_FIGURES
 
 
 # --- reports (reports.smk): one notebook per study, per orbits entry, two for validation -----
@@ -254,105 +223,22 @@ VALIDATION_FIGURES = {
 PYTHON = shlex.quote(sys.executable)
 
 
-def _study_datasets(name):
-    """``{kind: path}`` of the datasets the figures of study ``name`` read."""
-    entry = config["studies"][name]
-    out = {}
-    for fig in {f if isinstance(f, str) else f["name"] for f in entry["figures"]}:
-        names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
-        for kind in figures.FIGURES[fig]["reads"]:
-            out.setdefault(
-                kind, _DATASETS[kind].format(name=names.get(kind, name), noise=names["noise"])
-            )
-    return out
-
-
-def _attractor_datasets(name):
-    """``{basins, lyapunov: path}`` of the orbits entry study ``name`` draws Fig. 15 over
-    (``fig15_vs_fig16``), when that entry has an ``attractors`` block: the harmonic report's
-    noise-free predictors of the probabilities; {} otherwise."""
-    entry = config["studies"][name]
-    if "fig15_vs_fig16" not in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
-        return {}
-    orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
-    if not config["orbits"][orbits].get("attractors"):
-        return {}
-    return {kind: _DATASETS[kind].format(name=orbits) for kind in ("basins", "lyapunov")}
-
-
 def study_report_inputs(wildcards):
     """The notebook, the datasets and the figures of a study and of its ``report_with``, and
     the study's noise record (its provenance row, whether or not a figure draws it); with a
     map over an orbits entry that has attractors, their basins and Lyapunov datasets."""
-    entry = config["studies"][wildcards.study]
-    kind = arguments.study_report_kind(entry)
-    if wildcards.report != kind:
-        raise ValueError(f"study {wildcards.study}: its report is {kind}, not {wildcards.report}")
-    inputs = {
-        "notebook": f"notebooks/{kind}.ipynb",
-        "noise": _DATASETS["noise"].format(noise=entry["noise"]),
-    }
-    shown = []
-    for name in [wildcards.study, *entry.get("report_with", [])]:
-        for dataset, path in {**_study_datasets(name), **_attractor_datasets(name)}.items():
-            inputs.setdefault(dataset, path)
-        shown += [
-            f"results/figures/{name}/{f}.png"
-            for f in figures.figure_targets(config["studies"][name])
-        ]
-    return {**inputs, "figures": shown}
-
-
-def _maps_over(orbits_name):
-    """Map datasets of the built studies that draw Fig. 15 over orbits entry ``orbits_name``."""
-    for name in sorted(PLAN.drawn["studies"]):
-        entry = config["studies"][name]
-        for item in entry["figures"]:
-            if isinstance(item, dict) and item.get("orbits") == orbits_name:
-                return [_DATASETS["map"].format(name=name)]
-    return []
+    return targets.study_report_inputs(config, wildcards.study, wildcards.report)
 
 
 def orbits_report_inputs(wildcards):
     """The notebook, the dataset and the figures of orbits entry ``{orbits}``, and the map
     drawn over it (Fig. 15 against Fig. 16), if a built study draws one."""
-    entry = config["orbits"][wildcards.orbits]
-    inputs = {
-        "notebook": "notebooks/periodic_motions.ipynb",
-        "orbits": _DATASETS["orbits"].format(name=wildcards.orbits),
-        "figures": [
-            f"results/figures/orbits/{wildcards.orbits}/{f}.png"
-            for f in figures.figure_targets(entry)
-        ],
-    }
-    inputs.update({"map": path for path in _maps_over(wildcards.orbits)})
-    if "fig16" in figures.figure_targets(entry):
-        inputs["boundaries"] = _DATASETS["boundaries"].format(name=wildcards.orbits)
-    if entry.get("attractors"):
-        inputs.update(
-            {
-                kind: _DATASETS[kind].format(name=wildcards.orbits)
-                for kind in ("basins", "lyapunov")
-            }
-        )
-    return inputs
+    return targets.orbits_report_inputs(config, PLAN.drawn, wildcards.orbits)
 
 
 def validation_report_inputs(wildcards):
-    """The notebook, the dataset and the figure of validation report ``{vreport}``; the
-    stability report also quotes the full stress campaign (notebooks/stress_campaign.csv)."""
-    if wildcards.vreport == "performance":
-        return {
-            "notebook": "notebooks/performance.ipynb",
-            "work_precision": "results/validation/work_precision.nc",
-            "figures": ["results/figures/work_precision.png"],
-        }
-    return {
-        "notebook": "notebooks/stability.ipynb",
-        "stress": "results/validation/stress_sample.nc",
-        "campaign": "notebooks/stress_campaign.csv",
-        "figures": ["results/figures/stress.png"],
-    }
+    """The notebook, the dataset and the figure of validation report ``{vreport}``."""
+    return targets.validation_report_inputs(wildcards.vreport)
 
 
 def _report_notebook(wildcards):
@@ -384,50 +270,14 @@ def report_arguments(wildcards, input):
 
 
 # --- targets of `rule all` ------------------------------------------------------------------
-
-
-def sweep_targets():
-    """The side-by-side figure of every sweep whose studies the config builds."""
-    return configuration.sweep_figures(config, PLAN.drawn)
-
-
-def validation_targets():
-    """``results/figures/work_precision.png`` and ``stress.png``."""
-    return [f"results/figures/{name}.png" for name in VALIDATION_FIGURES]
-
-
-def report_targets():
-    """The HTML report of every built study and orbits entry, and the validation reports."""
-    drawn = PLAN.drawn
-    targets = [
-        f"results/reports/{name}/" f"{arguments.study_report_kind(config['studies'][name])}.html"
-        for name in sorted(drawn["studies"])
-    ]
-    targets += [
-        f"results/reports/orbits/{name}/periodic_motions.html" for name in sorted(drawn["orbits"])
-    ]
-    if config["validation"]["build"]:
-        targets += [f"results/reports/validation/{r}.html" for r in ("performance", "stability")]
-    return targets
+# The same lists the plan walks (vibroimpact.pipeline.targets.needed_files), so the plan counts
+# the jobs this DAG schedules.
 
 
 def all_targets():
     """The figures and reports of the entries the config builds (``PLAN.drawn``: with
     ``paper: false``, only the user's file's own entries)."""
-    drawn = PLAN.drawn
-    targets = [f"results/figures/{fig}.png" for fig in sorted(drawn["paper_figures"])]
-    for name in sorted(drawn["studies"]):
-        entry = config["studies"][name]
-        targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
-    for name in sorted(drawn["orbits"]):
-        entry = config["orbits"][name]
-        targets += [
-            f"results/figures/orbits/{name}/{f}.png" for f in figures.figure_targets(entry)
-        ]
-    targets += sweep_targets()
-    if config["validation"]["build"]:
-        targets += validation_targets()
-    return targets + report_targets()
+    return targets.all_targets(config, PLAN.drawn)
 
 
 # Resources: the cost model of vibroimpact.pipeline.config.costs (README, "Job costs"), the one

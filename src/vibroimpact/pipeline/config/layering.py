@@ -6,7 +6,10 @@
   entries are added; an entry named like a paper entry but different is refused unless the
   file lists it under ``replace`` (it would overwrite the paper's results); with
   ``paper: false`` only the file's own entries are built (the paper's stay available by
-  name, e.g. a noise record or an orbits map).
+  name, e.g. a noise record or an orbits map). Every other top-level block follows the same
+  rule (`BLOCKS`): a block that makes results (``validation``) is the paper's unless the
+  file lists it under ``replace``; only the build's settings (`SETTINGS`: ``paper``,
+  ``replace``, ``limits``, ``validation.build``) are the file's own.
 """
 import copy
 import json
@@ -17,11 +20,22 @@ import yaml
 
 from vibroimpact.pipeline.config.messages import ConfigError, _short
 
-__all__ = ["SECTIONS", "MAX_VALUES", "read_yaml", "check_size", "expanded_size", "compose",
-           "deep_merge"]
+__all__ = ["SECTIONS", "BLOCKS", "SETTINGS", "MAX_VALUES", "read_yaml", "check_size",
+           "expanded_size", "compose", "deep_merge"]
 
 #: Sections whose entries are named; a user's entry replaces a paper entry whole.
 SECTIONS = ("noises", "studies", "orbits", "paper_figures")
+
+#: Top-level blocks that are not named entries but make results of their own (``validation``:
+#: results/validation/*.nc, results/figures/work_precision.png, stress.png and the reports
+#: under results/reports/validation/): a user's block that differs from the paper's is
+#: refused unless the file lists it under ``replace`` (``replace: [validation]``), like an
+#: entry of `SECTIONS`. Value: the keys of the block that are settings of the build, not
+#: of its results (the user's own).
+BLOCKS = {"validation": ("build",)}
+
+#: Top-level keys that set how this build runs, not what a result holds: the user's own.
+SETTINGS = ("paper", "replace", "limits")
 
 #: Values a config may hold once YAML aliases are expanded (the paper's config holds ~600);
 #: a file beyond it (nested aliases: a "billion laughs") is refused before anything walks it.
@@ -210,11 +224,34 @@ def read_yaml(path, *, user=True):
     return data
 
 
-def _replaced(user, section, name):
+def _replaced(user, section, name=None):
     replace = user.get("replace", False)
     if replace is True:
         return True
-    return isinstance(replace, list) and f"{section}.{name}" in replace
+    item = section if name is None else f"{section}.{name}"
+    return isinstance(replace, list) and item in replace
+
+
+def _layer_block(config, user, key, problems):
+    """Layer the user's top-level block ``key`` (of `BLOCKS`) on the paper's: its settings
+    are the user's; a part that differs from the paper's is refused unless replaced."""
+    mine, paper = user[key], config.get(key)
+    if not isinstance(mine, dict) or not isinstance(paper, dict) or _replaced(user, key):
+        config[key] = copy.deepcopy(mine)        # replaced whole; the schema checks it
+        return
+    settings = BLOCKS[key]
+    differ = sorted(k for k, v in mine.items() if k not in settings and paper.get(k) != v)
+    for part in differ:
+        problems.append(
+            f"{key}.{part}: the paper's config (config/config.yaml) has this block; yours "
+            f"differs and would overwrite its results ({_BLOCK_RESULTS[key]}).\n"
+            f"  Leave it out (only {', '.join(f'{key}.{s}' for s in settings)} is yours to "
+            f"set), or list it to replace the paper's: replace: [{key}] (or replace: true)")
+    config[key] = {**paper, **copy.deepcopy(mine)}
+
+
+_BLOCK_RESULTS = {"validation": "results/validation/, results/figures/work_precision.png and "
+                                "stress.png, results/reports/validation/"}
 
 
 def compose(paper, user):
@@ -238,8 +275,11 @@ def compose(paper, user):
     config = copy.deepcopy(paper)
     problems = []
     for key, value in user.items():
-        if key not in SECTIONS:
-            config[key] = copy.deepcopy(value)      # paper, replace, limits: the user's
+        if key in BLOCKS:
+            _layer_block(config, user, key, problems)
+        elif key not in SECTIONS:
+            config[key] = copy.deepcopy(value)      # SETTINGS: the user's (others: the
+                                                    # schema names them)
     config.setdefault("paper", True)
     for section in SECTIONS:
         mine = user.get(section)
@@ -261,9 +301,12 @@ def compose(paper, user):
     if isinstance(replace, list):
         for item in replace:
             section, _, name = str(item).partition(".")
+            if str(item) in BLOCKS and isinstance(user.get(str(item)), dict):
+                continue
             if section not in SECTIONS or name not in (user.get(section) or {}):
                 problems.append(f"replace: {item!r} names no entry of your file; allowed: "
-                                f"<section>.<name> with section in {list(SECTIONS)}")
+                                f"<section>.<name> with section in {list(SECTIONS)}, or a "
+                                f"block of your file in {list(BLOCKS)}")
     if problems:
         raise ConfigError(problems)
     own = None

@@ -1,6 +1,8 @@
 """The plan of a build: cells, jobs, output bytes and CPU time per config entry.
 
-:func:`make_plan` costs every output of ``rule all`` with the one cost model
+:func:`make_plan` costs every job that ``rule all`` runs (its targets and every file they
+need, `vibroimpact.pipeline.targets.needed_files`: the jobs a dry run on a fresh copy
+schedules) with the one cost model
 (`vibroimpact.pipeline.config.costs`) before anything runs; :meth:`Plan.format` is what
 ``python -m vibroimpact plan`` prints and :meth:`Plan.refuse_beyond_limits` refuses a build
 beyond the config's ``limits``.
@@ -11,13 +13,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 import shutil
 
-from vibroimpact.pipeline import figures
+from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVERHEAD,
                                                JOB_START_S, REPORT_BYTES, REPORT_S,
                                                VALIDATION_S)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
-from vibroimpact.pipeline.config.sweeps import drawn_sweeps
 from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
 
 __all__ = ["Plan", "Row", "make_plan", "built_entries"]
@@ -73,7 +74,8 @@ class Plan:
                 f"(~{_time(self.cpu_s / max(cores, 1))} on {_n(cores, 'core')})")
 
     def format(self, cores=2):
-        lines = ["vibroimpact plan (every output of `rule all`, whether or not already built):"]
+        lines = ["vibroimpact plan (every job of `rule all` and of what it needs, whether or "
+                 "not already built):"]
         width = max([len(r.key) for r in self.rows] + [10])
         lines.append(f"  {'entry':<{width}}  {'jobs':>4}  {'outputs':>8}  {'CPU':>8}  what")
         for r in self.rows:
@@ -143,37 +145,61 @@ def _time(s):
     return f"{s:.2g} s"
 
 
-def _study_needs(entry):
-    needs = {r for f in entry["figures"] for r in figures.FIGURES[
-        f if isinstance(f, str) else f["name"]]["reads"]}
-    if "sweep" in entry:
-        needs.add("events")         # the sweep's side-by-side figure reads them
-    return needs
+_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace")
+_ORBIT_KINDS = ("orbits", "boundaries", "basins", "lyapunov")
 
 
 def built_entries(config, own=None):
-    """``(drawn, reads)`` of ``rule all``: ``drawn`` the entries whose figures it draws
-    (``{section: names}``, paper figures included), ``reads`` every entry whose datasets
-    those figures read (``{"studies", "orbits", "noises": names}``)."""
+    """``(drawn, build)`` of ``rule all``: ``drawn`` the entries whose figures it draws
+    (``{section: names}``, paper figures included); ``build`` what the build makes, from the
+    files it needs (`vibroimpact.pipeline.targets.needed_files`, the closure of ``rule
+    all``'s targets through the rules' own input functions): ``{"noises": names, "studies":
+    {name: kinds}, "orbits": {name: kinds}, "figures": {owner: count}, "sweeps": names,
+    "copies": count, "reports": count, "validation": files}``."""
     sections = ("studies", "orbits", "paper_figures")
     drawn = {s: set(config.get(s, {})) if own is None else set(own[s]) for s in sections}
     for fig in drawn["paper_figures"]:
         section = "orbits" if figures.FIGURES[fig]["owner"] == "orbits" else "studies"
         drawn[section].add(config["paper_figures"][fig])
-    reads = {"studies": set(drawn["studies"]), "orbits": set(drawn["orbits"]), "noises": set()}
-    for name in drawn["studies"]:
-        entry = config["studies"][name]
-        for item in entry["figures"]:
-            fig = item if isinstance(item, str) else item["name"]
-            for kind, other in figures.figure_sources(entry, fig).items():
-                reads[kind].add(other)
-        if _study_needs(entry) - {"orbits", "escape"}:    # escape: records of its own
-            reads["noises"].add(entry["noise"])
-    return drawn, reads
+    needed = targets.needed_files(config, drawn)
+    build = {"noises": set(), "studies": {}, "orbits": {}, "figures": {}, "sweeps": set(),
+             "copies": 0, "reports": 0, "validation": set()}
+    for name in config.get("studies", {}):
+        kinds = {k for k in _STUDY_KINDS if targets.DATASETS[k].format(name=name) in needed}
+        if kinds:
+            build["studies"][name] = kinds
+            if kinds - {"escape"}:                  # escape: records of its own
+                build["noises"].add(config["studies"][name]["noise"])
+    for name in config.get("orbits", {}):
+        kinds = {k for k in _ORBIT_KINDS if targets.DATASETS[k].format(name=name) in needed}
+        if kinds:
+            build["orbits"][name] = kinds
+    for path in needed:
+        parts = path.split("/")
+        if path.startswith("results/noise/"):
+            build["noises"].add(parts[-1][:-3])
+        elif path.startswith("results/validation/"):
+            build["validation"].add(path)
+        elif parts[1] == "figures" and len(parts) == 3:
+            if parts[2][:-4] in targets.VALIDATION_FIGURES:
+                build["validation"].add(path)
+            else:
+                build["copies"] += 1
+        elif parts[1] == "figures" and parts[-1] == "sweep.png" and len(parts) == 4:
+            build["sweeps"].add(parts[2])
+        elif parts[1] == "figures":
+            owner = "/".join(parts[2:-1])
+            build["figures"][owner] = build["figures"].get(owner, 0) + 1
+        elif parts[1] == "reports" and parts[2] == "validation":
+            build["validation"].add(path)
+        elif parts[1] == "reports":
+            build["reports"] += 1
+    return drawn, build
 
 
 def make_plan(config, own=None, *, results="results"):
-    """The :class:`Plan` of ``rule all``: cells, jobs, bytes and CPU seconds per entry."""
+    """The :class:`Plan` of ``rule all``: cells, jobs, bytes and CPU seconds per entry, of
+    every job the build runs (:func:`built_entries`)."""
     drawn, build = built_entries(config, own)
     plan = Plan(limits=dict(config["limits"]), results=str(results), drawn=drawn)
     for name in sorted(build["noises"]):
@@ -181,11 +207,13 @@ def make_plan(config, own=None, *, results="results"):
         n = int(entry["n_samples"])
         plan.rows.append(Row(f"noises.{name}", f"{n:,} samples", jobs=1,
                              bytes=8 * n + FILE_OVERHEAD, cpu_s=costs.noise_cpu_s(n)))
-    for name in sorted(build["studies"]):
+    owners = sorted(set(build["studies"]) | {o for o in build["figures"]
+                                             if not o.startswith("orbits/")})
+    for name in owners:
         entry = config["studies"][name]
         study = Study.from_config(name, entry)
         noise = config["noises"][entry["noise"]]
-        needs = _study_needs(entry)
+        needs = build["studies"].get(name, set())
         row = Row(f"studies.{name}", "")
         parts = []
         if "events" in needs:
@@ -225,28 +253,35 @@ def make_plan(config, own=None, *, results="results"):
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
             _add(row, 0, 1, 40 * steps, 0.0)
             parts.append("trace")
-        targets = len(figures.figure_targets(entry))
-        row.jobs += targets
-        row.bytes += targets * FIGURE_BYTES
-        row.cpu_s += targets * FIGURE_S + row.jobs * JOB_START_S
-        row.detail = ", ".join(parts) + f", {_n(targets, 'figure')}"
+        n_figs = build["figures"].get(name, 0)
+        row.jobs += n_figs
+        row.bytes += n_figs * FIGURE_BYTES
+        row.cpu_s += n_figs * FIGURE_S + row.jobs * JOB_START_S
+        row.detail = ", ".join(parts + [_n(n_figs, "figure")])
         plan.rows.append(row)
-    for name in sorted(build["orbits"]):
+    for name in sorted(set(build["orbits"]) | {o.split("/", 1)[1] for o in build["figures"]
+                                               if o.startswith("orbits/")}):
         entry = config["orbits"][name]
-        rows, n_tiles = orbit_rows(entry)
-        cells = len(rows) * grid_size(entry["delta"])
-        targets = len(figures.figure_targets(entry)) if name in drawn["orbits"] else 0
-        row = Row(f"orbits.{name}", f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}, "
-                  f"{_n(targets, 'figure')}", orbit_cells=cells, jobs=n_tiles + 1 + targets,
-                  bytes=2 * cells * len(entry["types"]) * 34 + targets * FIGURE_BYTES)
-        row.cpu_s = costs.orbit_cpu_s(cells, len(entry["types"])) + targets * FIGURE_S
-        if "fig16" in figures.figure_targets(entry) and name in drawn["orbits"]:
+        needs = build["orbits"].get(name, set())
+        n_figs = build["figures"].get(f"orbits/{name}", 0)
+        row = Row(f"orbits.{name}", "", jobs=n_figs, bytes=n_figs * FIGURE_BYTES,
+                  cpu_s=n_figs * FIGURE_S)
+        parts = []
+        if "orbits" in needs:
+            rows, n_tiles = orbit_rows(entry)
+            cells = len(rows) * grid_size(entry["delta"])
+            row.orbit_cells += cells
+            row.jobs += n_tiles + 1
+            row.bytes += 2 * cells * len(entry["types"]) * 34
+            row.cpu_s += costs.orbit_cpu_s(cells, len(entry["types"]))
+            parts.append(f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}")
+        if "boundaries" in needs:
             row.jobs += 1                       # the boundary curves Fig. 16 draws
             row.bytes += 200_000 * len(entry["types"])
             row.cpu_s += costs.boundaries_cpu_s(len(entry["types"]))
-            row.detail += ", boundary curves"
+            parts.append("boundary curves")
         block = entry.get("attractors")
-        if block:
+        if needs & {"basins", "lyapunov"}:
             a_rows, a_tiles = attractor_rows(entry)
             a_cells = len(a_rows) * grid_size(block["delta"])
             n_starts = int(block["n_starts"])
@@ -254,26 +289,34 @@ def make_plan(config, own=None, *, results="results"):
             row.jobs += a_tiles + 1
             row.bytes += a_cells * (8 * 5 * n_starts + 400) + 2 * FILE_OVERHEAD
             row.cpu_s += costs.attractor_cpu_s(a_cells, n_starts)
-            row.detail += (f", attractors {_n(a_cells, 'cell')} x {_n(n_starts, 'start')}")
+            parts.append(f"attractors {_n(a_cells, 'cell')} x {_n(n_starts, 'start')}")
         row.cpu_s += row.jobs * JOB_START_S
+        row.detail = ", ".join(parts + [_n(n_figs, "figure")])
         plan.rows.append(row)
-    for name in drawn_sweeps(config, drawn):
+    for name in sorted(build["sweeps"]):
         n = len(config["sweeps"][name]["studies"])
         plan.rows.append(Row(f"sweeps.{name}", f"{_n(n, 'study')} side by side, 1 figure", jobs=1,
                              bytes=FIGURE_BYTES, cpu_s=FIGURE_S + JOB_START_S))
-    reports = len(drawn["studies"]) + len(drawn["orbits"])
+    reports = build["reports"]
     if reports:
         plan.rows.append(Row("reports", f"{_n(reports, 'notebook')} executed, with HTML",
                              jobs=reports, bytes=reports * REPORT_BYTES,
                              cpu_s=reports * (REPORT_S + JOB_START_S)))
-    if config["validation"]["build"]:
-        plan.rows.append(Row("validation", "work-precision and stress-sample runs, 2 figures, "
-                             "2 reports", jobs=6, bytes=2 * FIGURE_BYTES + 2 * REPORT_BYTES,
-                             cpu_s=VALIDATION_S + 2 * (FIGURE_S + REPORT_S) + 6 * JOB_START_S))
-    copies = drawn["paper_figures"]
+    validation = build["validation"]
+    if validation:
+        runs = sum(f.endswith(".nc") for f in validation)
+        figs = sum(f.endswith(".png") for f in validation)
+        notebooks = sum(f.endswith(".html") for f in validation)
+        jobs = len(validation)
+        plan.rows.append(Row("validation", f"work-precision and stress-sample runs ({runs}), "
+                             f"{_n(figs, 'figure')}, {_n(notebooks, 'report')}", jobs=jobs,
+                             bytes=figs * FIGURE_BYTES + notebooks * REPORT_BYTES,
+                             cpu_s=VALIDATION_S * runs / 2 + figs * FIGURE_S
+                             + notebooks * REPORT_S + jobs * JOB_START_S))
+    copies = build["copies"]
     if copies:
-        plan.rows.append(Row("paper_figures", _n(len(copies), "copy"), jobs=len(copies),
-                             bytes=len(copies) * FIGURE_BYTES))
+        plan.rows.append(Row("paper_figures", _n(copies, "copy"), jobs=copies,
+                             bytes=copies * FIGURE_BYTES))
     try:
         probe = Path(results)
         while not probe.exists():

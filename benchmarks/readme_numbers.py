@@ -1,0 +1,174 @@
+"""The README's numbers of the default build, generated: the plan, and a finished build's own.
+
+    python benchmarks/readme_numbers.py                       # print them
+    python benchmarks/readme_numbers.py --write README.md     # rewrite the README's blocks
+    python benchmarks/readme_numbers.py --results /path/to/results --write README.md
+
+The README holds each generated number between ``<!-- readme_numbers:NAME -->`` and
+``<!-- /readme_numbers:NAME -->``; ``--write`` replaces the text between each pair, and
+nothing else:
+
+- ``plan``: ``make plan`` on the default config (`vibroimpact.pipeline.config.load`: the
+  cells, jobs, outputs and CPU the build will run, from the same target lists Snakemake's
+  DAG uses), at the commit of this tree; no build needed.
+- ``build``: one finished default build (``--results``, default ``results/``): the commit
+  its datasets record (``git_commit``), its jobs (one ``results/benchmarks/**.tsv`` each),
+  the jobs' CPU and wall time (Snakemake's ``benchmark:`` files), the span from the first
+  job's start to the last job's end, the heaviest jobs, the outputs on disk.
+- ``report``: the size of that build's ``results/report.html``.
+- ``figures``: which entry lists each figure, the config blocks it needs and its options,
+  from the figure table `vibroimpact.pipeline.figures.FIGURES` that the checks read.
+
+Re-run it after a build that changes what the README quotes (a new job, a new cost): the
+README's numbers then come from one build, named by its commit.
+"""
+import argparse
+import csv
+from pathlib import Path
+import re
+import subprocess
+import sys
+
+import xarray as xr
+
+from vibroimpact.pipeline import config as configuration, figures
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _commit(root):
+    out = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=root, capture_output=True,
+                         text=True)
+    # what the plan reads (not the README this script rewrites)
+    dirty = subprocess.run(["git", "status", "--porcelain", "--", "src", "config", "workflow",
+                            "Snakefile"], cwd=root, capture_output=True, text=True).stdout.strip()
+    return out.stdout.strip() + (" with uncommitted changes" if dirty else "")
+
+
+def plan_text(root=ROOT):
+    """The ``plan`` block: the default config's plan, at this tree's commit."""
+    _, plan = configuration.load(root=root)
+    return (f"`make plan` on the default config (generated at {_commit(root)} by "
+            f"`benchmarks/readme_numbers.py`): {plan.summary(2)}")
+
+
+def _minsec(s):
+    m, s = divmod(round(s), 60)
+    return f"{m} min {s} s" if m else f"{s} s"
+
+
+def build_numbers(results):
+    """``{commit, jobs, measured, cpu_s, job_s, span_s, heavy: [(job, s, cpu_s)], disk,
+    report}`` of
+    the finished build in ``results``."""
+    results = Path(results)
+    commits = set()
+    for path in sorted((results / "datasets").glob("*.nc"))[:50]:
+        with xr.open_dataset(path) as ds:
+            commits.add(str(ds.attrs.get("git_commit", "?"))[:7]
+                        + (" (dirty)" if int(ds.attrs.get("git_dirty", 0)) else ""))
+    rows = []
+    for tsv in sorted((results / "benchmarks").rglob("*.tsv")):
+        with tsv.open() as f:
+            row = next(csv.DictReader(f, delimiter="\t"))
+        name = tsv.relative_to(results / "benchmarks").with_suffix("").as_posix()
+        rows.append((name, float(row["s"]), float(row["cpu_time"]), tsv.stat().st_mtime))
+    if not rows:
+        raise SystemExit(f"{results}: no results/benchmarks/*.tsv: not a finished build")
+    span = max(r[3] for r in rows) - min(r[3] - r[1] for r in rows)
+    heavy = sorted(rows, key=lambda r: -r[1])[:4]
+    disk = sum(p.stat().st_size for p in results.rglob("*") if p.is_file()
+               and not {"logs", "benchmarks"} & set(p.relative_to(results).parts))
+    report = results / "report.html"
+    # the paper figures' copies (copy_paper_figure) are the jobs without a benchmark file
+    copies = [p for p in (results / "figures").glob("*.png")
+              if p.stem not in ("work_precision", "stress")]
+    return {"commit": ", ".join(sorted(commits)), "jobs": len(rows) + len(copies),
+            "measured": len(rows),
+            "cpu_s": sum(r[2] for r in rows), "job_s": sum(r[1] for r in rows), "span_s": span,
+            "heavy": [(r[0], r[1], r[2]) for r in heavy], "disk": disk,
+            "report": report.stat().st_size if report.exists() else None}
+
+
+def build_text(numbers):
+    """The ``build`` block: one build's own numbers, named by its commit."""
+    heavy = "; ".join(f"{name} {s:.0f} s ({cpu:.0f} s CPU)" for name, s, cpu in numbers["heavy"])
+    return (f"The default build at {numbers['commit']} (`benchmarks/readme_numbers.py` on its "
+            f"`results/`): {numbers['jobs']} jobs besides `all`; of the {numbers['measured']} "
+            f"with a benchmark file (all but the paper figures' copies) "
+            f"{_minsec(numbers['cpu_s'])} of CPU, {_minsec(numbers['job_s'])} of wall time "
+            f"added up, "
+            f"{_minsec(numbers['span_s'])} from the first job's start to the last job's end; "
+            f"its outputs take {numbers['disk'] / 1e6:.0f} MB (logs and benchmarks aside). "
+            f"The longest jobs: {heavy}")
+
+
+def report_text(numbers):
+    """The ``report`` block: the size of that build's Snakemake report."""
+    size = numbers["report"]
+    size = "not written" if size is None else f"{size / 1e6:.1f} MB"
+    return f"{size} for the default config at {numbers['commit']}"
+
+
+def figures_text():
+    """The ``figures`` block: a table of the figures an entry may list and what each needs
+    (the rules `vibroimpact.pipeline.config.checks` applies to the table FIGURES)."""
+    rows = ["", "| figure | listed by | needs in that entry | options of its item |",
+            "|---|---|---|---|"]
+    for fig, spec in figures.FIGURES.items():
+        owner = "a study" if spec["owner"] == "study" else "an `orbits` entry"
+        needs = [f"`{b}:`" for b in ("trace", "spectra", "escape") if b in spec["reads"]]
+        if "map" in spec["reads"]:
+            needs.append("the map grid (`inv_beta`, `delta`; `map:` defaults)")
+        if "events" in spec["reads"]:
+            needs.append("the `delta` grid")
+        if spec.get("needs"):
+            needs.append(f"`{spec['needs']}:`")
+        if spec.get("harmonic"):
+            needs.append("`amplitude` != 0")
+        needs += [f"an `{src}` entry of the same zeta and eps, named in its item"
+                  for src in spec.get("sources", ())]
+        options = [f"`{o}`" for o in spec.get("options", ())]
+        if spec.get("per"):
+            options.insert(0, f"`{spec['per']}` (one figure per value: `{fig}-0` ...)")
+        if "spectra" in spec["reads"]:
+            options.append("`beta_max`")
+        options += [f"`{src}`" for src in spec.get("sources", ())]
+        rows.append(f"| `{fig}` | {owner} | {', '.join(needs) or '-'} | "
+                    f"{', '.join(options) or '-'} |")
+    return "\n".join(rows) + "\n"
+
+
+def rewrite(readme, blocks):
+    """``readme`` with the text of each ``<!-- readme_numbers:NAME -->`` block replaced."""
+    text = Path(readme).read_text()
+    for name, value in blocks.items():
+        pattern = re.compile(rf"(<!-- readme_numbers:{name} -->)(.*?)(<!-- /readme_numbers:"
+                             rf"{name} -->)", re.S)
+        if not pattern.search(text):
+            raise SystemExit(f"{readme}: no <!-- readme_numbers:{name} --> block")
+        text = pattern.sub(lambda m, v=value: m[1] + v + m[3], text)
+    Path(readme).write_text(text)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--results", default=str(ROOT / "results"),
+                        help="a finished default build's results/ (default: this tree's)")
+    parser.add_argument("--write", metavar="README", help="rewrite the blocks of this file")
+    parser.add_argument("--plan-only", action="store_true",
+                        help="only the plan (no finished build needed)")
+    args = parser.parse_args(argv)
+    blocks = {"plan": plan_text(), "figures": figures_text()}
+    if not args.plan_only:
+        numbers = build_numbers(args.results)
+        blocks.update(build=build_text(numbers), report=report_text(numbers))
+    for name, value in blocks.items():
+        print(f"{name}: {value}")
+    if args.write:
+        rewrite(args.write, blocks)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,89 @@
+"""Outputs of earlier configs left beside the current ones: ``python -m
+vibroimpact.pipeline.stale [--configfile FILE ...] [--delete]`` (``make stale``, ``make
+clean-stale``; README, "Outputs").
+
+Snakemake never removes an output its config no longer asks for: a study that listed
+``fig13`` at three forcing periods and now at two keeps ``fig13-2.png`` in
+``results/figures/<study>/``, beside the current figures, with nothing marking it. The files
+the current config builds are known before anything runs
+(`vibroimpact.pipeline.targets.needed_files`, what the plan counts); this lists, under the
+directories of the entries the config draws (``results/figures/<study>/``,
+``results/figures/orbits/<name>/``, ``results/reports/<study>/``, ...) and their datasets
+(``results/datasets/<study>_events.nc`` ...), every file that is not among them, and with
+``--delete`` removes them. Other entries' outputs (with ``paper: false``, the paper's) are
+never listed: they belong to another config.
+"""
+import argparse
+from pathlib import Path
+import sys
+
+from vibroimpact.pipeline import targets
+
+__all__ = ["stale_files", "main"]
+
+#: Files made beside an output (a figure's PDF beside its PNG, a report's notebook and its
+#: rendering without images beside its HTML): current when that output is.
+_TWINS = {".pdf": ".png", ".ipynb": ".html", ".summary.html": ".html"}
+
+
+def stale_files(config, drawn, root="."):
+    """Files under ``root``/results of the entries in ``drawn`` that the config does not
+    build (sorted paths relative to ``root``)."""
+    root = Path(root)
+    needed = targets.needed_files(config, drawn)
+    places = []                     # (directory, glob) owned by a drawn entry
+    for name in drawn["studies"]:
+        places += [(f"results/figures/{name}", "*"), (f"results/reports/{name}", "*"),
+                   ("results/traces", f"{name}.nc")]
+        places += [("results/datasets", f"{name}_{kind}.nc")
+                   for kind in ("events", "map", "spectra", "escape")]
+    for name in drawn["orbits"]:
+        places += [(f"results/figures/orbits/{name}", "*"),
+                   (f"results/reports/orbits/{name}", "*"), ("results/orbits", f"{name}.nc")]
+        places += [("results/orbits", f"{name}_{kind}.nc")
+                   for kind in ("boundaries", "basins", "lyapunov")]
+    for name in config.get("sweeps", {}):
+        if set(config["sweeps"][name]["studies"]) <= drawn["studies"]:
+            places.append((f"results/figures/{name}", "sweep.*"))
+    stale = set()
+    for folder, pattern in places:
+        for path in (root / folder).glob(pattern):
+            if not path.is_file():
+                continue
+            rel = path.relative_to(root).as_posix()
+            suffix = next((s for s in _TWINS if rel.endswith(s)), "")
+            twin = rel[:len(rel) - len(suffix)] + _TWINS[suffix] if suffix else rel
+            if twin not in needed:
+                stale.add(rel)
+    return sorted(stale)
+
+
+def main(argv=None):
+    from vibroimpact.pipeline import config as configuration
+
+    parser = argparse.ArgumentParser(
+        prog="python -m vibroimpact.pipeline.stale",
+        description="list (or delete) the outputs of the config's entries that the config "
+                    "no longer builds")
+    parser.add_argument("--configfile", action="append", default=[], metavar="FILE",
+                        help="your config file, layered on config/config.yaml; repeat")
+    parser.add_argument("--directory", default=".", help="the project directory")
+    parser.add_argument("--delete", action="store_true", help="remove the listed files")
+    args = parser.parse_args(argv)
+    try:
+        config, plan = configuration.load(root=args.directory, user_files=args.configfile)
+    except configuration.ConfigError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 1
+    files = stale_files(config, plan.drawn, args.directory)
+    for rel in files:
+        print(rel)
+        if args.delete:
+            (Path(args.directory) / rel).unlink()
+    what = "removed" if args.delete else "not built by this config (make clean-stale removes them)"
+    print(f"{len(files)} file(s) {what}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,255 @@
+"""The files a build makes: the targets of ``rule all`` and the inputs of each rule above the
+simulations, in plain functions of the config.
+
+One place for both readers: the workflow's input functions (``workflow/rules/common.smk``)
+call these, and the plan (`vibroimpact.pipeline.config.plan`) walks :func:`needed_files`, the
+closure of ``rule all``'s targets through the same functions, so it counts the jobs a dry run
+schedules (a study drawn only in another's report, ``report_with``, included), not a second
+estimate of them. ``drawn`` is :attr:`~vibroimpact.pipeline.config.Plan.drawn`: ``{section:
+names}`` of the entries whose figures ``rule all`` draws. Paths are relative to the project
+directory; no Snakemake, no numerics.
+"""
+from vibroimpact.pipeline import figures
+from vibroimpact.pipeline.config.sweeps import sweep_figures
+from vibroimpact.reports.arguments import study_report_kind
+
+__all__ = ["DATASETS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
+           "paper_figure_source", "study_datasets", "attractor_datasets",
+           "study_report_inputs", "maps_over", "orbits_report_inputs",
+           "validation_report_inputs", "sweep_inputs", "sweep_targets", "validation_targets",
+           "report_targets", "all_targets", "needed_files", "rule_inputs"]
+
+#: Where each dataset a figure can read lives ({name}: the owner; {noise}: its noise record).
+DATASETS = {
+    "noise": "results/noise/{noise}.nc",
+    "trace": "results/traces/{name}.nc",
+    "spectra": "results/datasets/{name}_spectra.nc",
+    "events": "results/datasets/{name}_events.nc",
+    "map": "results/datasets/{name}_map.nc",
+    "escape": "results/datasets/{name}_escape.nc",
+    "orbits": "results/orbits/{name}.nc",
+    "boundaries": "results/orbits/{name}_boundaries.nc",
+    "basins": "results/orbits/{name}_basins.nc",
+    "lyapunov": "results/orbits/{name}_lyapunov.nc",
+}
+
+#: Each validation figure and the dataset it draws.
+VALIDATION_FIGURES = {
+    "work_precision": "results/validation/work_precision.nc",
+    "stress": "results/validation/stress_sample.nc",
+}
+
+
+def figure_names(entry):
+    """The names of the figures an entry lists (a figure given with options: its name)."""
+    return [f if isinstance(f, str) else f["name"] for f in entry.get("figures", [])]
+
+
+def _owner(config, owner):
+    """``(kind, name, entry)`` of ``owner``: a study name, or ``orbits/<name>``."""
+    if owner.startswith("orbits/"):
+        name = owner.split("/", 1)[1]
+        return "orbits", name, config["orbits"][name]
+    return "study", owner, config["studies"][owner]
+
+
+def figure_inputs(config, owner, fig):
+    """The datasets figure ``fig`` (``figNN``, ``figNN-k``) of ``owner`` draws, from the
+    table `~vibroimpact.pipeline.figures.FIGURES`."""
+    kind, name, entry = _owner(config, owner)
+    base, _ = figures.figure_variant(fig)
+    if figures.FIGURES.get(base, {}).get("owner") != kind:
+        raise ValueError(f"{owner}: no figure {base!r} for a {kind} entry")
+    names = dict(figures.figure_sources(entry, base), name=name, noise=entry.get("noise"))
+    return [DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
+            for d in figures.FIGURES[base]["reads"]]
+
+
+def paper_figure_source(config, paper_fig):
+    """``{"png", "pdf"}`` of the figure that ``paper_figures[paper_fig]`` names."""
+    if paper_fig not in config.get("paper_figures", {}):
+        raise ValueError(f"paper_figures: {paper_fig} is not listed; listed: "
+                         f"{sorted(config.get('paper_figures', {}))}")
+    name = config["paper_figures"][paper_fig]
+    section = "orbits" if figures.FIGURES[paper_fig]["owner"] == "orbits" else "studies"
+    owner = f"orbits/{name}" if section == "orbits" else name
+    target = figures.paper_target(config[section][name], paper_fig)
+    return {ext: f"results/figures/{owner}/{target}.{ext}" for ext in ("png", "pdf")}
+
+
+def study_datasets(config, name):
+    """``{kind: path}`` of the datasets the figures of study ``name`` read."""
+    entry = config["studies"][name]
+    out = {}
+    for fig in sorted(set(figure_names(entry))):
+        names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
+        for kind in figures.FIGURES[fig]["reads"]:
+            out.setdefault(kind, DATASETS[kind].format(name=names.get(kind, name),
+                                                       noise=names["noise"]))
+    return out
+
+
+def attractor_datasets(config, name):
+    """``{basins, lyapunov: path}`` of the orbits entry study ``name`` draws Fig. 15 over
+    (``fig15_vs_fig16``), when that entry has an ``attractors`` block: the harmonic report's
+    noise-free predictors of the probabilities; {} otherwise."""
+    entry = config["studies"][name]
+    if "fig15_vs_fig16" not in figure_names(entry):
+        return {}
+    orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
+    if not config["orbits"][orbits].get("attractors"):
+        return {}
+    return {kind: DATASETS[kind].format(name=orbits) for kind in ("basins", "lyapunov")}
+
+
+def study_report_inputs(config, study, report=None):
+    """The notebook, the datasets and the figures of study ``study`` and of its
+    ``report_with``, and its noise record (its provenance row, whether or not a figure draws
+    it); with a map over an orbits entry that has attractors, their basins and Lyapunov
+    datasets. ``report``: the notebook asked for, checked against the study's."""
+    entry = config["studies"][study]
+    kind = study_report_kind(entry)
+    if report is not None and report != kind:
+        raise ValueError(f"study {study}: its report is {kind}, not {report}")
+    inputs = {"notebook": f"notebooks/{kind}.ipynb",
+              "noise": DATASETS["noise"].format(noise=entry["noise"])}
+    shown = []
+    for name in [study, *entry.get("report_with", [])]:
+        for dataset, path in {**study_datasets(config, name),
+                              **attractor_datasets(config, name)}.items():
+            inputs.setdefault(dataset, path)
+        shown += [f"results/figures/{name}/{f}.png"
+                  for f in figures.figure_targets(config["studies"][name])]
+    return {**inputs, "figures": shown}
+
+
+def maps_over(config, drawn, orbits_name):
+    """Map datasets of the drawn studies that draw Fig. 15 over orbits entry ``orbits_name``
+    (the first, by name)."""
+    for name in sorted(drawn["studies"]):
+        for item in config["studies"][name]["figures"]:
+            if isinstance(item, dict) and item.get("orbits") == orbits_name:
+                return [DATASETS["map"].format(name=name)]
+    return []
+
+
+def orbits_report_inputs(config, drawn, name):
+    """The notebook, the dataset and the figures of orbits entry ``name``, and the map drawn
+    over it (Fig. 15 against Fig. 16), if a drawn study draws one."""
+    entry = config["orbits"][name]
+    inputs = {"notebook": "notebooks/periodic_motions.ipynb",
+              "orbits": DATASETS["orbits"].format(name=name),
+              "figures": [f"results/figures/orbits/{name}/{f}.png"
+                          for f in figures.figure_targets(entry)]}
+    for path in maps_over(config, drawn, name):
+        inputs["map"] = path
+    if "fig16" in figures.figure_targets(entry):
+        inputs["boundaries"] = DATASETS["boundaries"].format(name=name)
+    if entry.get("attractors"):
+        inputs.update({kind: DATASETS[kind].format(name=name) for kind in ("basins", "lyapunov")})
+    return inputs
+
+
+def validation_report_inputs(vreport):
+    """The notebook, the dataset and the figure of validation report ``vreport``; the
+    stability report also quotes the full stress campaign (notebooks/stress_campaign.csv)."""
+    if vreport == "performance":
+        return {"notebook": "notebooks/performance.ipynb",
+                "work_precision": VALIDATION_FIGURES["work_precision"],
+                "figures": ["results/figures/work_precision.png"]}
+    return {"notebook": "notebooks/stability.ipynb",
+            "stress": VALIDATION_FIGURES["stress"],
+            "campaign": "notebooks/stress_campaign.csv",
+            "figures": ["results/figures/stress.png"]}
+
+
+def sweep_inputs(config, sweep):
+    """The events datasets of the studies of sweep ``sweep``, in its order."""
+    if sweep not in config.get("sweeps", {}):
+        raise ValueError(f"{sweep} is not a sweep; sweeps: "
+                         f"{sorted(config.get('sweeps', {})) or 'none'}")
+    return [DATASETS["events"].format(name=study) for study in config["sweeps"][sweep]["studies"]]
+
+
+def sweep_targets(config, drawn):
+    """The side-by-side figure of every sweep whose studies are all drawn."""
+    return sweep_figures(config, drawn)
+
+
+def validation_targets():
+    """``results/figures/work_precision.png`` and ``stress.png``."""
+    return [f"results/figures/{name}.png" for name in VALIDATION_FIGURES]
+
+
+def report_targets(config, drawn):
+    """The HTML report of every drawn study and orbits entry, and the validation reports."""
+    targets = [f"results/reports/{name}/{study_report_kind(config['studies'][name])}.html"
+               for name in sorted(drawn["studies"])]
+    targets += [f"results/reports/orbits/{name}/periodic_motions.html"
+                for name in sorted(drawn["orbits"])]
+    if config["validation"]["build"]:
+        targets += [f"results/reports/validation/{r}.html" for r in ("performance", "stability")]
+    return targets
+
+
+def all_targets(config, drawn):
+    """The figures and reports of ``rule all``: of the drawn entries (with ``paper: false``,
+    only the user's file's own), the paper figures' copies, the sweeps' figures and the
+    validation targets when ``validation.build``."""
+    targets = [f"results/figures/{fig}.png" for fig in sorted(drawn["paper_figures"])]
+    for name in sorted(drawn["studies"]):
+        entry = config["studies"][name]
+        targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
+    for name in sorted(drawn["orbits"]):
+        entry = config["orbits"][name]
+        targets += [f"results/figures/orbits/{name}/{f}.png"
+                    for f in figures.figure_targets(entry)]
+    targets += sweep_targets(config, drawn)
+    if config["validation"]["build"]:
+        targets += validation_targets()
+    return targets + report_targets(config, drawn)
+
+
+def _flat(inputs):
+    out = []
+    for value in inputs.values():
+        out += value if isinstance(value, list) else [value]
+    return [p for p in out if p.startswith("results/")]
+
+
+def rule_inputs(config, drawn, path):
+    """The files under results/ that the rule making ``path`` reads, for the rules above the
+    datasets (figures, copies, sweeps, reports) and the boundary curves; [] for a dataset
+    made from tiles or a record (the plan costs those per entry)."""
+    parts = path.split("/")
+    if parts[:2] == ["results", "figures"] and path.endswith(".png"):
+        stem = parts[-1][:-4]
+        if len(parts) == 3 and stem in VALIDATION_FIGURES:
+            return [VALIDATION_FIGURES[stem]]
+        if len(parts) == 3:
+            return [paper_figure_source(config, stem)["png"]]
+        if stem == "sweep" and len(parts) == 4:
+            return sweep_inputs(config, parts[2])
+        return figure_inputs(config, "/".join(parts[2:-1]), stem)
+    if parts[:3] == ["results", "reports", "validation"]:
+        return _flat(validation_report_inputs(parts[3].rsplit(".", 1)[0]))
+    if parts[:3] == ["results", "reports", "orbits"]:
+        return _flat(orbits_report_inputs(config, drawn, parts[3]))
+    if parts[:2] == ["results", "reports"]:
+        return _flat(study_report_inputs(config, parts[2], parts[3].rsplit(".", 1)[0]))
+    if path.startswith("results/orbits/") and path.endswith("_boundaries.nc"):
+        return [path[:-len("_boundaries.nc")] + ".nc"]
+    return []
+
+
+def needed_files(config, drawn):
+    """Every file under results/ that ``rule all`` needs, whether or not already built: its
+    targets and, through :func:`rule_inputs`, the figures and datasets they read (a
+    ``report_with`` study's figures and datasets too), down to the datasets."""
+    needed, todo = set(), list(all_targets(config, drawn))
+    while todo:
+        path = todo.pop()
+        if path not in needed:
+            needed.add(path)
+            todo += rule_inputs(config, drawn, path)
+    return needed
