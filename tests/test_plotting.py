@@ -211,27 +211,32 @@ def test_fig09_bars_scale_and_markers(data):
     fig = plotting.fig09(events)
     ax_v, ax_z = fig.axes
     assert ax_v.get_yscale() == "linear" and ax_z.get_yscale() == "log"
-    t = t_quantile(20)
     for ax, name in ((ax_v, "v_after"), (ax_z, "interval")):
         # the plays without a collision in the record: shaded from d_c on, not a threshold line
         spans = [p for p in ax.patches if p.get_gid() == "no_collision"]
         assert len(spans) == 1
         assert spans[0].get_x() == pytest.approx(d_c)
-        # bars: +-t standard errors, t of 19 dof (Student, as BatchMeans.interval)
+        # bars: the stored 95 % interval ends (asymmetric for T/N), exactly
+        lo, hi = ds[f"{name}_mean_lo"].values, ds[f"{name}_mean_hi"].values
         segments = ax.containers[0].lines[2][0].get_segments()
-        half = np.array([0.5 * (s[1, 1] - s[0, 1]) for s in segments])
-        expected = t * ds[f"{name}_stderr"].values[enough]
-        np.testing.assert_allclose(half, expected[np.isfinite(expected)], rtol=1e-12)
+        drawn = enough & np.isfinite(lo)
+        np.testing.assert_allclose([s[0, 1] for s in segments], lo[drawn], rtol=1e-12)
+        np.testing.assert_allclose([s[1, 1] for s in segments], hi[drawn], rtol=1e-12)
         squares = [ln for ln in ax.get_lines() if ln.get_marker() == "s"]
         assert len(squares) == 1
-        # an interval needs two collisions: one collision is a cross in (a), nothing in (b)
-        shown = few & (n > 1) & np.isfinite(ds[f"{name}_mean"].values)
+        # (b) T/N rests on the count: from one collision on; (a) a mean needs an interval
+        shown = few & np.isfinite(lo) & (n >= (2 if name == "v_after" else 1))
         np.testing.assert_array_equal(squares[0].get_xdata(), ds["delta"].values[shown])
         assert squares[0].get_markerfacecolor() == "white"
+    # T/N is the record length over the count, and its interval holds it
+    z = ds["interval_mean"].values[n > 0]
+    np.testing.assert_allclose(z, ds["simulated_time"].values[n > 0] / n[n > 0], rtol=1e-12)
+    assert np.all((ds["interval_mean_lo"].values[n > 0] < z)
+                  & (z < ds["interval_mean_hi"].values[n > 0]))
     labels = [t.get_text() for t in fig.legends[0].get_texts()]     # one legend, both panels
     assert any("fewer than 20 collisions" in s for s in labels)
     assert any(f"no collision in this record for $\\delta$ > {d_c:g}" in s for s in labels)
-    assert any("t = 2.093" in s for s in labels)
+    assert any("95 % intervals" in s and "Garwood" in s for s in labels)
     assert ax_v.get_ylabel() == axis_label(ds["v_after_mean"])
     assert ax_z.get_ylabel() == axis_label(ds["interval_mean"])
     assert ax_z.get_xlabel() == axis_label(ds["delta"])
