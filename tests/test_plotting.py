@@ -21,7 +21,7 @@ from vibroimpact.orbits import orbit_map, periodic_orbits
 from vibroimpact.pipeline import datasets, tasks
 from vibroimpact.plotting import axis_label, critical_delta
 from vibroimpact.plotting.orbits import S_LEVELS, TYPE_COLORS, complex_multipliers
-from vibroimpact.stats.events import t_quantile
+from vibroimpact.stats.events import poisson_interval, t_quantile
 
 NOISE = dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=60_001,
              seed=19740914, nperseg=1024)
@@ -178,17 +178,25 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
         assert (f"{100 * beyond:.3g} % beyond axis" in label) == (beyond > 1e-3), label
     if var == "interval":   # intervals at the largest play overrun the 10-unit axis
         assert "beyond axis" in labels[0]
-    # band = +-t batch-means s.e., t of B - 1 = 19 dof
+    # band = +-t batch-means s.e., t of B - 1 = 19 dof, joined with Garwood's interval
     assert "batch-means" in _legend(ax).get_title().get_text()
+    assert "Garwood" in _legend(ax).get_title().get_text()
     assert f"t = {t:.4g}" in _legend(ax).get_title().get_text()
-    # the band of a bin drawn on its own (>= MIN_BIN_COUNT values) is density +- t s.e.
+    # the band of a bin drawn on its own (>= MIN_BIN_COUNT values): the wider of density +-
+    # t s.e. and Garwood's 95 % interval of its count c, G(c) / (n w)
     cell = events.sel(delta=0.0)
     y = np.asarray(cell[f"{var}_density"])
     se = np.asarray(cell[f"{var}_density_stderr"])
-    counts = plotting.bin_counts(cell, f"{var}_density")[1]
+    _, counts, n = plotting.bin_counts(cell, f"{var}_density")
+    width = float(events[var][1] - events[var][0])
     alone = counts >= plotting.MIN_BIN_COUNT
-    band = ax.collections[2].get_paths()[0].vertices[:, 1]              # delta = 0: third curve
-    assert np.nanmax(band) == pytest.approx(np.max((y + t * se)[alone]), rel=1e-12)
+    g_hi = poisson_interval(counts[alone].astype(float))[1] / (n * width)
+    bands = [c for c in ax.collections if c.get_gid() == "band"]
+    assert len(bands) == len(lines)
+    band = bands[2].get_paths()[0].vertices[:, 1]                        # delta = 0: third curve
+    assert np.nanmax(band) == pytest.approx(np.max(np.fmax((y + t * se)[alone], g_hi)),
+                                            rel=1e-12)
+    assert np.max(g_hi) > 0 and np.all(g_hi > y[alone])
     assert ax.get_ylabel() == axis_label(events[f"{var}_density"])
     assert ax.figure.axes[-1].get_xlabel() == axis_label(events[var])
 
@@ -599,6 +607,28 @@ def test_density_figure_draws_no_point_below_the_sparse_bin_count(data):
     x = np.asarray(line.get_xdata(), dtype=float)
     assert np.nanmax(x) < float(events["v_after"][-1]) - 0.5 * width   # the lone bin is not drawn
     assert ax.get_xlim()[1] < float(events["v_after"][-1])              # nor the axis taken to it
+
+
+def test_density_figure_draws_merged_runs_apart_from_the_curve(data):
+    """A merged run of sparse bins is a bar over its width, never a plateau of the curve."""
+    events = data["events"].copy(deep=True)
+    cell = dict(inv_beta=0, delta=int(np.argmin(np.abs(events["delta"].values))))
+    n = int(events["n_collisions"][cell])
+    width = float(events["v_after"][1] - events["v_after"][0])
+    dens = events["v_after_density"][cell].values.copy()
+    dens[-6:] = [30.0, 20.0, 4.0, 0.0, 3.0, 5.0]     # 12 values in the last four bins,
+    dens[-6:] /= n * width                            # after two full ones
+    events["v_after_density"][cell] = dens
+    ax = plotting.fig07(events, density_delta=[0.0]).axes[0]
+    (line,) = _data_lines(ax)
+    x = np.asarray(line.get_xdata(), dtype=float)
+    edges_right = float(events["v_after"][-1]) + 0.5 * width
+    assert np.nanmax(x) < edges_right - 4 * width       # the curve stops before the run
+    runs = [c for c in ax.collections if c.get_gid() == "sparse_run"]
+    (bar,) = [c for c in runs if np.allclose(np.diff(c.get_segments()[0][:, 1]), 0.0)]
+    (seg,) = [g for g in bar.get_segments() if g[1, 0] == pytest.approx(edges_right)]
+    np.testing.assert_allclose(seg[:, 0], [edges_right - 4 * width, edges_right], rtol=1e-12)
+    np.testing.assert_allclose(seg[:, 1], 12.0 / (n * 4 * width), rtol=1e-12)
 
 
 def test_a_single_bin_spans_zero_to_max():

@@ -261,11 +261,17 @@ def _t_alpha(level, dof):
 
 
 def _garwood(count, alpha):
-    """Garwood's interval of a Poisson mean at two-sided tail `alpha` (tails kept precise)."""
-    from scipy.stats import chi2
+    """Garwood's interval of a Poisson mean at two-sided tail `alpha` (tails kept precise).
 
-    lo = float(chi2.ppf(0.5 * alpha, 2.0 * count)) / 2.0 if count > 0 else 0.0
-    return lo, float(chi2.isf(0.5 * alpha, 2.0 * count + 2.0)) / 2.0
+    ``chdtri(v, p)`` is the chi-square quantile of upper tail p (what ``scipy.stats.chi2.isf``
+    computes, without the import of scipy.stats in a figure job).
+    """
+    from scipy.special import chdtri
+
+    k = np.asarray(count, dtype=float)
+    lo = np.where(k > 0, chdtri(np.maximum(2.0 * k, 1e-300), 1.0 - 0.5 * alpha) / 2.0, 0.0)
+    hi = chdtri(2.0 * k + 2.0, 0.5 * alpha) / 2.0
+    return (float(lo), float(hi)) if k.ndim == 0 else (lo, hi)
 
 
 def poisson_interval(count, level: float = 0.95) -> tuple[float, float]:
@@ -273,21 +279,23 @@ def poisson_interval(count, level: float = 0.95) -> tuple[float, float]:
 
     Parameters
     ----------
-    count : float
+    count : float or array_like of float
         The observed count k >= 0 (a non-integer k is allowed: an effective count).
     level : float, optional
         Confidence level, 0 < level < 1 (default 0.95).
 
     Returns
     -------
-    (float, float)
+    (float, float), or two arrays shaped like `count`
         ``(chi2_{a/2}(2k) / 2, chi2_{1-a/2}(2k + 2) / 2)`` with ``a = 1 - level``; the lower
         end is 0 for k = 0 (Garwood 1936). It covers the mean with probability >= level for
         every mean (the count is discrete, so the coverage is conservative).
     """
-    count = _checks.real("count", count, low=0.0)
+    k = np.asarray(count, dtype=float)
+    if not np.all(np.isfinite(k) & (k >= 0.0)):
+        raise ValueError(f"count must be finite and >= 0, got {count!r}")
     _checks.real("level", level, low=0.0, high=1.0, low_open=True, high_open=True)
-    return _garwood(count, 1.0 - level)
+    return _garwood(k, 1.0 - level)
 
 
 class EventRate(NamedTuple):
