@@ -249,8 +249,9 @@ def fig09(events, envelope="auto"):
     ----------
     events : xarray.Dataset
         Events dataset of a fine delta sweep (inv_beta index 0): ``v_after_mean``,
-        ``v_after_stderr``, ``interval_mean``, ``interval_stderr``, ``n_collisions``,
-        ``n_batches``; attributes ``record_length`` and, to draw Rice's asymptotes,
+        ``v_after_mean_lo/_hi``, ``interval_mean`` (T/N), ``interval_mean_lo/_hi``,
+        ``n_collisions``, ``n_batches`` (a dataset without the ``_lo/_hi`` ends: ``*_stderr``,
+        drawn +-t); attributes ``record_length`` and, to draw Rice's asymptotes,
         ``linear_sigma_x`` and ``linear_sigma_v``.
     envelope : {"auto", "always", "never"}
         The energy-envelope averaging (`vibroimpact.stats.energy_envelope`, docs/model.md
@@ -263,12 +264,15 @@ def fig09(events, envelope="auto"):
     Returns
     -------
     matplotlib.figure.Figure
-        Two stacked axes sharing delta; (b), the mean interval, on a log scale. Bars are
-        +-t batch-means standard errors, t the Student quantile of B - 1 dof at
-        `CONFIDENCE` (as `vibroimpact.stats.BatchMeans.interval`). Means resting on fewer
-        than `FEW_IMPACTS` collisions are open squares without bars (an interval needs two
-        collisions). Rice's large-play asymptotes (gid ``"rice"``): the mean velocity after
-        impact ``eps sigma_v sqrt(pi/2)`` and the mean interval ``1/nu+(delta)``, with the
+        Two stacked axes sharing delta; (b), the mean interval, on a log scale. Bars are the
+        stored 95 % intervals, honest for few and bursty collisions: (a) over equal stretches
+        of time (`vibroimpact.stats.mark_mean`), (b) Garwood's interval of the count widened
+        for overdispersion (`vibroimpact.stats.event_rate`). Points resting on fewer than
+        `FEW_IMPACTS` collisions are open squares, with their bars; (b) draws T/N from one
+        collision on, (a) leaves out plays whose collisions give no interval (a single
+        collision) and says so in the legend. Rice's large-play asymptotes (gid ``"rice"``):
+        the mean velocity after impact ``eps sigma_v sqrt(pi/2)`` and the mean interval
+        ``1/nu+(delta)``, with the
         record length, beyond which no interval can be measured. The plays with no
         collision in the record are shaded (gid ``"no_collision"``), from
         :func:`critical_delta` on: a property of this record, not a threshold. The
