@@ -371,8 +371,11 @@ def event_rate(times, t0: float, t1: float, n_batches: int = DEFAULT_N_BATCHES,
     quantile equals Student's t of ``nonempty batches - 1`` degrees of freedom (at most
     B - 1): a t interval in the normal limit, and widest where few batches hold an event.
     The result is the union with Garwood's interval: never narrower than it. Coverage,
-    measured in ``tests/test_event_rate_coverage.py`` on clustered processes of known rate:
-    >= 0.94 from about 10 events on.
+    measured in ``tests/test_event_rate_coverage.py`` on clustered processes of known rate
+    (bursts of 1, 1 + Poisson(1), or 1-3 events; 12, 25, 50 events expected; 1000 seeds):
+    0.96-0.98, where Garwood's interval alone covers 0.78-0.86 for the bursts. Where the
+    events are more regular than Poisson (an impact motion locked to a harmonic force, D
+    near 0) the Garwood floor makes the interval conservative: wider than the batch spread.
     """
     times, t0, t1 = _window(times, t0, t1)
     n_batches = int(_checks.integer("n_batches", n_batches, low=2))
