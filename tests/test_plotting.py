@@ -21,7 +21,7 @@ from vibroimpact.orbits import orbit_map, periodic_orbits
 from vibroimpact.pipeline import datasets, tasks
 from vibroimpact.plotting import axis_label, critical_delta
 from vibroimpact.plotting.orbits import S_LEVELS, TYPE_COLORS, complex_multipliers
-from vibroimpact.stats.events import t_quantile
+from vibroimpact.stats.events import poisson_interval, t_quantile
 
 NOISE = dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=60_001,
              seed=19740914, nperseg=1024)
@@ -178,17 +178,25 @@ def test_density_figures_label_impacts_beyond_axis_and_batch_band(data, name, va
         assert (f"{100 * beyond:.3g} % beyond axis" in label) == (beyond > 1e-3), label
     if var == "interval":   # intervals at the largest play overrun the 10-unit axis
         assert "beyond axis" in labels[0]
-    # band = +-t batch-means s.e., t of B - 1 = 19 dof
+    # band = +-t batch-means s.e., t of B - 1 = 19 dof, joined with Garwood's interval
     assert "batch-means" in _legend(ax).get_title().get_text()
+    assert "Garwood" in _legend(ax).get_title().get_text()
     assert f"t = {t:.4g}" in _legend(ax).get_title().get_text()
-    # the band of a bin drawn on its own (>= MIN_BIN_COUNT values) is density +- t s.e.
+    # the band of a bin drawn on its own (>= MIN_BIN_COUNT values): the wider of density +-
+    # t s.e. and Garwood's 95 % interval of its count c, G(c) / (n w)
     cell = events.sel(delta=0.0)
     y = np.asarray(cell[f"{var}_density"])
     se = np.asarray(cell[f"{var}_density_stderr"])
-    counts = plotting.bin_counts(cell, f"{var}_density")[1]
+    _, counts, n = plotting.bin_counts(cell, f"{var}_density")
+    width = float(events[var][1] - events[var][0])
     alone = counts >= plotting.MIN_BIN_COUNT
-    band = ax.collections[2].get_paths()[0].vertices[:, 1]              # delta = 0: third curve
-    assert np.nanmax(band) == pytest.approx(np.max((y + t * se)[alone]), rel=1e-12)
+    g_hi = poisson_interval(counts[alone].astype(float))[1] / (n * width)
+    bands = [c for c in ax.collections if c.get_gid() == "band"]
+    assert len(bands) == len(lines)
+    band = bands[2].get_paths()[0].vertices[:, 1]                        # delta = 0: third curve
+    assert np.nanmax(band) == pytest.approx(np.max(np.fmax((y + t * se)[alone], g_hi)),
+                                            rel=1e-12)
+    assert np.max(g_hi) > 0 and np.all(g_hi > y[alone])
     assert ax.get_ylabel() == axis_label(events[f"{var}_density"])
     assert ax.figure.axes[-1].get_xlabel() == axis_label(events[var])
 
@@ -284,27 +292,32 @@ def test_fig09_bars_scale_and_markers(data):
     fig = plotting.fig09(events)
     ax_v, ax_z = fig.axes
     assert ax_v.get_yscale() == "linear" and ax_z.get_yscale() == "log"
-    t = t_quantile(20)
     for ax, name in ((ax_v, "v_after"), (ax_z, "interval")):
         # the plays without a collision in the record: shaded from d_c on, not a threshold line
         spans = [p for p in ax.patches if p.get_gid() == "no_collision"]
         assert len(spans) == 1
         assert spans[0].get_x() == pytest.approx(d_c)
-        # bars: +-t standard errors, t of 19 dof (Student, as BatchMeans.interval)
+        # bars: the stored 95 % interval ends (asymmetric for T/N), exactly
+        lo, hi = ds[f"{name}_mean_lo"].values, ds[f"{name}_mean_hi"].values
         segments = ax.containers[0].lines[2][0].get_segments()
-        half = np.array([0.5 * (s[1, 1] - s[0, 1]) for s in segments])
-        expected = t * ds[f"{name}_stderr"].values[enough]
-        np.testing.assert_allclose(half, expected[np.isfinite(expected)], rtol=1e-12)
+        drawn = enough & np.isfinite(lo)
+        np.testing.assert_allclose([s[0, 1] for s in segments], lo[drawn], rtol=1e-12)
+        np.testing.assert_allclose([s[1, 1] for s in segments], hi[drawn], rtol=1e-12)
         squares = [ln for ln in ax.get_lines() if ln.get_marker() == "s"]
         assert len(squares) == 1
-        # an interval needs two collisions: one collision is a cross in (a), nothing in (b)
-        shown = few & (n > 1) & np.isfinite(ds[f"{name}_mean"].values)
+        # (b) T/N rests on the count: from one collision on; (a) a mean needs an interval
+        shown = few & np.isfinite(lo) & (n >= (2 if name == "v_after" else 1))
         np.testing.assert_array_equal(squares[0].get_xdata(), ds["delta"].values[shown])
         assert squares[0].get_markerfacecolor() == "white"
+    # T/N is the record length over the count, and its interval holds it
+    z = ds["interval_mean"].values[n > 0]
+    np.testing.assert_allclose(z, ds["simulated_time"].values[n > 0] / n[n > 0], rtol=1e-12)
+    assert np.all((ds["interval_mean_lo"].values[n > 0] < z)
+                  & (z < ds["interval_mean_hi"].values[n > 0]))
     labels = [t.get_text() for t in fig.legends[0].get_texts()]     # one legend, both panels
     assert any("fewer than 20 collisions" in s for s in labels)
     assert any(f"no collision in this record for $\\delta$ > {d_c:g}" in s for s in labels)
-    assert any("t = 2.093" in s for s in labels)
+    assert any("95 % intervals" in s and "Garwood" in s for s in labels)
     assert ax_v.get_ylabel() == axis_label(ds["v_after_mean"])
     assert ax_z.get_ylabel() == axis_label(ds["interval_mean"])
     assert ax_z.get_xlabel() == axis_label(ds["delta"])
@@ -667,6 +680,28 @@ def test_density_figure_draws_no_point_below_the_sparse_bin_count(data):
     x = np.asarray(line.get_xdata(), dtype=float)
     assert np.nanmax(x) < float(events["v_after"][-1]) - 0.5 * width   # the lone bin is not drawn
     assert ax.get_xlim()[1] < float(events["v_after"][-1])              # nor the axis taken to it
+
+
+def test_density_figure_draws_merged_runs_apart_from_the_curve(data):
+    """A merged run of sparse bins is a bar over its width, never a plateau of the curve."""
+    events = data["events"].copy(deep=True)
+    cell = dict(inv_beta=0, delta=int(np.argmin(np.abs(events["delta"].values))))
+    n = int(events["n_collisions"][cell])
+    width = float(events["v_after"][1] - events["v_after"][0])
+    dens = events["v_after_density"][cell].values.copy()
+    dens[-6:] = [30.0, 20.0, 4.0, 0.0, 3.0, 5.0]     # 12 values in the last four bins,
+    dens[-6:] /= n * width                            # after two full ones
+    events["v_after_density"][cell] = dens
+    ax = plotting.fig07(events, density_delta=[0.0]).axes[0]
+    (line,) = _data_lines(ax)
+    x = np.asarray(line.get_xdata(), dtype=float)
+    edges_right = float(events["v_after"][-1]) + 0.5 * width
+    assert np.nanmax(x) < edges_right - 4 * width       # the curve stops before the run
+    runs = [c for c in ax.collections if c.get_gid() == "sparse_run"]
+    (bar,) = [c for c in runs if np.allclose(np.diff(c.get_segments()[0][:, 1]), 0.0)]
+    (seg,) = [g for g in bar.get_segments() if g[1, 0] == pytest.approx(edges_right)]
+    np.testing.assert_allclose(seg[:, 0], [edges_right - 4 * width, edges_right], rtol=1e-12)
+    np.testing.assert_allclose(seg[:, 1], 12.0 / (n * 4 * width), rtol=1e-12)
 
 
 def test_a_single_bin_spans_zero_to_max():

@@ -15,7 +15,7 @@ from vibroimpact.stats import (
     linear_psd_response, linear_response_std, motion_map_agreement, motion_statistics,
     rayleigh_pdf, truncated_gaussian_pdf, variance_from_psd, velocity_after_impact, welch_psd,
 )
-from vibroimpact.stats.events import t_quantile
+from vibroimpact.stats.events import event_rate, mark_mean, poisson_interval, t_quantile
 
 
 def _ar1(rng, phi, n, reps=None, sigma_e=1.0):
@@ -243,6 +243,83 @@ def test_batch_means_short_and_invalid():
     assert batch_means(np.r_[1000.0, np.ones(40)]).mean == 1.0
     with pytest.raises(ValueError, match="n_batches"):
         batch_means(np.ones(100), n_batches=1)
+
+
+# ------------------------------------------------------------- event rates of few events
+
+@pytest.mark.parametrize("k", [0, 1, 3, 10, 51])
+def test_poisson_interval_is_garwoods(k):
+    # Independent check of the defining tails (1e-9): P(X >= k | lo) = P(X <= k | hi) = 2.5 %.
+    lo, hi = poisson_interval(k, 0.95)
+    assert sps.poisson.cdf(k, hi) == pytest.approx(0.025, abs=1e-9)
+    if k:
+        assert sps.poisson.sf(k - 1, lo) == pytest.approx(0.025, abs=1e-9)
+    else:
+        assert lo == 0.0 and hi == pytest.approx(-np.log(0.025), rel=1e-12)   # 3.689
+    with pytest.raises(ValueError, match="count"):
+        poisson_interval(-1)
+
+
+def test_event_rate_is_count_over_record_and_garwood_without_overdispersion():
+    # 40 events, two in each of the 20 batches: dispersion 0, so exactly Garwood's / T.
+    t0, t1 = 100.0, 2100.0
+    times = t0 + (np.arange(40) + 0.5) * 50.0
+    r = event_rate(times, t0, t1)
+    assert r.count == 40 and r.duration == 2000.0 and r.rate == 0.02
+    assert r.mean_interval == 50.0 and r.dispersion == 0.0
+    lo, hi = poisson_interval(40)
+    assert (r.rate_lo, r.rate_hi) == pytest.approx((lo / 2000.0, hi / 2000.0), rel=1e-12)
+    assert r.mean_interval_bounds == pytest.approx((2000.0 / hi, 2000.0 / lo), rel=1e-12)
+    assert r.mean_interval_stderr == pytest.approx(50.0 / np.sqrt(40), rel=1e-12)
+    # No event: the mean interval is unknown but at least T / 3.689 (95 %).
+    none = event_rate([], t0, t1)
+    assert np.isnan(none.mean_interval) and none.rate == 0.0
+    assert none.mean_interval_bounds == pytest.approx((2000.0 / -np.log(0.025), np.inf))
+    with pytest.raises(ValueError, match="times must lie"):
+        event_rate([50.0], t0, t1)
+    with pytest.raises(ValueError, match="t1"):
+        event_rate([], t1, t0)
+
+
+def test_event_rate_widens_for_bursts_and_mean_of_gaps_is_biased_low():
+    # Each excursion gives a burst of three events: the batch counts' dispersion is near 3
+    # and the interval is wider than Garwood's by about sqrt(3) on the log scale (> 1.4x).
+    rng = np.random.default_rng(7)
+    T = 1.0e6
+    centres = np.sort(rng.uniform(0.0, T - 10.0, 30))
+    times = np.repeat(centres, 3) + np.tile([0.0, 2.0, 5.0], 30)
+    r = event_rate(times, 0.0, T)
+    assert r.count == 90 and 1.5 < r.dispersion < 6.0
+    g_lo, g_hi = poisson_interval(90)
+    assert np.log(r.rate_hi / r.rate_lo) > 1.4 * np.log(g_hi / g_lo)
+    # The mean of the N - 1 gaps between first and last event, E = T / (N + 1) for a
+    # Poisson count given N: over 4000 records of 5 events it is 5/6 of T / N's mean ...
+    spans = np.sort(rng.uniform(0.0, T, (4000, 5)), axis=1)
+    gap_mean = (spans[:, -1] - spans[:, 0]) / 4
+    assert gap_mean.mean() == pytest.approx(T / 6, rel=0.03)   # sd of the mean ~ 0.6 %
+    # ... while N / T is unbiased for the rate: Poisson counts of mean 5, 4000 records.
+    counts = rng.poisson(5.0, 4000)
+    assert np.mean(counts / T) == pytest.approx(5.0 / T, rel=0.03)   # sd ~ 0.5 %
+
+
+def test_mark_mean_over_time_batches():
+    rng = np.random.default_rng(8)
+    times = np.sort(rng.uniform(0.0, 1000.0, 400))
+    v = 2.0 + rng.standard_normal(400)
+    m = mark_mean(v, times, 0.0, 1000.0)
+    assert m.mean == pytest.approx(v.mean(), rel=1e-14)
+    assert m.lo < m.mean < m.hi and 15 <= m.dof <= 19
+    # CR2 is exactly unbiased for independent equal-variance values: over 500 records of
+    # 400 unit-variance values the mean squared error is 1 / 400 within 5 % (its sd ~1.5 %).
+    se2 = [mark_mean(rng.standard_normal(400), times, 0.0, 1000.0).stderr ** 2
+           for _ in range(500)]
+    assert np.mean(se2) == pytest.approx(1.0 / 400, rel=0.05)
+    # All values in one batch: no error; no value: no mean.
+    one = mark_mean([1.0, 2.0], [1.0, 2.0], 0.0, 1000.0)
+    assert one.mean == 1.5 and np.isnan(one.stderr) and np.isnan(one.lo)
+    assert np.isnan(mark_mean([], [], 0.0, 1.0).mean)
+    with pytest.raises(ValueError, match="equal shapes"):
+        mark_mean([1.0], [1.0, 2.0], 0.0, 10.0)
 
 
 # --------------------------------------------------------------------- impact-motion types

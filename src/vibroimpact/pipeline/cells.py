@@ -90,7 +90,8 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     -------
     dict
         Scalars ``n_collisions, collision_rate, simulated_time, n_batches, v_after_mean,
-        v_after_stderr, v_after_lag1, interval_mean, interval_stderr, interval_lag1,
+        v_after_stderr, v_after_mean_lo, v_after_mean_hi, v_after_lag1, interval_mean,
+        interval_stderr, interval_mean_lo, interval_mean_hi, count_dispersion, interval_lag1,
         contact_fraction, stuck_fraction, stick_time_mean, rebounds_mean, n_rebounds,
         rebound_v_after_mean, v_after_beyond, interval_beyond``, the self-audit
         ``power_residual(_stderr), power_input, virial_residual(_stderr), virial_scale``
@@ -106,6 +107,15 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
 
     Notes
     -----
+    The mean interval is ``T / N`` (record length after the transient over the collisions in
+    it), the reciprocal of the rate (`stats.event_rate`): the mean of the N - 1 gaps between
+    the first and the last collision would leave the two end gaps out and be biased low where
+    collisions are few. Its interval (``interval_mean_lo``, ``interval_mean_hi``) is Garwood's
+    for the count, widened where the counts in B equal stretches of time are overdispersed
+    (``count_dispersion`` > 1: collisions in bursts). The mean velocity after impact and its
+    interval are batched in time too (`stats.mark_mean`), so a burst stays in one batch and a
+    few collisions give a wide interval. The lag-1 correlations are those of batch means of
+    equal numbers of values (`stats.batch_means`), a check of the sequences' memory.
     Density errors are batch-means standard errors per bin (`stats.density` with
     ``n_batches``). A lag-1 correlation of the batch means above ``2/sqrt(B)`` is logged as
     a warning on the ``vibroimpact`` logger: the batches are then too short for an honest
@@ -132,6 +142,8 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     cell = (f"cell delta={delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
     v_stats = stats.batch_means(v_after, n_batches) if v_after.size else None
     z_stats = stats.batch_means(z, n_batches) if z.size else None
+    rate = stats.event_rate(col.time, transient, t_end, n_batches)
+    v_mean = stats.mark_mean(v_after, col.time, transient, t_end, n_batches)
     _lag1_check("the velocity after impact", v_stats, cell)
     _lag1_check("the interval", z_stats, cell)
     v_dens = stats.density(v_after, bins["v_after"], total=v_after.size, n_batches=n_batches)
@@ -144,11 +156,16 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         collision_rate=v_after.size / duration,
         simulated_time=duration,
         n_batches=n_batches,
-        v_after_mean=v_stats.mean if v_stats else nan,
-        v_after_stderr=v_stats.stderr if v_stats else nan,
+        v_after_mean=v_mean.mean,
+        v_after_stderr=v_mean.stderr,
+        v_after_mean_lo=v_mean.lo,
+        v_after_mean_hi=v_mean.hi,
         v_after_lag1=v_stats.lag1 if v_stats else nan,
-        interval_mean=z_stats.mean if z_stats else nan,
-        interval_stderr=z_stats.stderr if z_stats else nan,
+        interval_mean=rate.mean_interval,
+        interval_stderr=rate.mean_interval_stderr,
+        interval_mean_lo=rate.mean_interval_bounds[0],
+        interval_mean_hi=rate.mean_interval_bounds[1],
+        count_dispersion=rate.dispersion,
         interval_lag1=z_stats.lag1 if z_stats else nan,
         contact_fraction=contact / duration,
         stuck_fraction=mean(col.stuck.astype(float)),

@@ -32,10 +32,23 @@ META = {
                              "(per-rebound view)", "1"),
     "simulated_time": ("record length after the transient", "1"),
     "v_after_mean": ("mean velocity after impact (per collision)", "1"),
-    "v_after_stderr": ("standard error of the mean velocity after impact (batch means)", "1"),
+    "v_after_stderr": ("standard error of the mean velocity after impact (ratio estimator over "
+                       "B equal stretches of time)", "1"),
+    "v_after_mean_lo": ("lower end of the 95 % interval of the mean velocity after impact "
+                        "(t of nonempty time batches - 1 dof)", "1"),
+    "v_after_mean_hi": ("upper end of the 95 % interval of the mean velocity after impact",
+                        "1"),
     "v_after_lag1": ("lag-1 autocorrelation of the batch means of the velocity after impact", "1"),
-    "interval_mean": ("mean interval between collisions", "1"),
-    "interval_stderr": ("standard error of the mean interval (batch means)", "1"),
+    "interval_mean": ("mean interval between collisions T/N (record length after the "
+                      "transient over the collisions in it: the reciprocal rate)", "1"),
+    "interval_stderr": ("standard error of the mean interval T/N (delta method, "
+                        "T/N sqrt(max(D, 1)/N), D the count dispersion)", "1"),
+    "interval_mean_lo": ("lower end of the 95 % interval of the mean interval T/N (Garwood, "
+                         "widened for overdispersed counts)", "1"),
+    "interval_mean_hi": ("upper end of the 95 % interval of the mean interval T/N (inf: no "
+                         "collision)", "1"),
+    "count_dispersion": ("index of dispersion var/mean of the collision counts in B equal "
+                         "stretches of time (1: Poisson; > 1: bursts)", "1"),
     "interval_lag1": ("lag-1 autocorrelation of the batch means of the interval", "1"),
     "power_residual": ("residual of the power balance <f v> - 2 zeta <v^2> - "
                        "(1 - eps^2) nu <V^2> / 2 (exact identity: zero within its error)", "1"),
@@ -112,8 +125,10 @@ META = {
 }
 
 _EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches",
-                  "v_after_mean", "v_after_stderr", "v_after_lag1", "interval_mean",
-                  "interval_stderr", "interval_lag1", "contact_fraction", "stuck_fraction",
+                  "v_after_mean", "v_after_stderr", "v_after_mean_lo", "v_after_mean_hi",
+                  "v_after_lag1", "interval_mean", "interval_stderr", "interval_mean_lo",
+                  "interval_mean_hi", "count_dispersion", "interval_lag1", "contact_fraction",
+                  "stuck_fraction",
                   "stick_time_mean", "rebounds_mean", "n_rebounds", "rebound_v_after_mean",
                   "v_after_beyond", "interval_beyond", "power_residual",
                   "power_residual_stderr", "power_input", "virial_residual",

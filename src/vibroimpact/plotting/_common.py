@@ -17,7 +17,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from vibroimpact._files import atomic_path
-from vibroimpact.stats.events import t_quantile
+from vibroimpact.stats.events import poisson_interval, t_quantile
 from vibroimpact.stats.spectra import line_power
 from vibroimpact.stats.theory import upcrossing_rate
 
@@ -530,7 +530,8 @@ def _beyond_text(fraction):
 
 #: The sparse-bin rule of every density figure: a bin is drawn on its own only when it holds
 #: at least this many values; a run of neighbouring sparser bins is merged until the run holds
-#: that many (one point at the run's centre, density = count / (n * run width)), and a run
+#: that many (a bar over the run's width, apart from the curve, density = count / (n * run
+#: width)), and a run
 #: that ends below it is not drawn. With 10 values the relative error of a merged bin is
 #: below about 1/sqrt(10) ~ 0.3, so no single value spikes down the log axis.
 MIN_BIN_COUNT = 10
@@ -625,13 +626,16 @@ def _bin_edges(centres):
 
 
 def _drawn_density(cell, var, band):
-    """``(x, density, stderr)`` polyline of one cell's density after the sparse-bin rule.
+    """The drawn parts of one cell's density after the sparse-bin rule: ``(curve, runs)``.
 
-    A bin drawn as it is gives one point at its centre; a merged run gives two, at its ends,
-    with the run's density (a plateau: the density is known only as the run's mean); the line
-    breaks (NaN) where bins between two drawn ones were empty or dropped. A merged run's
-    standard error combines its bins' as independent, ``sqrt(sum (se_i w_i)^2) / W``
-    (neighbouring bins' batch means are nearly uncorrelated); ``None`` without a ``band``.
+    ``curve = (x, density, stderr, count)``: the bins drawn on their own (>= `MIN_BIN_COUNT`
+    values), a point at each centre, with NaN breaks where the bins between two drawn ones
+    were empty, dropped or merged. ``runs = (left, right, density, stderr, count)``: the
+    merged runs of sparse bins. A run's density is known only as its mean over the run, so
+    it is drawn apart from the curve (a bar over the run's width), never joined to it as a
+    plateau that would read as structure. A run's standard error combines its bins' as
+    independent, ``sqrt(sum (se_i w_i)^2) / W`` (neighbouring bins' batch means are nearly
+    uncorrelated). ``stderr`` is None without a ``band``.
     """
     edges, counts, n = bin_counts(cell, var)
     left, right, count = merge_sparse_bins(edges, counts)
@@ -640,18 +644,37 @@ def _drawn_density(cell, var, band):
     hi = np.searchsorted(edges, right - 0.5 * w[0])         # one past its last
     se_bins = (None if band is None
                else np.nan_to_num(np.asarray(cell[band], dtype=float)) * w)
-    xs, ys, ses = [], [], []
-    for j in range(count.size):
-        if j and lo[j] != hi[j - 1]:
-            xs.append(np.nan), ys.append(np.nan), ses.append(np.nan)
-        width = right[j] - left[j]
-        y = count[j] / (n * width)
-        se = np.nan if se_bins is None else np.sqrt(np.sum(se_bins[lo[j]:hi[j]] ** 2)) / width
-        ends = [0.5 * (left[j] + right[j])] if hi[j] - lo[j] == 1 else [left[j], right[j]]
-        xs += ends
-        ys += [y] * len(ends)
-        ses += [se] * len(ends)
-    return np.array(xs), np.array(ys), None if band is None else np.array(ses)
+    width = right - left
+    y = count / (n * width) if count.size else np.empty(0)
+    se = (np.full(count.size, np.nan) if se_bins is None else
+          np.array([np.sqrt(np.sum(se_bins[i:j] ** 2)) for i, j in zip(lo, hi)]) / width)
+    single = (hi - lo) == 1
+    xs, ys, ses, cs = [], [], [], []
+    previous = None                                  # one past the last bin on the curve
+    for j in np.flatnonzero(single):
+        if previous is not None and lo[j] != previous:     # a gap, or a merged run between
+            xs.append(np.nan), ys.append(np.nan), ses.append(np.nan), cs.append(0)
+        xs.append(0.5 * (left[j] + right[j])), ys.append(y[j]), ses.append(se[j])
+        cs.append(count[j])
+        previous = hi[j]
+    curve = (np.array(xs), np.array(ys), None if band is None else np.array(ses),
+             np.array(cs, dtype=np.int64))
+    m = ~single
+    runs = (left[m], right[m], y[m], None if band is None else se[m], count[m])
+    return curve, runs
+
+
+def _density_bounds(y, half, count, n, width):
+    """The band of a drawn density: ``y +- half`` joined with Garwood's interval of its count.
+
+    ``count`` values in a bin (or run) of ``width`` out of ``n``: the density is never less
+    uncertain than its Poisson count says (`vibroimpact.stats.poisson_interval`, 95 %), and
+    the batch-means half-width ``half`` widens it where the values are correlated.
+    """
+    g_lo, g_hi = poisson_interval(np.asarray(count, dtype=float), CONFIDENCE)
+    scale = 1.0 / (n * np.asarray(width, dtype=float))
+    return (np.fmin(np.clip(y - half, 1e-300, None), g_lo * scale),
+            np.fmax(y + half, g_hi * scale))
 
 
 def _density_figure(events, i_beta, var, title, params, density_delta=None, linear=False,
@@ -662,9 +685,13 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     panel (b) draws the same curves on a linear axis, where the spread of the bulk reads;
     with `zoom` (a value of x), panel (a) shows every drawn bin and panel (b) the same
     curves, log too, on ``[0, zoom]``, where the bulk reads.
-    Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`). The band
-    is +-t batch-means standard errors (``{var}_stderr``), t the Student quantile of B - 1
-    dof (`CONFIDENCE`, B = ``n_batches``); each legend entry gives the cell's number of
+    Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`): a curve
+    joins the bins drawn on their own; a merged run of sparse bins is a bar over its width
+    apart from the curve (gid ``"sparse_run"``), with a vertical 95 % interval. The band
+    (gid ``"band"``) is +-t batch-means standard errors (``{var}_stderr``), t the Student
+    quantile of B - 1 dof (`CONFIDENCE`, B = ``n_batches``), joined with Garwood's interval
+    of the bin's count (a density of few values is never drawn surer than its Poisson
+    count allows); each legend entry gives the cell's number of
     collisions and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
     (``{quantity}_beyond``). The x axis ends at the last drawn bin.
 
@@ -685,25 +712,38 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     styles = family_styles(len(index))
     edges = _bin_edges(ds[x])
     x_end, top, low = edges[0], 0.0, np.inf
+    any_run = False
     for j, (style, k) in enumerate(zip(styles, index)):
         cell = ds.isel(delta=k)
         n = int(cell["n_collisions"])
-        xs, y, se = _drawn_density(cell, var, band)
+        (xs, y, se, c), (r_left, r_right, r_y, r_se, r_c) = _drawn_density(cell, var, band)
+        n_values = bin_counts(cell, var)[2]
         impacts = f"{n:,} collision{'' if n == 1 else 's'}" if n else "no collision"
         label = rf"$\delta$ = {_num(cell['delta'])}  ({impacts}{_beyond_text(beyond[k])})"
+        if band is not None and xs.size:
+            b_lo, b_hi = _density_bounds(y, t[k] * se, c, n_values, np.diff(edges)[0])
+        if band is not None and r_y.size:
+            r_lo, r_hi = _density_bounds(r_y, t[k] * r_se, r_c, n_values, r_right - r_left)
         for ax in axes:
             ax.plot(xs, y, color=style["color"], ls=style["ls"], marker=style["marker"],
                     markersize=3.5, markevery=_markevery(xs.size, j, len(index)),
                     label=label if ax is axes[0] else None)
-            if se is not None and xs.size:
-                half = t[k] * se
-                ax.fill_between(xs, np.clip(y - half, 1e-300, None), y + half,
-                                color=style["color"], alpha=0.15, lw=0)
-        if xs.size:
-            last = np.searchsorted(edges, xs[-1] - 1e-9 * abs(xs[-1]))   # its bin's right edge
-            x_end = max(x_end, edges[min(last, edges.size - 1)])
-            top = max(top, float(np.nanmax(y)))
-            low = min(low, float(np.nanmin(y)))
+            if band is not None and xs.size:
+                ax.fill_between(xs, b_lo, b_hi, color=style["color"], alpha=0.15, lw=0,
+                                gid="band")
+            if r_y.size:       # merged runs: apart from the curve, a bar over their width
+                ax.hlines(r_y, r_left, r_right, color=style["color"], lw=1.6,
+                          gid="sparse_run")
+                if band is not None:
+                    ax.vlines(0.5 * (r_left + r_right), r_lo, r_hi, color=style["color"],
+                              lw=0.8, gid="sparse_run")
+        any_run |= bool(r_y.size)
+        drawn_x = np.concatenate([xs[np.isfinite(xs)] + 0.5 * np.diff(edges)[0], r_right])
+        if drawn_x.size:
+            x_end = max(x_end, float(drawn_x.max()))
+            all_y = np.concatenate([y[np.isfinite(y)], r_y])
+            top = max(top, float(all_y.max()))
+            low = min(low, float(all_y.min()))
     ax_log = axes[0]
     for ax in axes if zoom is not None else axes[:1]:
         ax.set_yscale("log")
@@ -733,15 +773,19 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
         axes[0].set_xlabel(axis_label(ds[x]))
         _panel_tag(axes[0], "(a) every bin drawn")
         _panel_tag(axes[1], f"(b) the bulk, up to {_num(axes[1].get_xlim()[1])}")
-    rule = (f"bins with < {MIN_BIN_COUNT} values merged with their neighbours (plateaus), "
-            "runs still below not drawn")
+    rule = (f"bins with < {MIN_BIN_COUNT} values merged with their neighbours until they hold "
+            f"{MIN_BIN_COUNT}, runs still below not drawn")
+    if any_run:
+        rule += ("\nbars apart from the curves: a merged run's mean density over its width"
+                 + (" (vertical: its 95 % interval)" if band is not None else ""))
     title_text = rule
     if band is not None:
         b = np.unique(np.asarray(ds["n_batches"])[index])
         t_text = (f"t = {_num(t[index[0]])}, B = {int(b[0])} batches" if b.size == 1
                   else "t of B - 1 dof")
         title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
-                      f"({100 * CONFIDENCE:g} %, {t_text})\n{rule}")
+                      f"({100 * CONFIDENCE:g} %, {t_text}), at least Garwood's interval "
+                      f"of the count\n{rule}")
     if len(index) > LEGEND_INSIDE or two:
         # a legend this tall would hide the curves' peaks: below the axes instead
         fig.set_figheight(fig.get_figheight() * (1.2 if two else 1.3))

@@ -272,8 +272,9 @@ def fig09(events, envelope="auto"):
     ----------
     events : xarray.Dataset
         Events dataset of a fine delta sweep (inv_beta index 0): ``v_after_mean``,
-        ``v_after_stderr``, ``interval_mean``, ``interval_stderr``, ``n_collisions``,
-        ``n_batches``; attributes ``record_length`` and, to draw Rice's asymptotes,
+        ``v_after_mean_lo/_hi``, ``interval_mean`` (T/N), ``interval_mean_lo/_hi``,
+        ``n_collisions``, ``n_batches`` (a dataset without the ``_lo/_hi`` ends: ``*_stderr``,
+        drawn +-t); attributes ``record_length`` and, to draw Rice's asymptotes,
         ``linear_sigma_x`` and ``linear_sigma_v``.
     envelope : {"auto", "always", "never"}
         The energy-envelope averaging (`vibroimpact.stats.energy_envelope`, docs/model.md
@@ -286,12 +287,15 @@ def fig09(events, envelope="auto"):
     Returns
     -------
     matplotlib.figure.Figure
-        Two stacked axes sharing delta; (b), the mean interval, on a log scale. Bars are
-        +-t batch-means standard errors, t the Student quantile of B - 1 dof at
-        `CONFIDENCE` (as `vibroimpact.stats.BatchMeans.interval`). Means resting on fewer
-        than `FEW_IMPACTS` collisions are open squares without bars (an interval needs two
-        collisions). Rice's large-play asymptotes (gid ``"rice"``): the mean velocity after
-        impact ``eps sigma_v sqrt(pi/2)`` and the mean interval ``1/nu+(delta)``, with the
+        Two stacked axes sharing delta; (b), the mean interval, on a log scale. Bars are the
+        stored 95 % intervals, honest for few and bursty collisions: (a) over equal stretches
+        of time (`vibroimpact.stats.mark_mean`), (b) Garwood's interval of the count widened
+        for overdispersion (`vibroimpact.stats.event_rate`). Points resting on fewer than
+        `FEW_IMPACTS` collisions are open squares, with their bars; (b) draws T/N from one
+        collision on, (a) leaves out plays whose collisions give no interval (a single
+        collision) and says so in the legend. Rice's large-play asymptotes (gid ``"rice"``):
+        the mean velocity after impact ``eps sigma_v sqrt(pi/2)`` and the mean interval
+        ``1/nu+(delta)``, with the
         record length, beyond which no interval can be measured. The plays with no
         collision in the record are shaded (gid ``"no_collision"``), from
         :func:`critical_delta` on: a property of this record, not a threshold. The
@@ -309,6 +313,11 @@ def fig09(events, envelope="auto"):
     t_text = (f"t = {_num(t_quantile(batches[0], CONFIDENCE))}, {int(batches[0])} batches"
               if batches.size == 1 else "t of B - 1 dof")
     bar_label = rf"mean $\pm$ t$\cdot$batch-means s.e. ({100 * CONFIDENCE:g} %, {t_text})"
+    if "interval_mean_lo" in ds:
+        b_text = f"{int(batches[0])}" if batches.size == 1 else "B"
+        bar_label = (f"95 % intervals: (a) t over {b_text} equal stretches of time; (b) T/N "
+                     "(record / collisions),\nGarwood's interval of the count, widened where "
+                     "bursts of collisions overdisperse it")
     d_c = critical_delta(events)
     record = ds.attrs.get("record_length")
     sigma = (ds.attrs.get("linear_sigma_x"), ds.attrs.get("linear_sigma_v"))
@@ -335,14 +344,24 @@ def fig09(events, envelope="auto"):
     few_any = False
     for k, (ax, name, color) in enumerate(zip(axes, ("v_after", "interval"), ("C0", "C1"))):
         mean = np.asarray(ds[f"{name}_mean"], dtype=float)
-        err = t * np.asarray(ds[f"{name}_stderr"], dtype=float)
-        ax.errorbar(delta[enough], mean[enough], yerr=err[enough], color=color, marker="o",
-                    markersize=3.5)
-        few = ~enough & np.isfinite(mean) & (n > 1)
+        if f"{name}_mean_lo" in ds:           # the stored interval (honest for few events)
+            lo = np.asarray(ds[f"{name}_mean_lo"], dtype=float)
+            hi = np.asarray(ds[f"{name}_mean_hi"], dtype=float)
+        else:                                 # an older dataset: +-t batch-means s.e.
+            err = t * np.asarray(ds[f"{name}_stderr"], dtype=float)
+            lo, hi = mean - err, mean + err
+        # (b) T/N rests on the count, valid from one collision on; (a) a mean of marks
+        # needs them spread over two or more batches (its interval is NaN otherwise)
+        shown = np.isfinite(mean) & np.isfinite(lo) & (n >= (1 if k else 2))
+        solid = shown & enough
+        hi_drawn = np.where(np.isfinite(hi), hi, np.nan)
+        yerr = np.vstack([mean - lo, hi_drawn - mean])
+        ax.errorbar(delta[solid], mean[solid], yerr=yerr[:, solid], color=color, marker="o",
+                    markersize=3.5, ls="-")
+        few = shown & ~enough
         few_any |= bool(few.any())
-        ax.plot(delta[few], mean[few], ls="none", marker="s", mfc="white", color=color,
-                markersize=4.5)
-        ax.plot(delta[n == 1], mean[n == 1], ls="none", marker="x", color=color, markersize=4.5)
+        ax.errorbar(delta[few], mean[few], yerr=yerr[:, few], ls="none", marker="s",
+                    mfc="white", color=color, markersize=4.5, elinewidth=0.8)
         if rice:
             (line,) = ax.plot(d_rice, asymptotes[k], color="0.25", ls="--", lw=1.1)
             line.set_gid("rice")
@@ -355,6 +374,11 @@ def fig09(events, envelope="auto"):
             span.set_gid("no_collision")
         ax.set_ylabel(axis_label(ds[f"{name}_mean"]))
     axes[0].set_ylim(bottom=0.0)
+    if "v_after_mean_lo" in ds and enough.any():
+        # the intervals of a handful of collisions run off the axis (they are that wide)
+        v_top = np.nanmax(np.asarray(ds["v_after_mean_hi"], dtype=float)[enough])
+        if np.isfinite(v_top):
+            axes[0].set_ylim(top=1.6 * v_top)
     # the mean interval spans orders of magnitude (about 1 to 1e5 over the default sweep)
     axes[1].set_yscale("log")
     measured = np.asarray(ds["interval_mean"], dtype=float)
@@ -372,10 +396,19 @@ def fig09(events, envelope="auto"):
     marks = [Line2D([], [], color="0.3", marker="o", markersize=3.5, label=bar_label)]
     if few_any:
         marks.append(Line2D([], [], ls="none", marker="s", mfc="white", color="0.3",
-                            markersize=4.5, label=f"fewer than {FEW_IMPACTS} collisions (no bar)"))
-    if (n == 1).any():
-        marks.append(Line2D([], [], ls="none", marker="x", color="0.3", markersize=4.5,
-                            label="a single collision in the record (no interval, no bar)"))
+                            markersize=4.5, label=f"fewer than {FEW_IMPACTS} collisions ((b) one "
+                                                  "collision: T/N is the record length)"))
+    lone = (n == 1) | ((n > 1) & ~np.isfinite(np.asarray(
+        ds["v_after_mean_lo"] if "v_after_mean_lo" in ds else ds["v_after_stderr"],
+        dtype=float)))
+    if lone.any():
+        where = (f"{_num(delta[lone].min())}" if lone.sum() == 1
+                 else f"{_num(delta[lone].min())}-{_num(delta[lone].max())}")
+        what = ("a single collision" if np.all(n[lone] == 1)
+                else "collisions in one stretch of time only")
+        marks.append(Line2D([], [], ls="none",
+                            label=rf"(a) left out at $\delta$ = {where}: {what} (a count, "
+                                  "not a mean)"))
     if rice:
         marks.append(Line2D([], [], color="0.25", ls="--", lw=1.1,
                             label=r"Rice, large $\delta$: (a) $\varepsilon\sigma_v\sqrt{\pi/2}$, "

@@ -5,7 +5,8 @@ the impact events and the sampled record a(tau); these modules turn them into th
 the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracles.
 
 - `spectra`: Welch PSDs in the paper's convention (eqs. 8, 9) and the one conversion helper;
-- `events`: intervals, velocities after impact, densities, batch means;
+- `events`: intervals, velocities after impact, densities, batch means, event rates and
+  means of few, clustered events;
 - `collisions`: impacts grouped with the chatter and sticking they start (the unit of every
   impact statistic);
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
@@ -29,6 +30,8 @@ _WHERE = {
     "DEFAULT_N_BATCHES": "events", "impact_intervals": "events",
     "velocity_after_impact": "events", "interval_ratio": "events", "Density": "events",
     "density": "events", "BatchMeans": "events", "batch_means": "events", "t_quantile": "events",
+    "poisson_interval": "events", "EventRate": "events", "event_rate": "events",
+    "MarkMean": "events", "mark_mean": "events",
     "DEFAULT_REBOUND_FLOOR": "collisions", "MIN_REBOUND_FLOOR": "collisions",
     "Collisions": "collisions",
     "group_collisions": "collisions", "close_open_phase": "collisions",

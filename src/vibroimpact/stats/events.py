@@ -1,5 +1,5 @@
-"""Impact events: intervals, velocities after impact, densities, batch means
-(Figs. 7-9, 13, 14)."""
+"""Impact events: intervals, velocities after impact, densities, batch means, event rates
+with intervals honest for few and clustered events (Figs. 7-9, 13, 14)."""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -9,7 +9,8 @@ import numpy as np
 from vibroimpact import _checks
 
 __all__ = ["DEFAULT_N_BATCHES", "impact_intervals", "velocity_after_impact", "interval_ratio",
-           "Density", "density", "t_quantile", "BatchMeans", "batch_means"]
+           "Density", "density", "t_quantile", "BatchMeans", "batch_means", "poisson_interval",
+           "EventRate", "event_rate", "MarkMean", "mark_mean"]
 
 #: Batches in a batch-means standard error; >= 20 keeps the t-quantile close to the normal one.
 DEFAULT_N_BATCHES = 20
@@ -222,3 +223,248 @@ def batch_means(x, n_batches: int = DEFAULT_N_BATCHES) -> BatchMeans:
     lag1 = float(np.dot(d[:-1], d[1:]) / denom) if denom > 0 else np.nan
     return BatchMeans(float(means.mean()), float(means.std(ddof=1) / np.sqrt(n_batches)),
                       n_batches, lag1)
+
+
+def _batch_counts(times, t0, t1, n_batches):
+    """Counts of `times` in ``n_batches`` equal stretches of ``[t0, t1)`` (last one closed)."""
+    k = np.floor((times - t0) * (n_batches / (t1 - t0))).astype(np.int64)
+    return k, np.bincount(np.clip(k, 0, n_batches - 1), minlength=n_batches)
+
+
+def _window(times, t0, t1):
+    """`times` as floats, checked 1-D and inside the record ``[t0, t1]``."""
+    t0 = _checks.real("t0", t0)
+    t1 = _checks.real("t1", t1, low=t0, low_open=True)
+    times = np.asarray(times, dtype=float)
+    if times.ndim != 1:
+        raise ValueError(f"times must be one-dimensional, got shape {times.shape}")
+    if times.size and (times.min() < t0 or times.max() > t1):
+        raise ValueError(f"times must lie in the record [t0, t1] = [{t0!r}, {t1!r}], got "
+                         f"[{times.min()!r}, {times.max()!r}]")
+    return times, t0, t1
+
+
+def _effective_dof(counts):
+    """Degrees of freedom of a spread over batches: nonempty batches - 1, within [1, B - 1].
+
+    Batches without an event say little of how the events cluster: the spread of the counts
+    is learnt from at most as many independent pieces as there are occupied batches.
+    """
+    return max(1, min(counts.size - 1, int(np.count_nonzero(counts)) - 1))
+
+
+def _t_alpha(level, dof):
+    """The two-sided normal tail ``a`` whose quantile is Student's ``t_{(1+level)/2, dof}``."""
+    from scipy.special import ndtr, stdtrit
+
+    return float(2.0 * ndtr(-stdtrit(dof, 0.5 + 0.5 * level)))
+
+
+def _garwood(count, alpha):
+    """Garwood's interval of a Poisson mean at two-sided tail `alpha` (tails kept precise).
+
+    ``chdtri(v, p)`` is the chi-square quantile of upper tail p (what ``scipy.stats.chi2.isf``
+    computes, without the import of scipy.stats in a figure job).
+    """
+    from scipy.special import chdtri
+
+    k = np.asarray(count, dtype=float)
+    lo = np.where(k > 0, chdtri(np.maximum(2.0 * k, 1e-300), 1.0 - 0.5 * alpha) / 2.0, 0.0)
+    hi = chdtri(2.0 * k + 2.0, 0.5 * alpha) / 2.0
+    return (float(lo), float(hi)) if k.ndim == 0 else (lo, hi)
+
+
+def poisson_interval(count, level: float = 0.95) -> tuple[float, float]:
+    """Garwood's exact two-sided interval for the mean of a Poisson count.
+
+    Parameters
+    ----------
+    count : float or array_like of float
+        The observed count k >= 0 (a non-integer k is allowed: an effective count).
+    level : float, optional
+        Confidence level, 0 < level < 1 (default 0.95).
+
+    Returns
+    -------
+    (float, float), or two arrays shaped like `count`
+        ``(chi2_{a/2}(2k) / 2, chi2_{1-a/2}(2k + 2) / 2)`` with ``a = 1 - level``; the lower
+        end is 0 for k = 0 (Garwood 1936). It covers the mean with probability >= level for
+        every mean (the count is discrete, so the coverage is conservative).
+    """
+    k = np.asarray(count, dtype=float)
+    if not np.all(np.isfinite(k) & (k >= 0.0)):
+        raise ValueError(f"count must be finite and >= 0, got {count!r}")
+    _checks.real("level", level, low=0.0, high=1.0, low_open=True, high_open=True)
+    return _garwood(k, 1.0 - level)
+
+
+class EventRate(NamedTuple):
+    """Rate of a stationary point process with an interval honest for few, bursty events."""
+
+    count: int          #: events N in the record
+    duration: float     #: record length T
+    rate: float         #: N / T
+    rate_lo: float      #: lower end of the interval of the rate
+    rate_hi: float      #: upper end of the interval of the rate
+    dispersion: float   #: index of dispersion of the batch counts, var / mean (NaN: N = 0)
+    n_batches: int      #: equal stretches of time B the counts were taken in
+    level: float        #: confidence level of the interval
+
+    @property
+    def mean_interval(self) -> float:
+        """``T / N``, the mean interval between events (the reciprocal rate; NaN for N = 0)."""
+        return self.duration / self.count if self.count else np.nan
+
+    @property
+    def mean_interval_bounds(self) -> tuple[float, float]:
+        """The interval of the mean interval: ``(1 / rate_hi, 1 / rate_lo)`` (inf: rate_lo = 0)."""
+        return (1.0 / self.rate_hi,
+                1.0 / self.rate_lo if self.rate_lo > 0 else np.inf)
+
+    @property
+    def mean_interval_stderr(self) -> float:
+        """Delta-method standard error of `mean_interval`: ``(T/N) sqrt(max(D, 1) / N)``."""
+        if not self.count:
+            return np.nan
+        d = max(self.dispersion, 1.0) if np.isfinite(self.dispersion) else 1.0
+        return self.mean_interval * float(np.sqrt(d / self.count))
+
+
+def event_rate(times, t0: float, t1: float, n_batches: int = DEFAULT_N_BATCHES,
+               level: float = 0.95) -> EventRate:
+    """Rate of events in a record, with an interval honest when events are few and clustered.
+
+    Parameters
+    ----------
+    times : array_like of float, shape (N,)
+        Event times (e.g. collision starts), each within ``[t0, t1]``; order is free.
+    t0, t1 : float
+        The record observed (t0 < t1): for a simulated cell the transient and the record end.
+    n_batches : int, optional
+        Equal stretches of time B (>= 2; default 20) whose counts measure the overdispersion.
+    level : float, optional
+        Confidence level, 0 < level < 1 (default 0.95).
+
+    Returns
+    -------
+    EventRate
+        ``rate = N / T`` (``T = t1 - t0``), the interval of the rate, the dispersion index
+        D of the B batch counts and, as properties, the mean interval ``T / N``, its interval
+        and its standard error.
+
+    Notes
+    -----
+    For a stationary point process of intensity lambda the mean interval between events
+    (the Palm mean) is exactly ``1 / lambda``, and ``N / T`` is an unbiased estimator of
+    lambda; ``T / N`` is its consistent reciprocal. The mean of the N - 1 gaps between
+    the first and the last event leaves the two end gaps out and so is biased low when
+    events are few (it is ``(t_N - t_1) / (N - 1)``, a span shorter than T).
+
+    The interval is Garwood's (`poisson_interval`) for the count, divided by T, when the
+    counts are not overdispersed: a Poisson count has variance equal to its mean. Events
+    that come in bursts (one excursion giving two or three collisions) have a count with
+    variance ``D N``, ``D = E[S^2] / E[S] > 1`` for bursts of S events. D is estimated by
+    the index of dispersion of the counts in B equal stretches of time (``ddof = 1``) and,
+    when it exceeds 1, the count is treated as ``N / D`` independent Poisson bursts, each
+    worth D events (quasi-Poisson): ``rate in D * garwood(N / D) / T``. The dispersion is
+    estimated from the batches, so the interval's level is raised to that whose normal
+    quantile equals Student's t of ``nonempty batches - 1`` degrees of freedom (at most
+    B - 1): a t interval in the normal limit, and widest where few batches hold an event.
+    The result is the union with Garwood's interval: never narrower than it. Coverage,
+    measured in ``tests/test_event_rate_coverage.py`` on clustered processes of known rate
+    (bursts of 1, 1 + Poisson(1), or 1-3 events; 12, 25, 50 events expected; 1000 seeds):
+    0.96-0.98, where Garwood's interval alone covers 0.78-0.86 for the bursts. Where the
+    events are more regular than Poisson (an impact motion locked to a harmonic force, D
+    near 0) the Garwood floor makes the interval conservative: wider than the batch spread.
+    """
+    times, t0, t1 = _window(times, t0, t1)
+    n_batches = int(_checks.integer("n_batches", n_batches, low=2))
+    _checks.real("level", level, low=0.0, high=1.0, low_open=True, high_open=True)
+    duration = t1 - t0
+    n = int(times.size)
+    g_lo, g_hi = poisson_interval(n, level)
+    if n == 0:
+        return EventRate(0, duration, 0.0, 0.0, g_hi / duration, np.nan, n_batches, level)
+    _, counts = _batch_counts(times, t0, t1, n_batches)
+    dispersion = float(counts.var(ddof=1) / counts.mean())
+    lo, hi = g_lo, g_hi
+    if dispersion > 1.0:
+        q_lo, q_hi = _garwood(n / dispersion, _t_alpha(level, _effective_dof(counts)))
+        lo, hi = min(lo, dispersion * q_lo), max(hi, dispersion * q_hi)
+    return EventRate(n, duration, n / duration, lo / duration, hi / duration, dispersion,
+                     n_batches, level)
+
+
+class MarkMean(NamedTuple):
+    """Mean of a mark carried by events (one value per event) with a time-batch interval."""
+
+    mean: float     #: mean of the marks (NaN: no event)
+    stderr: float   #: ratio-estimator standard error over time batches (NaN: < 2 busy batches)
+    lo: float       #: lower end of the interval (NaN when `stderr` is)
+    hi: float       #: upper end of the interval
+    dof: float      #: degrees of freedom of its t quantile (effective batches - 1; 0: none)
+
+
+def mark_mean(values, times, t0: float, t1: float, n_batches: int = DEFAULT_N_BATCHES,
+              level: float = 0.95) -> MarkMean:
+    """Mean of per-event values and its interval, batched in time, honest for few events.
+
+    Parameters
+    ----------
+    values : array_like of float, shape (N,)
+        One value per event (e.g. the velocity after each collision).
+    times : array_like of float, shape (N,)
+        The events' times, within ``[t0, t1]``.
+    t0, t1 : float
+        The record (t0 < t1).
+    n_batches : int, optional
+        Equal stretches of time B (>= 2; default 20).
+    level : float, optional
+        Confidence level (default 0.95).
+
+    Returns
+    -------
+    MarkMean
+        ``mean = sum v / N`` and its cluster-robust (CR2) error over the time batches:
+        ``stderr^2 = sum_b (S_b - mean n_b)^2 / (1 - n_b / N) / N^2`` with ``S_b`` the sum
+        and ``n_b`` the count of values in batch b; the interval is ``mean +- t stderr``, t
+        of ``dof = N^2 / sum_b n_b^2 - 1`` degrees of freedom (the effective number of
+        batches less one, within [1, B - 1]).
+
+    Notes
+    -----
+    Batch means of equal numbers of values (`batch_means`) need many values per batch: with
+    20 batches of one or two values, the values of one burst fall in one batch or in two
+    neighbouring ones and the error ignores their correlation. Batches of equal time instead
+    hold whole bursts (bursts are short against the batch), empty batches are allowed, and the
+    error is the cluster-robust one of a mean over clusters with the bias-reduced (CR2)
+    leverage correction of Bell and McCaffrey (Survey Methodology 28, 169, 2002), exact for
+    independent equal-variance values. Its t quantile counts the effective number of
+    occupied batches (Kish's ``N^2 / sum n_b^2``), so a mean of a few events, or of one
+    batch holding most of them, gets a wide interval rather than a false one. Coverage on
+    bursts of 1-3 correlated values (``tests/test_event_rate_coverage.py``): 0.94-0.96 from
+    about 12 events on.
+    """
+    from scipy.special import stdtrit
+
+    times, t0, t1 = _window(times, t0, t1)
+    values = np.asarray(values, dtype=float)
+    if values.shape != times.shape:
+        raise ValueError(f"values and times must have equal shapes, got {values.shape} and "
+                         f"{times.shape}")
+    n_batches = int(_checks.integer("n_batches", n_batches, low=2))
+    _checks.real("level", level, low=0.0, high=1.0, low_open=True, high_open=True)
+    n = values.size
+    if n == 0:
+        return MarkMean(np.nan, np.nan, np.nan, np.nan, 0.0)
+    mean = float(values.mean())
+    k, counts = _batch_counts(times, t0, t1, n_batches)
+    if np.count_nonzero(counts) < 2:
+        return MarkMean(mean, np.nan, np.nan, np.nan, 0.0)
+    sums = np.bincount(np.clip(k, 0, n_batches - 1), weights=values, minlength=n_batches)
+    resid = sums - mean * counts
+    # CR2: each batch's residual scaled by 1 / sqrt(1 - leverage), leverage n_b / N
+    stderr = float(np.sqrt(np.sum(resid * resid / (1.0 - counts / n))) / n)
+    dof = max(1.0, min(n_batches - 1.0, n * n / float(np.dot(counts, counts)) - 1.0))
+    half = float(stdtrit(dof, 0.5 + 0.5 * level)) * stderr
+    return MarkMean(mean, stderr, mean - half, mean + half, dof)
