@@ -323,6 +323,25 @@ def test_fig09_bars_scale_and_markers(data):
     assert ax_z.get_xlabel() == axis_label(ds["delta"])
 
 
+def test_fig09_names_the_plays_held_on_the_wall_that_it_cannot_draw(data):
+    """A play too deep for the force to lift the mass (no collision, below every play with
+    one) has nothing to draw; the legend names it rather than the axis dropping it."""
+    events = data["events"].copy(deep=True)
+    lowest = float(events["delta"].min())
+    cell = dict(delta=lowest)
+    events["n_collisions"].loc[cell] = 0
+    for name in ("v_after_mean", "v_after_mean_lo", "v_after_mean_hi", "interval_mean",
+                 "interval_mean_lo", "interval_mean_hi"):
+        events[name].loc[cell] = np.nan
+    events["contact_fraction"].loc[cell] = 1.0
+    labels = [t.get_text() for t in plotting.fig09(events).legends[0].get_texts()]
+    held = [s for s in labels if s.startswith("not drawn: no collision")]
+    assert len(held) == 1 and f"= {lowest:g} (held on the wall" in held[0]
+    assert "at least 100 % of the record" in held[0]
+    untouched = [t.get_text() for t in plotting.fig09(data["events"]).legends[0].get_texts()]
+    assert not any(s.startswith("not drawn") for s in untouched)
+
+
 def test_fig09_draws_rice_asymptotes_of_the_wall_free_response(data):
     """Rice's rate checked against its closed form at one point, independent of the code:
     sigma_x = sigma_v = sqrt(S0 / 4 zeta) for white noise of two-sided level S0."""

@@ -409,6 +409,18 @@ def fig09(events, envelope="auto"):
         marks.append(Line2D([], [], ls="none",
                             label=rf"(a) left out at $\delta$ = {where}: {what} (a count, "
                                   "not a mean)"))
+    first = np.flatnonzero(n > 0)
+    held = (n == 0) & (delta < delta[first[0]]) if first.size else np.zeros(n.size, bool)
+    if held.any():
+        # a play too deep for the force ever to lift the mass: nothing to draw, said so
+        contact = (np.asarray(ds["contact_fraction"], dtype=float)[held]
+                   if "contact_fraction" in ds else np.empty(0))
+        rest = (f", in contact with it for at least {100 * float(contact.min()):.3g} % of the "
+                "record" if contact.size else "")
+        marks.append(Line2D([], [], ls="none",
+                            label=rf"not drawn: no collision at $\delta$ = "
+                                  f"{', '.join(_num(d) for d in delta[held])} (held on the wall "
+                                  f"throughout{rest})"))
     if rice:
         marks.append(Line2D([], [], color="0.25", ls="--", lw=1.1,
                             label=r"Rice, large $\delta$: (a) $\varepsilon\sigma_v\sqrt{\pi/2}$, "
