@@ -192,7 +192,9 @@ def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches,
         c = col if rule == "physical" else events.collisions(eps, floor, transient, rule=rule)
         z = c.intervals
         row = dict(rule_n_events=c.time.size, rule_collision_rate=c.time.size / duration,
-                   rule_v_after_mean=float(eps * c.velocity.mean()) if c.time.size else math.nan,
+                   rule_v_after_mean=stats.batch_means(
+                       stats.velocity_after_impact(c.velocity, eps), n_batches).mean
+                   if c.time.size else math.nan,
                    rule_interval_mean=stats.batch_means(z, n_batches).mean if z.size
                    else math.nan)
         if beta_f is not None:

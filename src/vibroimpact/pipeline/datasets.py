@@ -249,7 +249,7 @@ def map_tile(cells, results, motions, attrs):
 def aggregate_map(tiles, study, attrs):
     """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
     ds = _to_grid(tiles, study.inv_beta, study.delta).transpose(
-        "motion", "from_motion", "to_motion", "inv_beta", "delta", missing_dims="ignore")
+        "motion", "from_motion", "to_motion", "inv_beta", "delta", ..., missing_dims="ignore")
     ds.attrs = dict(attrs)
     return _annotate(ds)
 
