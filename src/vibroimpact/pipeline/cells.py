@@ -219,6 +219,7 @@ class _EventRecord:
     def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0):
         self.dt = dt
         self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
+        self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
         self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
         self.t_end = 0.0
@@ -246,16 +247,31 @@ class _EventRecord:
         v = eps * self.u[0][t >= transient]
         return v[v >= floor]
 
+    def pressed(self):
+        """The flights between the record's impacts that the push presses throughout
+        (`stats.pressed_flights`); those of earlier checks are kept, only new ones computed."""
+        n = self.steps[0].size if self.steps else 0
+        if n > self._n_pressed:
+            i = max(self._n_pressed - 1, 0)          # from the last impact already seen
+            f = self.force
+            step, offset = self.steps[0][i:], self.offsets[0][i:]
+            t = step * self.dt + offset
+            # a flight with a sticking phase is no hop: left out (it would cost its samples)
+            start = self.sticking()[0]
+            k = np.searchsorted(start, t[:-1], side="left")
+            free = k < start.size
+            free[free] = start[k[free]] < t[1:][free]
+            new = stats.pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
+                                        amplitude=f["amplitude"], beta=f["beta"],
+                                        flights=~free)
+            self._pressed, self._n_pressed = np.append(self._pressed, new), n
+        return self._pressed
+
     def collisions(self, eps, floor, transient, rule="physical"):
         """Collisions of the record so far that begin at or after ``transient``, grouped by
         ``rule`` (:data:`vibroimpact.stats.RULES`)."""
         start, end = self.sticking()
-        pressed = None
-        if rule == "physical":
-            f = self.force
-            pressed = stats.pressed_flights(self.steps[0], self.offsets[0], f["noise"],
-                                            self.dt, delta=f["delta"],
-                                            amplitude=f["amplitude"], beta=f["beta"])
+        pressed = self.pressed() if rule == "physical" else None
         return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
                                       rule=rule).after(transient)

@@ -126,15 +126,18 @@ def _next_true(mask):
     return np.minimum.accumulate(idx[::-1])[::-1]
 
 
-def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0):
-    """Which flights between consecutive impacts are pressed throughout (chatter hops).
+def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0,
+                    flights=None):
+    """Which flights between consecutive impacts are pressed throughout (the hops).
 
     ``out[j]`` is True when the push ``f(tau) - delta`` is ``> 0`` at every instant of
     ``[t_j, t_{j+1}]``, with ``f(tau) = r(tau) + amplitude sin(beta tau)`` and ``r`` the
     straight line between the samples ``noise[k] = r(k dt)`` (the simulator's force). Exact,
-    not sampled: the minimum of the push over a step is at one of its ends or, with a
-    harmonic part, at the closed-form root of ``r' + amplitude beta cos(beta tau) = 0`` where
-    the curvature is positive. It reads the force only, never a tolerance of the simulator.
+    not sampled: over each step of the flight the push's minimum is at one of the step's
+    ends or, with a harmonic part, at the closed-form root of
+    ``r' + amplitude beta cos(beta tau) = 0`` where the curvature is positive. It reads the
+    force only, never a tolerance of the simulator. The work is proportional to the steps of
+    the flights whose two impacts are pressed.
 
     Parameters
     ----------
@@ -146,6 +149,9 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
         Sample step.
     delta, amplitude, beta : float
         Play, harmonic amplitude and frequency ratio.
+    flights : array_like of bool, shape (n - 1,), optional
+        Only these flights are examined (the others are reported False), e.g. leaving out
+        the flights with a sticking phase, which are never hops.
 
     Returns
     -------
@@ -174,35 +180,35 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
         return value
 
     at_impact = push(step, offset) > 0.0
-    samples = np.arange(k_lo, k_hi)
-    bad = push(samples[:-1], np.zeros(samples.size - 1)) <= 0.0
-    cum = np.concatenate([[0], np.cumsum(bad)])
-    # samples strictly after t_j's step start up to t_{j+1}'s: k = step_j + 1 .. step_{j+1}
-    lo, hi = step[:-1] + 1 - k_lo, step[1:] + 1 - k_lo
-    pressed = at_impact[:-1] & at_impact[1:] & (cum[np.maximum(hi, lo)] - cum[lo] == 0)
-    if not harmonic or not pressed.any():
-        return pressed
-    # interior minima of the harmonic part, step by step, on the flights still pressed
+    pressed = at_impact[:-1] & at_impact[1:]
+    if flights is not None:
+        pressed &= np.asarray(flights, dtype=bool)
     j = np.flatnonzero(pressed)
-    count = step[j + 1] - step[j] + 1                  # steps the flight touches
+    if j.size == 0:
+        return pressed
+    # the flights' steps: [s_lo, s_hi] of step k, from t_j's step to t_{j+1}'s
+    count = step[j + 1] - step[j] + 1
     flight = np.repeat(j, count)
     k = step[flight] + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
     s_lo = np.where(k == step[flight], offset[flight], 0.0)
     s_hi = np.where(k == step[flight + 1], offset[flight + 1], dt)
-    i = k - k_lo
-    slope = (r[i + 1] - r[i]) / dt
-    c = -slope / (amplitude * beta)
-    ok = np.abs(c) <= 1.0
-    # minima of amplitude sin(theta) + slope theta / beta: cos(theta) = c, amplitude sin < 0
-    theta0 = -np.sign(amplitude) * np.arccos(np.clip(c, -1.0, 1.0))
-    two_pi = 2.0 * np.pi
-    th_lo, th_hi = beta * (k * dt + s_lo), beta * (k * dt + s_hi)
-    low = np.full(k.size, np.inf)
-    for n_turn in (np.ceil((th_lo - theta0) / two_pi), np.floor((th_hi - theta0) / two_pi)):
-        theta = theta0 + two_pi * n_turn
-        inside = ok & (theta >= th_lo) & (theta <= th_hi)
-        s = np.clip(s_lo + (theta - th_lo) / beta, s_lo, s_hi)
-        low = np.where(inside, np.minimum(low, push(k, s)), low)
+    low = push(k, s_hi)                    # each step's end (the flight's start is pressed)
+    if harmonic:
+        # interior minima of amplitude sin(theta) + slope theta / beta: cos(theta) = c with
+        # amplitude sin(theta) < 0
+        i = k - k_lo
+        c = -(r[i + 1] - r[i]) / dt / (amplitude * beta)
+        ok = np.abs(c) <= 1.0
+        theta0 = -np.sign(amplitude) * np.arccos(np.clip(c, -1.0, 1.0))
+        two_pi = 2.0 * np.pi
+        th_lo, th_hi = beta * (k * dt + s_lo), beta * (k * dt + s_hi)
+        for n_turn in (np.ceil((th_lo - theta0) / two_pi), np.floor((th_hi - theta0) / two_pi)):
+            theta = theta0 + two_pi * n_turn
+            inside = ok & (theta >= th_lo) & (theta <= th_hi)
+            if inside.any():
+                s = np.clip(s_lo[inside] + (theta[inside] - th_lo[inside]) / beta,
+                            s_lo[inside], s_hi[inside])
+                low[inside] = np.minimum(low[inside], push(k[inside], s))
     pulled = np.zeros(n - 1, bool)
     np.logical_or.at(pulled, flight, low <= 0.0)
     return pressed & ~pulled
