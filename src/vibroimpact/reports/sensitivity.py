@@ -116,40 +116,55 @@ def finding_sensitivity(events, findings=(2, 3)):
     Returns
     -------
     pandas.DataFrame
-        One row per finding: its verdict under each rule, and the largest difference between
+        One row per finding (and per 1/beta_f of a harmonic study): its verdict under each
+        rule, and the largest difference between
         the rules over the negative plays with collisions (the statistic, the play, its value
         under each rule). Empty when ``events`` carries no rules.
     """
-    from vibroimpact.reports import findings as fnd
-
     if not _has_rules(events):
         return pd.DataFrame()
     rules = [str(r) for r in events.rule.values]
-    variable = {2: ("v_after_mean", "rule_v_after_mean", "mean velocity after impact"),
-                3: ("interval_mean", "rule_interval_mean", "mean interval")}
     rows = []
-    for number in findings:
-        plain, by_rule, name = variable[number]
-        verdict = {}
-        for r in rules:
-            ds = events.assign({plain: events[by_rule].sel(rule=r, drop=True),
-                                "n_collisions": events["rule_n_events"].sel(rule=r, drop=True)})
-            verdict[RULE_NAMES[r]] = getattr(fnd, f"finding{number}")(ds).holds
-        # the largest relative spread between the rules at negative play
-        neg = events[by_rule].where((events.delta < 0)
-                                    & (events.rule_n_events >= fnd.MIN_IMPACTS))
-        ref = neg.sel(rule="physical", drop=True)
-        spread = (abs(neg - ref).max("rule") / abs(ref)).fillna(-1.0)
-        text = "no negative play with collisions"
-        if float(spread.max()) >= 0:
-            at = spread.argmax(...)
-            cell = neg.isel(at)
-            values = ", ".join(f"{RULE_NAMES[r]} {float(cell.sel(rule=r)):.3g}" for r in rules)
-            where = f"delta = {float(cell.delta):.3g}"
-            if "inv_beta" in cell.coords and events.sizes.get("inv_beta", 1) > 1:
-                where += f", 1/beta_f = {float(cell.inv_beta):.3g}"
-            text = (f"{name} at {where}: {values} ({100 * float(spread.isel(at)):.0f} % of the "
-                    f"physical value)")
-        rows.append(dict(finding=number, **verdict, **{"largest difference at negative play":
-                                                       text}))
+    for i in range(events.sizes.get("inv_beta", 1)):
+        ds = events.isel(inv_beta=slice(i, i + 1)) if "inv_beta" in events.dims else events
+        where = ({"inv_beta": float(ds.inv_beta[0])} if events.sizes.get("inv_beta", 1) > 1
+                 else {})
+        rows += [dict(finding=number, **where, **row)
+                 for number in findings for row in [_one_finding(ds, number, rules)]]
     return pd.DataFrame(rows)
+
+
+def _one_finding(events, number, rules):
+    """One finding's verdict under each rule and its largest difference at negative play,
+    on a dataset of one row of 1/beta_f."""
+    from vibroimpact.reports import findings as fnd
+
+    plain, by_rule, name = {2: ("v_after_mean", "rule_v_after_mean",
+                                "mean velocity after impact"),
+                            3: ("interval_mean", "rule_interval_mean", "mean interval")}[number]
+    verdict = {}
+    for r in rules:
+        ds = events.assign({plain: events[by_rule].sel(rule=r, drop=True),
+                            "n_collisions": events["rule_n_events"].sel(rule=r, drop=True)})
+        verdict[RULE_NAMES[r]] = getattr(fnd, f"finding{number}")(ds).holds
+    # the largest relative spread between the rules at negative play
+    neg = events[by_rule].where((events.delta < 0) & (events.rule_n_events >= fnd.MIN_IMPACTS))
+    ref = neg.sel(rule="physical", drop=True)
+    spread = (abs(neg - ref).max("rule") / abs(ref)).fillna(-1.0)
+    text = "no negative play with collisions"
+    if float(spread.max()) >= 0:
+        at = spread.argmax(...)
+        cell = neg.isel(at)
+        values = ", ".join(f"{RULE_NAMES[r]} {float(cell.sel(rule=r)):.3g}" for r in rules)
+        text = (f"{name} at delta = {float(cell.delta):.3g}: {values} "
+                f"({100 * float(spread.isel(at)):.0f} % of the physical value)")
+    return {**verdict, "largest difference at negative play": text}
+
+
+def styled(table):
+    """A table of this module for a report: numbers to three significant digits, text left
+    aligned and wrapped, no index."""
+    numbers = table.select_dtypes("number").columns
+    return (table.style.format("{:.3g}", subset=numbers, na_rep="")
+            .set_properties(**{"text-align": "left", "white-space": "normal"})
+            .hide(axis="index"))
