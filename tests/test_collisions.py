@@ -345,3 +345,17 @@ def test_the_per_rebound_view_counts_each_rebound_above_the_floor():
     assert list(c.first) == [0, 1, 2, 3] and list(c.impact_collision) == [0, 1, 2, 3, 3]
     assert list(c.rebounds) == [1, 1, 1, 1] and list(c.stuck) == [False, False, False, True]
     assert _group([1.0], [0.01], rule="rebounds").first.size == 0
+
+
+def test_the_attractor_kernels_hop_is_pressed_flights_without_noise():
+    """The attractor classifier (sin(beta tau) alone, amplitude 1) tells hops by the same
+    rule as `stats.pressed_flights`, in closed form."""
+    from vibroimpact.attractors.kernels import _hop
+
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        beta, delta = rng.uniform(0.3, 3.0), rng.uniform(-1.5, 1.0)
+        t = np.sort(rng.uniform(0.0, 50.0, 2))
+        t[1] = t[0] + rng.choice([rng.uniform(0, 0.3), rng.uniform(0, 10)])
+        exact = _pressed(t, None, delta=delta, amplitude=1.0, beta=beta)[0]
+        assert _hop(t[0], t[1], beta, delta) == exact, (beta, delta, t)
