@@ -359,3 +359,29 @@ def test_the_attractor_kernels_hop_is_pressed_flights_without_noise():
         t[1] = t[0] + rng.choice([rng.uniform(0, 0.3), rng.uniform(0, 10)])
         exact = _pressed(t, None, delta=delta, amplitude=1.0, beta=beta)[0]
         assert _hop(t[0], t[1], beta, delta) == exact, (beta, delta, t)
+
+
+@pytest.mark.parametrize("amplitude", [0.0, 0.8, -1.2])
+def test_the_compiled_hops_are_the_numpy_reference(amplitude):
+    """`impact.hops.pressed_flights` (what simulate and the cells run) equals
+    `stats.pressed_flights` (the statement of the rule) on a random force with and without a
+    harmonic part, with and without a mask of the flights to examine, and on a real record."""
+    from vibroimpact.impact import hops
+
+    rng = np.random.default_rng(12)
+    noise = 0.5 * rng.standard_normal(2001)
+    for delta in (-0.8, -0.3, 0.0, 0.4):
+        t = np.sort(rng.uniform(0.0, 199.9, 400))
+        step = np.floor(t / DT).astype(np.int64)
+        kw = dict(delta=delta, amplitude=amplitude, beta=1.3)
+        ref = stats.pressed_flights(step, t - step * DT, noise, DT, **kw)
+        assert np.array_equal(hops.pressed_flights(step, t - step * DT, noise, DT, **kw), ref)
+        mask = rng.random(t.size - 1) < 0.5
+        assert np.array_equal(hops.pressed_flights(step, t - step * DT, noise, DT, **kw,
+                                                   flights=mask), ref & mask)
+        assert 0 < ref.sum() < ref.size or delta > 0.0
+    res = simulate(0.05, 0.5, -0.5, noise=noise, dt=DT, amplitude=amplitude, beta=1.3)
+    kw = dict(delta=-0.5, amplitude=amplitude, beta=1.3)
+    assert np.array_equal(
+        hops.pressed_flights(res.impact_step, res.impact_offset, noise, DT, **kw),
+        stats.pressed_flights(res.impact_step, res.impact_offset, noise, DT, **kw))

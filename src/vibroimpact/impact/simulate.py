@@ -13,8 +13,9 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
+from vibroimpact.impact.hops import pressed_flights
 from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR, Collisions,
-                                          close_open_phase, group_collisions, pressed_flights)
+                                          close_open_phase, group_collisions)
 
 _BUFFER = 2 * kernels.STEP_HEADROOM
 

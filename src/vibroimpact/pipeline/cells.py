@@ -13,6 +13,7 @@ import numpy as np
 from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
+from vibroimpact.impact.hops import pressed_flights
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
 log = logging.getLogger("vibroimpact")
@@ -249,7 +250,8 @@ class _EventRecord:
 
     def pressed(self):
         """The flights between the record's impacts that the push presses throughout
-        (`stats.pressed_flights`); those of earlier checks are kept, only new ones computed."""
+        (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`); those of earlier
+        checks are kept, only new ones computed."""
         n = self.steps[0].size if self.steps else 0
         if n > self._n_pressed:
             i = max(self._n_pressed - 1, 0)          # from the last impact already seen
@@ -261,9 +263,8 @@ class _EventRecord:
             k = np.searchsorted(start, t[:-1], side="left")
             free = k < start.size
             free[free] = start[k[free]] < t[1:][free]
-            new = stats.pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
-                                        amplitude=f["amplitude"], beta=f["beta"],
-                                        flights=~free)
+            new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
+                                  amplitude=f["amplitude"], beta=f["beta"], flights=~free)
             self._pressed, self._n_pressed = np.append(self._pressed, new), n
         return self._pressed
 
