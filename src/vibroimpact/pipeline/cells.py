@@ -103,7 +103,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         ``motion_stick_probability`` (their impact-stick variants, whose collisions stick);
         without one there is no forcing period, so these are absent. The per-rebound view
         (``n_rebounds``, ``rebound_v_after_mean``) counts every rebound leaving the wall at speed
-        ``>= rebound_floor``.
+        ``>= rebound_floor``. The weight of the grouping rule: ``rule_n_events,
+        rule_collision_rate, rule_v_after_mean, rule_interval_mean`` (one value per rule of
+        `stats.RULES`: physical, impacts-only, per rebound) and, with a harmonic force,
+        ``rule_motion_probability, rule_motion_stick_probability`` (rules x motions); the
+        physical row equals the statistics above.
 
     Notes
     -----
@@ -438,6 +442,9 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         ``probability, stderr`` (per motion, on the intervals between collisions, motions
         with free flights), ``stick_probability, stick_stderr`` (their impact-stick
         variants: a collision of the group ends sticking),
+        ``rule_probability, rule_stick_probability`` (rules of `stats.RULES` x motions: the
+        probabilities under each grouping rule on the record as it stopped; the physical row
+        is ``probability, stick_probability``),
         ``n_switches, n_collisions, collision_rate, v_after_mean`` (of collisions),
         ``n_impacts_resolved`` (every rebound the kernel resolved: a numerical count, for cost
         models only), ``simulated_time, record_end`` (the last simulated instant: simulating
