@@ -17,11 +17,25 @@ from vibroimpact.stats import group_collisions
 DT = 0.1
 
 
-def _group(times, u, stick_start=(), stick_end=(), eps=0.5, floor=0.01):
+def _group(times, u, stick_start=(), stick_end=(), eps=0.5, floor=0.01, rule="impacts",
+           pressed=None):
+    """Group hand-made events (by default with the earlier, impacts-only rule)."""
     times = np.asarray(times, dtype=float)
     step = np.floor(times / DT).astype(np.int64)
     return group_collisions(step, times - step * DT, u, stick_start, stick_end, dt=DT, eps=eps,
-                            floor=floor)
+                            floor=floor, rule=rule, pressed=pressed)
+
+
+def _regroup(res, eps=0.5, rule="physical"):
+    """``res``'s impacts grouped again by `group_collisions` (the flights pressed from the
+    force it was simulated with)."""
+    p = res.params
+    pressed = stats.pressed_flights(res.impact_step, res.impact_offset, res.force_record,
+                                    p["dt"], delta=p["delta"], amplitude=p["amplitude"],
+                                    beta=p["beta"])
+    return group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
+                            res.stick_start, res.stick_end, dt=p["dt"], eps=eps,
+                            pressed=pressed, rule=rule)
 
 
 def test_free_impacts_are_collisions_of_their_own():
@@ -82,8 +96,7 @@ def test_simulate_reports_collisions_beside_its_impacts():
     noise = 0.5 * rng.standard_normal(30_001)
     res = simulate(0.05, 0.5, -0.5, noise=noise, dt=DT)
     assert res.n_collisions == res.collision_time.size < res.n_impacts
-    again = group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
-                             res.stick_start, res.stick_end, dt=DT, eps=0.5)
+    again = _regroup(res)
     assert np.array_equal(again.time, res.collision_time)
     assert np.array_equal(res.impact_velocity[again.first], res.collision_velocity)
     assert np.array_equal(np.unique(res.impact_collision), np.arange(res.n_collisions))
@@ -117,8 +130,7 @@ def test_an_impact_chatter_stick_cycle_is_a_1_1_motion_with_sticking_never_2_1(i
     z = 2.0 * np.pi / beta
     res = simulate(0.05, 0.5, delta, noise=None, dt=DT, amplitude=1.0, beta=beta, t_end=40 * z)
     t0 = 20 * z
-    c = group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
-                         res.stick_start, res.stick_end, dt=DT, eps=0.5).after(t0)
+    c = _regroup(res).after(t0)
     assert np.allclose(c.intervals / z, 1.0, atol=1e-9)
     assert c.stuck[:-1].all() and np.all(c.rebounds[:-1] > 2)
     m = stats.motion_statistics(c.time, c.intervals, beta, t0, res.t_end, stuck=c.stuck)
@@ -137,8 +149,7 @@ def test_the_2_1_motion_with_free_flights_stays_2_1():
     z = 2.0 * np.pi / beta
     res = simulate(0.05, 0.5, 0.0, noise=None, dt=DT, amplitude=1.0, beta=beta, t_end=80 * z)
     t0 = 40 * z
-    c = group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
-                         res.stick_start, res.stick_end, dt=DT, eps=0.5).after(t0)
+    c = _regroup(res).after(t0)
     m = stats.motion_statistics(c.time, c.intervals, beta, t0, res.t_end, stuck=c.stuck)
     assert m.probability[1] > 0.95 and m.stick_probability.sum() == 0.0
 
@@ -212,3 +223,165 @@ def test_no_collision_statistic_depends_on_an_event_tolerance(tmp_path):
         # (looser, fewer: RESOLVED_REBOUND keeps every rebound faster than 5e-5)
         chatter = [k for k in base if k.endswith("n_impacts_resolved") and "_m" in k]
         assert all(other[k] != base[k] for k in chatter), tag
+
+
+# --- the physical rule: chatter hops are the flights the push presses throughout ---------
+
+def _pressed(times, noise, delta=0.0, amplitude=0.0, beta=1.0):
+    times = np.asarray(times, dtype=float)
+    step = np.floor(times / DT).astype(np.int64)
+    return stats.pressed_flights(step, times - step * DT, noise, DT, delta=delta,
+                                 amplitude=amplitude, beta=beta)
+
+
+def test_pressed_flights_read_the_straight_line_between_samples():
+    noise = np.ones(101)                   # push f - delta = 1 - delta
+    t = [1.05, 2.0, 2.55]
+    assert list(_pressed(t, noise)) == [True, True]
+    assert list(_pressed(t, noise, delta=1.0)) == [False, False]       # push 0: not pressed
+    noise[15] = -0.2                       # one sample below the wall's push inside flight 0
+    assert list(_pressed(t, noise)) == [False, True]
+    # the straight line between samples: a dip between the impact and the next sample
+    noise = np.ones(101)
+    noise[21] = -1.0                       # push 1 at tau = 2.0, -1 at 2.1: zero at 2.05
+    assert list(_pressed([2.0, 2.04], noise)) == [True]
+    assert list(_pressed([2.0, 2.06], noise)) == [False]   # the later impact itself is pulled
+    assert _pressed([2.0], noise).size == 0 and _pressed([], noise).size == 0
+
+
+def test_pressed_flights_find_the_harmonic_minimum_inside_a_step():
+    """sin(tau) has its minimum -1 at 3 pi / 2 = 4.712, between the samples 4.7 and 4.8 where
+    it is above -1 + 7e-5: with delta = -1 + 1e-6 every sample is pressed and the flight is
+    not (pulled by 1e-6 for about 3e-3 time units)."""
+    t = [4.65, 4.85]
+    assert list(_pressed(t, None, delta=-1.0 + 1e-6, amplitude=1.0)) == [False]
+    assert list(_pressed(t, None, delta=-1.0 - 1e-6, amplitude=1.0)) == [True]
+    # a negative amplitude: the minimum at pi / 2
+    t = [1.52, 1.62]
+    assert list(_pressed(t, None, delta=-1.0 + 1e-6, amplitude=-1.0)) == [False]
+
+
+def test_pressed_flights_match_a_dense_sampling():
+    """Random plus harmonic force, random flights: the exact flag agrees with the push sampled
+    10^4 times a step wherever the sampled minimum is clear of zero (by 1e-6: the sampled
+    minimum of a smooth step misses the true one by at most |f''| h^2 / 8 < 1e-8)."""
+    rng = np.random.default_rng(3)
+    noise = 0.5 * rng.standard_normal(401)
+    A, beta, delta = 0.8, 1.7, -0.6
+    t = np.sort(rng.uniform(0.0, 39.9, 120))
+    exact = _pressed(t, noise, delta=delta, amplitude=A, beta=beta)
+    checked = 0
+    for j in range(t.size - 1):
+        tau = np.linspace(t[j], t[j + 1], max(2, int((t[j + 1] - t[j]) / DT * 1e4)))
+        k = np.minimum(np.floor(tau / DT).astype(int), noise.size - 2)
+        r = noise[k] + (noise[k + 1] - noise[k]) * (tau / DT - k)
+        low = np.min(r + A * np.sin(beta * tau) - delta)
+        if abs(low) > 1e-6:
+            assert exact[j] == (low > 0.0), j
+            checked += 1
+    assert checked > 100 and 10 < exact.sum() < checked - 10    # both kinds of flight tested
+
+
+def test_a_force_that_reverses_during_a_long_hop_splits_the_collision():
+    # an impact, a long flight of 3.0, then a chatter sequence sticking at 5.0 (release 6.0)
+    t = [1.0, 4.0, 4.5, 4.75, 4.875]
+    u = [0.9, 0.6, 0.3, 0.15, 0.07]
+    noise = np.ones(101)                              # pressed throughout: one collision
+    c = _group(t, u, [5.0], [6.0], rule="physical", pressed=_pressed(t, noise))
+    assert list(c.first) == [0] and list(c.stuck) == [True]
+    noise[25] = -0.3                                  # pulled at tau = 2.5: two collisions
+    c = _group(t, u, [5.0], [6.0], rule="physical", pressed=_pressed(t, noise))
+    assert list(c.first) == [0, 1] and list(c.stuck) == [False, True]
+    # the impacts-only rule cannot tell the two apart
+    assert list(_group(t, u, [5.0], [6.0]).first) == [0]
+
+
+def test_a_force_that_presses_throughout_keeps_a_long_first_rebound():
+    """A long first rebound that comes back faster than the next flight would suggest (the
+    impacts-only rule reads a free flight there) stays in the collision while the push
+    presses throughout; a run of hops that never sticks is no chatter (its impacts stay
+    collisions of their own)."""
+    t = [1.0, 4.0, 4.5, 4.75, 4.875]
+    u = [0.5, 0.9, 0.3, 0.15, 0.07]                   # the second impact faster than the first
+    pressed = _pressed(t, np.ones(101))
+    assert list(_group(t, u, [5.0], [6.0], rule="physical", pressed=pressed).first) == [0]
+    assert list(_group(t, u, [5.0], [6.0]).first) == [0, 1]
+    assert list(_group(t, u, rule="physical", pressed=pressed).first) == [0, 1, 2, 3, 4]
+    # sticking between two impacts always separates them (a release is a free flight)
+    c = _group([1.0, 1.5, 3.0], [0.5, 0.2, 0.4], [1.8], [2.5], rule="physical",
+               pressed=[True, True])
+    assert list(c.first) == [0, 2]
+    with pytest.raises(ValueError, match="pressed"):
+        _group(t, u, rule="physical")
+    with pytest.raises(ValueError, match="rule"):
+        _group(t, u, rule="other")
+
+
+def test_the_paper_fig3_free_flight_is_no_chatter():
+    """Fig. 3 (delta = 0, the random study's record from rest): the impact at tau = 42.57
+    follows a flight of 3.6 from 38.94 during which the force pulls; the flight 42.57 -> 44.52
+    is pulled too, and the chatter that sticks at 44.85 starts at 44.52. The impacts-only rule
+    folded 38.94 and 42.57 into it."""
+    from vibroimpact import noise
+
+    spec = noise.NoiseSpec(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0)
+    record = noise.generate_array(spec, 701, seed=19740914)
+    res = simulate(0.05, 0.5, 0.0, noise=record, dt=DT, t_end=60.0)
+    t = res.impact_time
+    i = int(np.argmin(abs(t - 38.936)))
+    assert np.allclose(t[i : i + 3], [38.936, 42.574, 44.523], atol=1e-3)
+    assert np.all(np.diff(res.impact_collision[i : i + 3]) == 1)      # three collisions
+    chatter = res.impact_collision == res.impact_collision[i + 2]
+    assert chatter.sum() > 5 and res.collision_stuck[res.impact_collision[i + 2]]
+    assert np.isclose(res.stick_start[0], 44.849, atol=1e-3)
+    old = res.grouped("impacts")
+    assert old.impact_collision[i] == old.impact_collision[i + 1] == old.impact_collision[i + 2]
+
+
+def test_the_per_rebound_view_counts_each_rebound_above_the_floor():
+    t = [1.0, 4.0, 4.5, 4.75, 4.875]
+    u = [0.9, 0.6, 0.3, 0.15, 0.01]                   # eps u = 0.005 < 0.01 for the last
+    c = _group(t, u, [5.0], [6.0], rule="rebounds")
+    assert list(c.first) == [0, 1, 2, 3] and list(c.impact_collision) == [0, 1, 2, 3, 3]
+    assert list(c.rebounds) == [1, 1, 1, 1] and list(c.stuck) == [False, False, False, True]
+    assert _group([1.0], [0.01], rule="rebounds").first.size == 0
+
+
+def test_the_attractor_kernels_hop_is_pressed_flights_without_noise():
+    """The attractor classifier (sin(beta tau) alone, amplitude 1) tells hops by the same
+    rule as `stats.pressed_flights`, in closed form."""
+    from vibroimpact.attractors.kernels import _hop
+
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        beta, delta = rng.uniform(0.3, 3.0), rng.uniform(-1.5, 1.0)
+        t = np.sort(rng.uniform(0.0, 50.0, 2))
+        t[1] = t[0] + rng.choice([rng.uniform(0, 0.3), rng.uniform(0, 10)])
+        exact = _pressed(t, None, delta=delta, amplitude=1.0, beta=beta)[0]
+        assert _hop(t[0], t[1], beta, delta) == exact, (beta, delta, t)
+
+
+@pytest.mark.parametrize("amplitude", [0.0, 0.8, -1.2])
+def test_the_compiled_hops_are_the_numpy_reference(amplitude):
+    """`impact.hops.pressed_flights` (what simulate and the cells run) equals
+    `stats.pressed_flights` (the statement of the rule) on a random force with and without a
+    harmonic part, with and without a mask of the flights to examine, and on a real record."""
+    from vibroimpact.impact import hops
+
+    rng = np.random.default_rng(12)
+    noise = 0.5 * rng.standard_normal(2001)
+    for delta in (-0.8, -0.3, 0.0, 0.4):
+        t = np.sort(rng.uniform(0.0, 199.9, 400))
+        step = np.floor(t / DT).astype(np.int64)
+        kw = dict(delta=delta, amplitude=amplitude, beta=1.3)
+        ref = stats.pressed_flights(step, t - step * DT, noise, DT, **kw)
+        assert np.array_equal(hops.pressed_flights(step, t - step * DT, noise, DT, **kw), ref)
+        mask = rng.random(t.size - 1) < 0.5
+        assert np.array_equal(hops.pressed_flights(step, t - step * DT, noise, DT, **kw,
+                                                   flights=mask), ref & mask)
+        assert 0 < ref.sum() < ref.size or delta > 0.0
+    res = simulate(0.05, 0.5, -0.5, noise=noise, dt=DT, amplitude=amplitude, beta=1.3)
+    kw = dict(delta=-0.5, amplitude=amplitude, beta=1.3)
+    assert np.array_equal(
+        hops.pressed_flights(res.impact_step, res.impact_offset, noise, DT, **kw),
+        stats.pressed_flights(res.impact_step, res.impact_offset, noise, DT, **kw))

@@ -54,7 +54,8 @@ def main(out):
             cell = cells.motion_map_cell(noises[rms], 0.1, zeta=0.05, eps=0.5, delta=delta,
                                          beta_f=1.0 / inv_beta, transient=200.0,
                                          max_periods=1000, target_stderr=0.02)
-            for key in ("probability", "stderr", "n_collisions", "record_end"):
+            for key in ("probability", "stderr", "n_collisions", "record_end",
+                        "rule_probability", "rule_stick_probability"):
                 result[f"{name}/map_{key}"] = np.asarray(cell[key], dtype=float)
     np.savez(out, **result)
 

@@ -273,10 +273,24 @@ def _period_of(rk, rs, ru, n_imp, h, tf, t_now_k, p, tol):
 
 
 @kernel
-def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk):
+def _hop(ta, tb, beta, delta):
+    """The flight ``[ta, tb]`` is pressed throughout by the push ``sin(beta tau) - delta``
+    (amplitude 1, no random force): its minimum is -1 - delta where ``beta tau`` passes
+    -pi/2 modulo 2 pi, else at an end (:func:`vibroimpact.stats.pressed_flights`)."""
+    two_pi = 2.0 * math.pi
+    n = math.ceil((beta * ta + 0.5 * math.pi) / two_pi)
+    low = min(math.sin(beta * ta), math.sin(beta * tb))
+    if -0.5 * math.pi + two_pi * n <= beta * tb:
+        low = -1.0
+    return low - delta > 0.0
+
+
+@kernel
+def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk, beta, delta):
     """Collisions per period of a periodic motion (period ``zp``, ``mm`` impacts): the
-    grouping of :func:`vibroimpact.stats.group_collisions` (a chatter run ending in sticking
-    joins the impact that starts it) on three periods, counted in the middle one."""
+    grouping of :func:`vibroimpact.stats.group_collisions` (the physical rule: a run of hops,
+    flights the push presses throughout, ending in sticking joins the impact that starts it)
+    on three periods, counted in the middle one."""
     # three periods: the last two as recorded, the next one by periodicity, so that a
     # chatter run that the period's edge cuts is seen whole from the middle period
     L = 3 * mm
@@ -303,9 +317,8 @@ def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk):
                     ends[j] = True
                     break
     cont = np.zeros(L, np.bool_)
-    for j in range(L - 1):
-        shrinks = (t[j + 1] - t[j]) > (t[j + 2] - t[j + 1])
-        cont[j] = (not ends[j]) and u[j + 1] < u[j] and (ends[j + 1] or shrinks)
+    for j in range(L):
+        cont[j] = (not ends[j]) and _hop(t[j], t[j + 1], beta, delta)
     n_coll = 0
     for j in range(mm, 2 * mm):
         # impact j joins j - 1 when j - 1 lies on a shrinking run ending in sticking
@@ -662,7 +675,8 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
             outi[I_PERIOD_M] = mm
             outi[I_PERIOD_P] = p
             if mode == STUCK or last_stick > t_last - zp:
-                mc = _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk)
+                mc = _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk,
+                                        beta, delta)
                 outf[F_LYAP1] = -np.inf
                 outf[F_LYAP2] = -np.inf
                 outf[F_RATE] = mc / zp

@@ -13,6 +13,7 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
+from vibroimpact.impact.hops import pressed_flights
 from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR, Collisions,
                                           close_open_phase, group_collisions)
 
@@ -73,6 +74,9 @@ class SimulationResult:
         The velocity floor of ``collision_rebounds``.
     params : dict
         The physical inputs.
+    force_record : array_like or None
+        The random force samples simulated (a reference, not a copy; None: none), which the
+        collisions read to tell chatter hops from free flights.
 
     The collision fields are computed on first access (``collisions`` holds them all). In a
     chunk of :func:`simulate_chunks` they are those of the chunk's own impacts (a collision
@@ -99,6 +103,7 @@ class SimulationResult:
     stuck_end: bool
     stuck_since: float
     params: dict = field(default_factory=dict)
+    force_record: object = field(default=None, repr=False, compare=False)
 
     # The collision fields are computed on first use (most streaming consumers group the
     # impacts of many chunks themselves) and cached; a frozen dataclass keeps a __dict__.
@@ -107,11 +112,22 @@ class SimulationResult:
         """The impacts grouped into collisions (:func:`vibroimpact.stats.group_collisions`);
         the ``collision_*`` attributes are its fields."""
         # a sticking phase still open at the end of a chunk ends there for its collisions
+        return self.grouped()
+
+    def grouped(self, rule="physical") -> Collisions:
+        """The impacts grouped by ``rule`` (:data:`vibroimpact.stats.RULES`; the default,
+        the physical rule, is :attr:`collisions`)."""
+        p = self.params
         start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
                                       self.t_end)
+        pressed = None
+        if rule == "physical":
+            pressed = pressed_flights(self.impact_step, self.impact_offset, self.force_record,
+                                      p["dt"], delta=p["delta"], amplitude=p["amplitude"],
+                                      beta=p["beta"])
         return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
-                                start, end, dt=self.params["dt"], eps=self.params["eps"],
-                                floor=self.params["rebound_floor"])
+                                start, end, dt=p["dt"], eps=p["eps"], floor=p["rebound_floor"],
+                                pressed=pressed, rule=rule)
 
     n_collisions = property(lambda self: int(self.collisions.first.size))
     collision_time = property(lambda self: self.collisions.time)
@@ -314,7 +330,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             t_chunk = t_end
         buf.drain(parts)
         requested = yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode,
-                                stick_open, final)
+                                stick_open, final, noise)
         k0 = k1
         if final:
             return
@@ -363,7 +379,8 @@ def _pair_sticking(time, kind, stick_open):
     return starts, ends
 
 
-def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final):
+def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final,
+          noise):
     cat = lambda key, dtype: np.concatenate(parts[key]) if parts[key] else np.empty(0, dtype)
     imp_step = cat("imp_step", np.int64)
     imp_off = cat("imp_off", np.float64)
@@ -400,6 +417,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         stuck_end=bool(stuck),
         stuck_since=float(stuck_since),
         params=params,
+        force_record=noise,
     )
 
 
@@ -480,5 +498,5 @@ def concatenate_results(chunks):
         n_chatter=sum(c.n_chatter for c in chunks),
         contact_time=float(sum(c.contact_time for c in chunks)),
         t_end=last.t_end, x_end=last.x_end, v_end=last.v_end, stuck_end=last.stuck_end,
-        stuck_since=last.stuck_since, params=last.params,
+        stuck_since=last.stuck_since, params=last.params, force_record=last.force_record,
     )

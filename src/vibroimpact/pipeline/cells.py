@@ -13,6 +13,7 @@ import numpy as np
 from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
+from vibroimpact.impact.hops import pressed_flights
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
 log = logging.getLogger("vibroimpact")
@@ -103,7 +104,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         ``motion_stick_probability`` (their impact-stick variants, whose collisions stick);
         without one there is no forcing period, so these are absent. The per-rebound view
         (``n_rebounds``, ``rebound_v_after_mean``) counts every rebound leaving the wall at speed
-        ``>= rebound_floor``.
+        ``>= rebound_floor``. The weight of the grouping rule: ``rule_n_events,
+        rule_collision_rate, rule_v_after_mean, rule_interval_mean`` (one value per rule of
+        `stats.RULES`: physical, impacts-only, per rebound) and, with a harmonic force,
+        ``rule_motion_probability, rule_motion_stick_probability`` (rules x motions); the
+        physical row equals the statistics above.
 
     Notes
     -----
@@ -126,7 +131,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
     n_batches = int(n_batches)
     harmonic = amplitude != 0.0
-    events = _EventRecord(dt)
+    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f)
     audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, zeta=zeta, eps=eps,
                             delta=delta, amplitude=amplitude, beta_f=beta_f)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
@@ -179,6 +184,10 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         interval_beyond=z_dens.beyond,
     )
     out.update(audit.result())
+    out.update(_rule_statistics(events, col, eps=eps, floor=rebound_floor, transient=transient,
+                                duration=duration, n_batches=n_batches,
+                                beta_f=beta_f if harmonic else None,
+                                motion_window=motion_window, motions=motions))
     if harmonic:
         ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
                                    n_batches=n_batches)
@@ -192,16 +201,47 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     return out
 
 
+def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches, beta_f,
+                     motion_window, motions):
+    """The statistics a figure draws under each grouping rule (`stats.RULES`: physical,
+    impacts-only, per rebound above ``floor``), stacked along the rules: ``rule_n_events,
+    rule_collision_rate, rule_v_after_mean, rule_interval_mean`` and, with a forcing period
+    (``beta_f`` not None), ``rule_motion_probability, rule_motion_stick_probability`` (rules
+    x motions). The physical row is the cell's own statistics; the others show what the
+    choice of rule weighs (the reports' sensitivity table)."""
+    rows = []
+    for rule in stats.RULES:
+        c = col if rule == "physical" else events.collisions(eps, floor, transient, rule=rule)
+        z = c.intervals
+        row = dict(rule_n_events=c.time.size, rule_collision_rate=c.time.size / duration,
+                   rule_v_after_mean=stats.batch_means(
+                       stats.velocity_after_impact(c.velocity, eps), n_batches).mean
+                   if c.time.size else math.nan,
+                   rule_interval_mean=stats.batch_means(z, n_batches).mean if z.size
+                   else math.nan)
+        if beta_f is not None:
+            p = list(stats.impact_motion_probabilities(
+                z, beta_f, motion_window, total_time=duration, motions=motions,
+                stuck=c.stuck[:-1]).values())
+            row.update(rule_motion_probability=np.array(p[:len(motions)]),
+                       rule_motion_stick_probability=np.array(p[len(motions):]))
+        rows.append(row)
+    return {name: np.array([row[name] for row in rows]) for name in rows[0]}
+
+
 class _EventRecord:
     """The impacts and sticking phases of a streamed record, gathered chunk by chunk.
 
     Collisions are grouped on the whole record at the end (a chatter sequence may cross a
     chunk boundary). Impacts are kept from the start of the record, so that a collision that
-    begins before the transient is grouped as it happened and then dropped.
+    begins before the transient is grouped as it happened and then dropped. The physical rule
+    reads the force (``noise``, ``delta``, ``amplitude``, ``beta_f``) along each flight.
     """
 
-    def __init__(self, dt):
+    def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0):
         self.dt = dt
+        self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
+        self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
         self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
         self.t_end = 0.0
@@ -229,11 +269,34 @@ class _EventRecord:
         v = eps * self.u[0][t >= transient]
         return v[v >= floor]
 
-    def collisions(self, eps, floor, transient):
-        """Collisions of the record so far that begin at or after ``transient``."""
+    def pressed(self):
+        """The flights between the record's impacts that the push presses throughout
+        (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`); those of earlier
+        checks are kept, only new ones computed."""
+        n = self.steps[0].size if self.steps else 0
+        if n > self._n_pressed:
+            i = max(self._n_pressed - 1, 0)          # from the last impact already seen
+            f = self.force
+            step, offset = self.steps[0][i:], self.offsets[0][i:]
+            t = step * self.dt + offset
+            # a flight with a sticking phase is no hop: left out (it would cost its samples)
+            start = self.sticking()[0]
+            k = np.searchsorted(start, t[:-1], side="left")
+            free = k < start.size
+            free[free] = start[k[free]] < t[1:][free]
+            new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
+                                  amplitude=f["amplitude"], beta=f["beta"], flights=~free)
+            self._pressed, self._n_pressed = np.append(self._pressed, new), n
+        return self._pressed
+
+    def collisions(self, eps, floor, transient, rule="physical"):
+        """Collisions of the record so far that begin at or after ``transient``, grouped by
+        ``rule`` (:data:`vibroimpact.stats.RULES`)."""
         start, end = self.sticking()
+        pressed = self.pressed() if rule == "physical" else None
         return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
-                                      dt=self.dt, eps=eps, floor=floor).after(transient)
+                                      dt=self.dt, eps=eps, floor=floor, pressed=pressed,
+                                      rule=rule).after(transient)
 
 
 class _IdentityRecord:
@@ -396,6 +459,9 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         ``probability, stderr`` (per motion, on the intervals between collisions, motions
         with free flights), ``stick_probability, stick_stderr`` (their impact-stick
         variants: a collision of the group ends sticking),
+        ``rule_probability, rule_stick_probability`` (rules of `stats.RULES` x motions: the
+        probabilities under each grouping rule on the record as it stopped; the physical row
+        is ``probability, stick_probability``),
         ``n_switches, n_collisions, collision_rate, v_after_mean`` (of collisions),
         ``n_impacts_resolved`` (every rebound the kernel resolved: a numerical count, for cost
         models only), ``simulated_time, record_end`` (the last simulated instant: simulating
@@ -420,7 +486,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next)
-    events = _EventRecord(dt)
+    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f)
     k, n_checks, request = 0, 0, None
     try:
         while True:
@@ -447,7 +513,14 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     duration = k * dt - transient
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
+    by_rule = [res] + [
+        stats.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
+                                motions=motions, n_batches=n_batches, stuck=c.stuck)
+        for c in (events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient, rule=rule)
+                  for rule in stats.RULES[1:])]
     return dict(probability=res.probability, stderr=res.stderr,
+                rule_probability=np.stack([r.probability for r in by_rule]),
+                rule_stick_probability=np.stack([r.stick_probability for r in by_rule]),
                 stick_probability=res.stick_probability, stick_stderr=res.stick_stderr,
                 n_switches=res.n_switches,
                 n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
@@ -511,7 +584,7 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         raise ValueError(f"record_length = {record_length!r} after the transient "
                          f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
                          f"holds {len(noise)}")
-    events = _EventRecord(dt)
+    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f)
     k = 0
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=n_end * dt):

@@ -72,6 +72,20 @@ META = {
     "ratio_beyond": ("fraction of ratios z_j / z beyond the last bin", "1"),
     "motion_probability": ("probability of the impact motion with free flights "
                            "(fraction of time)", "1"),
+    "rule": ("grouping rule of the impacts: physical (today's), impacts (the earlier "
+             "impacts-only rule), rebounds (every rebound above the floor)", "1"),
+    "rule_n_events": ("collisions (events) under the grouping rule", "1"),
+    "rule_collision_rate": ("collisions per unit time under the grouping rule", "1"),
+    "rule_v_after_mean": ("mean velocity after impact under the grouping rule", "1"),
+    "rule_interval_mean": ("mean interval between collisions under the grouping rule", "1"),
+    "rule_motion_probability": ("probability of the impact motion with free flights under "
+                                "the grouping rule (fraction of time)", "1"),
+    "rule_motion_stick_probability": ("probability of the motion's impact-stick variant "
+                                      "under the grouping rule (fraction of time)", "1"),
+    "rule_probability": ("probability of the impact motion with free flights under the "
+                         "grouping rule, at the cell's stopping point (fraction of time)", "1"),
+    "rule_stick_probability": ("probability of the motion's impact-stick variant under the "
+                               "grouping rule, at the cell's stopping point", "1"),
     "motion_stick_probability": ("probability of the motion's impact-stick variant "
                                  "(fraction of time)", "1"),
     "probability": ("probability of the impact motion with free flights (fraction of time)", "1"),
@@ -135,6 +149,9 @@ _EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches
                   "virial_residual_stderr", "virial_scale")
 _EVENT_DENSITIES = (("v_after_density", "v_after"), ("v_after_density_stderr", "v_after"),
                     ("interval_density", "interval"), ("interval_density_stderr", "interval"))
+#: The statistics under each grouping rule (`stats.RULES`), along dimension ``rule``.
+_RULE_SCALARS = ("rule_n_events", "rule_collision_rate", "rule_v_after_mean",
+                 "rule_interval_mean")
 #: Statistics that need a forcing period: present only for a harmonic study (amplitude != 0).
 _HARMONIC_SCALARS = ("ratio_beyond",)
 _HARMONIC_DENSITIES = (("ratio_density", "ratio"), ("ratio_density_stderr", "ratio"))
@@ -194,6 +211,13 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
         for name in ("motion_probability", "motion_stick_probability"):
             data[name] = (("cell", "motion"), np.stack([r[name] for r in results]))
         coords["motion"] = _motion_names(motions)
+    if "rule_collision_rate" in results[0]:         # the grouping rules' sensitivity
+        for name in _RULE_SCALARS:
+            data[name] = (("cell", "rule"), np.stack([r[name] for r in results]))
+        if harmonic:
+            for name in ("rule_motion_probability", "rule_motion_stick_probability"):
+                data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
+        coords["rule"] = list(stats.RULES)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -230,13 +254,17 @@ def map_tile(cells, results, motions, attrs):
     states = _motion_names(motions) + ["none"]
     coords = dict(_cell_coords(cells), motion=_motion_names(motions), from_motion=states,
                   to_motion=states)
+    if "rule_probability" in results[0]:         # the grouping rules' sensitivity
+        for name in ("rule_probability", "rule_stick_probability"):
+            data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
+        coords["rule"] = list(stats.RULES)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
 def aggregate_map(tiles, study, attrs):
     """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
     ds = _to_grid(tiles, study.inv_beta, study.delta).transpose(
-        "motion", "from_motion", "to_motion", "inv_beta", "delta", missing_dims="ignore")
+        "motion", "from_motion", "to_motion", "inv_beta", "delta", ..., missing_dims="ignore")
     ds.attrs = dict(attrs)
     return _annotate(ds)
 

@@ -35,6 +35,7 @@ _WHERE = {
     "DEFAULT_REBOUND_FLOOR": "collisions", "MIN_REBOUND_FLOOR": "collisions",
     "Collisions": "collisions",
     "group_collisions": "collisions", "close_open_phase": "collisions",
+    "pressed_flights": "collisions", "RULES": "collisions",
     "DEFAULT_MOTION_WINDOW": "motions", "DEFAULT_MOTIONS": "motions",
     "classify_impact_intervals": "motions", "impact_motion_probabilities": "motions",
     "count_motion_switches": "motions", "MotionStatistics": "motions",

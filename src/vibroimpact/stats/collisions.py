@@ -7,30 +7,46 @@ rest, so any count of individual rebounds is set by that tolerance. The unit of 
 statistic is therefore the **collision**: an impact that follows a free flight, together with
 the chatter sequence it starts and the sticking that follows, up to the release.
 
-Definition (exact on the recorded events, independent of where resolving stops): with impacts
-at ``t_0 < t_1 < ...`` and flights ``z_j = t_{j+1} - t_j``,
+Definition (the physical rule, exact, independent of where resolving stops): with impacts at
+``t_0 < t_1 < ...``, the flight from impact ``j`` to impact ``j + 1`` is a *hop* when no
+sticking phase begins in ``[t_j, t_{j+1})`` and the push ``f(tau) - delta`` (the force the
+wall would feel holding the mass, the sticking criterion of docs/model.md) is ``> 0`` at every
+instant of ``[t_j, t_{j+1}]``: the net force presses the mass toward the wall for the whole
+flight (away from the wall the spring adds to it). Any other flight, one in which the mass
+was pulled away at some moment (or released from the wall), is a *free flight*.
 
 - impact ``j`` *ends in sticking* when a sticking phase begins in ``[t_j, t_{j+1})`` (the
   accumulation point of a chatter sequence, or a plastic impact with ``eps = 0``);
 - the *chatter sequence* ending at such an impact ``j`` is the longest run of impacts
-  ``i, ..., j`` with no sticking between them whose rebounds shrink all the way to it: the
-  approach velocities fall, ``u_i > u_{i+1} > ... > u_j``, and so do the flights,
-  ``z_i > z_{i+1} > ... > z_{j-1}`` (a geometric sequence shrinks so; an impact faster than
-  the one before it, or a flight longer than the next, follows a free flight);
-- a *collision* is a chatter sequence with the sticking phase after it, or any other impact
-  on its own. Its first impact follows a free flight (a flight that is not part of a chatter
-  sequence, or a release from the wall).
+  ``i, ..., j`` joined by hops: it starts at the first impact after the last free flight;
+- a *collision* is an impact after a free flight with the chatter sequence it starts and the
+  sticking phases that follow (before the next collision), or any other impact on its own.
 
-A cycle of one impact, a chatter sequence and sticking is therefore one collision, and the
-interval between collisions runs from one collision's first impact to the next's. A run of
-shrinking rebounds that the force interrupts before its accumulation point (the push turns
-and the mass flies off) does not end in sticking: it is no chatter sequence, and its impacts
-are collisions of their own, as the input makes them. The tail
-rebounds that a tolerance decides to resolve or to sum all lie in the shrinking run, so they
-never change the grouping: every collision field below is independent of the simulator's
+:func:`pressed_flights` computes the hops exactly from the force record: the random force is
+the straight line between samples, so its minimum over a step is at the step's ends; the
+harmonic part ``A sin(beta tau)`` adds a closed-form interior minimum per step.
+
+A cycle of one impact, a chatter sequence and sticking is therefore one collision, and so is
+a long first rebound under a push that never lets go, whatever the rebound velocities do; a
+run that the force interrupts (it pulls, at some moment, and the mass flies off) is split
+where it pulled. A run of hops that never sticks is no chatter sequence: its impacts are
+collisions of their own (the stable (2/1) motion of Fig. 16 at ``1/beta = 1.1, delta = 0``
+has a pressed flight of 1.49 between its two impacts per period, and stays (2/1)). The
+interval between collisions runs from one collision's first impact to the next's. The tail
+rebounds that a tolerance decides to resolve or to sum all lie where the push is > 0 (the
+kernel sticks only there), inside hops that end in the same sticking phase: they never
+change the grouping, and every collision field below is independent of the simulator's
 tolerances (tests/test_collisions.py changes them by three orders of magnitude).
 
-Pure numpy on the simulator's event arrays: :func:`group_collisions`.
+Two other rules are kept for comparison (the reports' sensitivity table,
+docs/figures.md): ``rule="impacts"``, the earlier rule that reads the impacts only (the
+longest run of shrinking rebounds, ``u_i > u_{i+1} > ...`` and shrinking flights, that ends
+in sticking joins the impact that starts it), which folds some free flights into chatter;
+and ``rule="rebounds"``, every rebound leaving the wall at speed ``>= floor`` an event of its
+own (the per-rebound view; the slower ones join the event before them).
+
+Pure numpy on the simulator's event arrays and the force record: :func:`group_collisions`,
+:func:`pressed_flights`.
 """
 from __future__ import annotations
 
@@ -40,8 +56,13 @@ import numpy as np
 
 from vibroimpact import _checks
 
-__all__ = ["DEFAULT_REBOUND_FLOOR", "MIN_REBOUND_FLOOR", "Collisions", "group_collisions",
-           "close_open_phase"]
+__all__ = ["DEFAULT_REBOUND_FLOOR", "MIN_REBOUND_FLOOR", "RULES", "Collisions",
+           "group_collisions", "pressed_flights", "close_open_phase"]
+
+#: The grouping rules of :func:`group_collisions`: the physical rule (chatter hops are the
+#: flights pressed throughout), today's default; the earlier impacts-only rule; every rebound
+#: above the floor on its own.
+RULES = ("physical", "impacts", "rebounds")
 
 #: Default velocity floor of the rebound counts: rebounds leaving the wall slower than this are
 #: not counted. A rebound at speed ``v`` rises ``v**2 / (2 F)`` above the wall under a push
@@ -105,8 +126,97 @@ def _next_true(mask):
     return np.minimum.accumulate(idx[::-1])[::-1]
 
 
+def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0,
+                    flights=None):
+    """Which flights between consecutive impacts are pressed throughout (the hops).
+
+    ``out[j]`` is True when the push ``f(tau) - delta`` is ``> 0`` at every instant of
+    ``[t_j, t_{j+1}]``, with ``f(tau) = r(tau) + amplitude sin(beta tau)`` and ``r`` the
+    straight line between the samples ``noise[k] = r(k dt)`` (the simulator's force). Exact,
+    not sampled: over each step of the flight the push's minimum is at one of the step's
+    ends or, with a harmonic part, at the closed-form root of
+    ``r' + amplitude beta cos(beta tau) = 0`` where the curvature is positive. It reads the
+    force only, never a tolerance of the simulator. The work is proportional to the steps of
+    the flights whose two impacts are pressed.
+
+    Parameters
+    ----------
+    impact_step, impact_offset : array_like, shape (n,)
+        Impact instants ``t_j = step * dt + offset``, increasing.
+    noise : array_like or None
+        The random force samples the record was simulated with (None: no random force).
+    dt : float
+        Sample step.
+    delta, amplitude, beta : float
+        Play, harmonic amplitude and frequency ratio.
+    flights : array_like of bool, shape (n - 1,), optional
+        Only these flights are examined (the others are reported False), e.g. leaving out
+        the flights with a sticking phase, which are never hops.
+
+    Returns
+    -------
+    ndarray of bool, shape (max(n - 1, 0),)
+    """
+    step = np.asarray(impact_step, dtype=np.int64)
+    offset = np.asarray(impact_offset, dtype=float)
+    n = step.size
+    if n < 2:
+        return np.zeros(0, bool)
+    k_lo, k_hi = int(step[0]), int(step[-1]) + 2          # samples k_lo .. k_hi - 1
+    if noise is None:
+        r = np.zeros(k_hi - k_lo)
+    else:
+        r = np.asarray(noise[k_lo : min(k_hi, len(noise))], dtype=float)
+        if r.size < k_hi - k_lo:     # an impact on the record's last sample: no slope needed
+            r = np.append(r, np.full(k_hi - k_lo - r.size, r[-1]))
+    harmonic = amplitude != 0.0
+
+    def push(k, s):
+        """The push at ``k dt + s`` (k absolute sample indices, 0 <= s <= dt)."""
+        i = k - k_lo
+        value = r[i] + (r[i + 1] - r[i]) / dt * s - delta
+        if harmonic:
+            value = value + amplitude * np.sin(beta * (k * dt + s))
+        return value
+
+    at_impact = push(step, offset) > 0.0
+    pressed = at_impact[:-1] & at_impact[1:]
+    if flights is not None:
+        pressed &= np.asarray(flights, dtype=bool)
+    j = np.flatnonzero(pressed)
+    if j.size == 0:
+        return pressed
+    # the flights' steps: [s_lo, s_hi] of step k, from t_j's step to t_{j+1}'s
+    count = step[j + 1] - step[j] + 1
+    flight = np.repeat(j, count)
+    k = step[flight] + (np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count))
+    s_lo = np.where(k == step[flight], offset[flight], 0.0)
+    s_hi = np.where(k == step[flight + 1], offset[flight + 1], dt)
+    low = push(k, s_hi)                    # each step's end (the flight's start is pressed)
+    if harmonic:
+        # interior minima of amplitude sin(theta) + slope theta / beta: cos(theta) = c with
+        # amplitude sin(theta) < 0
+        i = k - k_lo
+        c = -(r[i + 1] - r[i]) / dt / (amplitude * beta)
+        ok = np.abs(c) <= 1.0
+        theta0 = -np.sign(amplitude) * np.arccos(np.clip(c, -1.0, 1.0))
+        two_pi = 2.0 * np.pi
+        th_lo, th_hi = beta * (k * dt + s_lo), beta * (k * dt + s_hi)
+        for n_turn in (np.ceil((th_lo - theta0) / two_pi), np.floor((th_hi - theta0) / two_pi)):
+            theta = theta0 + two_pi * n_turn
+            inside = ok & (theta >= th_lo) & (theta <= th_hi)
+            if inside.any():
+                s = np.clip(s_lo[inside] + (theta[inside] - th_lo[inside]) / beta,
+                            s_lo[inside], s_hi[inside])
+                low[inside] = np.minimum(low[inside], push(k[inside], s))
+    pulled = np.zeros(n - 1, bool)
+    np.logical_or.at(pulled, flight, low <= 0.0)
+    return pressed & ~pulled
+
+
 def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *,
-                     dt: float, eps: float, floor: float = DEFAULT_REBOUND_FLOOR) -> Collisions:
+                     dt: float, eps: float, floor: float = DEFAULT_REBOUND_FLOOR,
+                     pressed=None, rule: str = "physical") -> Collisions:
     """Group a record's impacts into collisions (definition: module docstring).
 
     Parameters
@@ -125,6 +235,13 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     floor : float
         Rebounds leaving the wall at speed ``>= floor`` are counted in ``rebounds``
         (default `DEFAULT_REBOUND_FLOOR`; ``>= MIN_REBOUND_FLOOR``).
+    pressed : array_like of bool, shape (n - 1,)
+        Which flights the push presses throughout, the hops (:func:`pressed_flights`);
+        required by the physical rule, unused by the others.
+    rule : {"physical", "impacts", "rebounds"}
+        The grouping (module docstring): the physical rule, the earlier impacts-only rule,
+        or every rebound above ``floor`` on its own (impacts before the first such rebound
+        then belong to no event, ``impact_collision = -1``).
 
     Returns
     -------
@@ -138,6 +255,8 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     dt = _checks.real("dt", dt, low=0.0, low_open=True)
     eps = _checks.eps(eps)
     floor = _checks.real("rebound_floor", floor, low=MIN_REBOUND_FLOOR)
+    if rule not in RULES:
+        raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
     if not (step.shape == offset.shape == u.shape) or step.ndim != 1:
         raise ValueError(f"impact_step, impact_offset and impact_velocity must be 1-D of one "
                          f"length, got {step.shape}, {offset.shape}, {u.shape}")
@@ -146,32 +265,39 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
                          f"{start.shape} and {end.shape}")
     n = step.size
     t = step * dt + offset
+    if rule == "physical":
+        if pressed is None:
+            raise ValueError("pressed (the flights pressed throughout, pressed_flights) is "
+                             "required by rule='physical'")
+        pressed = np.asarray(pressed, dtype=bool)
+        if pressed.shape != (max(n - 1, 0),):
+            raise ValueError(f"pressed must have one value per flight, shape "
+                             f"({max(n - 1, 0)},), got {pressed.shape}")
+    if rule == "rebounds" and n and not np.any(eps * u >= floor):
+        n = 0
     if n == 0:
         e_i, e_f = np.empty(0, np.int64), np.empty(0)
         return Collisions(e_i, e_i.copy(), e_i.copy(), e_f, e_f.copy(), e_f.copy(), e_i.copy(),
                           np.empty(0, bool), e_f.copy(), e_f.copy(), floor, dt)
-    z = np.diff(step).astype(float) * dt + np.diff(offset)
     # the first sticking phase that begins at or after each impact, and whether it begins
     # before the next impact
     k = np.searchsorted(start, t, side="left")
     t_next = np.append(t[1:], np.inf)
     ends = k < start.size
     ends[ends] = start[k[ends]] < t_next[ends]
-    # the chain j -> j+1 continues towards a sticking end when the rebounds shrink (the
-    # approach velocity falls, u_{j+1} < u_j) and so do the flights (z_j > z_{j+1}, unless
-    # j + 1 ends the sequence)
-    cont = np.zeros(n, bool)
-    shrinks = np.append(z[:-1] > z[1:], True)[: n - 1]
-    cont[:-1] = ~ends[:-1] & (u[1:] < u[:-1]) & (ends[1:] | shrinks)
-    # chatter[j]: impact j lies on a shrinking run that ends in sticking at or after j
-    next_end = _next_true(ends)
-    next_break = _next_true(~ends & ~cont)
-    chatter = (next_end < n) & (next_break > next_end)
-    joins = chatter[:-1] & ~ends[:-1]          # impact j + 1 belongs to the collision of j
     first_mask = np.ones(n, bool)
-    first_mask[1:] = ~joins
+    if rule == "physical":
+        # hops: no sticking between, pressed throughout; a run of them that ends in sticking
+        # is a chatter sequence, joined to the impact that starts it
+        cont = np.zeros(n, bool)
+        cont[:-1] = ~ends[:-1] & pressed
+        first_mask[1:] = ~_chatter_joins(cont, ends)
+    elif rule == "rebounds":
+        first_mask = eps * u >= floor
+    else:
+        first_mask[1:] = ~_impacts_only_joins(step, offset, u, ends, dt)
     first = np.flatnonzero(first_mask)
-    impact_collision = np.cumsum(first_mask) - 1
+    impact_collision = np.cumsum(first_mask) - 1     # -1 before a first rebound (rule "rebounds")
     # sticking phases that begin inside each collision [t_first, t_next_first)
     bounds = np.append(t[first], np.inf)
     lo = np.searchsorted(start, bounds[:-1], side="left")
@@ -186,3 +312,29 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     rebounds = np.add.reduceat((eps * u >= floor).astype(np.int64), first)
     return Collisions(first, impact_collision, step[first], offset[first], t[first], u[first],
                       rebounds, stuck, stick_time, duration, floor, dt)
+
+
+def _impacts_only_joins(step, offset, u, ends, dt):
+    """The earlier, impacts-only rule: ``joins[j]`` when impact ``j + 1`` belongs to the
+    collision of ``j``, that is ``j`` lies on a run of shrinking rebounds (``u`` and the
+    flights falling) that ends in sticking."""
+    n = step.size
+    z = np.diff(step).astype(float) * dt + np.diff(offset)
+    # the chain j -> j+1 continues towards a sticking end when the rebounds shrink (the
+    # approach velocity falls, u_{j+1} < u_j) and so do the flights (z_j > z_{j+1}, unless
+    # j + 1 ends the sequence)
+    cont = np.zeros(n, bool)
+    shrinks = np.append(z[:-1] > z[1:], True)[: n - 1]
+    cont[:-1] = ~ends[:-1] & (u[1:] < u[:-1]) & (ends[1:] | shrinks)
+    return _chatter_joins(cont, ends)
+
+
+def _chatter_joins(cont, ends):
+    """``joins[j]`` (impact ``j + 1`` belongs to the collision of ``j``): ``j`` lies on a run
+    of links ``cont`` that ends in sticking (``ends``) at or after ``j``, and does not end."""
+    n = ends.size
+    # chatter[j]: impact j lies on a run that ends in sticking at or after j
+    next_end = _next_true(ends)
+    next_break = _next_true(~ends & ~cont)
+    chatter = (next_end < n) & (next_break > next_end)
+    return chatter[:-1] & ~ends[:-1]

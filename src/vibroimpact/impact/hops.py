@@ -1,0 +1,91 @@
+"""The hops of a record compiled: :func:`vibroimpact.stats.pressed_flights` in one pass.
+
+Which flights between consecutive impacts the push ``f(tau) - delta`` presses throughout
+(docs/figures.md, "Collisions"), walked flight by flight and step by step in numba, stopping
+at the first step where the push is not positive, instead of evaluated on every step of
+every candidate flight in arrays: the numpy function stays the reference and the statement of
+the rule (tests/test_collisions.py holds this one to it); this is the one the simulator's
+results and the streaming cells run.
+
+Its kernel uses no simulator kernel and no constant of another module, so its numba cache is
+stamped with this file alone.
+"""
+import math
+
+import numpy as np
+from numba import njit
+
+from vibroimpact._kernel_cache import kernel_decorator
+
+kernel = kernel_decorator(njit, __file__, ("hops.py",), error_model="numpy")
+
+
+@kernel
+def _push(r, i, k, s, dt, delta, amplitude, beta):
+    """The push at ``k dt + s`` (``i = k - k_lo`` its index in ``r``)."""
+    value = r[i] + (r[i + 1] - r[i]) / dt * s - delta
+    if amplitude != 0.0:
+        value += amplitude * math.sin(beta * (k * dt + s))
+    return value
+
+
+@kernel
+def _pressed(step, offset, r, k_lo, dt, delta, amplitude, beta, examine, out):
+    two_pi = 2.0 * math.pi
+    sign = 1.0 if amplitude > 0.0 else -1.0
+    for j in range(step.size - 1):
+        out[j] = False
+        if not examine[j]:
+            continue
+        ka, kb = step[j], step[j + 1]
+        if (_push(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta) <= 0.0
+                or _push(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta) <= 0.0):
+            continue
+        ok = True
+        for k in range(ka, kb + 1):
+            i = k - k_lo
+            s_lo = offset[j] if k == ka else 0.0
+            s_hi = offset[j + 1] if k == kb else dt
+            if _push(r, i, k, s_hi, dt, delta, amplitude, beta) <= 0.0:
+                ok = False
+                break
+            if amplitude != 0.0:
+                # interior minima: cos(beta tau) = c where amplitude sin(beta tau) < 0
+                c = -(r[i + 1] - r[i]) / dt / (amplitude * beta)
+                if abs(c) <= 1.0:
+                    theta0 = -sign * math.acos(c)
+                    th_lo = beta * (k * dt + s_lo)
+                    th_hi = beta * (k * dt + s_hi)
+                    for n_turn in (math.ceil((th_lo - theta0) / two_pi),
+                                   math.floor((th_hi - theta0) / two_pi)):
+                        theta = theta0 + two_pi * n_turn
+                        if th_lo <= theta <= th_hi:
+                            s = min(max(s_lo + (theta - th_lo) / beta, s_lo), s_hi)
+                            if _push(r, i, k, s, dt, delta, amplitude, beta) <= 0.0:
+                                ok = False
+                if not ok:
+                    break
+        out[j] = ok
+
+
+def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0,
+                    flights=None):
+    """:func:`vibroimpact.stats.pressed_flights` compiled (same arguments and result)."""
+    step = np.ascontiguousarray(impact_step, dtype=np.int64)
+    offset = np.ascontiguousarray(impact_offset, dtype=np.float64)
+    n = step.size
+    if n < 2:
+        return np.zeros(0, bool)
+    k_lo, k_hi = int(step[0]), int(step[-1]) + 2
+    if noise is None:
+        r = np.zeros(k_hi - k_lo)
+    else:
+        r = np.ascontiguousarray(noise[k_lo : min(k_hi, len(noise))], dtype=np.float64)
+        if r.size < k_hi - k_lo:     # an impact on the record's last sample: no slope needed
+            r = np.append(r, np.full(k_hi - k_lo - r.size, r[-1]))
+    examine = (np.ones(n - 1, np.bool_) if flights is None
+               else np.ascontiguousarray(flights, dtype=np.bool_))
+    out = np.empty(n - 1, np.bool_)
+    _pressed(step, offset, r, k_lo, float(dt), float(delta), float(amplitude), float(beta),
+             examine, out)
+    return out
