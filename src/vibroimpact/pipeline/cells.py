@@ -213,12 +213,13 @@ def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches,
     for rule in stats.RULES:
         c = col if rule == "physical" else events.collisions(eps, floor, transient, rule=rule)
         z = c.intervals
+        # the same estimators as the cell's own: T/N and the mean of every value
         row = dict(rule_n_events=c.time.size, rule_collision_rate=c.time.size / duration,
-                   rule_v_after_mean=stats.batch_means(
-                       stats.velocity_after_impact(c.velocity, eps), n_batches).mean
-                   if c.time.size else math.nan,
-                   rule_interval_mean=stats.batch_means(z, n_batches).mean if z.size
-                   else math.nan)
+                   rule_v_after_mean=stats.mark_mean(
+                       stats.velocity_after_impact(c.velocity, eps), c.time, transient,
+                       transient + duration, n_batches).mean,
+                   rule_interval_mean=stats.event_rate(
+                       c.time, transient, transient + duration, n_batches).mean_interval)
         if beta_f is not None:
             p = list(stats.impact_motion_probabilities(
                 z, beta_f, motion_window, total_time=duration, motions=motions,
