@@ -61,14 +61,36 @@ def show_figures(figures):
         display(Markdown(f"`{path}`"), Image(filename=path))
 
 
-def show_table(found):
-    """The findings as a table: number, the paper's claim, this run's numbers, verdict."""
-    from IPython.display import display
+def show_table(found, omit_unavailable=False):
+    """The findings as a table: number, the paper's claim, this run's numbers, verdict; a
+    verdict's one-sentence summary (what holds, what does not) opens its numbers, in bold.
+
+    With ``omit_unavailable``, the findings this study cannot measure (``n/a``) are left out
+    of the table and named in one line under it, with why. Returns the table of every
+    finding given (:func:`vibroimpact.reports.findings.findings_table`).
+    """
+    from html import escape
+
+    from IPython.display import Markdown, display
 
     from vibroimpact.reports.findings import findings_table
 
     table = findings_table(found)
-    display(table.style.set_properties(**{"text-align": "left", "white-space": "normal"}))
+    shown = [f for f in found if not (omit_unavailable and f.holds == "n/a")]
+    if shown:
+        view = findings_table(shown)
+        view["claim"] = [escape(c) for c in view["claim"]]
+        view["measured"] = [(f"<b>{escape(f.summary)}</b><br>" if f.summary else "")
+                            + escape(f.measured) for f in shown]
+        display(view.style.set_properties(**{"text-align": "left", "white-space": "normal"}))
+    left = [f for f in found if f not in shown]
+    if left:
+        reasons = {}
+        for f in left:
+            reasons.setdefault(f.measured, []).append(str(f.number))
+        display(Markdown("*Not measured in this report:* " + "; ".join(
+            f"finding{'s' if len(n) > 1 else ''} {', '.join(n)} ({why})"
+            for why, n in reasons.items()) + "."))
     return table
 
 
