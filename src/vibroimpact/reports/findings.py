@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vibroimpact.stats.spectra import spectral_centroid
+from vibroimpact.stats.spectra import CENTROID_BAND, spectral_centroid
 from vibroimpact.stats.theory import upcrossing_rate
 
 #: Fewest impacts a play needs before its means and densities take part in a finding
@@ -293,7 +293,7 @@ def random_force(events=None, spectra=None):
 
 # --- harmonic plus random force (Figs. 11-15) --------------------------------------------------
 
-def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0, events=None):
+def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=CENTROID_BAND, events=None):
     """Input and response spectra under ``amplitude sin(beta_f tau) + r(tau)`` (Figs. 11, 12).
 
     The input: the line carries ``amplitude^2/2`` against the random part's power (the

@@ -26,7 +26,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from vibroimpact import _checks
 
 __all__ = ["PSD_DETREND", "WelchAccumulator", "welch_psd", "onesided_to_angular", "line_power",
-           "spectral_centroid", "variance_from_psd", "linear_psd_response"]
+           "CENTROID_BAND", "spectral_centroid", "variance_from_psd", "linear_psd_response"]
 
 #: Detrending of every PSD estimate in the package (input force and response alike): the mean
 #: of the whole record is removed, nothing per segment, so S is the spectrum of the fluctuation
@@ -272,7 +272,12 @@ LINE_HALF_WIDTH = 4
 LINE_BACKGROUND = 24
 
 
-def spectral_centroid(beta, S, band: float) -> float:
+#: Upper end of the band over which a response's centroid is taken (`spectral_centroid`): the
+#: resonance and the forcing frequencies of the paper's section 5, not the round-off tail.
+CENTROID_BAND = 3.0
+
+
+def spectral_centroid(beta, S, band: float = CENTROID_BAND) -> float:
     """Mean frequency of a PSD over ``0 < beta <= band``: ``sum(beta S) / sum(S)``.
 
     Parameters
