@@ -150,6 +150,7 @@ def test_a_papermilled_report_shows_its_parameters_once_its_title_first_and_wrap
     body = text[text.index("<body"):]
     assert body.index("The title") < body.index("this_run")        # the heading comes first
     assert "nb.harmonic_heading" not in text                       # its output, not its code
+    assert "<title>The title</title>" in text                      # the page's title
     style = text[:text.index("<body")]
     assert re.search(r"\.highlight pre[^}]*white-space: pre-wrap", style)  # long code wraps
     assert re.search(r"\.jp-OutputArea-output pre[^}]*white-space: pre-wrap", style, re.S)

@@ -393,6 +393,7 @@ _WRAP_CSS = """<style type="text/css">
 .jp-RenderedHTMLCommon td, .jp-RenderedHTMLCommon th { overflow-wrap: anywhere; }
 .jp-RenderedHTMLCommon code { overflow-wrap: anywhere; }
 .jp-OutputArea-output img { max-width: 100%; height: auto; }
+.celltag_heading .jp-OutputPrompt { display: none; }
 </style>"""
 
 #: nbconvert's JupyterLab template without what it loads from the network: require.js (no
@@ -409,6 +410,19 @@ _OFFLINE_TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
 
 def _tagged(cell, tag):
     return tag in cell.get("metadata", {}).get("tags", ())
+
+
+def _title(cells):
+    """The report's first ``# `` heading, from a heading cell's output or a markdown cell,
+    without its markup (the page's title); None when it has none."""
+    for cell in cells:
+        texts = ([o.get("data", {}).get("text/markdown", "") for o in cell.get("outputs", [])]
+                 if cell.cell_type == "code" else [cell.source])
+        for text in texts:
+            for line in text.splitlines():
+                if line.startswith("# "):
+                    return line[2:].replace("`", "").strip()
+    return None
 
 #: Code spans and fences (left alone), then display maths $$...$$, then inline maths $...$.
 _MATH = re.compile(r"(?P<code>(`+).*?\2)|\$\$(?P<display>.+?)\$\$|\$(?P<inline>[^$\n]+?)\$",
@@ -453,6 +467,9 @@ def render_html(ipynb, html, figures=True):
         nb.cells = [cell for cell in nb.cells if not _tagged(cell, "parameters")]
     headings = [cell for cell in nb.cells if _tagged(cell, "heading")]
     nb.cells = headings + [cell for cell in nb.cells if not _tagged(cell, "heading")]
+    title = _title(nb.cells)
+    if title:
+        nb.metadata["title"] = title
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             cell.source = mathml(cell.source)
