@@ -201,6 +201,32 @@ def test_a_map_studys_heading_and_audit_say_what_a_map_reports():
     assert "(1/beta_f = 1, delta = 1), (1/beta_f = 1.1, delta = 1)" in bad
 
 
+def test_the_findings_table_opens_a_verdict_with_its_sentence_and_names_what_it_leaves(
+        monkeypatch):
+    """The summary sentence, in bold, before the numbers; with ``omit_unavailable`` the n/a
+    findings leave the table for one line under it, grouped by why; the returned table
+    still holds every finding."""
+    from html import escape
+
+    import IPython.display
+
+    from vibroimpact.reports import findings
+
+    shown = []
+    monkeypatch.setattr(IPython.display, "display", lambda *objs: shown.extend(objs))
+    inside = dict(n_dominant=40, dominant_inside=0.9, domain_covered=0.8, rank_correlation=0.1)
+    found = [findings.not_available(5, "no spectrum"), findings.not_available(6, "no densities"),
+             findings.not_available(7, "no densities"), findings.finding8({"1/1": inside})]
+    table = notebook.show_table(found, omit_unavailable=True)
+    assert list(table.index) == [5, 6, 7, 8]
+    html = shown[0].to_html()
+    assert found[3].summary.startswith("Holds: the domains agree")
+    assert f"<b>{escape(found[3].summary)}</b><br>" in html
+    assert ">n/a<" not in html and ">partly<" in html
+    assert shown[1].data == ("*Not measured in this report:* finding 5 (no spectrum); "
+                             "findings 6, 7 (no densities).")
+
+
 def test_the_summary_for_snakemakes_report_has_no_image_but_says_which(tmp_path):
     html = tmp_path / "summary.html"
     notebook.main([str(_notebook(tmp_path)), str(html), "--no-figures"])
