@@ -7,7 +7,7 @@ from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
     _num, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
     axis_label)
-from vibroimpact.stats.spectra import CENTROID_BAND, spectral_centroid
+from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 
 
 def fig10(trace):
@@ -98,7 +98,7 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
         each delta's legend entry gives the power of the response's line at beta_f
         (`vibroimpact.stats.line_power`), comparable with Fig. 11's A^2/2 where the Welch
         peak heights are not, and the legend's title the resolution. The header's last line
-        says which way the response's centroid (`vibroimpact.stats.spectral_centroid`, the
+        says which way the response's centroid (`vibroimpact.stats.centroid`, the
         reports' finding 5) moves from the largest delta to the smallest, against the paper's
         "to lower frequency".
     """

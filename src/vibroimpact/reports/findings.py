@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vibroimpact.stats.spectra import CENTROID_BAND, spectral_centroid
+from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 from vibroimpact.stats.theory import upcrossing_rate
 
 #: Fewest impacts a play needs before its means and densities take part in a finding

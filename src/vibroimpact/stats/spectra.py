@@ -26,7 +26,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from vibroimpact import _checks
 
 __all__ = ["PSD_DETREND", "WelchAccumulator", "welch_psd", "onesided_to_angular", "line_power",
-           "CENTROID_BAND", "spectral_centroid", "variance_from_psd", "linear_psd_response"]
+           "variance_from_psd", "linear_psd_response"]
 
 #: Detrending of every PSD estimate in the package (input force and response alike): the mean
 #: of the whole record is removed, nothing per segment, so S is the spectrum of the fluctuation
@@ -270,35 +270,6 @@ LINE_HALF_WIDTH = 4
 #: The continuous background under a line: the median of the PSD between `LINE_HALF_WIDTH`
 #: and this many bins from the line on both sides.
 LINE_BACKGROUND = 24
-
-
-#: Upper end of the band over which a response's centroid is taken (`spectral_centroid`): the
-#: resonance and the forcing frequencies of the paper's section 5, not the round-off tail.
-CENTROID_BAND = 3.0
-
-
-def spectral_centroid(beta, S, band: float = CENTROID_BAND) -> float:
-    """Mean frequency of a PSD over ``0 < beta <= band``: ``sum(beta S) / sum(S)``.
-
-    Parameters
-    ----------
-    beta, S : array_like
-        PSD on an evenly spaced grid beta >= 0 (`welch_psd`).
-    band : float
-        Upper end of the frequencies taken.
-
-    Returns
-    -------
-    float
-        Where the power of ``S`` lies on average in the band (the paper's "moves to lower
-        frequency", section 5, read as this centroid falling); NaN when ``S`` has no power
-        there.
-    """
-    beta = np.asarray(beta, dtype=float)
-    S = np.asarray(S, dtype=float)
-    inside = (beta > 0) & (beta <= band)
-    total = float(S[inside].sum())
-    return float((beta[inside] * S[inside]).sum() / total) if total > 0 else float("nan")
 
 
 def line_power(beta, S, beta_line: float) -> float:
