@@ -108,6 +108,55 @@ def test_finding8_where_and_how_strongly():
     assert findings.finding8({"1/1": dict(inside, n_dominant=2)}).holds == "n/a"
 
 
+def test_every_partly_verdict_opens_with_what_holds_and_what_not():
+    """The summary sentence is computed from the data: its numbers are the dataset's."""
+    found = findings.finding3(random_events())
+    assert found.holds == "partly"
+    assert found.summary == ("Holds: the mean interval grows with delta from delta = -0.5 up "
+                             "(0.35 -> 300); does not: below delta = -0.5 it grows again as "
+                             "delta falls (to 0.4 at delta = -1), where the mass rests on the "
+                             "wall for a fraction 0.90 of the time.")
+    wide_large = findings.finding7(harmonic_events(cv=(1.5, 0.7, 0.6, 0.2, 0.15, 0.2, 0.6)))
+    assert wide_large.summary.startswith("Holds: the spread of the velocity after impact falls")
+    cv = findings._cv(harmonic_events(cv=(1.5, 0.7, 0.6, 0.2, 0.15, 0.2, 0.6)).isel(inv_beta=0),
+                      3.0)                                   # the density's, truncated at v = 0
+    assert f"does not: it is wide (CV {cv:.2f} >= " in wide_large.summary
+    assert "at delta = 3, where P(1/1) = 0.30" in wide_large.summary
+    inside = dict(n_dominant=40, dominant_inside=0.9, domain_covered=0.8, rank_correlation=0.1)
+    two = {"1/1": inside, "2/1": dict(inside, dominant_inside=0.8, rank_correlation=0.7)}
+    found = findings.finding8(two)
+    assert found.holds == "partly"
+    assert found.summary == ("Holds: the domains agree: 80-90 % of the cells where a motion has "
+                             "P >= 50 % lie inside its stable domain (>= 75 % asked); does not: "
+                             "S does not rank P inside them (rho = 0.10 for (1/1); >= 0.5 "
+                             "asked).")
+    assert findings.finding8({"1/1": dict(inside, rank_correlation=0.7)}).summary == ""
+    no = findings.finding8({"1/1": dict(inside, dominant_inside=0.3)})
+    assert no.summary.startswith("Does not hold: the domains do not agree: of the cells")
+    # the table opens the measured cell with it
+    table = findings.findings_table([found])
+    assert table.loc[8, "measured"].startswith(found.summary + " (1/1) 40 cells")
+
+
+def test_finding5_says_which_part_fails():
+    """A response whose centroid rises as delta falls: the summary names the 1/beta_f and the
+    centroids (from the spectra), and the verdict is partly."""
+    beta = np.linspace(0.0, 4.0, 401)
+    deltas = np.array([-0.5, 2.0])
+    S_a = np.array([0.01 + np.exp(-((beta - 1.1) / 0.3) ** 2),          # wide, higher
+                    0.01 + 5 * np.exp(-((beta - 1 / 1.1) / 0.02) ** 2)])  # narrow line at beta_f
+    spectra = xr.Dataset(
+        {"S_a": (("inv_beta", "delta", "beta"), S_a[None]),
+         "S_f": (("inv_beta", "beta"), np.full((1, beta.size), 1e-4))},
+        coords=dict(inv_beta=[1.1], delta=deltas, beta=beta))
+    found = findings.finding5(spectra)
+    assert found.holds == "partly", found.measured
+    assert found.summary.startswith("Holds: the input's power is concentrated at beta_f")
+    assert ("does not: as delta falls from 2 to -0.5 the response moves to higher frequency, "
+            "opposite to the paper (its centroid (beta <= 3) 1.00 -> 1.12" in found.summary)
+    assert "at 1/beta_f = 1.1)." in found.summary
+
+
 def test_the_table_has_one_row_per_finding_with_claim_measure_and_verdict():
     table = findings.findings_table(findings.random_force(random_events(), random_spectra()))
     assert list(table.index) == [1, 2, 3, 4]
@@ -127,7 +176,11 @@ def test_finding4_tells_the_reach_of_a_record_from_a_threshold():
     reach = events.assign_attrs(linear_sigma_x=sigma, linear_sigma_v=sigma,
                                 record_length=1.0 / nu)     # one expected in the record
     found = findings.finding4(reach)
-    assert found.holds == "partly" and "expects 1 " in found.measured
+    assert found.holds == "partly" and "an expected 1 up-crossings" in found.measured
+    # the rate and the count it gives, each with its unit
+    assert f"{nu:.3g} per unit time at delta = 3" in found.measured
+    assert "by 2.5 orders of magnitude" in found.summary       # 3 / 0.01: the last rate > 0
+    assert found.summary.startswith("Holds: ") and "does not: a critical delta" in found.summary
     threshold = reach.assign_attrs(record_length=100.0 / nu)   # 100 expected, none seen
     assert findings.finding4(threshold).holds == "yes"
 

@@ -485,6 +485,28 @@ def test_fig12_states_the_resolution_and_each_line_power(data):
                    for t in texts), (d, power, texts)
 
 
+@pytest.mark.parametrize("centres, way", [((1.2, 0.9), "rises as $\\delta$ decreases: the "
+                                                       "frequency shift runs opposite"),
+                                          ((0.9, 1.2), "falls as $\\delta$ decreases, as in "
+                                                       "the paper")])
+def test_fig12_says_which_way_the_response_moves(data, centres, way):
+    """One peak per play (at centres[0] for the smallest delta, centres[1] for the others):
+    the header's centroid is the peak's centre (a symmetric peak, far wider than the grid's
+    step, on a floor 1e-6 of its height: within 0.005) and its direction the one the paper's
+    finding 5 reads."""
+    spectra = data["spectra_h"].copy(deep=True)
+    beta = spectra["beta"]
+    smallest = spectra["delta"] == spectra["delta"].min()
+    centre = xr.where(smallest, centres[0], centres[1])
+    peak = 1e-6 + np.exp(-((beta - centre) / 0.15) ** 2)
+    spectra["S_a"] = peak.broadcast_like(spectra["S_a"]).transpose(*spectra["S_a"].dims)
+    title = _title(plotting.fig12(spectra, inv_beta=1.1))
+    deltas = np.sort(spectra["delta"].values)
+    assert (f"{centres[1]:.2f} at $\\delta$ = {deltas[-1]:g}, {centres[0]:.2f} at $\\delta$ = "
+            f"{deltas[0]:g};") in title.replace("\n", " "), title
+    assert way in title.replace("\n", " ")
+
+
 def _nearest_index(coord, value):
     return int(np.argmin(np.abs(np.asarray(coord, float) - value)))
 

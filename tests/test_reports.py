@@ -5,6 +5,7 @@ to stderr; the findings table in a report is the one `vibroimpact.reports.findin
 from the build's datasets, and it changes when a dataset does. `snakemake --report` gives one
 self-contained HTML of every figure, captioned, by study.
 """
+from html import escape as html_escape
 from pathlib import Path
 import re
 
@@ -54,6 +55,31 @@ def test_the_tables_are_the_findings_of_the_datasets(built):
     assert table == {f.number: f.holds for f in expected}
     harmonic = _verdicts(built / "results" / "reports" / "harmonic" / "harmonic_random.html")
     assert sorted(harmonic) == [5, 6, 7, 8] and "n/a" not in harmonic.values()
+
+
+def test_a_map_studys_report_is_titled_and_audited_as_one_and_shows_parameters_once(built):
+    """The map study (test config: `motion_map`, a map and no impact record) is titled by
+    what it holds, tables only finding 8 and names 5-7 under it, and audits its map; every
+    report shows papermill's parameters once (the injected values), and a partly verdict of
+    the harmonic report opens with its sentence."""
+    reports = built / "results" / "reports"
+    text = (reports / "motion_map" / "harmonic_random.html").read_text()
+    assert "<title>Harmonic plus random force: the probability map of study motion_map" in text
+    assert "Figs. 10-15" not in text and "keeps no impact record" in text
+    assert sorted(_verdicts(reports / "motion_map" / "harmonic_random.html")) == [8]
+    assert "Not measured in this report:" in text and "findings 6, 7" in text
+    assert "Self-audit passed:</strong> a map study keeps no impact record" in text
+    for report in REPORTS:
+        html = (reports / f"{report}.html").read_text()
+        assert "celltag_parameters" not in html and html.count("# Parameters") == 1, report
+    data = built / "results" / "datasets"
+    found = findings.random_force(events=xr.load_dataset(data / "random_events.nc"),
+                                  spectra=xr.load_dataset(data / "random_spectra.nc"))
+    random = (reports / "random" / "random_force.html").read_text()
+    for f in found:
+        assert f.holds != "partly" or f.summary, f
+        if f.summary:
+            assert f"<b>{html_escape(f.summary)}</b>" in random
 
 
 def _predictor_cells(html):

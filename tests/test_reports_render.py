@@ -118,6 +118,115 @@ def test_a_rendered_report_loads_nothing_and_its_maths_is_mathml(tmp_path):
     assert "<table>" in text and text.count(_PIXEL) == 1
 
 
+def _papermilled(tmp_path):
+    """A notebook as papermill leaves it: the ``parameters`` cell (the defaults), the
+    ``injected-parameters`` cell (this run's values: one long line of paths), a ``heading``
+    cell computed from them after the imports, and a long line of output."""
+    nb = nbformat.v4.new_notebook()
+    paths = " ".join(f"results/figures/motion_map/fig{n}.png" for n in range(10, 30))
+    nb.cells = [
+        nbformat.v4.new_code_cell('study = "default_study"', metadata={"tags": ["parameters"]}),
+        nbformat.v4.new_code_cell(f'study = "this_run"\nfigures = "{paths}"',
+                                  metadata={"tags": ["injected-parameters"]}),
+        nbformat.v4.new_code_cell("import notebook_helpers as nb"),
+        nbformat.v4.new_code_cell("nb.harmonic_heading(study)", metadata={"tags": ["heading"]},
+                                  outputs=[nbformat.v4.new_output(
+                                      "display_data", data={"text/markdown": "# The title",
+                                                            "text/plain": "title"})]),
+        nbformat.v4.new_code_cell("print(figures)", outputs=[nbformat.v4.new_output(
+            "stream", name="stdout", text=paths)]),
+    ]
+    path = tmp_path / "papermilled.ipynb"
+    nbformat.write(nb, path)
+    return path
+
+
+def test_a_papermilled_report_shows_its_parameters_once_its_title_first_and_wraps(tmp_path):
+    html = tmp_path / "report.html"
+    notebook.render_html(_papermilled(tmp_path), html)
+    text = html.read_text()
+    assert "default_study" not in text and "this_run" in text     # the injected values only
+    assert "celltag_parameters" not in text and "celltag_injected-parameters" in text
+    body = text[text.index("<body"):]
+    assert body.index("The title") < body.index("this_run")        # the heading comes first
+    assert "nb.harmonic_heading" not in text                       # its output, not its code
+    assert "<title>The title</title>" in text                      # the page's title
+    style = text[:text.index("<body")]
+    assert re.search(r"\.highlight pre[^}]*white-space: pre-wrap", style)  # long code wraps
+    assert re.search(r"\.jp-OutputArea-output pre[^}]*white-space: pre-wrap", style, re.S)
+
+
+def test_a_notebook_run_by_hand_keeps_its_parameters_cell(tmp_path):
+    """Without papermill's injected cell, the defaults are the values: they stay."""
+    nb = nbformat.read(_papermilled(tmp_path), as_version=4)
+    nb.cells = [c for c in nb.cells if "injected-parameters" not in c.metadata.get("tags", [])]
+    path = tmp_path / "by_hand.ipynb"
+    nbformat.write(nb, path)
+    notebook.render_html(path, tmp_path / "by_hand.html")
+    assert "default_study" in (tmp_path / "by_hand.html").read_text()
+
+
+def test_a_map_studys_heading_and_audit_say_what_a_map_reports():
+    """A map study (a map, no events, no spectra) is titled by its figures, says it keeps no
+    impact record, and its self-audit checks its probabilities; a study with events is
+    titled by section 5's figures it shows."""
+    figures = ("results/figures/m/fig15.png results/figures/m/fig15_vs_fig16.png "
+               "results/figures/m/residence.png")
+    assert notebook.is_map_study("", "", "map.nc") and not notebook.is_map_study("e.nc", "",
+                                                                                 "map.nc")
+    title = notebook.harmonic_heading("m", map="map.nc", figures=figures).data
+    assert title.startswith("# Harmonic plus random force: the probability map of study `m` "
+                            "(paper section 5, Fig. 15 against Fig. 16)")
+    assert "keeps no impact record" in title and "finding 8" in title
+    full = notebook.harmonic_heading("h", events="e.nc", spectra="s.nc", map="map.nc",
+                                     figures=" ".join(f"x/fig{n}.png" for n in range(10, 15))
+                                     + " " + figures).data
+    assert full.startswith("# Harmonic plus random force: study `h` (paper section 5, "
+                           "Figs. 10-15)")
+    grid = dict(motion=["1/1", "2/1"], inv_beta=[1.0, 1.1], delta=[0.0, 1.0])
+    p = np.array([[[0.6, 0.2], [0.1, 0.9]], [[0.3, 0.7], [0.5, 0.05]]])
+    motion_map = xr.Dataset({"probability": (("motion", "inv_beta", "delta"), p),
+                             "probability_stderr": (("motion", "inv_beta", "delta"),
+                                                    np.full(p.shape, 0.005)),
+                             "reached": (("inv_beta", "delta"), np.ones((2, 2), np.int8))},
+                            coords=grid, attrs={"target_stderr": 0.01})
+    audit = notebook.map_audit(motion_map).data
+    assert audit.startswith("**Self-audit passed:**") and "In 4 of its 4 cells" in audit
+    assert "largest sum 0.9500" in audit                           # 0.9 + 0.05 at (1.0, 1.0)
+    motion_map["probability"][0, 0, 1] = 0.9              # with (2/1)'s 0.7: more than all
+    motion_map["probability_stderr"][0, 1, 1] = 0.02      # above the target it claims reached
+    bad = notebook.map_audit(motion_map).data
+    assert bad.startswith("**Self-audit FAILED:**") and "In 3 of its 4 cells" in bad
+    assert "1 above the target" in bad
+    assert "(1/beta_f = 1, delta = 1), (1/beta_f = 1.1, delta = 1)" in bad
+
+
+def test_the_findings_table_opens_a_verdict_with_its_sentence_and_names_what_it_leaves(
+        monkeypatch):
+    """The summary sentence, in bold, before the numbers; with ``omit_unavailable`` the n/a
+    findings leave the table for one line under it, grouped by why; the returned table
+    still holds every finding."""
+    from html import escape
+
+    import IPython.display
+
+    from vibroimpact.reports import findings
+
+    shown = []
+    monkeypatch.setattr(IPython.display, "display", lambda *objs: shown.extend(objs))
+    inside = dict(n_dominant=40, dominant_inside=0.9, domain_covered=0.8, rank_correlation=0.1)
+    found = [findings.not_available(5, "no spectrum"), findings.not_available(6, "no densities"),
+             findings.not_available(7, "no densities"), findings.finding8({"1/1": inside})]
+    table = notebook.show_table(found, omit_unavailable=True)
+    assert list(table.index) == [5, 6, 7, 8]
+    html = shown[0].to_html()
+    assert found[3].summary.startswith("Holds: the domains agree")
+    assert f"<b>{escape(found[3].summary)}</b><br>" in html
+    assert ">n/a<" not in html and ">partly<" in html
+    assert shown[1].data == ("*Not measured in this report:* finding 5 (no spectrum); "
+                             "findings 6, 7 (no densities).")
+
+
 def test_the_summary_for_snakemakes_report_has_no_image_but_says_which(tmp_path):
     html = tmp_path / "summary.html"
     notebook.main([str(_notebook(tmp_path)), str(html), "--no-figures"])

@@ -7,6 +7,7 @@ from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
     _num, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
     axis_label)
+from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 
 
 def fig10(trace):
@@ -96,12 +97,34 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
         As :func:`fig06`; S_lin (random part only) dashed, the forcing frequency dotted;
         each delta's legend entry gives the power of the response's line at beta_f
         (`vibroimpact.stats.line_power`), comparable with Fig. 11's A^2/2 where the Welch
-        peak heights are not, and the legend's title the resolution.
+        peak heights are not, and the legend's title the resolution. The header's last line
+        says which way the response's centroid (`vibroimpact.stats.centroid`, the
+        reports' finding 5) moves from the largest delta to the smallest, against the paper's
+        "to lower frequency".
     """
     i = _nearest(spectra["inv_beta"], inv_beta)
     return _response_spectra(
         spectra, i, r"Fig. 12  Power spectral density of the displacement $a(\tau)$ of the mass",
-        _events_params(spectra, i), beta_max, r"linear $|H|^2 S_r$ (random part only)")
+        _events_params(spectra, i) + _centroid_note(spectra, i), beta_max,
+        r"linear $|H|^2 S_r$ (random part only)")
+
+
+def _centroid_note(spectra, i_beta):
+    """A header line: the response's centroid at the largest and the smallest delta, and
+    whether it falls as the paper says or rises (empty with fewer than two deltas)."""
+    row = spectra.isel(inv_beta=i_beta).sortby("delta")
+    if row.sizes["delta"] < 2:
+        return ""
+    beta = np.asarray(row["beta"], dtype=float)
+    at_small, at_large = (spectral_centroid(beta, np.asarray(row["S_a"].isel(delta=k)))
+                 for k in (0, -1))
+    if not (np.isfinite(at_small) and np.isfinite(at_large)):
+        return ""
+    way = ("falls as $\\delta$ decreases, as in the paper" if at_small < at_large else
+           "rises as $\\delta$ decreases: the frequency shift runs opposite to the paper's")
+    return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
+            f"$\\delta$ = {_num(float(row.delta[-1]))}, {at_small:.2f} at $\\delta$ = "
+            f"{_num(float(row.delta[0]))};  it {way}")
 
 
 @_styled

@@ -4,8 +4,10 @@ Every function takes the datasets a finding is about (as written by the workflow
 ``docs/datasets.md``) and returns a :class:`Finding`: the paper's claim, what this run
 measured, and whether the claim holds on it (``"yes"``, ``"partly"``, ``"no"``, or ``"n/a"`` when
 the datasets cannot decide it: missing, or, for the findings on collisions (2-4, 6, 7), a record
-with no collision at any play, which ``measured`` then says). The report notebooks show them
-as a table (:func:`findings_table`); the workflow tests assert them on the test config.
+with no collision at any play, which ``measured`` then says). Every ``"partly"`` (and ``"no"``)
+verdict also carries ``summary``: one sentence, from the same numbers, saying what holds and
+what does not, which the table puts first. The report notebooks show them as a table
+(:func:`findings_table`); the workflow tests assert them on the test config.
 Nothing here is typed in from a previous run: change a dataset and the verdict changes with it.
 
 The thresholds are the ones stated with each claim below; "within the resolution" means one
@@ -15,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 from vibroimpact.stats.theory import upcrossing_rate
 
 #: Fewest impacts a play needs before its means and densities take part in a finding
@@ -54,16 +57,28 @@ class Finding:
     holds : str
         ``"yes"``, ``"partly"`` (the stated part holds, the rest not), ``"no"``, or ``"n/a"``
         (the datasets given cannot decide it; ``measured`` says what is missing).
+    summary : str
+        One sentence, computed from the same numbers as ``measured``: what holds and what
+        does not ("Holds: ...; does not: ..."). Every ``"partly"`` verdict has one; ``""``
+        where ``measured`` says it alone.
     """
 
     number: int
     claim: str
     measured: str
     holds: str
+    summary: str = ""
 
 
-def _finding(number, measured, holds):
-    return Finding(number, CLAIMS[number], measured, holds)
+def _finding(number, measured, holds, summary=""):
+    return Finding(number, CLAIMS[number], measured, holds, summary)
+
+
+def _sentence(holds=None, fails=None):
+    """``"Holds: <holds>; does not: <fails>."``, either part left out when None."""
+    parts = ([f"Holds: {holds}"] if holds else []) + (
+        [("does not: " if holds else "Does not hold: ") + fails] if fails else [])
+    return "; ".join(parts) + "."
 
 
 def not_available(number, why):
@@ -203,7 +218,14 @@ def finding3(events):
     measured += (f"; below it: {_fmt(below.interval_mean.values)} at delta = "
                  f"{_fmt(below.delta.values)}, contact fraction "
                  f"{_fmt(below.contact_fraction.values, '.2f')}")
-    return _finding(3, measured, "partly" if d[turn] <= 0.0 else "no")
+    holds = "partly" if d[turn] <= 0.0 else "no"
+    summary = _sentence(
+        f"the mean interval grows with delta from delta = {d[turn]:.3g} up ({z[turn]:.3g} -> "
+        f"{z[-1]:.3g})" if holds == "partly" else None,
+        f"below delta = {d[turn]:.3g} it grows again as delta falls (to {z[0]:.3g} at "
+        f"delta = {d[0]:.3g}), where the mass rests on the wall for a fraction "
+        f"{float(below.contact_fraction.max()):.2f} of the time")
+    return _finding(3, measured, holds, summary)
 
 
 def finding4(events, orders=2.0):
@@ -235,15 +257,30 @@ def finding4(events, orders=2.0):
     falling = bool(np.all(np.diff(rate[d > 0]) <= 0)) and fall >= orders
     sigma = (ev.attrs.get("linear_sigma_x"), ev.attrs.get("linear_sigma_v"))
     record = ev.attrs.get("record_length")
-    if not (falling and none.size and None not in sigma and record is not None):
-        return _finding(4, measured, _yes(falling))
-    expected = float(record) * upcrossing_rate(float(none.min()), *map(float, sigma))
+    if not falling:
+        rises = bool(np.any(np.diff(rate[d > 0]) > 0))
+        return _finding(4, measured, "no", _sentence(fails=(
+            "the collision rate rises between some plays delta > 0" if rises else
+            f"the collision rate falls only {fall:.1f} orders of magnitude (< {orders:g})")))
+    if not (none.size and None not in sigma and record is not None):
+        return _finding(4, measured, "yes")
+    edge = float(none.min())
+    rice_edge = upcrossing_rate(edge, *map(float, sigma))
+    expected = float(record) * rice_edge
     rice = upcrossing_rate(at_low, *map(float, sigma))
-    measured += (f" in this record of length {float(record):.3g}, where Rice's up-crossing "
-                 f"rate expects {expected:.2g} (at delta = {at_low:.3g} it gives {rice:.3g}): ")
+    measured += (f" in this record of length {float(record):.3g} (units of tau); Rice's "
+                 f"up-crossing rate of the wall-free response is {rice_edge:.3g} per unit time "
+                 f"at delta = {edge:.3g}, an expected {expected:.2g} up-crossings in the record "
+                 f"(at delta = {at_low:.3g} it is {rice:.3g} per unit time, "
+                 f"{float(record) * rice:.3g} expected): ")
     if expected < 3.0:
         measured += "the impacts stop at the record's reach; the rate falls, never to zero"
-        return _finding(4, measured, "partly")
+        summary = _sentence(
+            f"the collision rate falls as delta grows, by {fall:.1f} orders of magnitude",
+            f"a critical delta past which no impact happens, since Rice's rate expects "
+            f"{expected:.2g} up-crossings of delta = {edge:.3g} in this record: the impacts "
+            f"stop at the record's reach")
+        return _finding(4, measured, "partly", summary)
     measured += "fewer impacts than the Gaussian response's excursions: a threshold"
     return _finding(4, measured, "yes")
 
@@ -260,7 +297,7 @@ def random_force(events=None, spectra=None):
 
 # --- harmonic plus random force (Figs. 11-15) --------------------------------------------------
 
-def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0, events=None):
+def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=CENTROID_BAND, events=None):
     """Input and response spectra under ``amplitude sin(beta_f tau) + r(tau)`` (Figs. 11, 12).
 
     The input: the line carries ``amplitude^2/2`` against the random part's power (the
@@ -285,6 +322,7 @@ def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0, events=None):
                                 f"finer one needs a longer spectra.nperseg")
     lines, shares, centroids = [], [], []
     spread_all, lower_all = True, True
+    wider, narrower, lower, higher = [], [], [], []
     for inv_beta in np.atleast_1d(spectra.inv_beta.values):
         s = spectra.sel(inv_beta=inv_beta).sortby("delta")
         beta = s.beta.values
@@ -295,23 +333,44 @@ def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=3.0, events=None):
         if s.sizes["delta"] < 2:
             return not_available(5, "needs spectra of a(tau) at two plays")
         near = np.abs(beta - 1 / inv_beta) < halfwidth
-        inside = (beta > 0) & (beta <= band)
         share = s.S_a.isel(beta=near).sum("beta") / s.S_a.sum("beta")
-        centroid = ((s.S_a * s.beta).isel(beta=inside).sum("beta")
-                    / s.S_a.isel(beta=inside).sum("beta"))
+        centroid = np.array([spectral_centroid(beta, s.S_a.isel(delta=k).values, band)
+                             for k in range(s.sizes["delta"])])
         shares.append(f"1/beta_f = {inv_beta:.3g}: {float(share[-1]):.2f} at delta = "
                       f"{float(s.delta[-1]):.3g} -> {float(share[0]):.2f} at delta = "
                       f"{float(s.delta[0]):.3g}")
         centroids.append(f"{float(centroid[-1]):.2f} -> {float(centroid[0]):.2f}")
         spread_all &= float(share[0]) < float(share[-1])
         lower_all &= float(centroid[0]) < float(centroid[-1])
+        (wider if float(share[0]) < float(share[-1]) else narrower).append(
+            f"{float(share[-1]):.2f} -> {float(share[0]):.2f} at 1/beta_f = {inv_beta:.3g}")
+        (lower if float(centroid[0]) < float(centroid[-1]) else higher).append(
+            f"{float(centroid[-1]):.2f} -> {float(centroid[0]):.2f} at 1/beta_f = "
+            f"{inv_beta:.3g}")
     concentrated = min(lines) > 0.8
     measured = (f"line share of the input power {_fmt(lines, '.2f')}; response power within "
                 f"+-{halfwidth:g} of beta_f, " + "; ".join(shares)
                 + f"; centroid (beta <= {band:g}) " + ", ".join(centroids))
     holds = "yes" if concentrated and spread_all and lower_all else (
         "partly" if concentrated and spread_all else "no")
-    return _finding(5, measured, holds)
+    deltas = np.sort(spectra.delta.values)
+    falling = f"as delta falls from {deltas[-1]:.3g} to {deltas[0]:.3g}"
+    near = f"its share within +-{halfwidth:g} of beta_f"
+    centre = f"its centroid (beta <= {band:g})"
+    held = [f"the input's power is concentrated at beta_f (line share {_fmt(lines, '.2f')})"
+            if concentrated else None,
+            f"{falling} the response's power spreads wider ({near} " + ", ".join(wider) + ")"
+            if wider else None,
+            f"moves to lower frequency ({centre} " + ", ".join(lower) + ")" if lower else None]
+    failed = [None if concentrated else f"the input's line carries only {_fmt(lines, '.2f')} "
+                                        f"of its power (<= 0.8)",
+              f"{falling} the response's power does not spread wider ({near} "
+              + ", ".join(narrower) + ")" if narrower else None,
+              f"{'' if narrower else falling + ' '}the response moves to higher frequency, "
+              f"opposite to the paper ({centre} " + ", ".join(higher) + ")" if higher else None]
+    summary = "" if holds == "yes" else _sentence(
+        " and ".join(h for h in held if h) or None, " and ".join(f for f in failed if f) or None)
+    return _finding(5, measured, holds, summary)
 
 
 def _peaks_below_one(ratio, density):
@@ -415,7 +474,16 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     if wide.any():
         measured += f"; wide at delta = {_fmt(d[wide])}, where (1/1) is not alone"
     holds = "no" if not rho <= correlation else "partly" if wide.any() else "yes"
-    return _finding(7, measured, holds)
+    falls = (f"the spread of the velocity after impact falls as P(1/1) grows (rank "
+             f"correlation {rho:.2f} <= {correlation:g})")
+    wide_text = (f"it is wide (CV {_fmt(cv[wide], '.2f')} >= {limit:.2f}) at delta = "
+                 f"{_fmt(d[wide])}, where P(1/1) = {_fmt(p11[wide], '.2f')} and (1/1) is not "
+                 f"alone")
+    summary = {"yes": "",
+               "partly": _sentence(falls, wide_text),
+               "no": _sentence(fails=f"the spread does not fall as P(1/1) grows (rank "
+                                     f"correlation {rho:.2f} > {correlation:g})")}[holds]
+    return _finding(7, measured, holds, summary)
 
 
 def _predictor(predictors, name, motion):
@@ -477,8 +545,38 @@ def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5, predictors=No
         return predictors is None or _resolved(_predictor(predictors, "S", m))
 
     strongly = all(strong(m, a) for m, a in judged.items())
-    return _finding(8, "; ".join(parts), "yes" if where and strongly else (
-        "partly" if where else "no"))
+    holds = "yes" if where and strongly else ("partly" if where else "no")
+    share = [100 * a["dominant_inside"] for a in judged.values()]
+    span = (f"{min(share):.0f}" if round(min(share)) == round(max(share)) else
+            f"{min(share):.0f}-{max(share):.0f}")
+    domains = (f"the domains agree: {span} % of the cells where a motion has P >= 50 % lie "
+               f"inside its stable domain (>= {100 * inside:.0f} % asked)")
+    outside = [f"({m}) {100 * a['dominant_inside']:.0f} %" for m, a in judged.items()
+               if a["dominant_inside"] < inside]
+    weak = [f"{_rho_text(m, a, predictors)} for ({m})" for m, a in judged.items()
+            if not strong(m, a)]
+    ranks = ("S does not rank P inside them (rho = " + ", ".join(weak)
+             + f"; >= {correlation:g}"
+             + (" with a 95 % interval clear of 0" if predictors is not None else "")
+             + " asked)") if weak else None
+    summary = {"yes": "",
+               "partly": _sentence(domains, ranks),
+               "no": _sentence(
+                   f"S ranks P inside the domains ({', '.join(f'({m})' for m in judged)})"
+                   if not weak else None,
+                   "the domains do not agree: of the cells where a motion has P >= 50 %, "
+                   + ", ".join(outside) + f" lie inside its stable domain (< {100 * inside:.0f} "
+                   "%)" + (f"; and {ranks}" if ranks else ""))}[holds]
+    return _finding(8, "; ".join(parts), holds, summary)
+
+
+def _rho_text(motion, agreement, predictors):
+    """The rank correlation of P and S of ``motion`` inside its domain, with its 95 % interval
+    when the predictors give one."""
+    c = _predictor(predictors, "S", motion)
+    if c is not None and np.isfinite(c.rho):
+        return f"{c.rho:.2f} [{c.low:.2f}, {c.high:.2f}]"
+    return f"{agreement['rank_correlation']:.2f}"
 
 
 def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, inv_beta=1.1,
@@ -501,8 +599,10 @@ def harmonic_random(events=None, spectra=None, agreement=None, amplitude=1.0, in
 
 
 def findings_table(found):
-    """The findings as a table (pandas DataFrame): number, claim, measured, holds."""
+    """The findings as a table (pandas DataFrame): number, claim, measured, holds; a
+    verdict's ``summary`` (what holds, what does not) opens its ``measured`` cell."""
     import pandas as pd
 
-    return pd.DataFrame([dict(finding=f.number, claim=f.claim, measured=f.measured,
+    return pd.DataFrame([dict(finding=f.number, claim=f.claim,
+                              measured=f"{f.summary} {f.measured}" if f.summary else f.measured,
                               holds=f.holds) for f in found]).set_index("finding")

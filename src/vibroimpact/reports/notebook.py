@@ -62,14 +62,36 @@ def show_figures(figures):
         display(Markdown(f"`{path}`"), Image(filename=path))
 
 
-def show_table(found):
-    """The findings as a table: number, the paper's claim, this run's numbers, verdict."""
-    from IPython.display import display
+def show_table(found, omit_unavailable=False):
+    """The findings as a table: number, the paper's claim, this run's numbers, verdict; a
+    verdict's one-sentence summary (what holds, what does not) opens its numbers, in bold.
+
+    With ``omit_unavailable``, the findings this study cannot measure (``n/a``) are left out
+    of the table and named in one line under it, with why. Returns the table of every
+    finding given (:func:`vibroimpact.reports.findings.findings_table`).
+    """
+    from html import escape
+
+    from IPython.display import Markdown, display
 
     from vibroimpact.reports.findings import findings_table
 
     table = findings_table(found)
-    display(table.style.set_properties(**{"text-align": "left", "white-space": "normal"}))
+    shown = [f for f in found if not (omit_unavailable and f.holds == "n/a")]
+    if shown:
+        view = findings_table(shown)
+        view["claim"] = [escape(c) for c in view["claim"]]
+        view["measured"] = [(f"<b>{escape(f.summary)}</b><br>" if f.summary else "")
+                            + escape(f.measured) for f in shown]
+        display(view.style.set_properties(**{"text-align": "left", "white-space": "normal"}))
+    left = [f for f in found if f not in shown]
+    if left:
+        reasons = {}
+        for f in left:
+            reasons.setdefault(f.measured, []).append(str(f.number))
+        display(Markdown("*Not measured in this report:* " + "; ".join(
+            f"finding{'s' if len(n) > 1 else ''} {', '.join(n)} ({why})"
+            for why, n in reasons.items()) + "."))
     return table
 
 
@@ -412,15 +434,44 @@ def stress_summary(ds):
 
 # --- HTML rendering for reading offline ---------------------------------------------------
 
+#: Long lines wrap inside the page: code (a papermill parameter holding a list of paths),
+#: text outputs and table cells; figures shrink to the page's width.
+_WRAP_CSS = """<style type="text/css">
+.jp-InputArea-editor pre, .jp-OutputArea-output pre, .highlight pre {
+  white-space: pre-wrap; overflow-wrap: anywhere; }
+.jp-RenderedHTMLCommon td, .jp-RenderedHTMLCommon th { overflow-wrap: anywhere; }
+.jp-RenderedHTMLCommon code { overflow-wrap: anywhere; }
+.jp-OutputArea-output img { max-width: 100%; height: auto; }
+.celltag_heading .jp-OutputPrompt { display: none; }
+</style>"""
+
 #: nbconvert's JupyterLab template without what it loads from the network: require.js (no
 #: output here needs it), MathJax (the maths is MathML, rendered at build time), mermaid and
-#: the widget manager. Its stylesheets are inlined by nbconvert itself.
+#: the widget manager; plus :data:`_WRAP_CSS`. Its stylesheets are inlined by nbconvert.
 _OFFLINE_TEMPLATE = """{%- extends 'lab/index.html.j2' -%}
 {%- block html_head_js -%}{%- endblock html_head_js -%}
 {%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
 {%- block html_head_js_mathjax -%}{%- endblock html_head_js_mathjax -%}
 {%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+{% block extra_css %}""" + _WRAP_CSS + """{% endblock extra_css %}
 """
+
+
+def _tagged(cell, tag):
+    return tag in cell.get("metadata", {}).get("tags", ())
+
+
+def _title(cells):
+    """The report's first ``# `` heading, from a heading cell's output or a markdown cell,
+    without its markup (the page's title); None when it has none."""
+    for cell in cells:
+        texts = ([o.get("data", {}).get("text/markdown", "") for o in cell.get("outputs", [])]
+                 if cell.cell_type == "code" else [cell.source])
+        for text in texts:
+            for line in text.splitlines():
+                if line.startswith("# "):
+                    return line[2:].replace("`", "").strip()
+    return None
 
 #: Code spans and fences (left alone), then display maths $$...$$, then inline maths $...$.
 _MATH = re.compile(r"(?P<code>(`+).*?\2)|\$\$(?P<display>.+?)\$\$|\$(?P<inline>[^$\n]+?)\$",
@@ -449,12 +500,25 @@ def render_html(ipynb, html, figures=True):
 
     Without ``figures``, the images are left out (each figure's path stays): the copy shown
     in Snakemake's report, which holds every figure once, beside it.
+
+    The parameters are shown once: a notebook executed by papermill holds its ``parameters``
+    cell (the defaults for a run by hand) and the ``injected-parameters`` cell with the values
+    of this run; only the latter is rendered. Cells tagged ``heading`` (a title computed from
+    the parameters) come first, their output without their code. Long lines wrap
+    (:data:`_WRAP_CSS`).
     """
     import nbformat
     from jinja2 import DictLoader
     from nbconvert import HTMLExporter
 
     nb = nbformat.read(ipynb, as_version=4)
+    if any(_tagged(cell, "injected-parameters") for cell in nb.cells):
+        nb.cells = [cell for cell in nb.cells if not _tagged(cell, "parameters")]
+    headings = [cell for cell in nb.cells if _tagged(cell, "heading")]
+    nb.cells = headings + [cell for cell in nb.cells if not _tagged(cell, "heading")]
+    title = _title(nb.cells)
+    if title:
+        nb.metadata["title"] = title
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             cell.source = mathml(cell.source)
@@ -468,6 +532,11 @@ def render_html(ipynb, html, figures=True):
                 output.data["text/markdown"] = mathml(output.data["text/markdown"])
     exporter = HTMLExporter(template_name="lab", template_file="offline.html.j2",
                             extra_loaders=[DictLoader({"offline.html.j2": _OFFLINE_TEMPLATE})])
+    if headings:
+        from nbconvert.preprocessors import TagRemovePreprocessor
+
+        exporter.register_preprocessor(TagRemovePreprocessor(remove_input_tags=("heading",)),
+                                       enabled=True)
     body, _ = exporter.from_notebook_node(nb)
     Path(html).write_text(body, encoding="utf-8")
 
@@ -643,3 +712,108 @@ def markov_summary(motion_map):
     names = {"data": "markov_value", "row_heading": "markov_state",
              "col_heading": "markov_column"}
     return _styled(table, names, table.attrs["note"])
+
+
+# --- what a harmonic report holds: a study with impact records, or a map study ------------
+
+_FIGURE_NUMBER = re.compile(r"fig(\d+)")
+
+
+def _figure_numbers(figures):
+    """The paper's figure numbers among the paths ``figures`` (``fig15_vs_fig16`` gives 15
+    and 16), sorted."""
+    return sorted({int(n) for path in paths(figures) for n in _FIGURE_NUMBER.findall(
+        Path(path).stem)})
+
+
+def _figure_range(numbers):
+    """``"Fig. 15"``, ``"Figs. 10-15"`` or ``"Figs. 10, 12"``; "" for none."""
+    if not numbers:
+        return ""
+    if len(numbers) == 1:
+        return f"Fig. {numbers[0]}"
+    if numbers == list(range(numbers[0], numbers[-1] + 1)):
+        return f"Figs. {numbers[0]}-{numbers[-1]}"
+    return "Figs. " + ", ".join(map(str, numbers))
+
+
+def is_map_study(events="", spectra="", map=""):
+    """Whether a harmonic report is a map study's: a probability map (Fig. 15) and neither
+    impact statistics nor spectra (the parameters are the notebook's paths, "" = none)."""
+    return bool(map) and not events and not spectra
+
+
+def harmonic_heading(study, events="", spectra="", map="", figures=""):
+    """The title and opening of a harmonic-plus-random report, from what the study has.
+
+    A study with impact records (``events``) or spectra: section 5's figures it shows and
+    findings 5-8. A map study (only ``map``): what such a study measures and reports, and
+    that findings 5-7 are not among them. The figure numbers come from ``figures``.
+    """
+    from IPython.display import Markdown
+
+    shown = _figure_range([n for n in _figure_numbers(figures) if n < 16])
+    if is_map_study(events, spectra, map):
+        against = " against Fig. 16" if 16 in _figure_numbers(figures) else ""
+        return Markdown(
+            f"# Harmonic plus random force: the probability map of study `{study}` "
+            f"(paper section 5, {shown or 'Fig. 15'}{against})\n\n"
+            "A map study runs one record per cell of the $(1/\\beta_f, \\delta)$ plane under "
+            "$A \\sin(\\beta_f \\tau) + r(\\tau)$ and keeps, per cell, the fraction of time "
+            "the mass spends in each periodic $(m/n)$ motion (its probability $P$, extended "
+            "until its standard error reaches the target), how often it switches between "
+            "them and how long it stays. It keeps no impact record and no spectrum. This "
+            "report shows the map (Fig. 15) and the map drawn over the stable domains of the "
+            "noise-free orbits (Fig. 16), whether the switching is Markov, what predicts $P$, "
+            "and the paper's finding 8, the one a map decides. Findings 5-7 (spectra, "
+            "densities of the impacts) are measured in the report of a study with impact "
+            "records, e.g. one that lists this study under `report_with`.")
+    return Markdown(
+        f"# Harmonic plus random force: study `{study}` (paper section 5"
+        + (f", {shown}" if shown else "") + ")\n\n"
+        "The same system driven by $A \\sin(\\beta_f \\tau) + r(\\tau)$ ($A$: `amplitude`, "
+        "$1/\\beta_f$: `inv_beta`). This report shows the study's figures (and those of the "
+        "studies it lists under `report_with`, e.g. the Fig. 15 map of the same system) and "
+        "measures the paper's findings 5-8 on their datasets. Executed by the workflow "
+        "(`snakemake results/reports/<study>/harmonic_random.html`); the notebook's defaults "
+        "are the paper's study `harmonic` with its map `motion_map`, so after `make` it also "
+        "runs by hand.")
+
+
+def map_audit(motion_map):
+    """The self-audit of a map study, which keeps no impact record (so no identity residual):
+    per cell, the motions' probabilities are fractions of one record's time (each in [0, 1],
+    their sum at most 1, the rest no listed motion), and a cell flagged as having reached the
+    target standard error (attribute ``target_stderr``) has every probability's standard
+    error within it. A verdict (Markdown) naming the cells that fail."""
+    from IPython.display import Markdown
+
+    if motion_map is None:
+        return Markdown("*This study has neither impact records nor a probability map: "
+                        "nothing to audit.*")
+    p = motion_map.probability
+    total = p.sum("motion")
+    outside = ((p < 0) | (p > 1)).any("motion") | (total > 1 + 1e-12)
+    target = float(motion_map.attrs.get("target_stderr", np.nan))
+    reached = motion_map.reached == 1
+    worst = float(motion_map.probability_stderr.where(reached).max()) if bool(
+        reached.any()) else np.nan
+    flagged = reached & (motion_map.probability_stderr > target).any("motion")
+    cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
+    failed = int(outside.sum()) + int(flagged.sum())
+    verdict = "**Self-audit passed:**" if failed == 0 else "**Self-audit FAILED:**"
+    text = (f"{verdict} a map study keeps no impact record, so the two exact identities of "
+            f"the events of a study are not its check (they are in the report of a study "
+            f"with impact statistics). In {cells - int(outside.sum())} of its {cells} cells "
+            f"every probability lies in [0, 1] and they sum to at most 1 (largest sum "
+            f"{float(total.max()):.4f}); "
+            f"{int(reached.sum())} cells flagged as having reached the target standard "
+            f"error {target:g}, the largest standard error among them {worst:.4g}"
+            + (f", {int(flagged.sum())} above the target" if int(flagged.sum()) else "")
+            + ".")
+    if failed:
+        bad = (outside | flagged).stack(cell=("inv_beta", "delta"))
+        where = [f"(1/beta_f = {ib:.4g}, delta = {d:.4g})"
+                 for ib, d in bad.cell.values[bad.values][:AUDIT_WORST]]
+        text += " Failing cells: " + ", ".join(where) + "."
+    return Markdown(text)

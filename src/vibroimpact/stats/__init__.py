@@ -14,7 +14,9 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
 - `escape`: the Arrhenius fit of residence times against the noise level;
 - `theory`: the wall-free linear response, elastic impacts under white noise, and the
   energy-envelope averaging for eps near 1;
-- `identities`: the power balance and the virial of a stationary record (a self-audit).
+- `identities`: the power balance and the virial of a stationary record (a self-audit);
+- `centroid`: the centroid of a spectrum over a band (finding 5, Fig. 12's header), imported
+  from its module (not re-exported: the simulation jobs do not reach it).
 
 Every public name is re-exported here lazily (``vibroimpact.stats.density``), so a job that
 needs one helper does not import the others' scipy modules.
