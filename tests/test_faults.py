@@ -412,3 +412,27 @@ def test_results_linked_into_a_read_only_mount_is_refused_without_chmod_advice(
     assert "no chmod can change that; remount it read-write" in line
     assert "chmod -R" not in line and "chmod u+w" not in line
     assert line.endswith("nothing was changed")
+
+
+def test_a_damaged_figure_is_refused(tmp_path, monkeypatch):
+    """A figure's PNG (which Snakemake's report embeds) with 16 bytes of its image data
+    overwritten fails its chunk CRC: named; the intact figure passes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from vibroimpact.plotting import save
+
+    fig = Figure()
+    fig.add_subplot().plot(np.sin(np.linspace(0, 10, 200)))
+    png, _ = save(fig, tmp_path / "results" / "figures" / "fig99.png")
+    monkeypatch.chdir(tmp_path)
+    assert io.check_readable("results") == []
+    blob = bytearray(png.read_bytes())
+    start = blob.index(b"IDAT") + 200
+    blob[start:start + 16] = np.full(2, 10.0).tobytes()
+    png.write_bytes(blob)
+    with pytest.raises(io.CorruptFileError, match="^results/figures/fig99.png: fails its PNG "
+                       "chunk checks"):
+        io.check_readable("results")

@@ -4,13 +4,16 @@
           it) and prints what a build would make: cells, jobs, disk and a rough time.
 ``run``   does the same checks, then prepares the directory and hands over to Snakemake:
           refuses a folder of ``results`` or ``.snakemake`` the user may not write (naming
-          it, before anything changes), removes the temporaries of writers that are gone,
-          refuses an unreadable result file (naming it), clears a lock left by a killed run
-          when no run is alive in this directory, asks Snakemake which outputs of the
-          requested build are missing and adds them to ``--forcerun`` (Snakemake alone never
-          rebuilds a deleted file whose consumers are up to date), and replaces itself with
-          ``snakemake`` (the default profile, ``profiles/default``, reruns the jobs a crash
-          interrupted).
+          it, before anything changes), takes the build lock (:func:`take_build_lock`,
+          held through the build; refused, naming the holder, while another build holds
+          it), removes the temporaries of writers that are gone, refuses a damaged result
+          file (every netCDF variable read through, its checksums checked, and every
+          figure's PNG CRCs: :func:`vibroimpact.pipeline.io.check_readable`; naming it),
+          clears a lock left by a killed run when no run is alive in this directory, asks
+          Snakemake which outputs of the requested build are missing and adds them to
+          ``--forcerun`` (Snakemake alone never rebuilds a deleted file whose consumers are
+          up to date), and replaces itself with ``snakemake`` (the default profile,
+          ``profiles/default``, reruns the jobs a crash interrupted).
 ``report`` writes Snakemake's own report of the build (``snakemake --report``: every figure
           once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
           all: it is rendered elsewhere and moved into place only when complete (``make``

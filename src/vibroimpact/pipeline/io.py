@@ -24,7 +24,7 @@ import numpy as np
 from vibroimpact._files import atomic_path
 
 __all__ = ["CHECKSUM", "CorruptFileError", "check_readable", "load_dataset", "verify",
-           "write_dataset", "write_noise", "noise_spec", "read_noise_attrs",
+           "verify_png", "write_dataset", "write_noise", "noise_spec", "read_noise_attrs",
            "read_input_correlation", "read_noise"]
 
 #: The netCDF4 encoding every variable the pipeline writes gets: a Fletcher-32 checksum of
@@ -117,9 +117,11 @@ def verify(path):
 
 
 def check_readable(root):
-    """:func:`verify` every netCDF file under ``root`` (not the temporaries): a damaged one
-    raises :class:`CorruptFileError` (the first one found) before any job would use it,
-    naming the file relative to the working directory (the path ``--forcerun`` takes).
+    """:func:`verify` every netCDF file under ``root`` (not the temporaries), and every
+    figure's PNG (:func:`verify_png`): a damaged one raises :class:`CorruptFileError` (the
+    first one found) before any job would use it, naming the file relative to the working
+    directory (the path ``--forcerun`` takes). PDF, HTML and notebook outputs carry no
+    checksum of their own, and no job reads them: they are not checked.
 
     Returns
     -------
@@ -136,7 +138,24 @@ def check_readable(root):
         name = os.path.relpath(path)
         if not verify(name):
             unchecked.append(name)
+    for path in sorted(root.rglob("*.png")):
+        if not path.name.startswith("."):
+            verify_png(os.path.relpath(path))
     return unchecked
+
+
+def verify_png(path):
+    """Check the CRC-32 of every chunk of the PNG file ``path`` (the figures, which
+    Snakemake's report embeds): :class:`CorruptFileError` naming it when one fails."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as image:
+            image.verify()
+    except FileNotFoundError:
+        raise
+    except Exception as err:        # Pillow raises SyntaxError, OSError, struct.error ...
+        raise CorruptFileError(path, err, what="fails its PNG chunk checks") from None
 
 
 def write_dataset(ds, path):
