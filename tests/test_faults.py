@@ -23,6 +23,15 @@ RUN = [sys.executable, "-m", "vibroimpact", "run", "--cores", "2", "--configfile
        "config/test.yaml"]
 
 
+@pytest.fixture(autouse=True)
+def _release_build_locks():
+    """`cli.main` run in this process keeps the build lock it took (a real `run` hands it to
+    Snakemake): released after each test."""
+    yield
+    while cli._HELD:
+        os.close(cli._HELD.popitem()[1])
+
+
 def _run(workdir, *args):
     out = subprocess.run([*RUN, *args], cwd=workdir, capture_output=True, text=True,
                          timeout=900)
@@ -321,6 +330,12 @@ def test_of_two_builds_started_at_the_same_instant_one_takes_the_lock(tmp_path):
         assert got == [False, True], attempt
 
 
+def _cmdline(pid):
+    import psutil
+
+    return psutil.Process(pid).cmdline()
+
+
 def test_a_run_is_refused_while_a_build_holds_the_lock_through_exec(
         tmp_path, monkeypatch, capsys):
     """A build that took the lock and replaced itself (exec) keeps it: a second `run` is
@@ -346,7 +361,7 @@ def test_a_run_is_refused_while_a_build_holds_the_lock_through_exec(
         monkeypatch.chdir(work)
         monkeypatch.setattr(os, "execv", lambda *a: pytest.fail("handed over to snakemake"))
         deadline = time.monotonic() + 10
-        while "sleep" not in " ".join(psutil_cmdline(holder.pid)):
+        while _cmdline(holder.pid)[:1] != ["sleep"]:        # it has replaced itself
             assert time.monotonic() < deadline
             time.sleep(0.05)
         code = cli.main(["run", "--cores", "1", "--configfile", "config/test.yaml"])
@@ -361,12 +376,6 @@ def test_a_run_is_refused_while_a_build_holds_the_lock_through_exec(
         holder.wait()
     fd, _ = cli.take_build_lock(work)
     assert fd is not None
-
-
-def psutil_cmdline(pid):
-    import psutil
-
-    return psutil.Process(pid).cmdline()
 
 
 # --- a read-only mount ---------------------------------------------------------------------------
