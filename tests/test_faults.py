@@ -10,15 +10,26 @@ from pathlib import Path
 import stat
 import subprocess
 import sys
+import time
 
+import numpy as np
 import pytest
 import xarray as xr
 
 from helpers import assert_same_data, data, make_workdir
-from vibroimpact.pipeline import cli
+from vibroimpact.pipeline import cli, io
 
 RUN = [sys.executable, "-m", "vibroimpact", "run", "--cores", "2", "--configfile",
        "config/test.yaml"]
+
+
+@pytest.fixture(autouse=True)
+def _release_build_locks():
+    """`cli.main` run in this process keeps the build lock it took (a real `run` hands it to
+    Snakemake): released after each test."""
+    yield
+    while cli._HELD:
+        os.close(cli._HELD.popitem()[1])
 
 
 def _run(workdir, *args):
@@ -55,7 +66,7 @@ def test_a_deleted_dataset_and_tile_are_rebuilt_by_the_run_command(built, tmp_pa
     assert "Nothing to be done" in _run(copy, "-n").stdout
 
 
-# --- a folder the build may not write ----------------------------------------------------------
+# --- a folder the build may not write ------------------------------------------------------------
 
 @pytest.fixture
 def as_a_user(monkeypatch):
@@ -126,7 +137,7 @@ def test_several_folders_the_build_may_not_write_are_counted(tmp_path, monkeypat
                        "changed")
 
 
-# --- the missing-output query -----------------------------------------------------------------
+# --- the missing-output query --------------------------------------------------------------------
 
 SUMMARY = """\
 output_file\tdate\trule\tlog-file(s)\tstatus\tplan
@@ -155,3 +166,282 @@ def test_missing_outputs_are_the_missing_ones_snakemake_would_not_rebuild():
 ])
 def test_the_missing_outputs_extend_the_users_own_forcerun(cmd, expected):
     assert cli.with_forcerun(cmd, ["x.nc", "y.nc"]) == expected
+
+
+# --- data damaged on disk: every variable carries a Fletcher-32 checksum -------------------------
+
+def _events_dataset(tmp_path):
+    """A noise record and the events dataset of a short random study, through the workflow's
+    own tasks (``tasks.make_noise``, ``events_tile``, ``aggregate``), so every writer of the
+    pipeline is the one on test."""
+    from test_plotting import NOISE, RANDOM
+    from vibroimpact.pipeline import tasks
+
+    noise = tmp_path / "results" / "noise" / "band.nc"
+    tasks.make_noise(dict(NOISE, n_samples=20_001), noise)
+    block = dict(RANDOM, delta=[round(-1.0 + 0.5 * k, 6) for k in range(16)])
+    tile = tmp_path / "results" / "cells" / "random" / "events" / "0.nc"
+    tasks.events_tile("random", block, 0, noise, tile)
+    events = tmp_path / "results" / "datasets" / "random_events.nc"
+    tasks.aggregate("random", block, "events", [tile], events, noise_path=noise)
+    return noise, tile, events
+
+
+def _overwrite(path, values, value=10.0):
+    """Overwrite 128 bytes of ``values``' data in ``path`` (found by their bytes) with the
+    float ``value``, as the newcomer did, and put the file's timestamps back."""
+    raw = np.ascontiguousarray(values, dtype="<f8")
+    blob, before = path.read_bytes(), path.stat()
+    start = blob.find(raw.tobytes()[:128])
+    assert start > 0 and blob.count(raw.tobytes()[:128]) == 1
+    with open(path, "r+b") as f:
+        f.seek(start)
+        f.write(np.full(16, value, "<f8").tobytes())
+    os.utime(path, ns=(before.st_atime_ns, before.st_mtime_ns))
+
+
+def test_every_variable_the_pipeline_writes_carries_a_checksum(tmp_path):
+    """Noise record, tile and dataset: every array variable (data, coordinates, strings,
+    integers) has Fletcher-32; only scalars cannot (HDF5 stores them unchunked)."""
+    import netCDF4
+
+    for path in _events_dataset(tmp_path):
+        with netCDF4.Dataset(path) as nc:
+            arrays = [v for v in nc.variables.values() if v.ndim]
+            assert len(arrays) >= 5, path
+            assert [v.name for v in arrays if not v.filters()["fletcher32"]] == [], path
+        assert io.verify(path) is True
+
+
+def test_damaged_data_bytes_are_refused_by_the_run_and_by_every_reader(
+        tmp_path, monkeypatch, capsys):
+    """128 bytes of `v_after_mean` in the events dataset overwritten by 10.0, the file's
+    timestamp put back (so Snakemake sees nothing): `run` refuses it in one line naming the
+    file and the variable, before Snakemake, and deletes nothing; a job's read refuses it too.
+    The same damage in a file written without checksums reads back as 10.0, unseen: the
+    checksum is what finds it."""
+    import netCDF4
+
+    work = make_workdir(tmp_path / "project")
+    noise, tile, events = _events_dataset(work)
+    v_after_mean = xr.load_dataset(events).v_after_mean.values
+    assert v_after_mean.size >= 16
+    legacy = tmp_path / "legacy.nc"
+    xr.load_dataset(events).drop_encoding().to_netcdf(legacy, engine="netcdf4")  # no sums
+    _overwrite(events, v_after_mean)
+    _overwrite(legacy, v_after_mean)
+
+    monkeypatch.chdir(work)
+    monkeypatch.setattr(os, "execv", lambda *a: pytest.fail("handed over to snakemake"))
+    code = cli.main(["run", "--cores", "1", "--configfile", "config/test.yaml"])
+    lines = capsys.readouterr().err.splitlines()
+    assert code == 1
+    assert lines[-1].startswith("error: results/datasets/random_events.nc: the data of variable "
+                                "v_after_mean fail their Fletcher-32 checksum"), lines[-1]
+    assert "delete it and run make" in lines[-1]
+    assert not any("Traceback" in line for line in lines)
+    assert events.exists()
+    with pytest.raises(io.CorruptFileError, match="random_events.nc"):
+        io.load_dataset(events)
+    with netCDF4.Dataset(events) as nc:            # the other variables still read
+        nc["n_collisions"][:]
+
+    seen = xr.load_dataset(legacy).v_after_mean.values
+    assert np.count_nonzero(seen.ravel() == 10.0) >= 16 and io.verify(legacy) is False
+
+
+def test_damaged_noise_samples_are_refused(tmp_path, monkeypatch):
+    """The noise record (written chunk by chunk by `write_noise`) is checked the same way."""
+    noise, _, _ = _events_dataset(tmp_path)
+    samples = xr.load_dataset(noise).r.values
+    _overwrite(noise, samples[5000:5016])
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(io.CorruptFileError, match="results/noise/band.nc: the data of "
+                       "variable r fail their Fletcher-32 checksum"):
+        io.check_readable(tmp_path / "results")
+
+
+def test_a_file_written_before_the_checksums_is_accepted_and_listed(tmp_path, monkeypatch):
+    """The rule for a build from before the checksums: read through, accepted, listed (its
+    writer's code digest changed, so the build rewrites it)."""
+    monkeypatch.chdir(tmp_path)
+    ds = xr.Dataset({"x": ("i", np.arange(10.0)), "s": ((), 1.0)})
+    ds.to_netcdf(tmp_path / "old.nc", engine="netcdf4")
+    io.write_dataset(ds, tmp_path / "new.nc")
+    assert io.check_readable(tmp_path) == ["old.nc"]
+
+
+# --- temporaries of killed writers ---------------------------------------------------------------
+
+def test_a_zombie_writers_temporary_is_swept(tmp_path):
+    """A writer killed but not yet reaped (a zombie) writes nothing more: its temporary is
+    stale; a live writer's is kept."""
+    import psutil
+
+    from vibroimpact import _files
+
+    host = os.uname().nodename
+    killed = subprocess.Popen(["sleep", "60"])
+    live = subprocess.Popen(["sleep", "60"])
+    try:
+        killed.kill()
+        deadline = time.monotonic() + 10
+        while psutil.Process(killed.pid).status() != psutil.STATUS_ZOMBIE:
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        stale = tmp_path / f".a.nc.{killed.pid}.0a1b2c3d4e5f@{host}.tmp"
+        kept = tmp_path / f".b.nc.{live.pid}.0a1b2c3d4e5f@{host}.tmp"
+        stale.write_bytes(b"half")
+        kept.write_bytes(b"half")
+        assert _files.sweep_stale_temporaries(tmp_path) == [stale]
+        assert kept.exists() and not stale.exists()
+        assert psutil.Process(killed.pid).status() == psutil.STATUS_ZOMBIE   # still unreaped
+    finally:
+        live.kill()
+        live.wait()
+        killed.wait()
+
+
+# --- one build at a time -------------------------------------------------------------------------
+
+def _race(root, barrier, results):
+    barrier.wait()
+    fd, holder = cli.take_build_lock(root)
+    results.put(fd is not None)
+    barrier.wait()                     # hold it until both have tried
+
+
+def test_of_two_builds_started_at_the_same_instant_one_takes_the_lock(tmp_path):
+    """The guard is one atomic step (flock): two processes released together by a barrier,
+    many times over, never both get the build lock."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("fork")
+    for attempt in range(20):
+        root = tmp_path / str(attempt)
+        root.mkdir()
+        barrier, results = ctx.Barrier(2), ctx.Queue()
+        procs = [ctx.Process(target=_race, args=(root, barrier, results)) for _ in range(2)]
+        for p in procs:
+            p.start()
+        got = sorted(results.get(timeout=60) for _ in procs)
+        for p in procs:
+            p.join(60)
+        assert got == [False, True], attempt
+
+
+def _cmdline(pid):
+    import psutil
+
+    return psutil.Process(pid).cmdline()
+
+
+def test_a_run_is_refused_while_a_build_holds_the_lock_through_exec(
+        tmp_path, monkeypatch, capsys):
+    """A build that took the lock and replaced itself (exec) keeps it: a second `run` is
+    refused in one line naming its pid, before it changes anything (a stale temporary
+    stays); the lock is the kernel's, so it is free again once that build has ended."""
+    work = make_workdir(tmp_path / "project")
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import os, sys; from pathlib import Path; "
+         "from vibroimpact.pipeline import cli; "
+         "assert cli.take_build_lock(Path(sys.argv[1]))[0] is not None; "
+         "os.execv('/bin/sleep', ['sleep', '60'])", str(work)])
+    try:
+        lock = work / cli.BUILD_LOCK
+        deadline = time.monotonic() + 60
+        while not (lock.exists() and lock.read_text().strip() == str(holder.pid)):
+            assert holder.poll() is None and time.monotonic() < deadline
+            time.sleep(0.05)
+        gone = subprocess.Popen(["true"])
+        gone.wait()
+        stale = work / "results" / f".fig.png.{gone.pid}.0a1b2c3d4e5f@{os.uname().nodename}.tmp"
+        stale.parent.mkdir(parents=True)
+        stale.write_bytes(b"")
+        monkeypatch.chdir(work)
+        monkeypatch.setattr(os, "execv", lambda *a: pytest.fail("handed over to snakemake"))
+        deadline = time.monotonic() + 10
+        while _cmdline(holder.pid)[:1] != ["sleep"]:        # it has replaced itself
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        code = cli.main(["run", "--cores", "1", "--configfile", "config/test.yaml"])
+        lines = capsys.readouterr().err.splitlines()
+        assert code == 1
+        assert lines[-1] == (f"error: another build is running in {work} (pid {holder.pid}); "
+                             f"wait for it to finish, or stop it (kill {holder.pid}) and run "
+                             f"again")
+        assert stale.exists()
+    finally:
+        holder.kill()
+        holder.wait()
+    fd, _ = cli.take_build_lock(work)
+    assert fd is not None
+
+
+# --- a read-only mount ---------------------------------------------------------------------------
+
+def test_results_linked_into_a_read_only_mount_is_refused_without_chmod_advice(
+        tmp_path, monkeypatch, capsys, as_a_user):
+    """`results` a symbolic link into a file system mounted read-only (`os.statvfs` reports
+    ST_RDONLY, as the kernel does for `mount -o ro`): the line says chmod cannot help and what
+    can (remount, a writable folder in the link's place, a copy of the project)."""
+    work = make_workdir(tmp_path / "project")
+    mount = tmp_path / "mnt"
+    (mount / "results" / "datasets").mkdir(parents=True)
+    (work / "results").symlink_to(mount / "results")
+    real_statvfs = os.statvfs
+
+    class ReadOnly:
+        def __init__(self, real):
+            self.real = real
+            self.f_flag = real.f_flag | os.ST_RDONLY
+
+        def __getattr__(self, name):
+            return getattr(self.real, name)
+
+    def statvfs(path):
+        real = real_statvfs(path)
+        inside = Path(os.path.realpath(path)).is_relative_to(mount)
+        return ReadOnly(real) if inside else real
+
+    monkeypatch.setattr(os, "statvfs", statvfs)
+    monkeypatch.chdir(work)
+    monkeypatch.setattr(os, "execv", lambda *a: pytest.fail("handed over to snakemake"))
+    for folder in (mount / "results", mount / "results" / "datasets"):
+        folder.chmod(0o555)                 # what a read-only mount gives os.access
+    try:
+        code = cli.main(["run", "--cores", "1", "--configfile", "config/test.yaml"])
+    finally:
+        for folder in (mount / "results", mount / "results" / "datasets"):
+            folder.chmod(0o755)
+    line = capsys.readouterr().err.splitlines()[-1]
+    assert code == 1
+    assert line.startswith("error: results is on a file system mounted read-only at "), line
+    assert f"through the link results -> {mount / 'results'}" in line
+    assert "no chmod can change that; remount it read-write" in line
+    assert "chmod -R" not in line and "chmod u+w" not in line
+    assert line.endswith("nothing was changed")
+
+
+def test_a_damaged_figure_is_refused(tmp_path, monkeypatch):
+    """A figure's PNG (which Snakemake's report embeds) with 16 bytes of its image data
+    overwritten fails its chunk CRC: named; the intact figure passes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    from vibroimpact.plotting import save
+
+    fig = Figure()
+    fig.add_subplot().plot(np.sin(np.linspace(0, 10, 200)))
+    png, _ = save(fig, tmp_path / "results" / "figures" / "fig99.png")
+    monkeypatch.chdir(tmp_path)
+    assert io.check_readable("results") == []
+    blob = bytearray(png.read_bytes())
+    start = blob.index(b"IDAT") + 200
+    blob[start:start + 16] = np.full(2, 10.0).tobytes()
+    png.write_bytes(blob)
+    with pytest.raises(io.CorruptFileError, match="^results/figures/fig99.png: fails its PNG "
+                       "chunk checks"):
+        io.check_readable("results")

@@ -68,19 +68,23 @@ def atomic_path(path):
 
 
 def _alive(pid):
+    """Whether process ``pid`` of this machine runs: it exists and is not a zombie (a killed
+    writer whose parent has not reaped it yet writes nothing any more)."""
+    import psutil
+
     try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
         return False
-    except PermissionError:
+    except psutil.Error:            # AccessDenied: it exists, and may still be writing
         return True
-    return True
 
 
 def sweep_stale_temporaries(root):
     """Remove the temporary files of writers that are gone, under directory ``root``.
 
-    A temporary of this machine is stale when its writer's process is no longer alive; one
+    A temporary of this machine is stale when its writer's process is no longer alive (gone,
+    or a zombie: killed, not yet reaped by its parent); one
     written on another machine (a cluster node) when untouched for two days. A live
     writer's temporary is never touched. Returns the removed paths.
     """

@@ -4,13 +4,16 @@
           it) and prints what a build would make: cells, jobs, disk and a rough time.
 ``run``   does the same checks, then prepares the directory and hands over to Snakemake:
           refuses a folder of ``results`` or ``.snakemake`` the user may not write (naming
-          it, before anything changes), removes the temporaries of writers that are gone,
-          refuses an unreadable result file (naming it), clears a lock left by a killed run
-          when no run is alive in this directory, asks Snakemake which outputs of the
-          requested build are missing and adds them to ``--forcerun`` (Snakemake alone never
-          rebuilds a deleted file whose consumers are up to date), and replaces itself with
-          ``snakemake`` (the default profile, ``profiles/default``, reruns the jobs a crash
-          interrupted).
+          it, before anything changes), takes the build lock (:func:`take_build_lock`,
+          held through the build; refused, naming the holder, while another build holds
+          it), removes the temporaries of writers that are gone, refuses a damaged result
+          file (every netCDF variable read through, its checksums checked, and every
+          figure's PNG CRCs: :func:`vibroimpact.pipeline.io.check_readable`; naming it),
+          clears a lock left by a killed run when no run is alive in this directory, asks
+          Snakemake which outputs of the requested build are missing and adds them to
+          ``--forcerun`` (Snakemake alone never rebuilds a deleted file whose consumers are
+          up to date), and replaces itself with ``snakemake`` (the default profile,
+          ``profiles/default``, reruns the jobs a crash interrupted).
 ``report`` writes Snakemake's own report of the build (``snakemake --report``: every figure
           once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
           all: it is rendered elsewhere and moved into place only when complete (``make``
@@ -128,13 +131,42 @@ def unwritable_folders(root):
     return [f for f in folders if not os.access(f, os.W_OK | os.X_OK)]
 
 
+def _mount_point(folder):
+    """The mount point of the file system holding ``folder`` (symbolic links resolved)."""
+    path = Path(os.path.realpath(folder))
+    dev = path.stat().st_dev
+    while path.parent != path and path.parent.stat().st_dev == dev:
+        path = path.parent
+    return path
+
+
+def _read_only(folder):
+    """Whether ``folder`` is on a file system mounted read-only (no ``chmod`` can help)."""
+    try:
+        return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except OSError:
+        return False
+
+
 def _unwritable_message(root, folders):
     """One line: the first folder ``root``'s build may not write, how many more, the remedy
-    (``chmod`` of the outermost ones when they are the user's, else whose they are)."""
+    (``chmod`` of the outermost ones when they are the user's, else whose they are; on a
+    read-only mount, which no ``chmod`` changes: remounting it, or building elsewhere)."""
     def shown(folder):
         return str(folder) if folder == root else os.path.relpath(folder)
 
     more = f", nor are {len(folders) - 1} more folders" if len(folders) > 1 else ""
+    read_only = [f for f in folders if _read_only(f)]
+    if read_only:
+        first = read_only[0]
+        links = [f"{shown(p)} -> {os.readlink(p)}"
+                 for p in (first, *first.parents) if p.is_symlink()]
+        via = f", through the link {links[-1]}" if links else ""
+        return (f"{shown(first)} is on a file system mounted read-only at "
+                f"{_mount_point(first)}{via}: no chmod "
+                f"can change that; remount it read-write, or give the build a writable folder "
+                f"in its place (e.g. replace the link by a folder on a writable disk), or build "
+                f"in a copy of the project; nothing was changed")
     others = sorted({f.stat().st_uid for f in folders} - {os.getuid()})
     if others:
         import pwd
@@ -153,6 +185,49 @@ def _unwritable_message(root, folders):
         fix = f"chmod u+w {shown(folders[0])}"
     return (f"{shown(folders[0])} is not writable by you{more} ({fix}, or build in a copy of "
             f"the project); nothing was changed")
+
+
+#: The lock file a ``run`` holds, with ``flock``, from its checks to the end of its build.
+BUILD_LOCK = Path(".snakemake") / "vibroimpact-build.lock"
+
+
+def take_build_lock(root):
+    """Take the build lock of project ``root`` (:data:`BUILD_LOCK`) or learn who holds it.
+
+    An exclusive ``flock`` of the lock file, asked without waiting: of two runs started at
+    the same instant the kernel gives it to one only (the check and the taking are one
+    step, unlike looking for Snakemake's locks first). The descriptor is inheritable, so the
+    lock passes to Snakemake with ``exec`` and stays taken for the whole build; the kernel
+    releases it when the build's process ends, however it ends (no stale lock to clear).
+
+    Returns
+    -------
+    (int, None) or (None, str)
+        The open descriptor holding the lock (the holder's pid written in the file), or
+        the pid of the run holding it (``"?"`` when it has not written it yet).
+    """
+    import fcntl
+
+    path = root / BUILD_LOCK
+    if path in _HELD:                 # this process holds it already (``main`` called again)
+        return _HELD[path], None
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "?"
+        os.close(fd)
+        return None, holder
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    os.set_inheritable(fd, True)
+    _HELD[path] = fd
+    return fd, None
+
+
+#: The build locks this process holds: lock file -> descriptor (kept until it exits).
+_HELD = {}
 
 
 def _snakemake():
@@ -275,14 +350,22 @@ def main(argv=None):
     unwritable = unwritable_folders(root)
     if unwritable:
         return _fail(_unwritable_message(root, unwritable), code=1)
+    lock, holder = take_build_lock(root)
+    if lock is None:
+        return _fail(f"another build is running in {root} (pid {holder}); wait for it to "
+                     f"finish, or stop it (kill {holder}) and run again", code=1)
     removed = _files.sweep_stale_temporaries(root / "results")
     if removed:
         print(f"vibroimpact: removed {len(removed)} temporary file(s) of interrupted writes",
               file=sys.stderr)
     try:
-        io.check_readable(root / "results")
+        unchecked = io.check_readable(root / "results")
     except io.CorruptFileError as err:
         return _fail(err, code=1)
+    if unchecked:
+        print(f"vibroimpact: {len(unchecked)} result file(s) carry no checksums (written "
+              f"before them, e.g. {unchecked[0]}): read through and accepted; the build "
+              f"rewrites them (their writer's code changed)", file=sys.stderr)
     code = _clear_stale_lock(root, config_args)
     if code:
         return code

@@ -4,6 +4,15 @@ A failed or interrupted write never leaves a file under the final name: everythi
 written to a temporary name in the same directory and renamed into place on success. A file
 that cannot be read (truncated or damaged by something else) gives :class:`CorruptFileError`:
 one line naming the file and telling to delete it, never a traceback from HDF5.
+
+Every array variable the pipeline writes carries HDF5's Fletcher-32 checksum of each of its
+chunks (:data:`CHECKSUM`): netCDF4 checks it whenever a chunk is read, so damaged data are
+refused (:class:`CorruptFileError`) by every reader, never drawn, and :func:`verify` reads
+every variable of a file to check all of them (``python -m vibroimpact run`` does that for
+every result before a job starts). Scalar variables cannot carry the filter (HDF5 stores them
+unchunked), nor can metadata (attributes): these are checked only as far as HDF5 can parse
+them. A file written before the checksums (none of its array variables has one) is read
+through and accepted: its writer's code digest changed with them, so the build reruns it.
 """
 import contextlib
 import os
@@ -14,17 +23,25 @@ import numpy as np
 
 from vibroimpact._files import atomic_path
 
-__all__ = ["CorruptFileError", "check_readable", "load_dataset", "write_dataset", "write_noise",
-           "noise_spec", "read_noise_attrs", "read_input_correlation", "read_noise"]
+__all__ = ["CHECKSUM", "CorruptFileError", "check_readable", "load_dataset", "verify",
+           "verify_png", "write_dataset", "write_noise", "noise_spec", "read_noise_attrs",
+           "read_input_correlation", "read_noise"]
+
+#: The netCDF4 encoding every variable the pipeline writes gets: a Fletcher-32 checksum of
+#: each chunk, checked by the library whenever the chunk is read (scalars: ignored by HDF5).
+CHECKSUM = {"fletcher32": True}
+
+#: Elements :func:`verify` reads at a time from one variable (bounds its memory).
+VERIFY_BLOCK = 2**22
 
 
 class CorruptFileError(OSError):
     """A result file that exists but cannot be read; ``str()`` is one line."""
 
-    def __init__(self, path, reason):
+    def __init__(self, path, reason, what="cannot be read as netCDF"):
         reason = (str(reason).strip().splitlines()[-1] if str(reason).strip()
                   else type(reason).__name__)
-        super().__init__(f"{path}: cannot be read as netCDF ({reason}): the file is truncated "
+        super().__init__(f"{path}: {what} ({reason}): the file is truncated "
                          f"or corrupt; delete it and run make (python -m vibroimpact run) "
                          f"again, which rebuilds it (plain snakemake does not: add "
                          f"--forcerun {path})")
@@ -57,27 +74,104 @@ def load_dataset(path):
         return xr.load_dataset(path, engine="netcdf4")
 
 
+def _blocks(shape, block=VERIFY_BLOCK):
+    """Index tuples covering an array of ``shape`` in slabs of the first axis, each at most
+    ``block`` elements (one row at least)."""
+    if not shape:
+        return [()]
+    row = int(np.prod(shape[1:], dtype=np.int64))
+    step = max(1, block // max(row, 1))
+    return [(slice(i, i + step),) for i in range(0, max(shape[0], 1), step)]
+
+
+def verify(path):
+    """Read every variable of the netCDF file ``path`` through, which checks the Fletcher-32
+    checksum of every chunk of those that carry one (:data:`CHECKSUM`).
+
+    Returns
+    -------
+    bool
+        Whether the file carries checksums (some array variable has one); ``False`` for a
+        file written before them, which is read through and accepted all the same.
+
+    Raises
+    ------
+    CorruptFileError
+        The file cannot be opened, or a variable's data cannot be read: named, with "fail
+        their Fletcher-32 checksum" when it carries one.
+    """
+    checked = False
+    with _open(path) as nc:
+        for name, var in nc.variables.items():
+            var.set_auto_maskandscale(False)
+            summed = bool(var.ndim and var.filters().get("fletcher32"))
+            checked |= summed
+            try:
+                for index in _blocks(var.shape):
+                    var[index]
+            except (OSError, RuntimeError, ValueError, IndexError) as err:
+                what = (f"the data of variable {name} fail their Fletcher-32 checksum" if summed
+                        else f"the data of variable {name} cannot be read")
+                raise CorruptFileError(path, err, what=what) from None
+    return checked
+
+
 def check_readable(root):
-    """Open every netCDF file under ``root`` (not the temporaries); the unreadable ones
-    raise :class:`CorruptFileError` (the first one found) before any job would use them,
-    naming the file relative to the working directory (the path ``--forcerun`` takes)."""
+    """:func:`verify` every netCDF file under ``root`` (not the temporaries), and every
+    figure's PNG (:func:`verify_png`): a damaged one raises :class:`CorruptFileError` (the
+    first one found) before any job would use it, naming the file relative to the working
+    directory (the path ``--forcerun`` takes). PDF, HTML and notebook outputs carry no
+    checksum of their own, and no job reads them: they are not checked.
+
+    Returns
+    -------
+    list of str
+        The files checked that carry no checksums (written before them).
+    """
     root = Path(root)
     if not root.is_dir():
-        return
+        return []
+    unchecked = []
     for path in sorted(root.rglob("*.nc")):
         if path.name.startswith("."):
             continue
-        _open(os.path.relpath(path)).close()
+        name = os.path.relpath(path)
+        if not verify(name):
+            unchecked.append(name)
+    for path in sorted(root.rglob("*.png")):
+        if not path.name.startswith("."):
+            verify_png(os.path.relpath(path))
+    return unchecked
+
+
+def verify_png(path):
+    """Check the CRC-32 of every chunk of the PNG file ``path`` (the figures, which
+    Snakemake's report embeds): :class:`CorruptFileError` naming it when one fails."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as image:
+            image.verify()
+    except FileNotFoundError:
+        raise
+    except Exception as err:        # Pillow raises SyntaxError, OSError, struct.error ...
+        raise CorruptFileError(path, err, what="fails its PNG chunk checks") from None
 
 
 def write_dataset(ds, path):
-    """Write an ``xarray.Dataset`` to netCDF4 atomically."""
+    """Write an ``xarray.Dataset`` to netCDF4 atomically, every variable with a Fletcher-32
+    checksum (:data:`CHECKSUM`); the encodings the variables bring along (from a file they
+    were read from) are kept, but never ``contiguous`` storage, which takes no checksum."""
+    ds = ds.copy(deep=False)          # new Variable objects: the caller's encodings stay
+    for var in ds.variables.values():
+        encoding = {k: v for k, v in var.encoding.items() if k != "contiguous"}
+        var.encoding = {**encoding, **CHECKSUM}
     with atomic_path(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4")
 
 
 def _var(nc, name, dims, data, long_name, units, dtype="f8"):
-    v = nc.createVariable(name, dtype, dims)
+    v = nc.createVariable(name, dtype, dims, **CHECKSUM)
     v[:] = data
     v.setncatts(dict(long_name=long_name, units=units))
     return v
@@ -107,7 +201,8 @@ def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estim
         nc = netCDF4.Dataset(tmp, "w", format="NETCDF4")
         try:
             nc.createDimension("sample", n_samples)
-            r = nc.createVariable("r", "f8", ("sample",), chunksizes=(min(n_samples, 2**18),))
+            r = nc.createVariable("r", "f8", ("sample",), chunksizes=(min(n_samples, 2**18),),
+                                  **CHECKSUM)
             r.setncatts(dict(long_name="random force sample r_k = r(k dt)", units="1"))
             head = []
             k = 0
