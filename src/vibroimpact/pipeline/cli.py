@@ -64,6 +64,9 @@ def _parser():
 #: Endings of a config file (Snakemake reads JSON or YAML); a name after --configfile with
 #: none of them that is no file is a target given in the wrong place.
 CONFIG_SUFFIXES = (".yaml", ".yml", ".json")
+#: Endings of the build's own outputs: a name after --configfile with one of them is a target,
+#: whether or not the file exists yet.
+OUTPUT_SUFFIXES = (".png", ".pdf", ".nc", ".html", ".ipynb", ".tsv")
 
 #: Where ``report`` writes Snakemake's report (README, "Reports").
 REPORT = "results/report.html"
@@ -329,7 +332,9 @@ def main(argv=None):
         os.environ[config.VERBOSE_ENV] = "1"
     root = Path(args.directory).resolve()
     for name in args.configfile:
-        if Path(name).suffix.lower() not in CONFIG_SUFFIXES and not Path(name).is_file():
+        suffix = Path(name).suffix.lower()
+        if suffix in OUTPUT_SUFFIXES or (suffix not in CONFIG_SUFFIXES
+                                         and not Path(name).is_file()):
             others = " ".join(f for f in args.configfile if f != name)
             hint = (f": give targets before it, e.g. run {name}"
                     + (f" --configfile {others}" if others else "")
