@@ -200,12 +200,14 @@ STUDIES = {
                    transient=10.0, tile_size=5, spectra=dict(delta=[1.0], nperseg=256),
                    trace=dict(delta=0.0, t_end=30.0),
                    figures=["fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09"]),
-    # the schema's minimum sizes: 16 samples, Welch segments of 16, no transient
+    # the smallest events record: 2 batches of a natural period 2 pi (128 samples at dt =
+    # 0.1), Welch segments of 16, no transient
     "minimal": dict(noise="tiny", zeta=0.05, eps=0.5, amplitude=0.0, delta=[0.0, 0.5],
                     transient=0.0, n_batches=2, trace=dict(delta=0.0, t_end=1.0),
                     figures=["fig03", "fig04", "fig05", "fig07", "fig08", "fig09"]),
-    # a trace and nothing else: the report has no events or spectra dataset
-    "trace_only": dict(noise="tiny", zeta=0.05, eps=0.5, amplitude=0.0, delta=[0.0],
+    # a trace and nothing else, on the schema's smallest record (16 samples): the report has
+    # no events or spectra dataset
+    "trace_only": dict(noise="tiniest", zeta=0.05, eps=0.5, amplitude=0.0, delta=[0.0],
                        transient=0.0, trace=dict(delta=0.0, t_end=1.0), figures=["fig03"]),
 }
 
@@ -213,8 +215,10 @@ STUDIES = {
 #: The user's file of these studies (test_workflow.py dry-runs it against the plan too).
 CONFIG = dict(paper=False, noises=dict(
     zero=dict(kind="band_limited", rms=0.0, dt=0.1, beta_c=4.0, n_samples=3001, seed=1),
-    tiny=dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=16, nperseg=16,
-              seed=2)), studies=STUDIES)
+    tiny=dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=128, nperseg=16,
+              seed=2),
+    tiniest=dict(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0, n_samples=16, nperseg=16,
+                 seed=2)), studies=STUDIES)
 
 
 @pytest.mark.workflow

@@ -308,10 +308,11 @@ def _check_study(config, name, entry, problems, limits, unforced):
     elif transient >= end:
         problems.add(f"{where}.transient", transient, "leaves no record for the statistics "
                      f"(t_end = {end:.6g})", f"0 <= transient < {end:.6g}")
-    if t_end is None or t_end <= tau * (1 + 1e-9):
-        _check_batches(where, entry, end - transient, dt, problems)
     uses = {r for f in entry["figures"] for r in figures.FIGURES[
         f if isinstance(f, str) else f["name"]]["reads"]}
+    if "events" in uses and (t_end is None or t_end <= tau * (1 + 1e-9)):
+        # the batches cut the events' record (a trace or a spectrum has none)
+        _check_batches(where, entry, end - transient, dt, problems)
     spectra = entry.get("spectra")
     if spectra:
         s_end = tau if spectra.get("t_end") is None else float(spectra["t_end"])
