@@ -4,6 +4,7 @@ import pytest
 import xarray as xr
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import LogNorm
+from matplotlib.path import Path
 
 from vibroimpact.plotting.maps import residence
 
@@ -47,10 +48,11 @@ def test_one_log_scale_panel_per_state_with_few_stretches_hatched():
     assert isinstance(norm, LogNorm) and all(m.norm is norm for m in meshes)
     assert norm.vmin == np.nanmin(t) and norm.vmax == np.nanmax(t)
     for ax, few in zip(panels, n < 5):
-        hatched = [c for c in ax.collections if c.get_gid() == "few_stretches"]
+        hatched = [c for c in ax.patches if c.get_gid() == "few_stretches"]
         assert len(hatched) == int(few.any())
-        if few.any():
-            assert len(hatched[0].get_paths()) == few.sum()
+        if few.any():       # one compound path, a closed rectangle per cell
+            path = hatched[0].get_path()
+            assert (path.codes == Path.CLOSEPOLY).sum() == few.sum()
     # a cell without a complete stretch is left blank (masked)
     assert meshes[0].get_array().mask.sum() == (n[0] == 0).sum()
 
@@ -76,7 +78,8 @@ def test_a_state_seen_only_in_cut_stretches_is_marked_not_left_blank():
     fig = residence(ds)
     FigureCanvasAgg(fig).draw()
     panels = [ax for ax in fig.axes if ax.get_title()]
-    marks = [[c for c in ax.collections if c.get_gid() == "only_cut"] for ax in panels]
+    marks = [[c for c in ax.patches if c.get_gid() == "only_cut"] for ax in panels]
     assert [len(m) for m in marks] == [1, 0, 0, 0]
-    (cell,) = marks[0][0].get_paths()
+    cell = marks[0][0].get_path()
+    assert (cell.codes == Path.CLOSEPOLY).sum() == 1
     assert cell.get_extents().bounds == pytest.approx((0.75, 0.5, 0.5, 1.0))

@@ -13,7 +13,7 @@ from matplotlib.collections import LineCollection, PatchCollection
 from matplotlib.contour import ContourSet
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch, Rectangle
+from matplotlib.patches import Patch, PathPatch, Rectangle
 from matplotlib.path import Path
 
 from vibroimpact import stats
@@ -97,6 +97,21 @@ def cell_rectangles(x, y, mask):
     xe, ye = cell_edges(x), cell_edges(y)
     return [Rectangle((xe[i], ye[j]), xe[i + 1] - xe[i], ye[j + 1] - ye[j])
             for i, j in zip(*np.nonzero(mask))]
+
+
+def cells_path(x, y, mask):
+    """One compound :class:`~matplotlib.path.Path` of the whole cells in `mask` (centres `x`,
+    `y`), a closed rectangle each: drawn as one path, a hatch over thousands of cells renders
+    in one pass (a collection of rectangles hatches each on its own, ~10 s for 5 000)."""
+    xe, ye = cell_edges(x), cell_edges(y)
+    i, j = np.nonzero(mask)
+    corners = np.stack([np.column_stack([xe[i], ye[j]]), np.column_stack([xe[i + 1], ye[j]]),
+                        np.column_stack([xe[i + 1], ye[j + 1]]),
+                        np.column_stack([xe[i], ye[j + 1]]),
+                        np.column_stack([xe[i], ye[j]])], axis=1)
+    codes = np.tile([Path.MOVETO, Path.LINETO, Path.LINETO, Path.LINETO, Path.CLOSEPOLY],
+                    i.size)
+    return Path(corners.reshape(-1, 2), codes.astype(Path.code_type))
 
 
 def mark_few_switches(ax, x, y, few):
@@ -586,11 +601,11 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
         few = ns < min_stretches
         if few.any():
             few_any = True
-            ax.add_collection(PatchCollection(cell_rectangles(x, y, few), gid="few_stretches",
-                                              **FEW_STRETCHES_STYLE), autolim=False)
+            ax.add_patch(PathPatch(cells_path(x, y, few), gid="few_stretches",
+                                   **FEW_STRETCHES_STYLE))
         if cut[k].any():
-            ax.add_collection(PatchCollection(cell_rectangles(x, y, cut[k]), gid="only_cut",
-                                              **ONLY_CUT_STYLE), autolim=False)
+            ax.add_patch(PathPatch(cells_path(x, y, cut[k]), gid="only_cut",
+                                   **ONLY_CUT_STYLE))
         ax.set_title("none" if name == "none" else f"({name})")
     _finish_axes(axes, motion_map)
     for ax in axes:                       # cells drawn whole: the extent is the cells' edges

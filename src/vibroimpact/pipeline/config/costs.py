@@ -22,11 +22,20 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 NS_PER_AUDIT_STEP = 25.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
-US_PER_START = 360.0       # one start of the attractor map, settled or run to its cap
+#: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
+#: map's 5,187 cells x 64 starts (68 us a start; its four tiles' benchmark files, 2 cores).
+US_PER_START = 70.0
+#: The share of its cap (`~vibroimpact.pipeline.study.map_cap_steps`) a map cell runs on
+#: average before its probabilities reach their target standard error: 0.34 on the default
+#: map (its `record_end` summed: 1.42e9 steps against 4.18e9 at the caps). A map whose cells
+#: all run to the cap costs up to 1 / 0.34 = 2.9 times the plan's figure.
+MAP_CAP_FRACTION = 0.34
 BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 FIGURE_S = 1.5             # one figure, start-up included
 REPORT_S = 4.0             # one report notebook executed and rendered (papermill, nbconvert)
-VALIDATION_S = 85.0        # the work-precision run and the stress sample together
+#: The work-precision run and the stress sample together, wall time (the work-precision job
+#: holds every core while it times): 44 + 21 s on the default build.
+VALIDATION_S = 65.0
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
 FILE_OVERHEAD = 20_000

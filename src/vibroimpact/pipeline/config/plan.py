@@ -229,8 +229,9 @@ def make_plan(config, own=None, *, results="results"):
             cap = sum(len(study.delta) * costs.study_steps("map", entry, noise, float(ib))
                       for ib in study.inv_beta)
             _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200,
-                 costs.simulate_cpu_s(1, cap))
-            parts.append(f"map {_n(cells, 'cell')} (CPU at the caps)")
+                 costs.simulate_cpu_s(1, cap * costs.MAP_CAP_FRACTION))
+            parts.append(f"map {_n(cells, 'cell')} (CPU at {costs.MAP_CAP_FRACTION:g} of the "
+                         f"caps, the paper map's mean; <= x{1 / costs.MAP_CAP_FRACTION:.1f})")
         if "spectra" in needs:
             cells = len(study.cells("spectra"))
             spec = entry["spectra"]
