@@ -445,3 +445,27 @@ def test_a_damaged_figure_is_refused(tmp_path, monkeypatch):
     with pytest.raises(io.CorruptFileError, match="^results/figures/fig99.png: fails its PNG "
                        "chunk checks"):
         io.check_readable("results")
+
+
+def test_a_real_read_only_mount_is_refused(tmp_path):
+    """The same with a real `mount -o ro` (a tmpfs in a private mount namespace, `unshare -m`;
+    skipped where that is not allowed)."""
+    import shutil
+
+    if shutil.which("unshare") is None or subprocess.run(
+            ["unshare", "-m", "true"], capture_output=True).returncode != 0:
+        pytest.skip("no private mount namespace here (unshare -m)")
+    work = make_workdir(tmp_path / "project")
+    mount = tmp_path / "mnt"
+    mount.mkdir()
+    (work / "results").symlink_to(mount / "results")
+    script = (f"mount -t tmpfs tmpfs {mount} && mkdir {mount}/results && "
+              f"mount -o remount,ro {mount} && exec {' '.join(RUN)}")
+    out = subprocess.run(["unshare", "-m", "sh", "-c", script], cwd=work, capture_output=True,
+                         text=True, timeout=120)
+    assert out.returncode == 1, out.stderr[-2000:]
+    assert out.stderr.splitlines()[-1] == (
+        f"error: results is on a file system mounted read-only at {mount}, through the link "
+        f"results -> {mount / 'results'}: no chmod can change that; remount it read-write, or "
+        f"give the build a writable folder in its place (e.g. replace the link by a folder on "
+        f"a writable disk), or build in a copy of the project; nothing was changed")
