@@ -1,14 +1,34 @@
 """Fixtures shared by the workflow suites: one build of the test config (helpers.py holds the
 functions that copy the project and run the workflow).
 
-`make test` runs the `workflow` and `slurm` markers in one pytest session, so the test config
-is built once (`built`) and every end-to-end test (datasets, findings, reports, the SLURM run)
-reads or compares against that build. The numba cache lives beside the installed (editable)
-package, so every build in every copy reuses the kernels compiled by the first.
+`make test` runs the `workflow` and `slurm` markers in one pytest session on two xdist workers
+with ``--dist loadgroup``. Every test that reads the build of the test config (the ``built``
+fixture, directly or through another fixture) is put in one xdist group, ``built``, so one
+worker builds the test config once and runs all of them in turn, while the other worker runs
+the suites that build their own copies (rebuild scope, faults, sweeps, degenerate and escape
+studies). Every other test is grouped by its module, as ``--dist loadscope`` would, so a
+module-scoped fixture (a module's own build) is built on one worker only. Without
+``--dist loadgroup`` (plain ``-n 2``, or no xdist) the groups are inert and ``built`` is still
+built once per session.
+The numba cache lives beside the installed (editable) package, so every build in every copy
+reuses the kernels compiled by the first.
 """
 import pytest
 
 from helpers import make_workdir, snakemake
+
+#: The xdist group of every test that needs the built test config (one build per session).
+BUILT_GROUP = "built"
+
+
+def pytest_collection_modifyitems(config, items):
+    """Tests needing ``built`` share one xdist worker, so the test config is built once; the
+    others share a worker with their module (its module-scoped fixtures are built once)."""
+    for item in items:
+        if "built" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.xdist_group(BUILT_GROUP))
+        else:
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
 
 
 @pytest.fixture(scope="session")
