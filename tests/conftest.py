@@ -6,10 +6,12 @@ with ``--dist loadgroup``. Every test that reads the build of the test config (t
 fixture, directly or through another fixture) is put in one xdist group, ``built``, so one
 worker builds the test config once and runs all of them in turn, while the other worker runs
 the suites that build their own copies (rebuild scope, faults, sweeps, degenerate and escape
-studies). Every other test is grouped by its module, as ``--dist loadscope`` would, so a
-module-scoped fixture (a module's own build) is built on one worker only. Without
-``--dist loadgroup`` (plain ``-n 2``, or no xdist) the groups are inert and ``built`` is still
-built once per session.
+studies), each test on whichever worker is free. A module whose module-scoped fixture is a
+build of its own (test_rebuild_scope.py) puts its tests in one group itself
+(``pytest.mark.xdist_group``), so that build is made on one worker only; the cheap
+module-scoped copies (test_config_errors.py's ``copy_dir``) are made once per worker, and
+their tests spread over both. Without ``--dist loadgroup`` (plain ``-n 2``, or no xdist) the
+groups are inert and ``built`` is still built once per session.
 The numba cache lives beside the installed (editable) package, so every build in every copy
 reuses the kernels compiled by the first.
 """
@@ -22,13 +24,10 @@ BUILT_GROUP = "built"
 
 
 def pytest_collection_modifyitems(config, items):
-    """Tests needing ``built`` share one xdist worker, so the test config is built once; the
-    others share a worker with their module (its module-scoped fixtures are built once)."""
+    """Tests needing ``built`` share one xdist worker, so the test config is built once."""
     for item in items:
         if "built" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.xdist_group(BUILT_GROUP))
-        else:
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
 
 
 @pytest.fixture(scope="session")
