@@ -15,6 +15,7 @@ groups are inert and ``built`` is still built once per session.
 The numba cache lives beside the installed (editable) package, so every build in every copy
 reuses the kernels compiled by the first.
 """
+from _pytest.nodeid import coerce_node_id
 import pytest
 
 from helpers import make_workdir, snakemake
@@ -23,11 +24,26 @@ from helpers import make_workdir, snakemake
 BUILT_GROUP = "built"
 
 
+@pytest.hookimpl(trylast=True)
 def pytest_collection_modifyitems(config, items):
-    """Tests needing ``built`` share one xdist worker, so the test config is built once."""
+    """Tests needing ``built`` share one xdist worker, so the test config is built once.
+
+    xdist's ``--dist loadgroup`` schedules by a ``@group`` suffix that its worker appends to
+    each marked test's node id (``item._nodeid``); pytest 9 computes ``nodeid`` from
+    ``item._id`` instead, so that suffix is lost and every group spreads over both workers
+    (measured: the test config built twice). The suffix is set here, on ``_id``, after xdist's
+    own hook (``trylast``); the check on the ids' suffix keeps it correct if xdist fixes it.
+    """
     for item in items:
         if "built" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.xdist_group(BUILT_GROUP))
+    if not getattr(config.option, "loadgroup", False):      # xdist worker, --dist loadgroup
+        return
+    for item in items:
+        names = sorted({str(m.args[0] if m.args else m.kwargs.get("name", "default"))
+                        for m in item.iter_markers("xdist_group")})
+        if names and "@" not in item.nodeid:
+            item._id = coerce_node_id(f"{item.nodeid}@{'_'.join(names)}")
 
 
 @pytest.fixture(scope="session")
