@@ -3,7 +3,8 @@
 # `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
 # of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, the
 # slow (stress/convergence) suite on two workers, the end-to-end workflow and SLURM suites
-# (one session: the test config is built once; the SLURM suite installs and starts a
+# (one session on two workers: the test config is built once, on one worker, while the other
+# runs the suites that build their own copies; the SLURM suite installs and starts a
 # one-node cluster, as root); `make lint` runs Snakemake's linter, ruff and snakefmt.
 PYTHON ?= python3
 VENV   := .venv
@@ -14,6 +15,9 @@ CORES  ?= all
 # (pytest-xdist; the fast suite is CPU-bound, mostly numba compilation on a fresh clone)
 FAST_WORKERS ?= -n 2
 SLOW_WORKERS ?= -n 2
+# the workflow and SLURM suites on both cores: every test of the built test config on one
+# worker (xdist group `built`, tests/conftest.py), the other tests grouped by module
+WORKFLOW_WORKERS ?= -n 2 --dist loadgroup
 # your own config, layered on config/config.yaml: make CONFIG=my_study.yaml
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
@@ -52,7 +56,7 @@ test: $(STAMP)
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q $(FAST_WORKERS)
 	$(BIN)/python -m pytest -q -m slow $(SLOW_WORKERS)
-	$(BIN)/python -m pytest -q -m "workflow or slurm"
+	$(BIN)/python -m pytest -q -m "workflow or slurm" $(WORKFLOW_WORKERS)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py

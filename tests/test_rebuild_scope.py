@@ -18,7 +18,9 @@ import yaml
 
 from helpers import copy_tree
 
-pytestmark = pytest.mark.workflow
+#: one xdist worker for the module (`make test` runs it with --dist loadgroup): `repo` is a
+#: whole build of the test config, made once
+pytestmark = [pytest.mark.workflow, pytest.mark.xdist_group("rebuild_scope")]
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
