@@ -18,6 +18,14 @@ Two measurements, nothing asserted:
    the two force terms of a linearly interpolated force per step, nothing else), in turn in one
    process (``--rounds`` alternations, best of each): ns per step and their ratio.
 
+Measured 2026-11-27 01:42-01:48 UTC (load average 5 on 2 cores, shared machine), all 5187
+cells of the default build's map, this tree = the merge base f02e60b (no kernel change yet):
+this tree 133.6 s wall / 71.0 s cell CPU; merge base 136.6 / 72.8; peer 3091f6a 75.1 / 49.4
+(0.69 x the CPU: the issue-33 hop check and two extra grouping rules per cell cost +44 %);
+max |dP| to the peer 0.037 (the physical collision rule of issue 33, expected). Step without
+impact: simulator 3.97 ns, prototype 4.33 ns (0.92 x; an earlier 2e6-step run gave 1.23 x:
+noisy at this load).
+
 Usage::
 
     python benchmarks/bench_map_floor.py --noise results/noise/harmonic_input.nc
