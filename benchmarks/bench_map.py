@@ -221,7 +221,7 @@ def sample_cells(ds, n, rng):
 
 
 def peer(ds, samples, dt, kw, n_cells, repeats, seed):
-    flat = ds.transpose("inv_beta", "delta", "motion")
+    flat = ds.transpose("inv_beta", "delta", "motion", ...)
     n_delta = ds.sizes["delta"]
     pick, q75 = sample_cells(ds, n_cells, np.random.default_rng(seed))
     print(f"\n== 4. Peer in this run: {pick.size} cells (seed {seed}; "
@@ -301,7 +301,7 @@ def peer_revision(ds, noise_path, kw, rev, stride):
     from pathlib import Path
 
     root = Path(__file__).resolve().parents[1]
-    flat = ds.transpose("inv_beta", "delta", "motion")
+    flat = ds.transpose("inv_beta", "delta", "motion", ...)
     cells = [(float(b), float(d)) for b in flat.inv_beta.values for d in flat.delta.values]
     cells = cells[::stride]
     job = json.dumps(dict(noise=str(noise_path), cells=cells,
