@@ -20,6 +20,7 @@ from numba import njit, prange
 import numpy as np
 
 from vibroimpact._kernel_cache import kernel_decorator
+from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
 from vibroimpact.impact import _jit as _impact_jit
 from vibroimpact.impact.layout import (BUFFER_FULL, FREE, N_COUNTERS, N_FTOT, N_PARAMS,
                                        N_STATE, OK, P_A, P_AQ, P_BETA, P_BH_HI, P_BH_LO,
@@ -377,8 +378,29 @@ def _flight_impact(a11, a12, a21, a22, s, f, u, zeta, omega, eps, delta):
     b12 = p11 * a12 + p12 * a22
     b21 = p21 * a11 + p22 * a21
     b22 = p21 * a12 + p22 * a22
-    g = (1.0 + eps) * (f - delta) / u
-    return -eps * b11, -eps * b12, g * b11 - eps * b21, g * b12 - eps * b22
+    s11, s21, s22 = saltation(eps, u, f, delta, zeta)
+    return s11 * b11, s11 * b12, s21 * b11 + s22 * b21, s21 * b12 + s22 * b22
+
+
+@kernel
+def saltation(eps, u, f, delta, zeta):
+    """Saltation matrix ``S = [[s11, 0], [s21, s22]]`` of an impact on the wall at ``x = delta``
+    met at approach velocity ``u > 0`` where the force is ``f``: the tangent map from just
+    before to just after the impact, ``S = Dg + (F_+ - Dg F_-) e_x^T / u`` with the reset
+    ``g(x, v) = (x, rebound_velocity(eps, v))`` and the flows before and after.
+
+    Notes
+    -----
+    ``s11 = v_+ / u``, ``s22 = d v_+ / du``, ``s21 = (a_+ - s22 a_-) / u`` with the
+    accelerations ``a_-+ = f - 2 zeta v_-+ - delta``, written as
+    ``((1 - s22) (f - delta) - 2 zeta (v_+ - s22 u)) / u`` for any law. Newton's law makes the
+    last term exactly 0 (``v_+ = s22 u`` to the bit), leaving the classic ``(1 + eps) (f -
+    delta) / u`` rounded exactly as before.
+    """
+    v_plus = rebound_velocity(eps, u)
+    s22 = rebound_derivative(eps, u)
+    s21 = ((1.0 - s22) * (f - delta) - 2.0 * zeta * (v_plus - s22 * u)) / u
+    return rebound_ratio(eps, u), s21, s22
 
 
 @kernel
@@ -534,12 +556,12 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                     u = imp_u[ip]
                     if not tan_dead:
                         f = math.sin(phase(ek, es, P[P_BH_HI], P[P_BH_LO], beta))
-                        g = (1.0 + eps) * (f - delta) / u
+                        s11, s21, s22 = saltation(eps, u, f, delta, zeta)
                         for cc in range(2):
                             a = qm[0, cc]
                             b = qm[1, cc]
-                            qm[0, cc] = -eps * a
-                            qm[1, cc] = g * a - eps * b
+                            qm[0, cc] = s11 * a
+                            qm[1, cc] = s21 * a + s22 * b
                         before0, before1 = acc[0], acc[1]
                         _qr(qm, acc)
                         if tau >= t_b:

@@ -1,10 +1,15 @@
 """Newton on the full 2m-equation system of an (m/n) motion (paper eqs. 10-11), with
 its analytic Jacobian, and the uncertainty of a solution from the conditioning there.
+
+The Jacobian's ``d/du_a`` columns carry the impact law's ``rebound_derivative``; its
+``d/tau_a`` columns write the start's shift with ``eps * ua`` for ``-rebound_velocity`` (Newton's
+law, as in :func:`vibroimpact.orbits.flight.impact_map_jacobian`).
 """
 from math import sin
 
 import numpy as np
 
+from vibroimpact._law import rebound_derivative
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import flight, harmonic_constants
 from vibroimpact.orbits.linalg import _norm, _solve_inplace
@@ -42,8 +47,8 @@ def _residual_jacobian(y, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac):
         g_a = delta - sin(beta * ta) - 2.0 * zeta * eps * ua
         jac[r1, a] += p11 * eps * ua + p12 * g_a
         jac[r2, a] += p21 * eps * ua + p22 * g_a
-        jac[r1, m + a] += -eps * p12
-        jac[r2, m + a] += -eps * p22
+        jac[r1, m + a] += rebound_derivative(eps, ua) * p12
+        jac[r2, m + a] += rebound_derivative(eps, ua) * p22
         jac[r1, b] += v
         jac[r2, b] += acc
         jac[r2, m + b] += -1.0
