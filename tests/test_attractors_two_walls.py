@@ -132,7 +132,7 @@ def test_exponent_sum_against_the_simulators_rates():
 def test_map_keywords_and_refusals():
     r = attractor_map([INV_BETA], [DELTA], ZETA, EPS, n_starts=4, gap=(0.0, CLEARANCE),
                       velocity=(-2.0, 2.0), clearance=CLEARANCE, eps_lower=EPS_LO)
-    assert r["n_stable"].sum() == 0                   # the one-wall solver lists nothing here
+    assert r["n_stable"].sum() == 0       # no stable one-wall orbit stays above the wall below
     assert r["impact_rate_lower"][0, 0] > 0.1
     one = attractor_map([INV_BETA], [DELTA], ZETA, EPS, n_starts=4, gap=(0.0, CLEARANCE))
     assert np.all(one["impact_rate_lower"][np.isfinite(one["impact_rate_lower"])] == 0)
@@ -146,3 +146,43 @@ def test_map_keywords_and_refusals():
     with pytest.raises(ValueError, match="clearance"):
         attractor_map([INV_BETA], [DELTA], ZETA, EPS, n_starts=4, gap=(0.0, 0.5),
                       clearance=-1.0)
+
+
+def test_orbit_floor_is_the_lowest_point_of_the_flights():
+    # a stable (1/1) orbit of the Fig. 15 plane: its lowest point by dense sampling of the
+    # closed-form flight (the floor is found exactly, so sampling can only come out higher)
+    from vibroimpact import periodic_orbits
+    from vibroimpact.orbits.flight import flight
+    from vibroimpact.orbits.tolerances import FLIGHT_STACK
+    beta, delta = 1.0, 2.0
+    orbit = [o for o in periodic_orbits(1, 1, beta, delta, ZETA, 0.5) if o.stable][0]
+    y = np.array([orbit.tau0, orbit.velocities[0]])
+    z = 2 * math.pi / beta
+    floor = ak.orbit_floor(y, 1, z, beta, delta, ZETA, 0.5, np.empty((FLIGHT_STACK, 2)))
+    wd = math.sqrt(1 - ZETA ** 2)
+    q = 1 / math.hypot(1 - beta ** 2, 2 * ZETA * beta)
+    phi = math.atan2(2 * ZETA * beta, 1 - beta ** 2)
+    xs = [flight(y[0], y[1], s, beta, delta, ZETA, 0.5, wd, q, phi)[0]
+          for s in np.linspace(0, z, 20001)]
+    assert min(xs) - 1e-6 <= floor <= min(xs) + 1e-12
+    # the two-wall map lists the orbit while the wall below stays under its floor
+    clear = delta - floor
+    for c, listed in ((clear + 0.05, 1), (clear - 0.05, 0)):
+        ns = A.stable_orbits(np.array([1 / beta]), np.array([delta]), A._types(((1, 1),)),
+                             ZETA, 0.5, c)[0]
+        assert ns[0, 0, 0] == listed
+
+
+def test_a_far_wall_below_changes_nothing():
+    # the Fig. 15 plane's cells with one stable (1/1), one (2/1), chaotic starts: a wall 60
+    # below, out of reach, leaves every start's record bit for bit as with one wall
+    kw = dict(n_starts=6, max_time=600.0)
+    one = attractor_map([1.0, 0.35], [2.0, 0.0], ZETA, 0.5, **kw)
+    far = attractor_map([1.0, 0.35], [2.0, 0.0], ZETA, 0.5, clearance=60.0, eps_lower=0.3,
+                        **kw)
+    assert np.all(far.pop("impact_rate_lower")[np.isfinite(one["impact_rate_lower"])] == 0)
+    one.pop("impact_rate_lower")
+    assert one.keys() == far.keys()
+    assert one["n_stable"].sum() > 0 and np.any(one["class_start"] == ak.CHAOTIC)
+    for key, value in one.items():
+        np.testing.assert_array_equal(far[key], value, err_msg=key)

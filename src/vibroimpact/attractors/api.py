@@ -93,17 +93,18 @@ def clopper_pearson(k, n, confidence=CONFIDENCE):
     return lo, hi
 
 
-def stable_orbits(inv_beta, delta, types, zeta, eps):
+def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf):
     """Stable admissible solver orbits per cell and type (arrays of
     :func:`kernels.cell_orbits`): ``n_stable (n_types, nb, nd)``, and per cell,
-    type and orbit the phases, approach velocities, intervals and ``ln max|mu|``."""
+    type and orbit the phases, approach velocities, intervals and ``ln max|mu|``. With a
+    finite ``clearance`` only the orbits that stay above the wall below."""
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
     shape = (nb, nd, nt, ak.K_ORBITS, ak.M_COLS)
     n_stable = np.zeros((nt, nb, nd), np.int64)
     oph, ou, oz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     lnmu = np.full(shape[:4], np.nan)
     ak.cell_orbits(inv_beta, delta, types, float(zeta), float(eps), n_stable, oph, ou, oz,
-                   lnmu)
+                   lnmu, float(clearance))
     return n_stable, oph, ou, oz, lnmu
 
 
@@ -280,10 +281,12 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     sticking at either); the tangent crosses an impact at the lower wall by the same saltation
     in the mirrored frame ``x -> -x`` (approach speed ``-x'``, force ``-f``, wall at
     ``-(delta - clearance)``, restitution ``eps_lower``), so the exponents' sum is
-    ``-2 zeta + 2 sum_w nu_w ln eps_w`` over the walls. The closed-form solver knows one wall,
-    so with two no orbit is listed (``n_stable`` is 0): a settled periodic motion is
-    "periodic_other" with its exponents from its own last period, and a collision at the
-    other wall always starts a new collision.
+    ``-2 zeta + 2 sum_w nu_w ln eps_w`` over the walls. The closed-form solver knows one wall:
+    its orbits whose flights stay above the wall below (``min x >= delta - clearance``) are
+    orbits of the two-wall oscillator with the same multipliers, and are listed
+    (``n_stable`` counts those); a motion that meets both walls settles as "periodic_other",
+    with its exponents from its own last period. An impact at the other wall always starts a
+    new collision.
     """
     (inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time, match_tol,
      seed) = _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,
@@ -368,9 +371,7 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
 
     nb, nd = inv_beta.size, delta.size
     t_a = time.perf_counter()
-    n_stable, oph, ou, oz, lnmu = stable_orbits(inv_beta, delta, types, zeta, eps)
-    if clearance < math.inf:
-        n_stable[:] = 0                 # the one-wall solver's orbits: none listed (Notes)
+    n_stable, oph, ou, oz, lnmu = stable_orbits(inv_beta, delta, types, zeta, eps, clearance)
     t_b = time.perf_counter()
     u, theta, g, v0 = sobol_starts(n_starts, gap, velocity, seed)
     n_cells = nb * nd
@@ -408,9 +409,7 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
     clearance, eps_lower = _validate_walls(clearance, eps_lower, eps, (0.0, 0.0))
     ib = np.array([float(inv_beta)])
     dd = np.array([float(delta)])
-    n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps)
-    if clearance < math.inf:
-        n_stable[:] = 0
+    n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps, clearance)
     theta, x0, v0 = (np.ascontiguousarray(a, dtype=float).ravel() for a in (theta, x0, v0))
     n = theta.size
     outf = np.empty((n, ak.N_F))

@@ -33,7 +33,7 @@ from vibroimpact.impact.motion import phase, two_prod
 from vibroimpact.impact.stepping import run_steps
 from vibroimpact.impact.tolerances import STEP_HEADROOM
 from vibroimpact.orbits import _jit as _orbits_jit
-from vibroimpact.orbits.flight import lam_of, monodromy, orbit_margin, propagator
+from vibroimpact.orbits.flight import flight_max, lam_of, monodromy, orbit_margin, propagator
 from vibroimpact.orbits.solve import solve_type
 from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, MAX_SOLUTIONS,
                                            SCAN_STEP_M2, SCAN_STEP_M3)
@@ -94,11 +94,33 @@ N_I = 7
 
 
 @kernel
-def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z, orb_lnmu):
+def orbit_floor(y, m, z, beta, delta, zeta, eps, stack):
+    """Lowest point ``min x`` over the flights of the solver orbit ``y`` (``inf`` if none has
+    an interior minimum): :func:`vibroimpact.orbits.flight.flight_max` in the mirrored frame.
+
+    ``-x`` is the flight of the same oscillator under ``sin(beta (tau + pi / beta))`` from
+    the wall at ``-delta`` with approach velocity ``-u`` (Newton's law is odd in ``u``).
+    """
+    shift = math.pi / beta
+    worst = -np.inf
+    for j in range(1, m + 1):
+        a = j - 1
+        b = j % m
+        tb = y[b] + (z if j == m else 0.0)
+        worst = max(worst, flight_max(y[a] + shift, -y[m + a], tb - y[a], beta, -delta, zeta,
+                                      eps, stack))
+    return -worst
+
+
+@kernel
+def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z, orb_lnmu,
+                clearance):
     """The stable admissible solver orbits of every cell and type (parallel over cells).
 
     As :func:`vibroimpact.periodic_orbits`: ``solve_type`` with the same scan steps, admissible
-    when ``orbit_margin >= -ADMISSIBLE_TOL``, stable when ``lam_of(T) < 1``. Per orbit:
+    when ``orbit_margin >= -ADMISSIBLE_TOL``, stable when ``lam_of(T) < 1``; with a finite
+    ``clearance``, also above the wall at ``delta - clearance`` (:func:`orbit_floor`), so
+    that the orbit is one of the two-wall oscillator, with the same multipliers. Per orbit:
     ``orb_ph`` the impact phases ``(tau_j mod T_f) / T_f``, ``orb_u`` the approach velocities,
     ``orb_z`` the interval from impact j to j + 1, ``orb_lnmu`` ``ln max|mu|``.
     """
@@ -124,6 +146,9 @@ def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb
             for s in range(cnt):
                 y = sols[s, :2 * m]
                 if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
+                    continue
+                if clearance < np.inf and (orbit_floor(y, m, z, beta, delta, zeta, eps, stack)
+                                           < delta - clearance + ADMISSIBLE_TOL):
                     continue
                 monodromy(y, m, z, beta, delta, zeta, eps, tmat)
                 lam = lam_of(tmat, m)
