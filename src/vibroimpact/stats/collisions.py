@@ -303,7 +303,7 @@ def _pressed(impact_step, impact_offset, noise, dt, delta, amplitude, beta, flig
 
 def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *,
                      dt: float, eps: float, floor: float = DEFAULT_REBOUND_FLOOR,
-                     pressed=None, rule: str = "physical", wall=None,
+                     pressed=None, rule: str = "physical", wall=None, stick_wall=None,
                      eps_lower=None) -> Collisions:
     """Group a record's impacts into collisions (definition: module docstring).
 
@@ -334,6 +334,12 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         The wall of each impact (0: at ``delta``, 1: at ``delta - gap``; the simulator's
         ``impact_wall``). An impact at the other wall than the one before it always starts
         a new collision. Default: all at the wall at ``delta`` (one wall).
+    stick_wall : array_like of int, shape (m,) or (m - 1,), optional
+        The wall of each sticking phase (the simulator's ``stick_wall``; a phase still open
+        at a chunk's end, appended by :func:`close_open_phase`, may lack its own). Checked
+        against the impacts: a phase rests on the wall of the last impact before it, so
+        its time counts for the collision at that wall; a record where it does not is
+        refused.
     eps_lower : float, optional
         Restitution of the wall at ``delta - gap`` (default ``eps``): the rebound speed of
         an impact there is ``eps_lower * u``.
@@ -360,6 +366,8 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         raise ValueError(f"stick_start and stick_end must be 1-D of one length, got "
                          f"{start.shape} and {end.shape}")
     wall = _impact_walls(wall, step.size)
+    if stick_wall is not None:
+        _check_stick_walls(stick_wall, start, step * dt + offset, wall)
     # the rebound speed's coefficient, per impact where a second wall has its own
     if eps_lower is not None:
         eps_lower = _checks.eps(eps_lower, "eps_lower")
@@ -415,6 +423,24 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     rebounds = np.add.reduceat((eps * u >= floor).astype(np.int64), first)
     return Collisions(first, impact_collision, step[first], offset[first], t[first], u[first],
                       rebounds, stuck, stick_time, duration, floor, dt, wall[first])
+
+
+def _check_stick_walls(stick_wall, start, t, wall):
+    """Refuse sticking phases whose wall is not that of the last impact before them."""
+    sw = np.asarray(stick_wall)
+    if sw.ndim != 1 or sw.size not in (start.size, start.size - 1) or not np.all(
+            (sw == 0) | (sw == 1)):
+        raise ValueError(f"stick_wall must hold one value per sticking phase (the last may "
+                         f"be missing), each 0 or 1, shape ({start.size},), got shape "
+                         f"{sw.shape}")
+    last = np.searchsorted(t, start[:sw.size], side="right") - 1
+    seen = last >= 0
+    bad = np.flatnonzero(seen & (sw != wall[np.maximum(last, 0)]))
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"sticking phase {i} (from {start[i]!r}) rests on wall {sw[i]} but "
+                         f"the impact before it hit wall {wall[last[i]]}: stick_wall and "
+                         f"wall disagree")
 
 
 def _impact_walls(wall, n):
