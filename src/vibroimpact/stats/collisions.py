@@ -433,6 +433,8 @@ def _check_stick_walls(stick_wall, start, t, wall):
         raise ValueError(f"stick_wall must hold one value per sticking phase (the last may "
                          f"be missing), each 0 or 1, shape ({start.size},), got shape "
                          f"{sw.shape}")
+    if t.size == 0:
+        return
     last = np.searchsorted(t, start[:sw.size], side="right") - 1
     seen = last >= 0
     bad = np.flatnonzero(seen & (sw != wall[np.maximum(last, 0)]))
