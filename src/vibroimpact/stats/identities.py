@@ -29,6 +29,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from vibroimpact import _checks
+
 #: Gauss-Legendre nodes per piece of motion between events. A piece is at most one force
 #: step long (h = 0.1 in the studies); its integrands are x, v, f and their products, entire
 #: functions of time whose rates (1, beta_f) are far below 1/h, so 5 nodes integrate them to
@@ -60,8 +62,6 @@ def moment_rows(two_walls: bool) -> tuple:
 def wall_arrays(gap, eps_lower, delta, impact_wall, stick_wall, n_impacts, n_phases):
     """None with one wall; else ``(lower, eps_lower, impact_wall, stick_wall)`` checked
     (positions ``delta - gap``; int8 walls of the impacts and of the sticking phases)."""
-    from vibroimpact import _checks
-
     if gap is None:
         if eps_lower is not None or impact_wall is not None or stick_wall is not None:
             raise ValueError("eps_lower, impact_wall and stick_wall need a second wall: give "
