@@ -16,9 +16,9 @@ the force's: the piecewise-linear white force is correlated over one sample step
 each reflection v flips while f does not, so for about h after an impact the force feeds the
 rebound less than white noise would. That is a first-order bias in nu h (nu the impacts of
 both walls per unit time), measured on the simulator at h = 0.05, 0.025, 0.0125
-(delta = 0.3 sigma_x, gap = 0.8 sigma_x, nu = 0.94): -2.1 nu h on <u^2>, -1 nu h on <u>,
--0.8 nu h on the rates, halving with h. The allowance is 3 nu h of each quantity (1.8 % here,
-with h = 0.0125 and nu = 0.49).
+(delta = 0.3 sigma_x, gap = 0.8 sigma_x, nu = 0.94, four seeds each): about -2 nu h on
+<u^2>, -1 nu h on <u>, -0.8 nu h on the rates (docs/model.md, section 7). The allowance is
+3 nu h of each quantity (1.8 % here, with h = 0.0125 and nu = 0.49).
 """
 import numpy as np
 import pytest
