@@ -73,6 +73,12 @@ def test_mirror_symmetry():
         want = -getattr(a, name) if name == "v" else getattr(a, name)
         np.testing.assert_array_equal(getattr(b, name), want, err_msg=name)
     np.testing.assert_allclose(b.a, 1.2 - a.a, rtol=0, atol=np.spacing(1.2))
+    # and so are the collisions (the physical rule reads the push into each wall)
+    assert a.n_collisions < a.n_impacts
+    np.testing.assert_array_equal(a.collision_wall, 1 - b.collision_wall)
+    for name in ("collision_time", "collision_rebounds", "collision_stuck",
+                 "collision_duration"):
+        np.testing.assert_array_equal(getattr(b, name), getattr(a, name), err_msg=name)
 
 
 def _dop853_impacts(zeta, eps, eps_lower, delta, gap, amplitude, beta, t_end):
