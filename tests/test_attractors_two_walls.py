@@ -104,7 +104,6 @@ def test_exponent_sum_has_a_term_per_wall():
     np.testing.assert_allclose(f[:, ak.F_LYAP1] + f[:, ak.F_LYAP2], law, rtol=0, atol=1e-9)
 
 
-@pytest.mark.slow
 def test_exponent_sum_against_the_simulators_rates():
     # the same law with each wall's impact rate measured independently: the public two-wall
     # simulator over a long run (starts' rates agree with it within the batch-means error)
