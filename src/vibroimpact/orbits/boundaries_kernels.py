@@ -19,14 +19,15 @@ test function (central differences), each a few microseconds of scalar arithmeti
 Python the call overhead alone (~1 us per scalar operation) would be larger than the work.
 
 The impact law enters as in :mod:`vibroimpact.orbits.flight` (``rebound_velocity``,
-``rebound_derivative``; the ``d/dtau`` entries and ``det T = eps^(2m) exp(-2 zeta z)`` are
-Newton's law written out: docs/architecture.md, "Adding physics").
+``rebound_derivative``, ``rebound_ratio``); only ``det T = eps^(2m) exp(-2 zeta z)`` of the
+fold and period-doubling conditions is Newton's law written out (docs/architecture.md, "Adding
+physics").
 """
 from math import ceil, cos, exp, pi, sin
 
 import numpy as np
 
-from vibroimpact._law import rebound_derivative, rebound_velocity
+from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import _flight_xv, flight, flight_max, harmonic_constants
 from vibroimpact.orbits.linalg import _solve_inplace
@@ -60,9 +61,10 @@ def scaled_trace(y, m, z, beta, delta, zeta, eps):
         ub = y[m + b]
         x, v, acc, p11, p12, p21, p22 = flight(ta, ua, tb - ta, beta, delta, zeta, eps, wd, q,
                                                phi)
-        g_a = delta - sin(beta * ta) - 2.0 * zeta * eps * ua
-        dx_dta = p11 * eps * ua + p12 * g_a
-        dv_dta = p21 * eps * ua + p22 * g_a
+        e_a = -rebound_ratio(eps, ua)                 # -v_+ = e_a ua
+        g_a = delta - sin(beta * ta) - 2.0 * zeta * e_a * ua
+        dx_dta = p11 * e_a * ua + p12 * g_a
+        dv_dta = p21 * e_a * ua + p22 * g_a
         a_b = sin(beta * tb) - 2.0 * zeta * ub - delta
         s11 = -dx_dta
         s12 = -rebound_derivative(eps, ua) * p12
