@@ -50,17 +50,18 @@ def rebound_derivative(eps, u):
     (the orbit solver's and the attractors' Jacobians, the saltation matrix).
 
     Newton's law: ``-eps``. A new law edits this beside :func:`rebound_velocity`
-    (tests/test_model.py holds the pair to a finite difference).
+    (tests/test_impact_law.py holds the pair to a finite difference).
     """
     return -eps
 
 
 def rebound_ratio(eps, u):
-    """``rebound_velocity(eps, u) / u``: the saltation matrix's position entry.
+    """``rebound_velocity(eps, u) / u``: the saltation matrix's position entry, and the
+    orbit solver's ``-v_+ = -rebound_ratio * u`` in its Jacobians' ``d/dtau`` entries.
 
     Newton's law: ``-eps``, written out so that it is ``-eps`` to the last bit (the quotient
     ``(-eps * u) / u`` is not). A new law edits this beside :func:`rebound_velocity`
-    (tests/test_model.py holds the three to one another).
+    (tests/test_impact_law.py holds the three to one another).
     """
     return -eps
 
