@@ -211,7 +211,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             continue
         _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, sg * u)
         cnt[CNT_IMPACTS] += 1
-        v = sg * rebound(eps, u)
+        v = sg * rebound(Pw[P_EPS], u)      # the law of the wall just met
         just_hit = True
 
 
