@@ -10,10 +10,9 @@ import math
 import numpy as np
 import pytest
 
-from vibroimpact import periodic_orbits, simulate
+from vibroimpact import periodic_motions, periodic_orbits, simulate
 from vibroimpact.model import Model
 from vibroimpact.orbits import shooting
-from vibroimpact.orbits.shooting import periodic_motions
 
 ZETA, EPS = 0.05, 0.5           # config/config.yaml, orbits.harmonic (Fig. 16)
 TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))
@@ -62,6 +61,8 @@ def test_one_wall_every_stable_closed_form_motion_is_found(inv_beta, delta):
         assert mo is not None and dist <= AGREE, (orbit.m, orbit.n, dist)
         assert same_multipliers(mo.multipliers, orbit.multipliers) <= AGREE
         assert mo.stable and mo.admissible and mo.counts == (orbit.m, 0)
+        # the same rotation: the earliest impact phase in the first forcing cycle
+        assert np.max(np.abs(mo.state - np.array(orbit.state(0.0), dtype=float))) <= AGREE
         np.testing.assert_allclose(np.sort(np.mod(mo.impact_time, mo.period)),
                                    np.sort(np.mod(orbit.impact_times, mo.period)), atol=AGREE)
     # and conversely: every stable impact motion shooting finds of these types is a closed-form one
