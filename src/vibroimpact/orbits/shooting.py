@@ -174,6 +174,26 @@ def _piece(s_prev, x_prev, s_c, x_c, th0, c1, c2, P):
 
 
 @kernel
+def _bound(k, lo, h, th0, gamma0, amp, P):
+    """Bound of ``|x^(k)|`` on ``[lo, lo + h]`` of the flight fitted by ``_fit``.
+
+    ``x^(k) = Im(e^{i wd s} C(s))`` with ``C(s) = aq beta^k e^{i(th0 + k pi/2 + (beta - wd) s)}
+    + amp e^{-zeta s} e^{i(gamma0 + k rho)}`` (``e^{i rho} = -zeta + i wd``: each derivative of
+    the free part turns it by ``rho`` with unit gain). ``|C(lo)|`` is exact, and ``C`` moves by
+    at most ``(|aq| beta^k |beta - wd| + zeta amp e^{-zeta lo}) h`` on the bracket. Near
+    resonance the forced and free parts nearly cancel, and this bound stays near ``|x^(k)|``
+    where the sum of their amplitudes would be many times larger.
+    """
+    zeta, wd, aq, beta = P[_ZETA], P[_WD], P[_AQ], P[_BETA]
+    f = aq * beta ** k
+    g = amp * math.exp(-zeta * lo)
+    rho = math.atan2(wd, -zeta)
+    delta = (th0 + beta * lo + 0.5 * k * math.pi) - (gamma0 + wd * lo + k * rho)
+    c_lo = math.sqrt(max(f * f + g * g + 2.0 * f * g * math.cos(delta), 0.0))
+    return c_lo + (abs(f) * abs(beta - wd) + zeta * g) * h
+
+
+@kernel
 def _first_contact(t0, x0, v0, length, P, stack, res):
     """First contact in ``(0, length]`` of the flight from ``(t0, x0, v0)`` with either wall.
 
@@ -182,9 +202,10 @@ def _first_contact(t0, x0, v0, length, P, stack, res):
     interior extremum before the contact (``inf`` if none). See the module docstring.
     """
     th0, c1, c2 = _fit(t0, x0, v0, P)
-    zeta, wd, aq, beta = P[_ZETA], P[_WD], abs(P[_AQ]), P[_BETA]
+    wd, beta = P[_WD], P[_BETA]
     upper, lower = P[_UPPER], P[_LOWER]
     amp = math.hypot(c1, c2)              # amplitude of every derivative of the free part
+    gamma0 = math.atan2(c1, c2)           # free part: amp e^{-zeta s} sin(wd s + gamma0)
     n0 = max(MIN_BRACKETS, int(math.ceil(length * max(beta, wd) / PHASE_STEP)))
     min_h = MIN_STEP * max(1.0, length)
     s_prev, x_prev = 0.0, x0
@@ -200,9 +221,8 @@ def _first_contact(t0, x0, v0, length, P, stack, res):
             h = hi - lo
             xl, vl, al, jl = _eval(lo, th0, c1, c2, P)
             xh, vh, ah, jh = _eval(hi, th0, c1, c2, P)
-            e_lo = math.exp(-zeta * lo)
-            m2 = aq * beta * beta + e_lo * amp    # bound of |x''| on [lo, hi]
-            m3 = aq * beta ** 3 + e_lo * amp      # bound of |x'''| on [lo, hi]
+            m2 = _bound(2, lo, h, th0, gamma0, amp, P)    # of |x''| on [lo, hi]
+            m3 = _bound(3, lo, h, th0, gamma0, amp, P)    # of |x'''| on [lo, hi]
             if vl * vh > 0.0 and abs(vl) + abs(vh) > m2 * h:
                 continue                          # x' keeps its sign: no critical point
             sliver = False
@@ -517,7 +537,9 @@ def _newton(flow, X0, n):
             return None, None, np.nan, "chatter", "Newton reached a chattering flow"
         F = Y - X
         res = float(np.max(np.abs(F)))
-        if converged and res > NEWTON_POLISH * res_prev:
+        if converged and (res >= NEWTON_POLISH * res_prev or res == 0.0):
+            if res < res_prev:
+                return theta, X, res, None, ""
             return theta, X_prev, res_prev, None, ""
         if res <= NEWTON_TOL * _scale(X):
             converged = True
