@@ -13,8 +13,9 @@ Method
   at the flight's start (closed form; as :mod:`vibroimpact.orbits.flight` for one wall).
 - First contact with either wall, rigorously: the critical points of ``x`` (zeros of ``x'``)
   are found left to right on brackets that a bound on the next derivative proves to hold no
-  zero of ``x'`` or a single one (otherwise the bracket is bisected; the same proof as
-  ``orbits.flight.flight_max``). Between two critical points ``x`` is monotone, so a wall is
+  zero of ``x'`` or a single one (otherwise the bracket is bisected; the proof of
+  ``orbits.flight.flight_max``, with a bound of the derivatives that stays tight near
+  resonance: ``_bound``). Between two critical points ``x`` is monotone, so a wall is
   crossed there exactly when the piece ends beyond it, and the crossing is then the only root
   of ``x - wall`` on the piece (safeguarded Newton). A flight that rises towards a wall and
   turns back without a sign change at the samples (grazing, double crossing) is therefore
