@@ -87,6 +87,14 @@ GRAZING_TOL = 1e-9
 #: step, it only sets where the samples fall) and the periods simulated before Newton.
 SETTLE_SAMPLES = 64
 SETTLE_PERIODS = 100
+#: A settled state this close (relative to 1 + |X|) to a phase-0 state of a motion found
+#: already is that motion (it has settled onto it: Newton from it would return it again).
+SETTLED_TOL = 1e-6
+#: Default starts: a DEFAULT_STARTS x DEFAULT_STARTS grid. 64 starts, as the attractor study
+#: (config orbits.harmonic.attractors.n_starts): on the Fig. 16 grid a 5 x 5 grid misses
+#: stable motions with basins of ~2% of the start box (a (3/1) beside a (4/1) at
+#: 1/beta = 1.2, delta = -0.16), which 8 x 8 finds.
+DEFAULT_STARTS = 8
 
 # status codes of the flow kernel
 OK, CHATTER = 0, 1
@@ -609,7 +617,7 @@ def _motion(flow, model, n, theta, X_theta, residual):
         residual=residual), None, ""
 
 
-def default_starts(model, k=5, speed=4.0, reach=4.0):
+def default_starts(model, k=DEFAULT_STARTS, speed=4.0, reach=4.0):
     """A ``k x k`` grid of starts: ``x`` inside the walls (at most ``reach`` below the upper
     wall), ``x'`` in ``[-speed, speed]``."""
     low = max(model.lower, model.delta - reach)
@@ -637,6 +645,14 @@ def settle(model, starts, periods=SETTLE_PERIODS):
         out[i] = r.x_end, r.v_end
         resting[i] = bool(r.stuck_end) or bool(np.any(r.stick_end > t_end - tf))
     return out, resting
+
+
+def _known(X, n, found):
+    """Whether the settled state ``X`` lies on a motion found already whose period divides
+    ``n`` (within ``SETTLED_TOL``)."""
+    tol = SETTLED_TOL * _scale(X)
+    return any(n % mo.n == 0 and np.min(np.max(np.abs(mo.phase0_states - X), axis=1)) <= tol
+               for mo in found)
 
 
 def _same(a, b):
@@ -689,7 +705,7 @@ def periodic_motions(model, n, seeds=None, *, starts=None, settle_periods=SETTLE
     else:
         seeds = _states("seeds", seeds, model)
     found, skipped = [], []
-    for nn in ns:
+    for nn in sorted(set(ns)):
         flow = _Flow(model, nn)
         for i, X0 in enumerate(seeds):
             seed = (float(X0[0]), float(X0[1]))
@@ -697,6 +713,8 @@ def periodic_motions(model, n, seeds=None, *, starts=None, settle_periods=SETTLE
                 skipped.append(SkippedSeed(seed, nn, "sticking",
                                            "the settled start rests on a wall"))
                 continue
+            if resting is not None and _known(X0, nn, found):
+                continue             # settled onto a motion found already: nothing new
             theta, X, res, kind, why = _newton(flow, X0, nn)
             if kind is not None:
                 skipped.append(SkippedSeed(seed, nn, kind, why))
