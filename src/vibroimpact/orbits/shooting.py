@@ -86,15 +86,22 @@ GRAZING_TOL = 1e-9
 #: Settling: forcing-cycle grid of the simulator (samples per forcing period; exact at any
 #: step, it only sets where the samples fall) and the periods simulated before Newton.
 SETTLE_SAMPLES = 64
-SETTLE_PERIODS = 100
+SETTLE_PERIODS = 50
+#: A settled start seeds Newton for the n after which it returns within RETURN_TOL (relative
+#: to 1 + |X|): well inside Newton's basin, and far above the distance to a stable motion
+#: left by SETTLE_PERIODS (multiplier^50 ~ 1e-3 even at |mu| = 0.87). A start that returns
+#: after none of the n is run again, SETTLE_ROUNDS rounds at most (slowly settling motions,
+#: |mu| near 1), then reported "not_periodic" (chaos, or a period not among the n).
+RETURN_TOL = 1e-2
+SETTLE_ROUNDS = 4
 #: A settled state this close (relative to 1 + |X|) to a phase-0 state of a motion found
-#: already is that motion (it has settled onto it: Newton from it would return it again).
-SETTLED_TOL = 1e-6
-#: Default starts: a DEFAULT_STARTS x DEFAULT_STARTS grid. 64 starts, as the attractor study
-#: (config orbits.harmonic.attractors.n_starts): on the Fig. 16 grid a 5 x 5 grid misses
-#: stable motions with basins of ~2% of the start box (a (3/1) beside a (4/1) at
-#: 1/beta = 1.2, delta = -0.16), which 8 x 8 finds.
-DEFAULT_STARTS = 8
+#: already (or to a seed that failed already) is on it: Newton from it is not run again.
+SETTLED_TOL = 1e-3
+#: Default starts: a DEFAULT_STARTS x DEFAULT_STARTS grid. On the Fig. 16 grid stable motions
+#: coexist with basins of ~2% of the start box (a (1/1) beside a (2/1) at 1/beta = 1.2,
+#: delta = 0.44; a (3/1) beside a (4/1) at delta = -0.16): 5 x 5 and 8 x 8 miss the first,
+#: 12 x 12 finds both.
+DEFAULT_STARTS = 12
 
 # status codes of the flow kernel
 OK, CHATTER = 0, 1
@@ -484,8 +491,9 @@ class PeriodicMotion:
 @dataclass(frozen=True)
 class SkippedSeed:
     """A seed that gave no motion: ``kind`` is ``"sticking"`` (the settled start rests on a
-    wall), ``"chatter"`` (the flow from it chatters: not followed), ``"not_converged"`` or
-    ``"shorter_period"``; ``reason`` says more."""
+    wall), ``"chatter"`` (the flow from it chatters: not followed), ``"not_periodic"`` (the
+    settled start repeats after none of the n), ``"not_converged"`` or ``"shorter_period"``;
+    ``reason`` says more; ``n`` is None when the seed was dropped for every n."""
 
     seed: tuple
     n: int
@@ -647,12 +655,70 @@ def settle(model, starts, periods=SETTLE_PERIODS):
     return out, resting
 
 
+def _returns(model, X, n_max):
+    """``|X_p - X|`` (max norm) after ``p = 1 .. n_max`` periods of the exact flow from the
+    phase-0 state ``X`` (``inf`` from a chatter on)."""
+    flow = _Flow(model, 1)
+    out = np.full(n_max, np.inf)
+    Y = X
+    for p in range(n_max):
+        Y, _, _, _, status = flow.run(0.0, flow.tf, Y)
+        if status != OK:
+            break
+        out[p] = np.max(np.abs(Y - X))
+    return out
+
+
+def _settled_seeds(model, starts, periods, ns, skipped):
+    """Newton seeds from ``starts``: each run by the simulator until it repeats after one of
+    the ``ns`` periods (within ``RETURN_TOL``), in rounds of ``periods`` forcing periods, at
+    most ``SETTLE_ROUNDS``. Returns the seeds and, for each, the set of ``n`` it repeats
+    after; appends to ``skipped`` the starts that rest on a wall, chatter or never repeat."""
+    X = np.asarray(starts, dtype=float)
+    pending = np.arange(len(X))
+    seeds, periods_of = [], []
+    for rnd in range(SETTLE_ROUNDS):
+        X_p, resting = settle(model, X[pending], periods)
+        X[pending] = X_p
+        still = []
+        for i, rest in zip(pending, resting):
+            seed = (float(X[i, 0]), float(X[i, 1]))
+            if rest:
+                skipped.append(SkippedSeed(seed, None, "sticking",
+                                           "the settled start rests on a wall"))
+                continue
+            r = _returns(model, X[i], max(ns))
+            if not np.isfinite(r[-1]):
+                skipped.append(SkippedSeed(seed, None, "chatter",
+                                           "the flow from the settled start chatters"))
+                continue
+            ok = {k for k in ns if r[k - 1] <= RETURN_TOL * _scale(X[i])}
+            if ok:
+                seeds.append(X[i].copy())
+                periods_of.append(ok)
+            elif rnd + 1 < SETTLE_ROUNDS:
+                still.append(i)
+            else:
+                skipped.append(SkippedSeed(seed, None, "not_periodic",
+                                           f"no return within {RETURN_TOL} after n = {ns} "
+                                           f"periods in {SETTLE_ROUNDS * periods} periods"))
+        pending = np.array(still, dtype=int)
+        if pending.size == 0:
+            break
+    return seeds, periods_of
+
+
 def _known(X, n, found):
     """Whether the settled state ``X`` lies on a motion found already whose period divides
     ``n`` (within ``SETTLED_TOL``)."""
     tol = SETTLED_TOL * _scale(X)
     return any(n % mo.n == 0 and np.min(np.max(np.abs(mo.phase0_states - X), axis=1)) <= tol
                for mo in found)
+
+
+def _near(X, states):
+    tol = SETTLED_TOL * _scale(X)
+    return any(np.max(np.abs(Y - X)) <= tol for Y in states)
 
 
 def _same(a, b):
@@ -674,17 +740,19 @@ def periodic_motions(model, n, seeds=None, *, starts=None, settle_periods=SETTLE
     seeds : array_like, shape (k, 2), optional
         States ``(x, x')`` at phase 0 to start Newton from. Default: settled starts.
     starts : array_like, shape (k, 2), optional
-        Starts at phase 0 run for ``settle_periods`` forcing periods (exact simulator) whose
-        final states seed Newton, when ``seeds`` is None. Default :func:`default_starts`.
+        Starts at phase 0 run by the exact simulator (chatter and sticking included) whose
+        settled states seed Newton, when ``seeds`` is None. Default :func:`default_starts`.
     settle_periods : int
-        Forcing periods simulated before Newton.
+        Forcing periods of a settling round (>= 1): a start seeds Newton for the n after
+        which it repeats (within ``RETURN_TOL``), else it runs another round (at most
+        ``SETTLE_ROUNDS``).
 
     Returns
     -------
     MotionSet
         ``motions``: `PeriodicMotion` s, each once (sorted by n, name, state); ``skipped``:
-        a `SkippedSeed` for each seed and n that gave none (chatter and sticking are not
-        handled: see the module docstring).
+        a `SkippedSeed` for each seed that gave none (chatter and sticking are not handled:
+        see the module docstring).
 
     Notes
     -----
@@ -697,31 +765,26 @@ def periodic_motions(model, n, seeds=None, *, starts=None, settle_periods=SETTLE
     if not ns:
         raise ValueError("n must be a positive integer or a non-empty sequence of them")
     ns = [_checks.integer("n", k, low=1) for k in ns]
-    settle_periods = _checks.integer("settle_periods", settle_periods, low=0)
-    resting = None
+    settle_periods = _checks.integer("settle_periods", settle_periods, low=1)
+    found, skipped = [], []
     if seeds is None:
         starts = default_starts(model) if starts is None else _states("starts", starts, model)
-        seeds, resting = settle(model, starts, settle_periods)
+        seeds, periods_of = _settled_seeds(model, starts, settle_periods, ns, skipped)
     else:
         seeds = _states("seeds", seeds, model)
-    found, skipped = [], []
+        periods_of = [set(ns)] * len(seeds)
     for nn in sorted(set(ns)):
         flow = _Flow(model, nn)
-        for i, X0 in enumerate(seeds):
-            seed = (float(X0[0]), float(X0[1]))
-            if resting is not None and resting[i]:
-                skipped.append(SkippedSeed(seed, nn, "sticking",
-                                           "the settled start rests on a wall"))
-                continue
-            if resting is not None and _known(X0, nn, found):
-                continue             # settled onto a motion found already: nothing new
+        failed = []
+        for X0, periods in zip(seeds, periods_of):
+            if nn not in periods or _known(X0, nn, found) or _near(X0, failed):
+                continue             # not repeating after nn periods, or tried already
             theta, X, res, kind, why = _newton(flow, X0, nn)
+            if kind is None:
+                motion, kind, why = _motion(flow, model, nn, theta, X, res)
             if kind is not None:
-                skipped.append(SkippedSeed(seed, nn, kind, why))
-                continue
-            motion, kind, why = _motion(flow, model, nn, theta, X, res)
-            if motion is None:
-                skipped.append(SkippedSeed(seed, nn, kind, why))
+                skipped.append(SkippedSeed((float(X0[0]), float(X0[1])), nn, kind, why))
+                failed.append(X0)
             elif not any(_same(motion, other) for other in found):
                 found.append(motion)
     found.sort(key=lambda mo: (mo.n, mo.name, tuple(mo.state)))
