@@ -28,10 +28,14 @@ Method
   between the impacts' phases (so no impact sits on the section while Newton moves the orbit),
   with halving of steps that do not reduce the residual; converged when the residual is below
   ``NEWTON_TOL`` (relative to ``1 + |X|``), then polished while a step halves it.
+- Seeds: a grid of starts run by the simulator in rounds until each repeats after one of the
+  asked n (``RETURN_TOL``); Newton runs from it for those n, unless it has settled onto a motion
+  found already. A stable motion is found when its basin meets the grid of starts.
 - Not handled: chatter and sticking (an impact slower than ``CHATTER_SPEED`` or more than
   ``MAX_IMPACTS_PER_PERIOD`` impacts in a forcing period); such seeds are reported in
   ``skipped`` with kind ``"chatter"`` (Newton never runs through sticking), as are settled
-  starts resting on a wall (``"sticking"``), starts Newton does not converge from
+  starts resting on a wall (``"sticking"``) or repeating after none of the n
+  (``"not_periodic"``), starts Newton does not converge from
   (``"not_converged"``) and motions of a shorter period than asked (``"shorter_period"``:
   they are the motions of that shorter ``n``).
 """
