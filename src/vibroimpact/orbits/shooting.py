@@ -455,8 +455,6 @@ class PeriodicMotion:
     grazing: bool
     residual: float
 
-    kind = "periodic"
-
     @property
     def counts(self):
         return (int(np.sum(self.impact_wall == 0)), int(np.sum(self.impact_wall == 1)))
