@@ -256,3 +256,18 @@ def test_derivative_bound_holds_on_random_flights():
         for k in (2, 3):
             bound = shooting._bound(k, lo, h, th0, math.atan2(c1, c2), math.hypot(c1, c2), P)
             assert np.max(np.abs(vals[:, k])) <= bound * (1 + 1e-12)
+
+
+@pytest.mark.parametrize("g, inv_beta", [(3.0, 1.4), (2.0, 0.6), (1.0, 2.0)])
+def test_symmetric_stops_give_mirror_pairs(g, inv_beta):
+    """With symmetric stops, y(tau) = -x(tau + pi/beta) is a motion whenever x is (the force
+    changes sign over half a cycle), with the walls' counts swapped; the default starts are a
+    mirror-symmetric grid, so the mirror of every motion found is found."""
+    model = Model.stops(ZETA, g, 0.0, eps=EPS, amplitude=1.0, beta=1.0 / inv_beta)
+    motions = periodic_motions(model, (1, 2))
+    assert len(motions) > 0
+    for mo in motions:
+        mirror = -mo.state_at(math.pi / model.beta)
+        twins = [o for o in motions if o.n == mo.n and o.counts == mo.counts[::-1]]
+        dist = min(np.min(np.max(np.abs(o.phase0_states - mirror), axis=1)) for o in twins)
+        assert dist <= 1e-9, (mo.name, dist)
