@@ -136,22 +136,31 @@ class SimulationResult:
         """The impacts grouped by ``rule`` (:data:`vibroimpact.stats.RULES`; the default,
         the physical rule, is :attr:`collisions`)."""
         p = self.params
-        start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
-                                      self.t_end)
-        pressed = None
-        if rule == "physical":
-            pressed = pressed_flights(self.impact_step, self.impact_offset, self.force_record,
-                                      p["dt"], delta=p["delta"], amplitude=p["amplitude"],
-                                      beta=p["beta"])
         if "gap" not in p:
+            start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                          self.t_end)
+            pressed = None
+            if rule == "physical":
+                pressed = pressed_flights(self.impact_step, self.impact_offset,
+                                          self.force_record, p["dt"], delta=p["delta"],
+                                          amplitude=p["amplitude"], beta=p["beta"])
             return group_collisions(self.impact_step, self.impact_offset,
                                     self.impact_velocity, start, end, dt=p["dt"],
                                     eps=p["eps"], floor=p["rebound_floor"], pressed=pressed,
                                     rule=rule)
+        # two walls: a rest still going on at the end is on the wall the mass ends on
+        start, end, wall = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                            self.t_end, self.stick_wall,
+                                            int(self.x_end != p["delta"]))
+        pressed = None
+        if rule == "physical":
+            pressed = pressed_flights(self.impact_step, self.impact_offset, self.force_record,
+                                      p["dt"], delta=p["delta"], amplitude=p["amplitude"],
+                                      beta=p["beta"], wall=self.impact_wall, gap=p["gap"])
         return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
                                 start, end, dt=p["dt"], eps=p["eps"], floor=p["rebound_floor"],
                                 pressed=pressed, rule=rule, wall=self.impact_wall,
-                                stick_wall=self.stick_wall, eps_lower=p["eps_lower"])
+                                stick_wall=wall, eps_lower=p["eps_lower"])
 
     n_collisions = property(lambda self: int(self.collisions.first.size))
     collision_time = property(lambda self: self.collisions.time)
@@ -162,6 +171,7 @@ class SimulationResult:
     collision_stuck = property(lambda self: self.collisions.stuck)
     collision_stick_time = property(lambda self: self.collisions.stick_time)
     collision_duration = property(lambda self: self.collisions.duration)
+    collision_wall = property(lambda self: self.collisions.wall)
     impact_collision = property(lambda self: self.collisions.impact_collision)
     rebound_floor = property(lambda self: self.params["rebound_floor"])
 
