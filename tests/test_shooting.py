@@ -21,9 +21,9 @@ TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))
 AGREE = 1e-9
 
 
-def closed_form(inv_beta, delta, stable_only=True):
+def closed_form(inv_beta, delta, stable_only=True, eps=EPS):
     beta = 1.0 / inv_beta
-    return [o for m, n in TYPES for o in periodic_orbits(m, n, beta, delta, ZETA, EPS)
+    return [o for m, n in TYPES for o in periodic_orbits(m, n, beta, delta, ZETA, eps)
             if o.stable or not stable_only]
 
 
@@ -69,6 +69,21 @@ def test_one_wall_every_stable_closed_form_motion_is_found(inv_beta, delta):
     for mo in motions:
         if mo.stable and (mo.m, mo.n) in TYPES:
             assert any(match([mo], o)[1] <= AGREE for o in expected), mo.name
+
+
+@pytest.mark.parametrize("eps, inv_beta, delta", [
+    (0.0, 1.2, 1.75), (0.0, 2.4, 1.0),                    # plastic: each impact leaves v = 0
+    (1.0, 1.2, 0.5), (1.0, 1.5, 0.0), (1.0, 1.5, 1.5),    # elastic, coexisting stable motions
+])
+def test_plastic_and_elastic_walls(eps, inv_beta, delta):
+    model = Model.paper(ZETA, eps, delta, 1.0, 1.0 / inv_beta)
+    motions = periodic_motions(model, (1, 2, 3))
+    expected = closed_form(inv_beta, delta, eps=eps)
+    assert expected
+    for orbit in expected:
+        mo, dist = match(motions, orbit)
+        assert mo is not None and dist <= AGREE, (orbit.m, orbit.n, dist)
+        assert same_multipliers(mo.multipliers, orbit.multipliers) <= AGREE
 
 
 @pytest.mark.parametrize("inv_beta, delta", [(0.4, 0.3), (0.4, 0.6)])

@@ -279,6 +279,10 @@ def _first_contact(t0, x0, v0, length, P, stack, res):
                 stack[top + 1, 1] = mid
                 top += 2
                 continue
+            if s_prev == 0.0 and s_c <= min_h:
+                # a zero of x' at the flight's start made of round-off (x' = -0 after a
+                # plastic impact): x has not moved, the next piece decides
+                continue
             x_c, v_c, a_c, j_c = _eval(s_c, th0, c1, c2, P)
             s_hit, wall = _piece(s_prev, x_prev, s_c, x_c, th0, c1, c2, P)
             if wall >= 0:
