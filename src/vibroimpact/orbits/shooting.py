@@ -462,6 +462,7 @@ class PeriodicMotion:
 
     @property
     def counts(self):
+        """``(m_upper, m_lower)``: impacts per period on each wall."""
         return (int(np.sum(self.impact_wall == 0)), int(np.sum(self.impact_wall == 1)))
 
     @property
@@ -575,14 +576,14 @@ def _newton(flow, X0, n):
         if converged:
             X = X + dX
             continue
-        lam = 1.0
+        step = 1.0
         for _h in range(NEWTON_HALVINGS):
-            Xn = X + lam * dX
+            Xn = X + step * dX
             Yn, _, _, _, st = flow.run(theta, theta + z, Xn)
             inside = flow.lower <= Xn[0] <= flow.upper
             if inside and st == OK and float(np.max(np.abs(Yn - Xn))) < res:
                 break
-            lam *= 0.5
+            step *= 0.5
         else:
             return None, None, np.nan, "not_converged", "no step reduces the residual"
         X = Xn
