@@ -643,21 +643,19 @@ def default_starts(model, k=DEFAULT_STARTS, speed=4.0, reach=4.0):
 
 
 def settle(model, starts, periods=SETTLE_PERIODS):
-    """Run each start for ``periods`` forcing periods with :func:`vibroimpact.simulate` (exact,
-    chatter and sticking included); ``(states at phase 0, resting)`` with ``resting`` true
-    where the mass rests on a wall in the last period."""
-    from vibroimpact.impact.simulate import simulate
+    """Run each start for ``periods`` forcing periods with the exact simulator
+    (:func:`vibroimpact.impact.simulate.simulate_model`: chatter and sticking included);
+    ``(states at phase 0, resting)`` with ``resting`` true where the mass rests on a wall in
+    the last period."""
+    from vibroimpact.impact.simulate import simulate_model
 
     tf = 2.0 * math.pi / model.beta
     t_end = periods * tf
-    two = model.n_walls == 2
     out = np.empty((len(starts), 2))
     resting = np.zeros(len(starts), dtype=bool)
     for i, (x0, v0) in enumerate(starts):
-        r = simulate(model.zeta, model.eps, model.delta, None, dt=tf / SETTLE_SAMPLES,
-                     amplitude=model.amplitude, beta=model.beta, x0=float(x0), v0=float(v0),
-                     t_end=t_end, gap=model.gap if two else None,
-                     eps_lower=model.eps_lower if two else None)
+        r = simulate_model(model, None, dt=tf / SETTLE_SAMPLES, x0=float(x0), v0=float(v0),
+                           t_end=t_end)
         out[i] = r.x_end, r.v_end
         resting[i] = bool(r.stuck_end) or bool(np.any(r.stick_end > t_end - tf))
     return out, resting
