@@ -8,6 +8,7 @@ import pandas as pd
 import xarray as xr
 
 from vibroimpact import stats
+from vibroimpact.stats.motions import motion_key
 
 #: long_name and units of every variable the datasets hold.
 META = {
@@ -136,6 +137,33 @@ META = {
     "impact_time": ("impact instant", "1"),
     "impact_velocity": ("approach velocity at impact", "1"),
     "impact_collision": ("collision of the impact (index; its first impact starts it)", "1"),
+    # two walls only (a study with a gap): docs/datasets.md, "Two walls"
+    "wall": ("wall: upper (x = delta, hit from below) or lower (x = delta - gap, hit from "
+             "above)", "1"),
+    "impact_wall": ("wall of the impact (0: upper, at delta; 1: lower, at delta - gap)", "1"),
+    "wall_n_collisions": ("number of collisions at the wall", "1"),
+    "wall_collision_rate": ("collisions at the wall per unit time", "1"),
+    "wall_v_after_mean": ("mean velocity after impact at the wall (eps_w u, per collision)",
+                          "1"),
+    "wall_v_after_mean_lo": ("lower end of the 95 % interval of the wall's mean velocity "
+                             "after impact", "1"),
+    "wall_v_after_mean_hi": ("upper end of the 95 % interval of the wall's mean velocity "
+                             "after impact", "1"),
+    "wall_interval_mean": ("mean interval between collisions at the wall T/N_w (the "
+                           "reciprocal of its rate)", "1"),
+    "wall_interval_mean_lo": ("lower end of the 95 % interval of the wall's mean interval",
+                              "1"),
+    "wall_interval_mean_hi": ("upper end of the 95 % interval of the wall's mean interval "
+                              "(inf: no collision)", "1"),
+    "wall_stuck_fraction": ("fraction of the wall's collisions that end sticking on it", "1"),
+    "wall_v_after_density": ("probability density of the velocity after impact at the wall",
+                             "1"),
+    "wall_v_after_density_stderr": ("batch-means standard error of the wall's velocity "
+                                    "density", "1"),
+    "wall_interval_density": ("probability density of the interval between collisions at "
+                              "the wall (one of its collisions to its next)", "1"),
+    "wall_interval_density_stderr": ("batch-means standard error of the wall's interval "
+                                     "density", "1"),
 }
 
 _EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches",
@@ -184,7 +212,33 @@ def _cell_coords(cells):
 
 
 def _motion_names(motions):
-    return [f"{m}/{n}" for m, n in motions]
+    """``"m/n"``, or ``"(m_upper,m_lower)/n"`` for a two-wall motion (`stats.motions`)."""
+    return [motion_key(m) for m in motions]
+
+
+#: The walls of a two-wall dataset's ``wall`` dimension (`pipeline.cells.WALLS`).
+WALLS = ("upper", "lower")
+#: Per-wall statistics of a two-wall events tile: scalars over ``wall``, densities over
+#: ``wall`` and their bins.
+_WALL_SCALARS = ("wall_n_collisions", "wall_collision_rate", "wall_v_after_mean",
+                 "wall_v_after_mean_lo", "wall_v_after_mean_hi", "wall_interval_mean",
+                 "wall_interval_mean_lo", "wall_interval_mean_hi", "wall_stuck_fraction")
+_WALL_DENSITIES = (("wall_v_after_density", "v_after"),
+                   ("wall_v_after_density_stderr", "v_after"),
+                   ("wall_interval_density", "interval"),
+                   ("wall_interval_density_stderr", "interval"))
+_MAP_WALL_SCALARS = ("wall_n_collisions", "wall_collision_rate", "wall_v_after_mean")
+
+
+def _add_walls(data, coords, results, scalars, densities=()):
+    """The per-wall variables of a two-wall tile (when its results carry them)."""
+    if scalars[0] not in results[0]:
+        return
+    for name in scalars:
+        data[name] = (("cell", "wall"), np.stack([r[name] for r in results]))
+    for name, dim in densities:
+        data[name] = (("cell", "wall", dim), np.stack([r[name] for r in results]))
+    coords["wall"] = list(WALLS)
 
 
 def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
@@ -218,6 +272,7 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
             for name in ("rule_motion_probability", "rule_motion_stick_probability"):
                 data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
+    _add_walls(data, coords, results, _WALL_SCALARS, _WALL_DENSITIES)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -258,6 +313,7 @@ def map_tile(cells, results, motions, attrs):
         for name in ("rule_probability", "rule_stick_probability"):
             data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
+    _add_walls(data, coords, results, _MAP_WALL_SCALARS)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -331,6 +387,8 @@ def trace_dataset(tr, attrs):
              impact_velocity=("impact", tr["impact_velocity"]),
              impact_collision=("impact", tr["impact_collision"])),
         coords=dict(tau=tr["tau"]), attrs=attrs)
+    if "impact_wall" in tr:         # two walls
+        ds["impact_wall"] = ("impact", np.asarray(tr["impact_wall"], dtype=np.int8))
     return _annotate(ds)
 
 

@@ -14,7 +14,7 @@ from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
-                                        grid_values, map_cap_steps, orbit_rows)
+                                        grid_values, map_cap_steps, orbit_rows, walls)
 
 log = logging.getLogger("vibroimpact")
 
@@ -96,7 +96,18 @@ def _study_attrs(study, block, noise_attrs):
                  zeta=study.zeta, eps=study.eps, amplitude=study.amplitude,
                  noise=block["noise"], dt=float(noise_attrs["dt"]))
     attrs.update(noise)
+    attrs.update(_wall_attrs(study.gap, study.eps_lower))
     return attrs
+
+
+def _wall_attrs(gap, eps_lower):
+    """The second wall's attributes of a two-wall dataset (none for one wall: its attributes
+    are those it always had)."""
+    if gap is None:
+        return {}
+    return dict(gap=float(gap), eps_lower=float(eps_lower), n_walls=2,
+                walls="upper: x = delta (hit from below, eps); lower: x = delta - gap (hit "
+                      "from above, eps_lower)")
 
 
 def _record_attrs(block, t_end, n_samples, dt):
@@ -114,8 +125,10 @@ def _rebound_floor(block):
 
 
 def _physics(study, cell):
-    return dict(zeta=study.zeta, eps=study.eps, delta=cell.delta, amplitude=study.amplitude,
-                beta_f=1.0 / cell.inv_beta)
+    """The cell's resolved model (`Study.model`) as the keywords of `pipeline.cells`."""
+    params = study.model(cell).params()
+    params["beta_f"] = params.pop("beta")
+    return params
 
 
 def _tile_job(study, tile, grid, what, run_cell, to_dataset, out):
@@ -235,7 +248,8 @@ def trace(name, block, noise_path, out):
     spec = block["trace"]
     inv_beta = float(spec.get("inv_beta", study.inv_beta[0]))
     tr = cells.trace(samples, dt, zeta=study.zeta, eps=study.eps, delta=float(spec["delta"]),
-                     amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
+                     amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]),
+                     **study.walls())
     attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
                  beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
@@ -250,7 +264,8 @@ def _escape_attrs(name, block, noise):
     return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])), study=name,
                 zeta=float(block["zeta"]), eps=float(block["eps"]),
                 amplitude=float(block["amplitude"]), noise=block["noise"],
-                dt=float(noise["dt"]), **spec, transient=float(block["transient"]),
+                dt=float(noise["dt"]), **spec, **_wall_attrs(*walls(block, f"studies.{name}")),
+                transient=float(block["transient"]),
                 record_length=float(escape["record_length"]),
                 motion_window=float(block["motion_window"]),
                 seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
@@ -275,6 +290,8 @@ def escape_level(name, block, noise, index, out):
     log.info("level %d: rms %g, %d samples of %s", index, rms, n, spec)
     samples = generate_array(spec, n, escape_seed(noise["seed"], index))
     motions = [tuple(int(k) for k in m) for m in block["motions"]]
+    gap, eps_lower = walls(block, f"studies.{name}")
+    second = {} if gap is None else dict(gap=gap, eps_lower=eps_lower)
     progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]))
     results = []
     for inv_beta, delta in escape["cells"]:
@@ -282,7 +299,7 @@ def escape_level(name, block, noise, index, out):
             samples, spec.dt, zeta=float(block["zeta"]), eps=float(block["eps"]),
             delta=float(delta), beta_f=1.0 / float(inv_beta),
             amplitude=float(block["amplitude"]), transient=transient, record_length=length,
-            motions=motions, window=float(block["motion_window"])))
+            motions=motions, window=float(block["motion_window"]), **second))
         progress.cell_done(results[-1])
     io.write_dataset(datasets.escape_part(index, rms, escape["cells"], results, motions,
                                           _escape_attrs(name, block, noise)), out)

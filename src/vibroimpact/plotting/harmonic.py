@@ -7,6 +7,7 @@ from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
     _num, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
     axis_label)
+from vibroimpact.plotting.walls import two_walls, wall_density_figure
 from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 
 
@@ -177,10 +178,15 @@ def fig14(events, inv_beta, density_delta=None):
     """Fig. 14: density of the velocity after impact under sin(tau/inv_beta) + r(tau).
 
     As :func:`fig07`, at the ``inv_beta`` of the dataset nearest to the one given; a
-    non-harmonic study raises ValueError (its velocity density is fig07).
+    non-harmonic study raises ValueError (its velocity density is fig07). A two-wall
+    dataset: one panel per wall (`plotting.walls.wall_density_figure`).
     """
     _require_harmonic(events, "fig14")
     i = _nearest(events["inv_beta"], inv_beta)
+    if two_walls(events):
+        return wall_density_figure(events, i, "v_after", "Fig. 14 (two walls)  Probability "
+                                   "density of the velocity after impact, per wall",
+                                   density_delta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",
                              _events_params(events, i, ("v_after",)), density_delta,
