@@ -5,6 +5,8 @@ from numba import njit
 from vibroimpact._kernel_cache import kernel_decorator
 
 #: The modules the compiled kernels are made of (constants included).
-KERNEL_MODULES = ("tolerances.py", "layout.py", "motion.py", "events.py", "stepping.py")
+#: ``../model.py`` holds the impact law the stepping compiles in.
+KERNEL_MODULES = ("tolerances.py", "layout.py", "motion.py", "events.py", "stepping.py",
+                  "../model.py")
 
 kernel = kernel_decorator(njit, __file__, KERNEL_MODULES, error_model="numpy")
