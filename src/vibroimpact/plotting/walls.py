@@ -30,14 +30,6 @@ def two_walls(ds):
     return "wall" in ds.dims
 
 
-def wall_params(ds):
-    """The second wall's parameters, for a figure's header (``""`` for one wall)."""
-    if "gap" not in ds.attrs:
-        return ""
-    return (f"gap g = {_num(ds.attrs['gap'])} (lower wall at x = $\\delta - g$), "
-            f"$\\varepsilon_{{lower}}$ = {_num(ds.attrs['eps_lower'])}")
-
-
 def wall_density_figure(events, i_beta, quantity, title, density_delta=None):
     """One density panel per wall of ``wall_{quantity}_density``, one curve per density delta.
 
@@ -101,13 +93,13 @@ def wall_density_figure(events, i_beta, quantity, title, density_delta=None):
         _panel_tag(ax, WALL_NAMES.get(wall, wall))
         ax.legend(loc="upper right", fontsize="small")
     axes[-1].set_xlabel(axis_label(ds[x]))
-    _header(fig, title, _events_params(events, i_beta, (quantity,)) + "\n" + wall_params(events))
+    _header(fig, title, _events_params(events, i_beta, (quantity,)))
     return fig
 
 
 def _density_label(quantity):
-    return {"v_after": "probability density of the velocity after impact",
-            "interval": "probability density of the interval\nbetween collisions at the wall"
+    return {"v_after": "density of the velocity\nafter impact",
+            "interval": "density of the interval\nbetween collisions at the wall"
             }[quantity]
 
 
@@ -149,13 +141,12 @@ def wall_means_figure(events, title, i_beta=0):
             ax.errorbar(delta[ok], mean[ok], yerr=err[:, ok], color=style["color"],
                         marker=style["marker"], ls=style["ls"], markersize=3.5, capsize=2,
                         label=WALL_NAMES.get(wall, wall))
-    axes[0].set_ylabel("mean velocity after impact")
+    axes[0].set_ylabel("mean velocity\nafter impact")
     axes[1].set_ylabel("mean interval between\ncollisions at the wall")
     axes[1].set_yscale("log")
     axes[1].set_xlabel(axis_label(ds["delta"]))
     _panel_tag(axes[0], r"(a) mean velocity after impact $\varepsilon_w u$")
     _panel_tag(axes[1], r"(b) mean interval $T / N_w$")
     axes[0].legend(loc="best", fontsize="small")
-    _header(fig, title, _events_params(events, i_beta, ("v_after", "interval")) + "\n"
-            + wall_params(events))
+    _header(fig, title, _events_params(events, i_beta, ("v_after", "interval")))
     return fig
