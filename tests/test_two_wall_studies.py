@@ -6,7 +6,7 @@ import yaml
 
 from vibroimpact.pipeline import cells, datasets
 from vibroimpact.pipeline import config as configuration
-from vibroimpact.pipeline.study import JOB_KEYS, ORBIT_JOB_KEYS, Study
+from vibroimpact.pipeline.study import JOB_KEYS, ORBIT_JOB_KEYS, Study, study_model
 from vibroimpact.stats import motions as motion_stats
 
 from helpers import ROOT
@@ -84,7 +84,7 @@ def test_a_gap_without_eps_lower_takes_eps_and_resolves_one_model(tmp_path):
     study = Study.from_config("mine", entry)
     assert (study.gap, study.eps_lower, study.n_walls) == (2.0, 0.5, 2)
     cell = study.cells()[1]
-    model = study.model(cell)
+    model = study_model(study, cell)
     assert (model.delta, model.lower, model.eps_lower) == (1.0, -1.0, 0.5)
     assert model.beta == 1.0 / 1.1
     assert study.motions == ((1, 1, 1), (1, 1))
@@ -100,8 +100,8 @@ def test_the_paper_studies_have_one_wall_and_their_job_params_no_wall_key():
         assert "gap" not in entry and "eps_lower" not in entry, name
         study = Study.from_config(name, entry)
         assert study.walls() == {} and study.n_walls == 1
-        assert study.model(study.cells(("events" if study.delta.size else "spectra"))[0]
-                           ).n_walls == 1
+        assert study_model(study, study.cells(
+            "events" if study.delta.size else "spectra")[0]).n_walls == 1
 
 
 def test_the_example_config_loads_with_two_walls():
@@ -143,6 +143,25 @@ def test_symmetric_stops_mirror_the_walls_exactly():
     assert np.isnan(a["power_residual"])        # the one-wall audit is not applied
 
 
+def test_each_wall_rebounds_with_its_own_restitution():
+    """Stops at +-1 with eps 0.7 above and 0.3 below under r, against eps 0.3 above and 0.7
+    below under -r: the mirror image, so the walls' statistics swap (velocity after impact
+    eps_w u with each wall's own eps_w)."""
+    r = _noise(rms=1.2, seed=11)
+    kw = dict(zeta=0.05, delta=1.0, gap=2.0, transient=50.0, bins=BINS, n_batches=10)
+    a = cells.event_statistics(r, 0.1, eps=0.7, eps_lower=0.3, **kw)
+    b = cells.event_statistics(-r, 0.1, eps=0.3, eps_lower=0.7, **kw)
+    assert a["wall_n_collisions"].min() > 20
+    assert a["wall_n_collisions"].tolist() == b["wall_n_collisions"][::-1].tolist()
+    np.testing.assert_allclose(a["wall_v_after_mean"], b["wall_v_after_mean"][::-1], rtol=1e-9)
+    # the physical and impacts-only rules (the per-rebound rule's floor test is
+    # `stats.group_collisions`', which takes one eps until it knows the walls)
+    np.testing.assert_allclose(a["rule_v_after_mean"][:2], b["rule_v_after_mean"][:2],
+                               rtol=1e-9)
+    np.testing.assert_allclose(a["rebound_v_after_mean"], b["rebound_v_after_mean"],
+                               rtol=1e-9)
+
+
 def test_a_far_second_wall_gives_the_one_wall_cell():
     """A lower wall 1e3 below (never reached): every statistic of the one-wall cell, and
     every collision at the upper wall."""
@@ -165,7 +184,7 @@ def test_the_two_wall_tile_dataset_has_a_wall_dimension():
                                         delta=[1.0], tile_size=1, gap=2.0, eps_lower=0.3,
                                         motions=[[1, 1, 1], [1, 0, 1]]))
     cell = study.cells()[0]
-    params = study.model(cell).params()
+    params = study_model(study, cell).params()
     params["beta_f"] = params.pop("beta")
     result = cells.event_statistics(r, 0.1, **params, transient=50.0, bins=BINS, n_batches=10,
                                     motions=study.motions)
@@ -249,3 +268,45 @@ def test_a_two_wall_config_builds_its_datasets_and_a_figure(tmp_path):
     assert motion_map["wall_collision_rate"].dims == ("inv_beta", "delta", "wall")
     assert float(motion_map["probability"].max()) > 0.0
     assert (work / targets[2]).stat().st_size > 10_000
+
+
+def test_the_paper_cells_get_the_arguments_they_always_got():
+    """The jobs resolve each cell's model (`Study.model`); for the paper's one-wall studies
+    the keywords it gives the cells are the loose values the jobs passed before models,
+    float for float (so their datasets stay bit for bit)."""
+    from vibroimpact.pipeline.tasks import _physics
+
+    config, plan = configuration.load(root=ROOT)
+    for name, study in plan.studies.items():
+        for kind in ("events", "spectra"):
+            for cell in study.cells(kind):
+                assert _physics(study, cell) == dict(
+                    zeta=study.zeta, eps=study.eps, delta=cell.delta,
+                    amplitude=study.amplitude, beta_f=1.0 / cell.inv_beta), (name, cell)
+
+
+def test_the_plan_resolves_each_study_once_from_the_checked_grids():
+    """`configuration.load` expands each grid once (the checks) and the plan, the workflow
+    (common.smk's STUDIES = PLAN.studies) and the cost model reuse it; a study resolved
+    anew from its entry has the same grids, value for value."""
+    config, plan = configuration.load(root=ROOT)
+    assert set(plan.studies) == set(config["studies"])
+    for name, study in plan.studies.items():
+        again = Study.from_config(name, config["studies"][name])
+        for axis in ("inv_beta", "delta", "spectra_delta"):
+            assert np.array_equal(getattr(study, axis), getattr(again, axis)), (name, axis)
+
+
+def test_the_aggregate_reads_the_axes_from_its_tiles():
+    study = Study.from_config("s", dict(zeta=0.05, eps=0.5, amplitude=1.0,
+                                        inv_beta=[0.9090909090909091, 1.1],
+                                        delta={"start": 2.0, "stop": 3.0, "step": 0.1},
+                                        tile_size=4))
+    tiles = []
+    for t in range(study.n_tiles()):
+        cells_t = study.tile(t)
+        tiles.append(datasets.xr.Dataset(coords=datasets._cell_coords(cells_t)))
+    inv_beta, delta = datasets.tile_axes(tiles[::-1], n_cells=len(study.cells()))
+    assert np.array_equal(inv_beta, study.inv_beta) and np.array_equal(delta, study.delta)
+    with pytest.raises(ValueError, match="expected 0..21"):
+        datasets.tile_axes(tiles[1:], n_cells=22)

@@ -285,11 +285,12 @@ def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches,
         c = col if rule == "physical" else events.collisions(eps, floor, transient, rule=rule)
         z = c.intervals
         walls = {} if not events.walls else dict(walls=events.collision_walls(c)[:-1])
+        v_after = (stats.velocity_after_impact(c.velocity, eps) if not events.walls else
+                   _rebound_eps(eps, events.walls, events.collision_walls(c)) * c.velocity)
         # the same estimators as the cell's own: T/N and the mean of every value
         row = dict(rule_n_events=c.time.size, rule_collision_rate=c.time.size / duration,
                    rule_v_after_mean=stats.mark_mean(
-                       stats.velocity_after_impact(c.velocity, eps), c.time, transient,
-                       transient + duration, n_batches).mean,
+                       v_after, c.time, transient, transient + duration, n_batches).mean,
                    rule_interval_mean=stats.event_rate(
                        c.time, transient, transient + duration, n_batches).mean_interval)
         if beta_f is not None:
@@ -353,8 +354,11 @@ class _EventRecord:
                                       self.t_end)
 
     def rebound_speeds(self, eps, floor, transient):
-        """Speeds ``eps u`` of the rebounds at or after ``transient`` that reach ``floor``."""
+        """Speeds ``eps u`` (two walls: ``eps_w u``) of the rebounds at or after
+        ``transient`` that reach ``floor``."""
         t = self.steps[0] * self.dt + self.offsets[0]
+        if self.walls:      # each rebound with its wall's restitution
+            eps = _rebound_eps(eps, self.walls, self.wall[0])[t >= transient]
         v = eps * self.u[0][t >= transient]
         return v[v >= floor]
 

@@ -317,9 +317,10 @@ def map_tile(cells, results, motions, attrs):
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
-def aggregate_map(tiles, study, attrs):
-    """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
-    ds = _to_grid(tiles, study.inv_beta, study.delta).transpose(
+def aggregate_map(tiles, study, attrs, n_cells=None):
+    """Probability-map dataset of a study (``docs/datasets.md``) from its tiles (the axes
+    the study's, or with ``study=None`` the tiles' own, `tile_axes`)."""
+    ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells)).transpose(
         "motion", "from_motion", "to_motion", "inv_beta", "delta", ..., missing_dims="ignore")
     ds.attrs = dict(attrs)
     return _annotate(ds)
@@ -334,6 +335,46 @@ def spectra_tile(cells, results, attrs):
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
+def tile_axes(tiles, n_cells=None):
+    """``(inv_beta, delta)``: the axes of a study's grid, read from its tiles' cells.
+
+    A tile stores each cell's index (``cell = i * n_delta + j``, inv_beta-major,
+    `pipeline.study.Study.cells`) with its values ``inv_beta_cell`` and ``delta_cell``, so
+    the aggregate needs no config to rebuild the axes (they are the values the cells ran
+    with, bit for bit).
+
+    ``n_cells``: the grid's number of cells, when known (a missing tile is then an error).
+
+    Raises
+    ------
+    ValueError
+        If the cells are not ``0 .. n_cells - 1`` or do not form an ``inv_beta x delta``
+        grid in that order.
+    """
+    cell = np.concatenate([np.asarray(t["cell"]) for t in tiles])
+    order = np.argsort(cell, kind="stable")
+    n = cell.size if n_cells is None else int(n_cells)
+    if not np.array_equal(cell[order], np.arange(n)):
+        raise ValueError(f"tiles cover cells {cell[order].tolist()}, expected 0..{n - 1}")
+    ib = np.concatenate([np.asarray(t["inv_beta_cell"], dtype=float) for t in tiles])[order]
+    d = np.concatenate([np.asarray(t["delta_cell"], dtype=float) for t in tiles])[order]
+    other = np.flatnonzero(ib != ib[0])
+    n_delta = int(other[0]) if other.size else ib.size
+    inv_beta, delta = ib[::n_delta], d[:n_delta]
+    if (ib.size % n_delta or not np.array_equal(ib, np.repeat(inv_beta, n_delta))
+            or not np.array_equal(d, np.tile(delta, inv_beta.size))):
+        raise ValueError("the tiles' cells do not form an inv_beta x delta grid "
+                         "(cell = i * n_delta + j)")
+    return inv_beta, delta
+
+
+def _axes(tiles, study, kind="events", n_cells=None):
+    """The grid's axes: the study's when given, else the tiles' (`tile_axes`)."""
+    if study is None:
+        return tile_axes(tiles, n_cells)
+    return study.inv_beta, study.spectra_delta if kind == "spectra" else study.delta
+
+
 def _to_grid(tiles, inv_beta, delta):
     """Concatenate tiles along ``cell`` and reshape to ``(inv_beta, delta, ...)``."""
     ds = xr.concat(tiles, dim="cell").sortby("cell")
@@ -346,21 +387,26 @@ def _to_grid(tiles, inv_beta, delta):
     return ds.transpose("inv_beta", "delta", ...)
 
 
-def aggregate_events(tiles, study, attrs):
-    """Events dataset of a study (``docs/datasets.md``) from its tiles."""
-    ds = _to_grid(tiles, study.inv_beta, study.delta)
+def aggregate_events(tiles, study, attrs, n_cells=None):
+    """Events dataset of a study (``docs/datasets.md``) from its tiles (the axes the
+    study's, or with ``study=None`` the tiles' own, `tile_axes`)."""
+    ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells))
     ds.attrs = dict(attrs)
     return _annotate(ds)
 
 
-def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
+def aggregate_spectra(tiles, study, spec, attrs, input_correlation, zeta=None, n_cells=None):
     """Spectra dataset of a study, with the linear reference ``S_lin = |H|^2 S_f``.
+
+    ``study`` gives the axes and ``zeta``; with ``study=None`` the axes are the tiles' own
+    (`tile_axes`) and ``zeta`` is given.
 
     ``spec`` is the :class:`~vibroimpact.noise.NoiseSpec` of the random force; the reference
     uses the spectrum of the piecewise-linear force the simulator integrates.
     ``input_correlation`` is ``(lag, estimate, target)`` of the random input (eq. 8).
     """
-    ds = _to_grid(tiles, study.inv_beta, study.spectra_delta)
+    ds = _to_grid(tiles, *_axes(tiles, study, "spectra", n_cells))
+    zeta = study.zeta if study is not None else zeta
     # every cell of a row estimates S_f from the same stretch of the same input: keep one
     S_f = ds["S_f"]
     if not (S_f == S_f.isel(delta=0)).all():
@@ -369,7 +415,7 @@ def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
     ds["S_f"] = S_f.isel(delta=0, drop=True)
     beta = ds["beta"].values
     S_r = spec.psd_piecewise_linear(beta)
-    ds["S_lin"] = ("beta", stats.linear_psd_response(beta, S_r, study.zeta))
+    ds["S_lin"] = ("beta", stats.linear_psd_response(beta, S_r, zeta))
     ds["S_r_target"] = ("beta", S_r)
     lag, phi, phi_target = input_correlation
     ds = ds.assign_coords(lag=lag)

@@ -126,21 +126,31 @@ class Study:
     eps_lower: float | None = None
 
     @classmethod
-    def from_config(cls, name, entry):
+    def from_config(cls, name, entry, grids=None):
         """Build from a validated config entry ``studies[name]`` (the schema's defaults
         filled in), or the part of it a job reads: an entry without ``delta`` has an empty
-        events grid, one without ``motions`` classifies none (a spectra or trace job)."""
+        events grid, one without ``motions`` classifies none (a spectra or trace job).
+
+        ``grids``: the entry's grids already expanded (``{"inv_beta", "delta",
+        "spectra_delta"}``, as `pipeline.config.checks.check` returns them), used as they
+        are instead of expanding them again."""
+        grids = grids or {}
         amplitude = float(entry["amplitude"])
-        inv_beta = grid_values(entry["inv_beta"]) if amplitude != 0.0 else np.array([1.0])
+        inv_beta = (np.array([1.0]) if amplitude == 0.0 else grids["inv_beta"]
+                    if grids.get("inv_beta") is not None else grid_values(entry["inv_beta"]))
         if np.any(inv_beta <= 0.0):
             raise ValueError(f"studies.{name}.inv_beta must hold values > 0, got {inv_beta!r}")
         spectra = entry.get("spectra") or {}
         gap, eps_lower = walls(entry, f"studies.{name}")
+
+        def grid(key, spec):
+            return grids[key] if grids.get(key) is not None else grid_values(spec)
+
         return cls(name=name, zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                    amplitude=amplitude, inv_beta=inv_beta,
-                   delta=grid_values(entry["delta"]) if "delta" in entry else np.empty(0),
-                   spectra_delta=(grid_values(spectra["delta"]) if spectra.get("delta")
-                                  else np.empty(0)),
+                   delta=grid("delta", entry["delta"]) if "delta" in entry else np.empty(0),
+                   spectra_delta=(grid("spectra_delta", spectra["delta"])
+                                  if spectra.get("delta") else np.empty(0)),
                    tile_size=int(entry["tile_size"]),
                    motions=tuple(tuple(int(k) for k in m) for m in entry.get("motions", ())),
                    gap=gap, eps_lower=eps_lower)
@@ -158,13 +168,6 @@ class Study:
             return {}
         return dict(gap=self.gap, eps_lower=self.eps_lower)
 
-    def model(self, cell):
-        """The resolved :class:`vibroimpact.model.Model` of one cell: the study's oscillator
-        and walls at the cell's play, forced by ``amplitude sin(tau / inv_beta)``."""
-        from vibroimpact.model import Model
-
-        return Model.paper(self.zeta, self.eps, cell.delta, self.amplitude,
-                           1.0 / cell.inv_beta, **self.walls())
 
     def cells(self, kind="events"):
         """All cells of the events grid (``inv_beta x delta``; also the map's) or of the
@@ -187,6 +190,17 @@ class Study:
         if not 0 <= t < n:
             raise ValueError(f"tile must lie in [0, {n - 1}], got {t!r}")
         return self.cells(kind)[t::n]
+
+
+def study_model(study, cell):
+    """The resolved :class:`vibroimpact.model.Model` of one cell of ``study``: its oscillator
+    and walls at the cell's play, forced by ``amplitude sin(tau / inv_beta)`` (a function, not
+    a method of `Study`: only the jobs that simulate reach the model and its kernels' layout,
+    so a figure's code digest stays free of them)."""
+    from vibroimpact.model import Model
+
+    return Model.paper(study.zeta, study.eps, cell.delta, study.amplitude,
+                       1.0 / cell.inv_beta, **study.walls())
 
 
 def walls(entry, where):

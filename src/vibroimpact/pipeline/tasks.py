@@ -14,7 +14,8 @@ from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
-                                        grid_values, map_cap_steps, orbit_rows, walls)
+                                        grid_size, grid_values, map_cap_steps, orbit_rows,
+                                        walls)
 
 log = logging.getLogger("vibroimpact")
 
@@ -125,8 +126,10 @@ def _rebound_floor(block):
 
 
 def _physics(study, cell):
-    """The cell's resolved model (`Study.model`) as the keywords of `pipeline.cells`."""
-    params = study.model(cell).params()
+    """The cell's resolved model (`study.study_model`) as the keywords of `pipeline.cells`."""
+    from vibroimpact.pipeline.study import study_model    # the jobs that simulate only
+
+    params = study_model(study, cell).params()
     params["beta_f"] = params.pop("beta")
     return params
 
@@ -318,8 +321,12 @@ def aggregate_escape(name, block, noise, parts, out):
 
 def aggregate(name, block, kind, tiles, out, noise_path=None):
     """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: a study's
-    dataset."""
-    study = Study.from_config(name, block)
+    dataset. The grid's axes are the tiles' own (`datasets.tile_axes`: the values their
+    cells ran with), not the config's grid expanded once more."""
+    zeta = float(block["zeta"])
+    # the grid's size (counted, not expanded): a missing tile is an error
+    rows = grid_size(block["inv_beta"]) if float(block["amplitude"]) != 0.0 else 1
+    n_cells = rows * grid_size((block["spectra"] if kind == "spectra" else block)["delta"])
     parts = [io.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)
     attrs.update(provenance(block, attrs.get("seed")))
@@ -327,15 +334,16 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
         if float(attrs.get("amplitude", 0.0)) == 0.0:
             # the wall-free response's std's: fig09 draws Rice's large-play asymptotes
             sigma_x, sigma_v = stats.linear_response_std(
-                io.noise_spec(attrs).psd_piecewise_linear, study.zeta)
+                io.noise_spec(attrs).psd_piecewise_linear, zeta)
             attrs.update(linear_sigma_x=sigma_x, linear_sigma_v=sigma_v)
-        ds = datasets.aggregate_events(parts, study, attrs)
+        ds = datasets.aggregate_events(parts, None, attrs, n_cells=n_cells)
     elif kind == "map":
-        ds = datasets.aggregate_map(parts, study, attrs)
+        ds = datasets.aggregate_map(parts, None, attrs, n_cells=n_cells)
     else:
         spec = io.noise_spec(io.read_noise_attrs(noise_path))
-        ds = datasets.aggregate_spectra(parts, study, spec, attrs,
-                                        input_correlation=io.read_input_correlation(noise_path))
+        ds = datasets.aggregate_spectra(parts, None, spec, attrs,
+                                        input_correlation=io.read_input_correlation(noise_path),
+                                        zeta=zeta, n_cells=n_cells)
     io.write_dataset(ds, out)
 
 

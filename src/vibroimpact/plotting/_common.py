@@ -840,7 +840,13 @@ def _events_params(events, i_beta, drawn=tuple(COLLISION_QUANTITIES)):
     if "n_collisions" not in events:
         return line
     return line + "\n" + ";  ".join([COLLISION_NOTE]
-                                    + [COLLISION_QUANTITIES[name] for name in drawn])
+                                    + [_two_wall_note(events, COLLISION_QUANTITIES[name])
+                                       for name in drawn])
+
+
+def _two_wall_note(ds, text):
+    """A quantity's definition with its wall's restitution ``eps_w`` when there are two."""
+    return text.replace(r"\varepsilon u", r"\varepsilon_w u") if "gap" in ds.attrs else text
 
 
 # --------------------------------------------------------------------------------------------

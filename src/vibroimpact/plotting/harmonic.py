@@ -121,6 +121,10 @@ def _centroid_note(spectra, i_beta):
                  for k in (0, -1))
     if not (np.isfinite(at_small) and np.isfinite(at_large)):
         return ""
+    if "gap" in spectra.attrs:      # two walls: the paper's finding (one wall) is no reference
+        return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
+                f"$\\delta$ = {_num(float(row.delta[-1]))}, {at_small:.2f} at $\\delta$ = "
+                f"{_num(float(row.delta[0]))}")
     way = ("falls as $\\delta$ decreases, as in the paper" if at_small < at_large else
            "rises as $\\delta$ decreases: the frequency shift runs opposite to the paper's")
     return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "

@@ -291,6 +291,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
     n, dt, tau = noise_record(config["noises"][entry["noise"]])
     record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
     grids = {"delta": _grid(problems, f"{where}.delta", entry["delta"], limits["max_cells"])}
+    resolved = {}       # the grids, and the spectra's plays: what the study resolves to
     harmonic = float(entry["amplitude"]) != 0.0
     grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_cells"], positive=True)
@@ -356,6 +357,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
                              f"transient to t_end)",
                              f"16 <= nperseg <= {samples}, or a longer spectra.t_end")
         sgrid = _grid(problems, f"{where}.spectra.delta", spectra["delta"], limits["max_cells"])
+        resolved["spectra_delta"] = sgrid
         if sgrid is not None and grids["delta"] is not None:
             for j, v in enumerate(sgrid):
                 if not _on_grid(v, grids["delta"]):
@@ -416,7 +418,8 @@ def _check_study(config, name, entry, problems, limits, unforced):
         _check_escape(where, entry, grids, harmonic, dt, problems)
     if all(g is not None for g in grids.values()):
         _check_figures(config, "studies", name, entry, problems, grids)
-    return grids
+    resolved.update(grids)
+    return resolved
 
 
 #: Shortest batch of the batch-means standard errors: a natural period 2 pi (time units),
@@ -587,6 +590,13 @@ def check(config, schema, own=None):
     ``config`` has passed `~vibroimpact.pipeline.config.messages.validate` against
     ``schema``; ``own`` is from `~vibroimpact.pipeline.config.layering.compose`.
 
+    Returns
+    -------
+    dict
+        ``{study: {"inv_beta", "delta", "spectra_delta"}}``: each study's grids, expanded
+        here once (`pipeline.study.Study.from_config` takes them as ``grids``, so the plan
+        and the workflow expand none again).
+
     Raises
     ------
     ConfigError
@@ -597,8 +607,9 @@ def check(config, schema, own=None):
     _check_noises(config, problems)
     # a random study's inv_beta left out (the schema's default) is not one it ignores
     unforced = schema["$defs"]["study"]["properties"]["inv_beta"]["default"]
+    resolved = {}
     for name, entry in config["studies"].items():
-        _check_study(config, name, entry, problems, limits, unforced)
+        resolved[name] = _check_study(config, name, entry, problems, limits, unforced)
     for name, entry in config["orbits"].items():
         _check_orbits(config, name, entry, problems, limits)
     _check_paper_figures(config, problems, None if own is None else own["paper_figures"])
@@ -607,3 +618,4 @@ def check(config, schema, own=None):
                      "paper: false with at least one study or orbits entry that lists figures")
     if problems:
         raise ConfigError(problems)
+    return resolved
