@@ -136,22 +136,31 @@ class SimulationResult:
         """The impacts grouped by ``rule`` (:data:`vibroimpact.stats.RULES`; the default,
         the physical rule, is :attr:`collisions`)."""
         p = self.params
-        start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
-                                      self.t_end)
-        pressed = None
-        if rule == "physical":
-            pressed = pressed_flights(self.impact_step, self.impact_offset, self.force_record,
-                                      p["dt"], delta=p["delta"], amplitude=p["amplitude"],
-                                      beta=p["beta"])
         if "gap" not in p:
+            start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                          self.t_end)
+            pressed = None
+            if rule == "physical":
+                pressed = pressed_flights(self.impact_step, self.impact_offset,
+                                          self.force_record, p["dt"], delta=p["delta"],
+                                          amplitude=p["amplitude"], beta=p["beta"])
             return group_collisions(self.impact_step, self.impact_offset,
                                     self.impact_velocity, start, end, dt=p["dt"],
                                     eps=p["eps"], floor=p["rebound_floor"], pressed=pressed,
                                     rule=rule)
+        # two walls: a rest still going on at the end is on the wall the mass ends on
+        start, end, wall = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                            self.t_end, self.stick_wall,
+                                            int(self.x_end != p["delta"]))
+        pressed = None
+        if rule == "physical":
+            pressed = pressed_flights(self.impact_step, self.impact_offset, self.force_record,
+                                      p["dt"], delta=p["delta"], amplitude=p["amplitude"],
+                                      beta=p["beta"], wall=self.impact_wall, gap=p["gap"])
         return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
                                 start, end, dt=p["dt"], eps=p["eps"], floor=p["rebound_floor"],
                                 pressed=pressed, rule=rule, wall=self.impact_wall,
-                                stick_wall=self.stick_wall, eps_lower=p["eps_lower"])
+                                stick_wall=wall, eps_lower=p["eps_lower"])
 
     n_collisions = property(lambda self: int(self.collisions.first.size))
     collision_time = property(lambda self: self.collisions.time)
@@ -162,6 +171,7 @@ class SimulationResult:
     collision_stuck = property(lambda self: self.collisions.stuck)
     collision_stick_time = property(lambda self: self.collisions.stick_time)
     collision_duration = property(lambda self: self.collisions.duration)
+    collision_wall = property(lambda self: self.collisions.wall)
     impact_collision = property(lambda self: self.collisions.impact_collision)
     rebound_floor = property(lambda self: self.params["rebound_floor"])
 
@@ -171,11 +181,16 @@ def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, r
     zeta = _checks.zeta(zeta)
     eps = _checks.eps(eps)
     delta = _checks.real("delta", delta)
-    dt = _checks.real("dt", dt, low=0.0, low_open=True)
     amplitude = _checks.real("amplitude", amplitude)
     beta = _checks.real("beta", beta, low=0.0, low_open=True)
     model = Model.paper(zeta, eps, delta, amplitude, beta, gap=gap, eps_lower=eps_lower)
-    lower = model.lower
+    return (model,) + _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size)
+
+
+def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size):
+    """The run's own arguments (everything but the model), checked against its walls."""
+    delta, lower = model.delta, model.lower
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
     # the static position, on the nearer wall when the walls leave it out
     x0 = max(lower, min(0.0, delta)) if x0 is None else _checks.real("x0", x0)
     if x0 > delta:
@@ -198,7 +213,7 @@ def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, r
                          f"{(len(noise) - 1) * dt!r}, got {t_end!r}")
     record_every = _checks.integer("record_every", record_every, low=0)
     chunk_size = _checks.integer("chunk_size", chunk_size, low=1)
-    return model, dt, x0, v0, t_end, record_every, chunk_size
+    return dt, x0, v0, t_end, record_every, chunk_size
 
 
 def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
@@ -535,6 +550,17 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
                                   record_every=record_every, chunk_size=chunk_size,
                                   rebound_floor=rebound_floor, gap=gap, eps_lower=eps_lower))
     return concatenate_results(chunks)
+
+
+def simulate_model(model, noise=None, dt=0.1, x0=None, v0=0.0, t_end=None, *, record_every=0,
+                   chunk_size=2**20, rebound_floor=DEFAULT_REBOUND_FLOOR):
+    """:func:`simulate` of a :class:`vibroimpact.model.Model` (its walls placed exactly where
+    the model puts them); the other arguments as for :func:`simulate`."""
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a vibroimpact.model.Model, got {type(model).__name__}")
+    run = _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size)
+    rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
+    return concatenate_results(list(_simulate_model(model, noise, *run, rebound_floor)))
 
 
 def concatenate_results(chunks):

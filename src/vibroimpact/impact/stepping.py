@@ -90,10 +90,16 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
     if at_wall:
         x = delta
         side = 0
-    elif two and x <= _wall_position(P, 1):
-        x = _wall_position(P, 1)
-        side = 1
-        at_wall = True
+    elif two:
+        lower = _wall_position(P, 1)
+        if x <= lower:
+            x = lower
+            side = 1
+            at_wall = True
+        elif mode == FREE and x - lower < delta - x:
+            # a flight is followed in the frame of the nearer wall: its end state is
+            # x - wall in difference form there, accurate to the distance from that wall
+            side = 1
     just_hit = False
     imp0, stk0 = cnt[CNT_IMPACTS], cnt[CNT_STICK_EVENTS]
     while True:
