@@ -57,49 +57,19 @@ def _lag1_check(name, result, cell):
 WALLS = ("upper", "lower")
 
 
-def _walls(gap, eps_lower):
+def _walls(gap, eps_lower, eps=None):
     """The second wall as `simulate_chunks` keywords: ``{}`` with one wall (``gap`` None), so
-    a one-wall cell makes the call it always made."""
+    a one-wall cell makes the call it always made; ``eps_lower`` None is ``eps``."""
     if gap is None:
         if eps_lower is not None:
             raise ValueError("eps_lower needs a second wall: give gap as well")
         return {}
-    return dict(gap=float(gap), eps_lower=eps_lower)
+    return dict(gap=float(gap), eps_lower=float(eps if eps_lower is None else eps_lower))
 
 
 def _rebound_eps(eps, walls, wall):
     """Restitution of each collision's wall (``wall``: 0 or 1 per collision)."""
-    return np.where(wall == 0, eps, walls["eps_lower"] if walls["eps_lower"] is not None
-                    else eps)
-
-
-def _wall_statistics(col, wall, v_after, *, dt, bins, transient, t_end, n_batches):
-    """The statistics the figures draw, per wall (`WALLS` order): ``wall_n_collisions,
-    wall_collision_rate, wall_v_after_mean(_lo, _hi), wall_interval_mean(_lo, _hi),
-    wall_stuck_fraction`` and the densities ``wall_v_after_density(_stderr)``,
-    ``wall_interval_density(_stderr)``. A wall's interval runs from one of its collisions
-    to its next (the collisions at the other wall between them are not counted): its mean
-    is ``T / N_w``, the reciprocal of its rate, as the cell's own."""
-    rows = []
-    for w in range(len(WALLS)):
-        at = wall == w
-        t, v = col.time[at], v_after[at]
-        z = np.diff(col.step[at]).astype(float) * dt + np.diff(col.offset[at])
-        rate = stats.event_rate(t, transient, t_end, n_batches)
-        v_mean = stats.mark_mean(v, t, transient, t_end, n_batches)
-        v_dens = stats.density(v, bins["v_after"], total=v.size, n_batches=n_batches)
-        z_dens = stats.density(z, bins["interval"], total=z.size, n_batches=n_batches)
-        rows.append(dict(
-            wall_n_collisions=int(t.size), wall_collision_rate=t.size / (t_end - transient),
-            wall_v_after_mean=v_mean.mean, wall_v_after_mean_lo=v_mean.lo,
-            wall_v_after_mean_hi=v_mean.hi, wall_interval_mean=rate.mean_interval,
-            wall_interval_mean_lo=rate.mean_interval_bounds[0],
-            wall_interval_mean_hi=rate.mean_interval_bounds[1],
-            wall_stuck_fraction=(float(col.stuck[at].mean()) if t.size else math.nan),
-            wall_v_after_density=v_dens.density, wall_v_after_density_stderr=v_dens.stderr,
-            wall_interval_density=z_dens.density,
-            wall_interval_density_stderr=z_dens.stderr))
-    return {name: np.array([row[name] for row in rows]) for name in rows[0]}
+    return np.where(wall == 0, eps, walls["eps_lower"])
 
 
 def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
@@ -167,9 +137,8 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         With two walls (``gap``) the statistics above are over the collisions at either wall
         (a velocity after impact is ``eps_w u`` with its wall's restitution), the motions
         are classified with the collisions' walls (two-wall motions ``(m_upper, m_lower,
-        n)``, `stats.motions`), and the per-wall statistics of `_wall_statistics` are added
-        (arrays over `WALLS`); the self-audit's identities are written for one wall, so its
-        six values are NaN.
+        n)``, `stats.motions`), the per-wall statistics of `stats.wall_statistics` are added
+        (arrays over `WALLS`) and the self-audit has a term per wall.
 
     Notes
     -----
@@ -192,18 +161,17 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
     n_batches = int(n_batches)
     harmonic = amplitude != 0.0
-    walls = _walls(gap, eps_lower)
+    walls = _walls(gap, eps_lower, eps)
     events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, zeta=zeta, eps=eps,
-                            delta=delta, amplitude=amplitude, beta_f=beta_f)
+                            delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=t_end, record_every=1,
                                  chunk_size=chunk_size, **walls):
         events.add(chunk)
-        if not walls:
-            audit.add(chunk)
+        audit.add(chunk)
     col = events.collisions(eps, rebound_floor, transient)
-    contact = _clipped_contact(*events.sticking(), transient)
+    contact = _clipped_contact(*events.sticking()[:2], transient)
     duration = t_end - transient
     wall = events.collision_walls(col) if walls else None
     v_after = (stats.velocity_after_impact(col.velocity, eps) if not walls
@@ -249,10 +217,12 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         interval_density=z_dens.density, interval_density_stderr=z_dens.stderr,
         interval_beyond=z_dens.beyond,
     )
-    out.update(audit.result() if not walls else audit.empty())
+    out.update(audit.result())
     if walls:
-        out.update(_wall_statistics(col, wall, v_after, dt=dt, bins=bins,
-                                    transient=transient, t_end=t_end, n_batches=n_batches))
+        out.update(stats.wall_statistics(col, transient, t_end, eps=eps,
+                                         eps_lower=walls["eps_lower"], bins=bins,
+                                         n_batches=n_batches,
+                                         beta_f=beta_f if harmonic else None))
     out.update(_rule_statistics(events, col, eps=eps, floor=rebound_floor, transient=transient,
                                 duration=duration, n_batches=n_batches,
                                 beta_f=beta_f if harmonic else None,
@@ -309,19 +279,23 @@ class _EventRecord:
     Collisions are grouped on the whole record at the end (a chatter sequence may cross a
     chunk boundary). Impacts are kept from the start of the record, so that a collision that
     begins before the transient is grouped as it happened and then dropped. The physical rule
-    reads the force (``noise``, ``delta``, ``amplitude``, ``beta_f``) along each flight.
+    reads the force (``noise``, ``delta``, ``amplitude``, ``beta_f``) along each flight. With
+    a second wall (``gap``) the walls of the impacts and of the sticking phases are gathered
+    too, and the grouping is per wall (`stats.group_collisions` with ``wall``: a collision
+    never spans the two walls, a hop is pressed onto the wall it is at).
     """
 
     def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0, gap=None,
                  eps_lower=None):
         self.dt = dt
         self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
-        #: the second wall (``{}``: one wall): its impacts' walls are gathered too
+        #: the second wall (``{}``: one wall)
         self.walls = _walls(gap, eps_lower)
         self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
+        self.stuck_wall = 0      # the wall of a rest still going on at the last chunk's end
         self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
-        self.wall = []
+        self.wall, self.stick_wall = [], []
         self.t_end = 0.0
 
     def add(self, chunk):
@@ -333,7 +307,9 @@ class _EventRecord:
         names = ("steps", "offsets", "u", "starts", "ends")
         if self.walls:
             self.wall.append(np.asarray(chunk.impact_wall, dtype=np.int8))
-            names += ("wall",)
+            self.stick_wall.append(np.asarray(chunk.stick_wall, dtype=np.int8))
+            self.stuck_wall = int(chunk.x_end != self.force["delta"])
+            names += ("wall", "stick_wall")
         self.t_end = chunk.t_end
         self.stuck_since = chunk.stuck_since
         if len(self.steps) > 1:           # keep one array per kind: checks regroup each time
@@ -341,17 +317,18 @@ class _EventRecord:
                 setattr(self, name, [np.concatenate(getattr(self, name))])
 
     def collision_walls(self, col):
-        """The wall of each collision of ``col`` (int8, 0: at delta, 1: at delta - gap):
-        ``col.wall`` when the grouping records it, else its first impact's wall."""
-        wall = getattr(col, "wall", None)
-        if wall is not None:
-            return np.asarray(wall, dtype=np.int8)
-        return self.wall[0][col.first] if col.first.size else np.zeros(0, np.int8)
+        """The wall of each collision of ``col`` (int8, 0: at delta, 1: at delta - gap)."""
+        return np.asarray(col.wall, dtype=np.int8)
 
     def sticking(self):
-        """Sticking phases so far; one still open ends at the last chunk's end."""
+        """Sticking phases so far; one still open ends at the last chunk's end. With two
+        walls ``(start, end, wall)``, the open one on the wall the mass rests on."""
+        if not self.walls:
+            return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                          self.t_end)
         return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
-                                      self.t_end)
+                                      self.t_end, stick_wall=self.stick_wall[0],
+                                      stuck_wall=self.stuck_wall)
 
     def rebound_speeds(self, eps, floor, transient):
         """Speeds ``eps u`` (two walls: ``eps_w u``) of the rebounds at or after
@@ -364,8 +341,9 @@ class _EventRecord:
 
     def pressed(self):
         """The flights between the record's impacts that the push presses throughout
-        (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`); those of earlier
-        checks are kept, only new ones computed."""
+        (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`; with two walls, onto
+        the wall the flight is at); those of earlier checks are kept, only new ones
+        computed."""
         n = self.steps[0].size if self.steps else 0
         if n > self._n_pressed:
             i = max(self._n_pressed - 1, 0)          # from the last impact already seen
@@ -377,57 +355,28 @@ class _EventRecord:
             k = np.searchsorted(start, t[:-1], side="left")
             free = k < start.size
             free[free] = start[k[free]] < t[1:][free]
-            if not self.walls:
-                new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
-                                      amplitude=f["amplitude"], beta=f["beta"], flights=~free)
-            else:
-                new = self._pressed_two_walls(i, step, offset, ~free)
+            walls = {} if not self.walls else dict(wall=self.wall[0][i:],
+                                                   gap=self.walls["gap"])
+            new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
+                                  amplitude=f["amplitude"], beta=f["beta"], flights=~free,
+                                  **walls)
             self._pressed, self._n_pressed = np.append(self._pressed, new), n
         return self._pressed
-
-    def _pressed_two_walls(self, i, step, offset, flights):
-        """Hops with two walls: a flight between impacts at one wall, pressed onto that wall
-        throughout (at the lower wall the push ``f - (delta - gap)`` stays < 0: the upper
-        wall's test in the mirrored frame x -> -x); a flight from one wall to the other is
-        never a hop."""
-        f = self.force
-        wall = self.wall[0][i:]
-        same = wall[:-1] == wall[1:]
-        upper = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
-                                amplitude=f["amplitude"], beta=f["beta"],
-                                flights=flights & same & (wall[:-1] == 0))
-        lower_at = f["delta"] - self.walls["gap"]
-        lower = pressed_flights(step, offset, _negated(f["noise"]), self.dt, delta=-lower_at,
-                                amplitude=-f["amplitude"], beta=f["beta"],
-                                flights=flights & same & (wall[:-1] == 1))
-        return np.where(wall[:-1] == 0, upper, lower) & same
 
     def collisions(self, eps, floor, transient, rule="physical"):
         """Collisions of the record so far that begin at or after ``transient``, grouped by
         ``rule`` (:data:`vibroimpact.stats.RULES`)."""
-        start, end = self.sticking()
         pressed = self.pressed() if rule == "physical" else None
+        if not self.walls:
+            start, end = self.sticking()
+            return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
+                                          end, dt=self.dt, eps=eps, floor=floor,
+                                          pressed=pressed, rule=rule).after(transient)
+        start, end, wall = self.sticking()
         return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
-                                      rule=rule).after(transient)
-
-
-def _negated(noise):
-    """``-noise`` read slice by slice (None stays None)."""
-    return None if noise is None else _Negated(noise)
-
-
-class _Negated:
-    """``-noise``, read slice by slice (the force in the mirrored frame x -> -x)."""
-
-    def __init__(self, noise):
-        self.noise = noise
-
-    def __len__(self):
-        return len(self.noise)
-
-    def __getitem__(self, key):
-        return -np.asarray(self.noise[key], dtype=float)
+                                      rule=rule, wall=self.wall[0], stick_wall=wall,
+                                      eps_lower=self.walls["eps_lower"]).after(transient)
 
 
 class _IdentityRecord:
@@ -437,11 +386,14 @@ class _IdentityRecord:
     ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. Each chunk
     brings the state at its samples (``record_every=1``) and its impacts and sticking
     phases; :func:`vibroimpact.impact.audit.audit_moments` (the compiled
-    :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly.
+    :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly. With a second
+    wall (``gap``, ``eps_lower`` in ``params``) the identities have a term per wall
+    (docs/model.md, "Two walls"): the impact sums are kept per wall.
     """
 
     def __init__(self, noise, dt, transient, t_end, n_batches, **params):
         self.noise, self.dt, self.params = noise, dt, params
+        self.two = params.get("gap") is not None
         self.k_start = int(math.ceil(transient / dt - 1e-9))
         self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
         self.n_batches = n_batches
@@ -449,9 +401,11 @@ class _IdentityRecord:
         # the first sample of each batch of _batch, and the window's end
         self.bounds = self.k_start + (np.arange(n_batches + 1) * n + n_batches - 1) // n_batches
         self.steps = np.diff(self.bounds)
-        self.moments = np.zeros((len(stats.identities.MOMENTS), n_batches))
-        self.sum_u = np.zeros(n_batches)
-        self.sum_u2 = np.zeros(n_batches)
+        rows = len(stats.moment_rows(True)) if self.two else len(stats.identities.MOMENTS)
+        self.moments = np.zeros((rows, n_batches))
+        shape = (2, n_batches) if self.two else n_batches
+        self.sum_u = np.zeros(shape)
+        self.sum_u2 = np.zeros(shape)
 
     def _batch(self, k):
         n = self.k_stop - self.k_start
@@ -465,25 +419,33 @@ class _IdentityRecord:
         if hi > lo:
             keep = slice(lo - k0, hi - k0)
             r = np.asarray(self.noise[lo : hi + 1], dtype=float)
-            start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
-                                                chunk.stuck_since, chunk.t_end)
+            if not self.two:
+                start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
+                                                    chunk.stuck_since, chunk.t_end)
+                walls = {}
+            else:   # a rest open at the chunk's end: on the wall the mass rests on
+                start, end, stick_wall = stats.close_open_phase(
+                    chunk.stick_start, chunk.stick_end, chunk.stuck_since, chunk.t_end,
+                    stick_wall=chunk.stick_wall,
+                    stuck_wall=int(chunk.x_end != self.params["delta"]))
+                walls = dict(impact_wall=chunk.impact_wall, stick_wall=stick_wall)
             self.moments += audit_moments(
                 lo, chunk.a[keep], chunk.v[keep], r, self.dt,
                 **self.params, impact_time=chunk.impact_time,
                 impact_velocity=chunk.impact_velocity, stick_start=start, stick_end=end,
-                batch_bounds=self.bounds)
+                batch_bounds=self.bounds, **walls)
         step = chunk.impact_step
         hit = (step >= self.k_start) & (step < self.k_stop)
         u, b = chunk.impact_velocity[hit], self._batch(step[hit])
-        self.sum_u += np.bincount(b, weights=u, minlength=self.n_batches)
-        self.sum_u2 += np.bincount(b, weights=u * u, minlength=self.n_batches)
-
-    @staticmethod
-    def empty():
-        """The residuals' keys, NaN: not computed (a two-wall cell)."""
-        nan = math.nan
-        return dict(power_residual=nan, power_residual_stderr=nan, power_input=nan,
-                    virial_residual=nan, virial_residual_stderr=nan, virial_scale=nan)
+        if not self.two:
+            self.sum_u += np.bincount(b, weights=u, minlength=self.n_batches)
+            self.sum_u2 += np.bincount(b, weights=u * u, minlength=self.n_batches)
+            return
+        wall = np.asarray(chunk.impact_wall)[hit]
+        for w in (0, 1):
+            at = wall == w
+            self.sum_u[w] += np.bincount(b[at], weights=u[at], minlength=self.n_batches)
+            self.sum_u2[w] += np.bincount(b[at], weights=u[at] ** 2, minlength=self.n_batches)
 
     def result(self):
         """The residuals and their errors, as ``event_statistics`` keys (NaN: no batches)."""
@@ -492,9 +454,10 @@ class _IdentityRecord:
             nan = math.nan
             return dict(power_residual=nan, power_residual_stderr=nan, power_input=nan,
                         virial_residual=nan, virial_residual_stderr=nan, virial_scale=nan)
+        walls = {} if not self.two else dict(gap=p["gap"], eps_lower=p["eps_lower"])
         res = stats.identity_residuals(self.moments, self.sum_u, self.sum_u2,
                                        self.steps * self.dt, zeta=p["zeta"], eps=p["eps"],
-                                       delta=p["delta"])
+                                       delta=p["delta"], **walls)
         return dict(power_residual=res.power, power_residual_stderr=res.power_stderr,
                     power_input=res.power_input, virial_residual=res.virial,
                     virial_residual_stderr=res.virial_stderr, virial_scale=res.virial_scale)
@@ -529,7 +492,7 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     acc_f = stats.WelchAccumulator(dt, nperseg)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=t_end, record_every=1, chunk_size=chunk_size,
-                                 **_walls(gap, eps_lower)):
+                                 **_walls(gap, eps_lower, eps)):
         k = np.rint(chunk.grid_time / dt).astype(np.int64)
         keep = k >= skip
         if not keep.any():
@@ -551,7 +514,7 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=
     ``t_end`` longer than the noise record raises ValueError.
     """
     t_end = _record_end(noise, dt, t_end)
-    walls = _walls(gap, eps_lower)
+    walls = _walls(gap, eps_lower, eps)
     res = next(iter(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                     beta=beta_f, t_end=t_end, record_every=1,
                                     chunk_size=int(math.ceil(t_end / dt)) + 1, **walls)))
@@ -642,7 +605,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     """
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
-    walls = _walls(gap, eps_lower)
+    walls = _walls(gap, eps_lower, eps)
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next, **walls)
     events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
@@ -757,7 +720,7 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         raise ValueError(f"record_length = {record_length!r} after the transient "
                          f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
                          f"holds {len(noise)}")
-    walls = _walls(gap, eps_lower)
+    walls = _walls(gap, eps_lower, eps)
     events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     k = 0
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,

@@ -142,6 +142,22 @@ META = {
              "above)", "1"),
     "impact_wall": ("wall of the impact (0: upper, at delta; 1: lower, at delta - gap)", "1"),
     "wall_n_collisions": ("number of collisions at the wall", "1"),
+    "wall_collision_rate_lo": ("lower end of the 95 % interval of the wall's collision rate",
+                               "1"),
+    "wall_collision_rate_hi": ("upper end of the 95 % interval of the wall's collision rate",
+                               "1"),
+    "wall_count_dispersion": ("index of dispersion of the wall's collision counts in B equal "
+                              "stretches of time", "1"),
+    "wall_interval_stderr": ("standard error of the wall's mean interval T/N_w", "1"),
+    "wall_v_after_stderr": ("standard error of the wall's mean velocity after impact", "1"),
+    "wall_v_after_beyond": ("fraction of the wall's velocities after impact beyond the last "
+                            "bin", "1"),
+    "wall_interval_beyond": ("fraction of the wall's intervals beyond the last bin", "1"),
+    "wall_ratio_density": ("probability density of z_j / z between collisions at the wall",
+                           "1"),
+    "wall_ratio_density_stderr": ("batch-means standard error of the wall's density of "
+                                  "z_j / z", "1"),
+    "wall_ratio_beyond": ("fraction of the wall's ratios z_j / z beyond the last bin", "1"),
     "wall_collision_rate": ("collisions at the wall per unit time", "1"),
     "wall_v_after_mean": ("mean velocity after impact at the wall (eps_w u, per collision)",
                           "1"),
@@ -216,28 +232,25 @@ def _motion_names(motions):
     return [motion_key(m) for m in motions]
 
 
-#: The walls of a two-wall dataset's ``wall`` dimension (`pipeline.cells.WALLS`).
+#: The walls of a two-wall dataset's ``wall`` dimension (`stats.WALLS`).
 WALLS = ("upper", "lower")
-#: Per-wall statistics of a two-wall events tile: scalars over ``wall``, densities over
-#: ``wall`` and their bins.
-_WALL_SCALARS = ("wall_n_collisions", "wall_collision_rate", "wall_v_after_mean",
-                 "wall_v_after_mean_lo", "wall_v_after_mean_hi", "wall_interval_mean",
-                 "wall_interval_mean_lo", "wall_interval_mean_hi", "wall_stuck_fraction")
-_WALL_DENSITIES = (("wall_v_after_density", "v_after"),
-                   ("wall_v_after_density_stderr", "v_after"),
-                   ("wall_interval_density", "interval"),
-                   ("wall_interval_density_stderr", "interval"))
-_MAP_WALL_SCALARS = ("wall_n_collisions", "wall_collision_rate", "wall_v_after_mean")
+#: The bins of each per-wall density (`stats.wall_statistics`: ``wall_<quantity>_density``).
+_WALL_BINS = {"wall_v_after": "v_after", "wall_interval": "interval", "wall_ratio": "ratio"}
 
 
-def _add_walls(data, coords, results, scalars, densities=()):
-    """The per-wall variables of a two-wall tile (when its results carry them)."""
-    if scalars[0] not in results[0]:
+def _add_walls(data, coords, results):
+    """The per-wall variables of a two-wall tile (the results' ``wall_*`` arrays, wall
+    first): scalars over ``(cell, wall)``, densities over ``(cell, wall, <their bins>)``."""
+    names = [k for k in results[0] if k.startswith("wall_")]
+    if not names:
         return
-    for name in scalars:
-        data[name] = (("cell", "wall"), np.stack([r[name] for r in results]))
-    for name, dim in densities:
-        data[name] = (("cell", "wall", dim), np.stack([r[name] for r in results]))
+    for name in names:
+        values = np.stack([np.asarray(r[name]) for r in results])
+        if values.ndim == 2:
+            data[name] = (("cell", "wall"), values)
+        else:
+            dim = _WALL_BINS[name.removesuffix("_stderr").removesuffix("_density")]
+            data[name] = (("cell", "wall", dim), values)
     coords["wall"] = list(WALLS)
 
 
@@ -272,7 +285,7 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
             for name in ("rule_motion_probability", "rule_motion_stick_probability"):
                 data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
-    _add_walls(data, coords, results, _WALL_SCALARS, _WALL_DENSITIES)
+    _add_walls(data, coords, results)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -313,7 +326,7 @@ def map_tile(cells, results, motions, attrs):
         for name in ("rule_probability", "rule_stick_probability"):
             data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
-    _add_walls(data, coords, results, _MAP_WALL_SCALARS)
+    _add_walls(data, coords, results)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
