@@ -521,16 +521,9 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=
     k = np.rint(res.grid_time / dt).astype(np.int64)
     r = np.asarray(noise[k[0] : k[-1] + 1], dtype=float)
     f = r + amplitude * np.sin(beta_f * res.grid_time)
-    if walls:       # grouped here, with the hops of each wall (`_EventRecord`)
-        events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f,
-                              **walls)
-        events.add(res)
-        collision = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, 0.0).impact_collision
-    else:
-        collision = res.impact_collision
     out = dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
                impact_time=res.impact_time, impact_velocity=res.impact_velocity,
-               impact_collision=collision)
+               impact_collision=res.impact_collision)
     if walls:
         out["impact_wall"] = np.asarray(res.impact_wall, dtype=np.int8)
     return out
