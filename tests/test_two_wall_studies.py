@@ -6,7 +6,8 @@ import yaml
 
 from vibroimpact.pipeline import cells, datasets
 from vibroimpact.pipeline import config as configuration
-from vibroimpact.pipeline.study import JOB_KEYS, ORBIT_JOB_KEYS, Study, study_model
+from vibroimpact.pipeline.cells import study_model
+from vibroimpact.pipeline.study import JOB_KEYS, ORBIT_JOB_KEYS, Study
 from vibroimpact.stats import motions as motion_stats
 
 from helpers import ROOT

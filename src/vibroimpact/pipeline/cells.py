@@ -14,6 +14,7 @@ from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
+from vibroimpact.model import Model
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
 log = logging.getLogger("vibroimpact")
@@ -55,6 +56,15 @@ def _lag1_check(name, result, cell):
 #: The walls of a two-wall dataset, in the order of its ``wall`` dimension (the simulator's
 #: ``impact_wall``: 0 the wall at delta, 1 the wall at delta - gap).
 WALLS = ("upper", "lower")
+
+
+def study_model(study, cell):
+    """The resolved :class:`vibroimpact.model.Model` of one cell of ``study``
+    (`pipeline.study.Study`): its oscillator and walls at the cell's play, forced by
+    ``amplitude sin(tau / inv_beta)``. Here, beside the simulator, not on `Study`: reading a
+    config or drawing a figure loads no kernel (the import contracts, pyproject.toml)."""
+    return Model.paper(study.zeta, study.eps, cell.delta, study.amplitude,
+                       1.0 / cell.inv_beta, **study.walls())
 
 
 def _walls(gap, eps_lower, eps=None):

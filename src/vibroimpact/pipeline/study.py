@@ -192,17 +192,6 @@ class Study:
         return self.cells(kind)[t::n]
 
 
-def study_model(study, cell):
-    """The resolved :class:`vibroimpact.model.Model` of one cell of ``study``: its oscillator
-    and walls at the cell's play, forced by ``amplitude sin(tau / inv_beta)`` (a function, not
-    a method of `Study`: only the jobs that simulate reach the model and its kernels' layout,
-    so a figure's code digest stays free of them)."""
-    from vibroimpact.model import Model
-
-    return Model.paper(study.zeta, study.eps, cell.delta, study.amplitude,
-                       1.0 / cell.inv_beta, **study.walls())
-
-
 def walls(entry, where):
     """``(gap, eps_lower)`` of a study or ``orbits`` entry: ``(None, None)`` with one wall;
     with a ``gap``, ``eps_lower`` defaults to the entry's ``eps``.

@@ -126,8 +126,8 @@ def _rebound_floor(block):
 
 
 def _physics(study, cell):
-    """The cell's resolved model (`study.study_model`) as the keywords of `pipeline.cells`."""
-    from vibroimpact.pipeline.study import study_model    # the jobs that simulate only
+    """The cell's resolved model (`cells.study_model`) as the keywords of `pipeline.cells`."""
+    from vibroimpact.pipeline.cells import study_model    # the jobs that simulate only
 
     params = study_model(study, cell).params()
     params["beta_f"] = params.pop("beta")
