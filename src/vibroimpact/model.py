@@ -18,8 +18,10 @@ A machine designer's symmetric stops at ``+-g/2`` about an offset ``x_c`` are
 
 Each wall has its own impact law. The law is :class:`Restitution` (Newton's law, the
 paper's eq. 7: the velocity after impact is ``-eps`` times the velocity before); it is the
-one place that law is written (:func:`rebound_velocity` is its numba form, which the
-simulator's kernel calls).
+one place that law is written: :func:`rebound_velocity`, with its derivative
+:func:`rebound_derivative` and its ratio :func:`rebound_ratio` beside it (plain Python;
+:mod:`vibroimpact._law` compiles them once for the kernels, docs/architecture.md "Adding
+physics").
 """
 from dataclasses import dataclass, field
 import math
@@ -41,6 +43,27 @@ def rebound_velocity(eps, u):
     so numba compiles it into the kernels as it is (``vibroimpact.impact.stepping``).
     """
     return -eps * u
+
+
+def rebound_derivative(eps, u):
+    """``d rebound_velocity / du`` at the approach velocity ``u``: the impact's tangent
+    (the orbit solver's and the attractors' Jacobians, the saltation matrix).
+
+    Newton's law: ``-eps``. A new law edits this beside :func:`rebound_velocity`
+    (tests/test_impact_law.py holds the pair to a finite difference).
+    """
+    return -eps
+
+
+def rebound_ratio(eps, u):
+    """``rebound_velocity(eps, u) / u``: the saltation matrix's position entry, and the
+    orbit solver's ``-v_+ = -rebound_ratio * u`` in its Jacobians' ``d/dtau`` entries.
+
+    Newton's law: ``-eps``, written out so that it is ``-eps`` to the last bit (the quotient
+    ``(-eps * u) / u`` is not). A new law edits this beside :func:`rebound_velocity`
+    (tests/test_impact_law.py holds the three to one another).
+    """
+    return -eps
 
 
 @dataclass(frozen=True)
