@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import json
 import re
 from pathlib import Path
 
@@ -17,6 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from vibroimpact._files import atomic_path
+from vibroimpact._symbols import PARAMETERS, fixed_caption
 from vibroimpact.stats.events import poisson_interval, t_quantile
 from vibroimpact.stats.spectra import line_power
 from vibroimpact.stats.theory import upcrossing_rate
@@ -108,6 +110,10 @@ LABELS = {
     "S_f": r"PSD $S_f(\beta)$",
     "S": r"degree of stability $S$",
 }
+#: Every parameter a map's plane may run over has its label here too (`vibroimpact._symbols`:
+#: zeta, eps, eps_lower, gap, amplitude, rms; delta and inv_beta as above).
+LABELS.update({name: label for name, (_, _, label) in PARAMETERS.items()
+               if name not in LABELS})
 
 
 def axis_label(da, extra=""):
@@ -286,7 +292,7 @@ def no_collision_text(ds, where="in this record at any $\\delta$"):
         return text + "\nthe force is zero (rms$_r$ = 0, no harmonic): the mass stays at rest"
     if rms == 0.0:
         return text + " (rms$_r$ = 0)"
-    if sigma_x > 0.0 and sigma_v > 0.0:
+    if sigma_x > 0.0 and sigma_v > 0.0 and "delta" in ds.variables:
         smallest = float(np.min(np.asarray(ds["delta"], dtype=float)))
         text += ("\n" + rf"its smallest $\delta$ = {_num(smallest)} is "
                  rf"{_num(smallest / sigma_x)} $\sigma_x$ of the wall-free response "
@@ -309,6 +315,79 @@ def _system_text(ds):
         text += (rf";  lower wall at $\delta$ - {_num(ds.attrs['gap'])}, "
                  rf"$\varepsilon_l$ = {_num(ds.attrs['eps_lower'])}")
     return text
+
+
+# --------------------------------------------------------------------------------------------
+# The plane of a map (issue 36): its two axes and what it holds fixed
+# --------------------------------------------------------------------------------------------
+
+#: The paper's plane: a map dataset without ``attrs["axes"]`` runs over it.
+DEFAULT_PLANE = ("inv_beta", "delta")
+#: Global attributes a map dataset of the paper's plane carries for its fixed parameters
+#: (the fixed caption of a dataset without ``attrs["fixed"]``), by parameter name.
+FIXED_ATTRS = {"zeta": "zeta", "eps": "eps", "eps_lower": "eps_lower", "delta": "delta",
+               "gap": "gap", "amplitude": "amplitude", "inv_beta": "inv_beta",
+               "rms": "noise_rms"}
+
+
+def _decoded(value, what):
+    """An attribute stored as JSON text (or already decoded by the reader)."""
+    if isinstance(value, (bytes, str)):
+        try:
+            return json.loads(value)
+        except ValueError:
+            raise ValueError(f"attrs[{what!r}] must be JSON text, got {value!r}") from None
+    return value
+
+
+def plane_axes(ds):
+    """The names ``(x, y)`` of a map's two axes: ``ds.attrs["axes"]`` (x first), else the
+    paper's ``("inv_beta", "delta")``; each must be a dimension of `ds`."""
+    axes = ds.attrs.get("axes")
+    if axes is None:
+        return DEFAULT_PLANE
+    if isinstance(axes, (bytes, str)):
+        text = axes.decode() if isinstance(axes, bytes) else axes
+        axes = _decoded(text, "axes") if text.lstrip().startswith("[") else text.split()
+    axes = tuple(str(a) for a in np.atleast_1d(axes))
+    if len(axes) != 2 or axes[0] == axes[1]:
+        raise ValueError(f"attrs['axes'] must name two different parameters, got {axes!r}")
+    missing = [a for a in axes if a not in ds.dims]
+    if missing:
+        raise ValueError(f"the plane's axes {list(axes)} must be dimensions of the dataset; "
+                         f"{missing} is not among {list(ds.dims)}")
+    return axes
+
+
+def custom_plane(ds):
+    """Whether a map dataset names its plane (``attrs["axes"]``): its figures then write the
+    fixed caption (`plane_fixed`) in place of the paper's parameter line."""
+    return "axes" in ds.attrs
+
+
+def plane_fixed(ds):
+    """``{name: value}`` of what a map holds fixed: ``ds.attrs["fixed"]`` (JSON text of a
+    dict), else the parameters among the global attributes (`FIXED_ATTRS`); never an axis."""
+    axes = plane_axes(ds)
+    if "fixed" in ds.attrs:
+        fixed = _decoded(ds.attrs["fixed"], "fixed")
+        if not isinstance(fixed, dict):
+            raise ValueError(f"attrs['fixed'] must be a dict, got {fixed!r}")
+    else:
+        fixed = {name: ds.attrs[key] for name, key in FIXED_ATTRS.items() if key in ds.attrs}
+    return {k: v for k, v in fixed.items() if k not in axes}
+
+
+def plane_caption(ds, math=True):
+    """``"fixed: ζ = 0.05, A = 1, 1/β_f = 1.1, σ_r = 0.29"`` of a map dataset (`plane_fixed`)."""
+    text = fixed_caption(plane_fixed(ds), math=math)
+    return f"fixed: {text}" if text else "nothing fixed"
+
+
+def on_plane(da, ds):
+    """`da` with its plane's axes last, x before y (a ``(..., x, y)`` array for drawing)."""
+    x, y = plane_axes(ds)
+    return da.transpose(..., x, y)
 
 
 def motion_title(name):

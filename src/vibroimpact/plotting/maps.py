@@ -18,8 +18,10 @@ from matplotlib.path import Path
 
 from vibroimpact import stats
 from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _same_system,
-                                          _styled, _system_text, axis_label,
-                                          motion_title, no_collision_text, note_on_axes)
+                                          _spectrum_parts, _styled, _system_text, axis_label,
+                                          custom_plane, motion_title, no_collision_text,
+                                          note_on_axes, on_plane, plane_axes, plane_caption,
+                                          plane_fixed)
 
 #: Probability contours (%) of Fig. 15 (the paper draws 10 % steps).
 PROBABILITY_LEVELS = (10, 20, 30, 40, 50, 60, 70, 80, 90)
@@ -324,7 +326,24 @@ def _map_text(ds):
 
 
 def _grid(ds):
-    return ds["inv_beta"].values, ds["delta"].values
+    """Cell centres ``(x, y)`` along the map's two axes (`plane_axes`)."""
+    x, y = plane_axes(ds)
+    return ds[x].values, ds[y].values
+
+
+def _plane_forcing_text(ds):
+    """The force of a map over a named plane: ``f(tau) = A sin(beta_f tau) + r(tau)`` (the
+    spectrum's kind and cut-off; its rms and A, when fixed, are in the fixed caption)."""
+    spectrum = ", ".join(_spectrum_parts(ds.attrs))
+    return (r"$f(\tau)$ = $A\sin(\beta_f\tau) + r(\tau)$"
+            + (f" ({spectrum})" if spectrum else ""))
+
+
+def _map_params(ds):
+    """The header's parameter line: the paper's for its plane, else the fixed caption."""
+    if not custom_plane(ds):
+        return f"{_system_text(ds)};  {_map_forcing_text(ds)}"
+    return f"{plane_caption(ds)};  {_plane_forcing_text(ds)}"
 
 
 def _cliff_handle(lw):
@@ -337,8 +356,7 @@ def _finish_figure(fig, motion_map, handles, title):
     """Legend below the panels and the header: system, forcing, the map's statistics."""
     if handles:
         fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
-    _header(fig, title, f"{_system_text(motion_map)};  {_map_forcing_text(motion_map)}\n"
-                        f"{_map_text(motion_map)}")
+    _header(fig, title, f"{_map_params(motion_map)}\n{_map_text(motion_map)}")
     return fig
 
 
@@ -346,12 +364,13 @@ def _finish_axes(axes, ds):
     """Labels, the grid's extent (from centre to centre, as the filled contours) and, on a
     map without a collision, the words."""
     x, y = _grid(ds)
+    x_name, y_name = plane_axes(ds)
     empty = "n_collisions" in ds and int(ds["n_collisions"].sum()) == 0
     for ax in axes:
         ax.set_xlim(*(x if x.size > 1 else cell_edges(x))[[0, -1]])
         ax.set_ylim(*(y if y.size > 1 else cell_edges(y))[[0, -1]])
-        ax.set_xlabel(axis_label(ds["inv_beta"]))
-        ax.set_ylabel(axis_label(ds["delta"]))
+        ax.set_xlabel(axis_label(ds[x_name]))
+        ax.set_ylabel(axis_label(ds[y_name]))
         ax.label_outer()
         if empty:
             note_on_axes(ax, no_collision_text(ds, where="in any cell\nof this map"))
@@ -387,11 +406,13 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         cap stopped the cell before the target precision.
     """
     motions = [str(m) for m in motion_map["motion"].values]
-    panels = [(motion_title(m), motion_map["probability"].sel(motion=m).values)
+    panels = [(motion_title(m), on_plane(motion_map["probability"].sel(motion=m),
+                                         motion_map).values)
               for m in motions]
     if "stick_probability" in motion_map:
         panels.append((" + ".join(motion_title(m) for m in motions) + " with sticking",
-                       motion_map["stick_probability"].sum("motion").values))
+                       on_plane(motion_map["stick_probability"].sum("motion"),
+                                motion_map).values))
     x, y = _grid(motion_map)
     # two panels a row: at a page's width four in a row left the labels tiny
     ncols = min(len(panels), FIG15_COLUMNS)
@@ -402,8 +423,8 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
     for ax in grid[len(panels):]:
         ax.set_visible(False)
     axes = grid[:len(panels)]
-    few = motion_map["few_switches"].values.astype(bool)
-    short = ~motion_map["reached"].values.astype(bool)
+    few = on_plane(motion_map["few_switches"], motion_map).values.astype(bool)
+    short = ~on_plane(motion_map["reached"], motion_map).values.astype(bool)
     fill_levels = [0.0, *levels, 100.0]
     shaded, has_cliff = None, False
     for ax, (title, prob) in zip(axes, panels):
@@ -422,7 +443,7 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
     _finish_axes(axes, motion_map)
     for ax in grid[len(panels) - ncols:len(panels)]:
         ax.xaxis.set_tick_params(labelbottom=True)      # under a hidden panel's place too
-        ax.set_xlabel(axis_label(motion_map["inv_beta"]))
+        ax.set_xlabel(axis_label(motion_map[plane_axes(motion_map)[0]]))
     fig.colorbar(shaded, ax=grid.tolist(), label="probability of the motion (%)",
                  shrink=0.6, pad=0.02, aspect=30)
     handles = [few_switches_handle(motion_map)] if few.any() else []
@@ -437,10 +458,32 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
 
 def _orbits_on(motion_map, orbits, name):
     """``(stable, S)`` of motion `name` on the map's grid (nearest orbit-map cell)."""
-    sel = orbits.sel(type=name).sel(inv_beta=motion_map["inv_beta"], delta=motion_map["delta"],
-                                    method="nearest")
-    stable = sel["n_stable"].values > 0
-    return stable, np.where(stable, sel["S"].values, np.nan)
+    x, y = plane_axes(motion_map)
+    sel = orbits.sel(type=name).sel({x: motion_map[x], y: motion_map[y]}, method="nearest")
+    stable = on_plane(sel["n_stable"], motion_map).values > 0
+    return stable, np.where(stable, on_plane(sel["S"], motion_map).values, np.nan)
+
+
+#: Parameters a map and the orbit map drawn under it must share (the noise's are the map's
+#: alone: the orbit map has none).
+SHARED_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta")
+
+
+def _same_plane(motion_map, orbits):
+    """Raise unless a map and an orbit map are of one system over one plane: the paper's
+    check (zeta, eps) for its plane; over a named plane the same axes and the same value of
+    every parameter both hold fixed (`SHARED_PARAMETERS`)."""
+    if not custom_plane(motion_map) and not custom_plane(orbits):
+        _same_system(motion_map, orbits, ("the map", "the orbit map"))
+        return
+    if plane_axes(motion_map) != plane_axes(orbits):
+        raise ValueError(f"the map runs over {list(plane_axes(motion_map))} but the orbit map "
+                         f"over {list(plane_axes(orbits))}: not the same plane")
+    a, b = plane_fixed(motion_map), plane_fixed(orbits)
+    for key in SHARED_PARAMETERS:
+        if key in a and key in b and float(a[key]) != float(b[key]):
+            raise ValueError(f"the map has {key} = {a[key]!r} but the orbit map {b[key]!r}: "
+                             f"not the same system")
 
 
 def map_agreement(motion_map, orbits, threshold=0.5):
@@ -453,7 +496,7 @@ def map_agreement(motion_map, orbits, threshold=0.5):
     out = {}
     for name in shared:
         stable, S = _orbits_on(motion_map, orbits, name)
-        p = motion_map["probability"].sel(motion=name).values
+        p = on_plane(motion_map["probability"].sel(motion=name), motion_map).values
         out[name] = stats.motion_map_agreement(p, stable, S, threshold)
     return out
 
@@ -492,29 +535,29 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
         cells with probability >= 50 % inside the stable domain; share of the domain where
         the motion dominates; Spearman's rank correlation of probability and S there).
     """
-    _same_system(motion_map, orbits, ("the map", "the orbit map"))
+    _same_plane(motion_map, orbits)
     agreement = map_agreement(motion_map, orbits)
     if not agreement:
         raise ValueError(f"no motion of the map {list(motion_map['motion'].values)} is in the "
                          f"orbit map {list(orbits['type'].values)}")
     x, y = _grid(motion_map)
-    xo, yo = orbits["inv_beta"].values, orbits["delta"].values
+    xo, yo = (orbits[name].values for name in plane_axes(motion_map))
     fig = Figure(figsize=(4.0 * len(agreement) + 0.5, 4.8))
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(agreement), sharex=True, sharey=True, squeeze=False).ravel()
-    few = motion_map["few_switches"].values.astype(bool)
+    few = on_plane(motion_map["few_switches"], motion_map).values.astype(bool)
     has_cliff = False
     for k, (ax, name) in enumerate(zip(axes, agreement)):
         sel = orbits.sel(type=name)
-        stable = sel["n_stable"].values > 0
+        stable = on_plane(sel["n_stable"], motion_map).values > 0
         color = TYPE_COLORS[k % len(TYPE_COLORS)]
         if stable.any():
             ax.contourf(xo, yo, stable.T.astype(float), levels=[0.5, 1.5], colors=["0.88"])
-            S = np.where(stable, sel["S"].values, np.nan)
+            S = np.where(stable, on_plane(sel["S"], motion_map).values, np.nan)
             ax.contour(xo, yo, S.T, levels=S_LEVELS, colors="0.55", linewidths=0.4)
             ax.contour(xo, yo, stable.T.astype(float), levels=[0.5], colors="0.3",
                        linewidths=1.0)
-        p = 100.0 * motion_map["probability"].sel(motion=name).values
+        p = 100.0 * on_plane(motion_map["probability"].sel(motion=name), motion_map).values
         widths = [1.8 if level == CLIFF_LEVEL else 0.8 for level in levels]
         lines, cliff = probability_contours(ax, x, y, p, levels, colors=[color],
                                             linewidths=widths)
@@ -582,8 +625,8 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
     states = [str(s) for s in stay["state"].values]
     x, y = _grid(motion_map)
     xe, ye = cell_edges(x), cell_edges(y)
-    t = stay["residence_time"].values
-    n = stay["n_stretches"].values
+    t = on_plane(stay["residence_time"], motion_map).values
+    n = on_plane(stay["n_stretches"], motion_map).values
     shown = np.isfinite(t) & (t > 0)
     norm = (LogNorm(vmin=float(t[shown].min()), vmax=max(float(t[shown].max()),
                                                           1.01 * float(t[shown].min())))
@@ -593,7 +636,8 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
     axes = fig.subplots(1, len(states), sharex=True, sharey=True, squeeze=False).ravel()
     mesh = None
     few_any = False
-    cut = ((n == 0) & (stay["n_censored"].values > 0) if "n_censored" in stay
+    cut = ((n == 0) & (on_plane(stay["n_censored"], motion_map).values > 0)
+           if "n_censored" in stay
            else np.zeros(n.shape, bool))
     for k, (ax, name, ts, ns, ok) in enumerate(zip(axes, states, t, n, shown)):
         if ok.any():

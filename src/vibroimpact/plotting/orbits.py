@@ -10,7 +10,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from vibroimpact.plotting._common import (_attr, _header, _nearest, _same_system, _styled,
-                                          _system_text, axis_label)
+                                          _system_text, axis_label, custom_plane,
+                                          motion_title, on_plane, plane_axes, plane_caption,
+                                          plane_fixed)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -56,19 +58,48 @@ CODIM2_STYLE = dict(ls="none", marker="o", ms=4.5, mfc="white", mew=1.0, zorder=
 COMPLEX_RTOL = 1e-7
 
 
-def complex_multipliers(orbits, m, n):
+def _on_cells(orbits, name):
+    """Parameter `name` at every cell of an orbit map's plane, shape (x, y): its coordinate
+    when it is an axis, else its fixed value (`plane_fixed`; the paper's plane: attributes)."""
+    x, y = plane_axes(orbits)
+    shape = (orbits[x].size, orbits[y].size)
+    if name == x:
+        return np.broadcast_to(np.asarray(orbits[x], dtype=float)[:, None], shape)
+    if name == y:
+        return np.broadcast_to(np.asarray(orbits[y], dtype=float)[None, :], shape)
+    fixed = plane_fixed(orbits)
+    if name not in fixed:
+        raise KeyError(f"the orbit map neither runs over nor fixes {name!r}")
+    return np.full(shape, float(fixed[name]))
+
+
+def type_counts(name):
+    """``(m, n, m_lower)`` of a motion type's name: ``"2/1"`` is (2, 1, 0), a two-wall
+    ``"(1,1)/1"`` is (2, 1, 1) (m counts the impacts on both walls)."""
+    counts, n = name.rsplit("/", 1)
+    if counts.startswith("("):
+        upper, lower = (int(k) for k in counts.strip("()").split(","))
+        return upper + lower, int(n), lower
+    return int(counts), int(n), 0
+
+
+def complex_multipliers(orbits, m, n, m_lower=0):
     """Where the most stable (m/n) motion has a complex pair of multipliers.
 
     Parameters
     ----------
     orbits : xarray.Dataset
-        Orbit map of one type: ``lam(inv_beta, delta)``; global attributes ``zeta``, ``eps``.
+        Orbit map of one type: ``lam`` over its plane (``(inv_beta, delta)``, or the two axes
+        of ``attrs["axes"]``); zeta, eps and 1/beta from the axes or the fixed values
+        (global attributes ``zeta``, ``eps`` on the paper's plane).
     m, n : int
-        The motion type.
+        The motion type (m impacts in all, per n forcing periods).
+    m_lower : int
+        Of the m impacts, those on a second wall (restitution ``eps_lower``).
 
     Returns
     -------
-    ndarray of bool, shape (inv_beta, delta)
+    ndarray of bool, shape (x, y)
 
     Notes
     -----
@@ -76,14 +107,26 @@ def complex_multipliers(orbits, m, n):
     Section 8.7), so there ``lam = eps e^(-zeta z / m)`` and ``S = 100 (1 - lam)`` depend on
     1/beta alone (``z = 2 pi n / beta``): contours of S are vertical lines there. Where the
     multipliers turn real, S leaves that value with infinite slope (a square-root branch), so
-    contour levels interpolated across the switch are artefacts of the grid.
+    contour levels interpolated across the switch are artefacts of the grid. With two walls
+    ``det T = eps^(2 m_u) eps_l^(2 m_l) e^(-2 zeta z)``, so ``eps`` above becomes
+    ``(eps^m_u eps_l^m_l)^(1/m)``.
     """
-    zeta, eps = float(_attr(orbits, "zeta")), float(_attr(orbits, "eps"))
-    z = 2.0 * np.pi * n * np.asarray(orbits["inv_beta"], dtype=float)
-    lam_c = eps * np.exp(-zeta * z / m)
-    lam = np.asarray(orbits["lam"], dtype=float)
+    if not custom_plane(orbits):
+        zeta, eps = float(_attr(orbits, "zeta")), float(_attr(orbits, "eps"))
+        z = 2.0 * np.pi * n * np.asarray(orbits["inv_beta"], dtype=float)
+        lam_c = (eps * np.exp(-zeta * z / m))[:, None]
+    else:
+        zeta, eps = _on_cells(orbits, "zeta"), _on_cells(orbits, "eps")
+        if m_lower:
+            fixed = plane_fixed(orbits)
+            lower = (_on_cells(orbits, "eps_lower") if "eps_lower" in plane_axes(orbits)
+                     or "eps_lower" in fixed else eps)
+            eps = (eps ** (m - m_lower) * lower ** m_lower) ** (1.0 / m)
+        z = 2.0 * np.pi * n * _on_cells(orbits, "inv_beta")
+        lam_c = eps * np.exp(-zeta * z / m)
+    lam = on_plane(orbits["lam"], orbits).values.astype(float)
     with np.errstate(invalid="ignore"):
-        return lam <= lam_c[:, None] * (1.0 + COMPLEX_RTOL)
+        return lam <= lam_c * (1.0 + COMPLEX_RTOL)
 
 
 def _box_cells(ax, word, shape):
@@ -311,6 +354,10 @@ def fig16(orbits, boundaries=None):
 
     if boundaries is not None and not int(boundaries.attrs.get("traced", 1)):
         boundaries = None           # not traced (eps = 0): the cell edges, as without them
+    if boundaries is not None and custom_plane(orbits):
+        raise ValueError(f"the exact boundaries are traced over the (inv_beta, delta) plane "
+                         f"only; this orbit map runs over {list(plane_axes(orbits))}: draw it "
+                         f"without boundaries")
     if boundaries is not None:
         _same_system(boundaries, orbits, ("the boundaries", "the orbit map"))
     types = [str(t) for t in orbits["type"].values]
@@ -319,8 +366,9 @@ def fig16(orbits, boundaries=None):
     fig = Figure(figsize=(10.0, 3.3 * nrows))
     FigureCanvasAgg(fig)
     axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False).ravel()
-    x = orbits["inv_beta"].values
-    y = orbits["delta"].values
+    x_name, y_name = plane_axes(orbits)
+    x = orbits[x_name].values
+    y = orbits[y_name].values
     xe, ye = cell_edges(x), cell_edges(y)
     overview = axes[0]
     reason_cmap = ListedColormap([REASONS[c][0] for c in sorted(REASONS)])
@@ -328,23 +376,23 @@ def fig16(orbits, boundaries=None):
     for i, name in enumerate(types):
         sel = orbits.sel(type=name)
         color = TYPE_COLORS[i % len(TYPE_COLORS)]
-        stable = sel["n_stable"].values > 0
+        stable = on_plane(sel["n_stable"], orbits).values > 0
         panels[name] = (axes[i + 1], color)
         if boundaries is None:
             overview.add_collection(LineCollection(cell_outline(x, y, stable), colors=[color],
                                                    linewidths=1.3, capstyle="projecting"))
-        overview.plot([], [], color=color, lw=1.8, label=f"({name})")
+        overview.plot([], [], color=color, lw=1.8, label=motion_title(name))
         ax = axes[i + 1]
-        reason = sel["reason"].values
+        reason = on_plane(sel["reason"], orbits).values
         ax.pcolormesh(xe, ye, np.ma.masked_where(stable, reason).T, cmap=reason_cmap,
                       vmin=min(REASONS) - 0.5, vmax=max(REASONS) + 0.5, rasterized=True)
-        S = np.where(stable, sel["S"].values, np.nan)
+        S = np.where(stable, on_plane(sel["S"], orbits).values, np.nan)
         # cell by cell (a domain one cell wide included), rasterized in the PDF
         shaded = ax.pcolormesh(xe, ye, np.ma.masked_invalid(S).T, cmap="viridis_r", vmin=0.0,
                                vmax=100.0, rasterized=True)
         if stable.any():
-            m, n = (int(k) for k in name.split("/"))
-            cplx = complex_multipliers(sel, m, n) & stable
+            m, n, m_lower = type_counts(name)
+            cplx = complex_multipliers(sel, m, n, m_lower) & stable
             real = np.where(cplx, np.nan, S).T
             if np.isfinite(real).any():
                 lines = ax.contour(x, y, real, levels=S_LEVELS, colors="k", linewidths=0.5)
@@ -361,7 +409,7 @@ def fig16(orbits, boundaries=None):
                                              linewidths=EDGE_WIDTH, capstyle="projecting",
                                              gid="stable-edge"))
         regions.append((ax, reason, stable))
-        ax.set_title(f"({name})")
+        ax.set_title(motion_title(name))
     kinds, marked = ([], False) if boundaries is None else _draw_boundaries(overview, panels,
                                                                             boundaries)
     overview.set_title("(a) stable domains")
@@ -372,12 +420,12 @@ def fig16(orbits, boundaries=None):
     for ax in axes[len(types) + 1:]:
         ax.set_visible(False)
     for ax in axes:
-        ax.set_xlabel(axis_label(orbits["inv_beta"]))
-        ax.set_ylabel(axis_label(orbits["delta"]))
+        ax.set_xlabel(axis_label(orbits[x_name]))
+        ax.set_ylabel(axis_label(orbits[y_name]))
         ax.label_outer()
     for ax in axes[len(types) + 1 - ncols:len(types) + 1]:
         ax.xaxis.set_tick_params(labelbottom=True)
-        ax.set_xlabel(axis_label(orbits["inv_beta"]))
+        ax.set_xlabel(axis_label(orbits[x_name]))
     present = set(np.unique(orbits["reason"].values).tolist())
     handles = [Patch(facecolor=colour, edgecolor="0.6", label=cause)
                for code, (colour, _, cause) in REASONS.items() if code in present]
@@ -401,9 +449,11 @@ def fig16(orbits, boundaries=None):
                      "(white and grey here; it does not say which letter is which region)",
                title_fontsize=7)
     edges = "" if boundaries is None else ";  bold lines: the domains' edges, by kind"
+    system = (rf"{_system_text(orbits)};  $f(\tau) = \sin(\beta_f\tau)$"
+              if not custom_plane(orbits)
+              else rf"{plane_caption(orbits)};  $f(\tau) = A\sin(\beta_f\tau)$")
     _header(fig, "Fig. 16  Parameter domains of stable periodic impact motions",
-            rf"{_system_text(orbits)};  $f(\tau) = \sin(\beta_f\tau)$;  thin lines: "
-            r"contours of the degree of stability $S$ (%)" + edges)
+            rf"{system};  thin lines: contours of the degree of stability $S$ (%)" + edges)
     fig.draw_without_rendering()       # the words are fitted to the panels' final size
     for ax, reason, stable in regions:
         _name_regions(ax, x, y, reason, stable)
