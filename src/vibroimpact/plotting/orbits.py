@@ -24,6 +24,10 @@ REASONS = {
     2: ("0.84", "crosses\nthe wall", "solutions cross the wall: eq. (13) violated"),
     3: ("#f4b6b6", "unstable", "solutions unstable: eq. (22) violated (the paper's U)"),
 }
+#: With two walls the motions come from Newton shooting seeded by settled starts
+#: (`vibroimpact.orbits.shooting`): code 1 says none was found, not that none exists.
+TWO_WALL_REASONS = {**REASONS, 1: ("white", "none found",
+                                   "no motion of the type found from the settled starts")}
 #: Text colour of each reason's region words (dark enough on its own fill).
 REASON_TEXT_COLORS = {1: "0.25", 2: "0.2", 3: "#8b1a1a"}
 #: A reason is named in its largest connected region when that holds `LARGEST_NAMED` of the
@@ -161,7 +165,7 @@ def _marker_cells(ax, x, y):
     return taken
 
 
-def _name_regions(ax, x, y, reason, stable):
+def _name_regions(ax, x, y, reason, stable, reasons=REASONS):
     """Write each reason's words in its sizable regions (with a leader to those too thin).
 
     A word goes where its box fits inside the region (on two lines if it must), as deep
@@ -175,7 +179,7 @@ def _name_regions(ax, x, y, reason, stable):
     taken = stable | _marker_cells(ax, x, y)
     scale = np.array([1.0 / x.size, 1.0 / y.size])        # a cell, as a share of the panel
     for code in (3, 2, 1):       # the thin unstable regions first: they need space near them
-        word = REASONS[code][1]
+        word = reasons[code][1]
         mask = reason == code
         parts, n = ndimage.label(mask)
         sizes = ndimage.sum_labels(mask, parts, np.arange(1, n + 1))
@@ -371,6 +375,8 @@ def fig16(orbits, boundaries=None):
     y = orbits[y_name].values
     xe, ye = cell_edges(x), cell_edges(y)
     overview = axes[0]
+    two_walls = any(str(t).startswith("(") for t in types)
+    reasons = TWO_WALL_REASONS if two_walls else REASONS
     reason_cmap = ListedColormap([REASONS[c][0] for c in sorted(REASONS)])
     shaded, regions, panels = None, [], {}
     for i, name in enumerate(types):
@@ -428,7 +434,7 @@ def fig16(orbits, boundaries=None):
         ax.set_xlabel(axis_label(orbits[x_name]))
     present = set(np.unique(orbits["reason"].values).tolist())
     handles = [Patch(facecolor=colour, edgecolor="0.6", label=cause)
-               for code, (colour, _, cause) in REASONS.items() if code in present]
+               for code, (colour, _, cause) in reasons.items() if code in present]
     if boundaries is None:
         handles.append(Line2D([], [], color="k", lw=EDGE_WIDTH,
                               label="edge of the stable domain (where 3 cells thick or more)"))
@@ -438,9 +444,11 @@ def fig16(orbits, boundaries=None):
     if marked:
         handles.append(Line2D([], [], mec="k", label="codimension two: two edges meet",
                               **CODIM2_STYLE))
+    restitution = (r"(\varepsilon^{m_u}\varepsilon_l^{m_l})^{1/m}" if two_walls
+                   else r"\varepsilon")
     handles += [Line2D([], [], color="0.1", lw=0.9, ls=":",
                        label=r"edge of complex multipliers (inside: $S = 100(1 - "
-                             r"\varepsilon e^{-\zeta z/m})$, no contours)")]
+                             rf"{restitution} e^{{-\zeta z/m}})$, no contours)")]
     if shaded is not None:
         fig.colorbar(shaded, ax=axes[1:].tolist(), label=axis_label(orbits["S"]), shrink=0.8,
                      ticks=np.arange(0, 101, 10))
@@ -456,5 +464,5 @@ def fig16(orbits, boundaries=None):
             rf"{system};  thin lines: contours of the degree of stability $S$ (%)" + edges)
     fig.draw_without_rendering()       # the words are fitted to the panels' final size
     for ax, reason, stable in regions:
-        _name_regions(ax, x, y, reason, stable)
+        _name_regions(ax, x, y, reason, stable, reasons)
     return fig
