@@ -104,7 +104,7 @@ def _axis(name, values, allowed, two_walls):
     if arr.size == 0:
         raise ValueError(f"{name} values must be a non-empty array")
     for v in arr:
-        _check_value(name, v)
+        _check_value(name, float(v))
     return arr
 
 
