@@ -218,3 +218,21 @@ def test_stack_errors_name_the_problem(tmp_path):
         map_stack(a)
     with pytest.raises(ValueError, match=r"motions \['1/2'\] are not in every map"):
         map_stack(a, b, motions=["1/2"])
+
+
+def test_residence_over_another_plane(tmp_path):
+    ds = _plane_map(tmp_path)
+    shape = (ds.sizes["motion"], ds.sizes["delta"], ds.sizes["eps"])
+    time = np.broadcast_to(np.linspace(1.0, 50.0, ds.sizes["eps"]), shape).copy()
+    ds = ds.assign(residence_time=(("motion", "delta", "eps"), time),
+                   n_stretches=(("motion", "delta", "eps"), np.full(shape, 20)),
+                   residence_time_none=(("delta", "eps"), time[0]),
+                   n_stretches_none=(("delta", "eps"), np.full(shape[1:], 20)))
+    fig = plotting.residence(ds)
+    panels = [ax for ax in fig.axes if ax.get_title() in ("(1/1)", "(2/1)", "none")]
+    assert len(panels) == 3
+    mesh = [c for c in panels[0].collections if c.get_gid() == "residence"][0]
+    # cells coloured along eps (x) by the time that grows along eps
+    drawn = mesh.get_array().reshape(ds.sizes["delta"], ds.sizes["eps"])
+    assert np.allclose(drawn[0], np.linspace(1.0, 50.0, ds.sizes["eps"]))
+    assert panels[0].get_xlabel() == r"restitution $\varepsilon$"
