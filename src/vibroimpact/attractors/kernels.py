@@ -168,7 +168,7 @@ def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb
 
 @kernel
 def _params(zeta, eps, delta, h, beta, clearance, eps_lower):
-    """The simulator's parameter vector (:meth:`vibroimpact.model.Model.kernel_parameters`)
+    """The simulator's parameter vector (:meth:`vibroimpact.impact.simulate.model_parameters`)
     for A = 1: one wall when ``clearance`` is infinite, else twice the slots, the second half
     the wall at ``delta - clearance`` in the mirrored frame ``x -> -x``."""
     P1 = _params_upper(zeta, eps, delta, h, beta)

@@ -119,7 +119,7 @@ WALL_LO = 4
 
 # the two walls: the parameter vector ``P`` holds N_PARAMS slots per wall, the upper wall's
 # (the paper's, at x = delta) first; the lower wall's half is that wall in the mirrored frame
-# x -> -x (vibroimpact.model.Model.kernel_parameters), so every search serves both walls.
+# x -> -x (vibroimpact.impact.simulate.model_parameters), so every search serves both walls.
 # In the event buffers the wall is the sign of ``imp_u`` (the lab-frame velocity x' at the
 # impact: > 0 at the upper wall, < 0 at the lower) and the kind of a sticking event:
 STICK_OFF = 0.0      # release from the upper wall

@@ -217,9 +217,48 @@ def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size):
 
 
 def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
-    """The parameter vector ``P`` read by the kernels for the one-wall oscillator (see
-    :meth:`vibroimpact.model.Model.kernel_parameters`, which builds it)."""
-    return Model.paper(zeta, eps, delta, amplitude, beta).kernel_parameters(dt)
+    """The parameter vector ``P`` read by the kernels for the one-wall oscillator
+    (:func:`model_parameters` of the paper's model)."""
+    return model_parameters(Model.paper(zeta, eps, delta, amplitude, beta), dt)
+
+
+def model_parameters(model, dt):
+    """The parameter vector ``P`` the simulator's kernels read, for sample step ``dt``.
+
+    One wall: the ``N_PARAMS`` slots of :mod:`vibroimpact.impact.layout`, exactly as
+    before models existed. Two walls: twice as many; the second half is the lower wall
+    seen in the mirrored frame ``x -> -x`` (force and harmonic amplitude negated, wall
+    at ``-(delta - gap)`` hit from below, its own restitution), so that every search of
+    :mod:`vibroimpact.impact.events` serves both walls unchanged.
+    """
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    zeta, beta, amplitude = model.zeta, model.beta, model.amplitude
+    omega = math.sqrt(1.0 - zeta * zeta)
+    q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
+    phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
+    E = math.exp(-zeta * dt)
+    C, S = math.cos(omega * dt), math.sin(omega * dt)
+    bh_hi, bh_lo = kernels.two_prod(beta, dt)
+    P = np.empty(kernels.N_PARAMS * model.n_walls)
+    P[[kernels.P_ZETA, kernels.P_OMEGA, kernels.P_EPS, kernels.P_DELTA, kernels.P_DT]] = (
+        zeta, omega, model.eps, model.delta, dt)
+    P[[kernels.P_A, kernels.P_BETA, kernels.P_AQ, kernels.P_PHI]] = (
+        amplitude, beta, amplitude * q, phi)
+    P[[kernels.P_COS_PHI, kernels.P_SIN_PHI]] = math.cos(phi), math.sin(phi)
+    P[[kernels.P_BH_HI, kernels.P_BH_LO]] = bh_hi, bh_lo
+    P[[kernels.P_M11, kernels.P_M12, kernels.P_M21, kernels.P_M22]] = (
+        E * (C + zeta * S / omega), E * S / omega, -E * S / omega,
+        E * (C - zeta * S / omega))
+    P[[kernels.P_INV_DT, kernels.P_INV_OMEGA, kernels.P_COS_BH, kernels.P_SIN_BH]] = (
+        1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt))
+    if model.n_walls == 2:
+        n = kernels.N_PARAMS
+        P[n:] = P[:n]
+        P[n + kernels.P_EPS] = model.eps_lower
+        P[n + kernels.P_DELTA] = -model.lower
+        P[n + kernels.P_A] = -amplitude
+        P[n + kernels.P_AQ] = -P[kernels.P_AQ]
+    return P
 
 
 def _split_steps(t_end, dt):
@@ -307,7 +346,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
 def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, rebound_floor):
     """:func:`simulate_chunks` once its arguments are checked and resolved into ``model``."""
     delta, beta = model.delta, model.beta
-    P = model.kernel_parameters(dt)
+    P = model_parameters(model, dt)
     params = dict(zeta=model.zeta, eps=model.eps, delta=delta, dt=dt,
                   amplitude=model.amplitude, beta=beta, x0=x0, v0=v0,
                   rebound_floor=rebound_floor)

@@ -22,17 +22,13 @@ from vibroimpact.impact.layout import (BAD_NOISE, BUFFER_FULL, C_DF0, C_F0, C_R,
                                        S_W, S_WV, STICK_LO, STICK_OFF, STICK_ON, STUCK,
                                        STUCK_LO, TOO_MANY_EVENTS, TOUCH, WALL, WALL_LO)
 from vibroimpact.impact.motion import phase, segment
-from vibroimpact.model import rebound_velocity
+from vibroimpact._law import rebound_velocity
 from vibroimpact.impact.tolerances import (BOUND_SAFETY, CHATTER_ESTIMATE_TOL,
                                            ELASTIC_MICRO_FLIGHT, EPS64,
                                            EXCLUSION_MARGIN_REL, MANY_EVENTS,
                                            MICRO_FLIGHTS_PER_HEADROOM, MICRO_HEIGHT,
                                            RESYNC_EVERY, STEP_HEADROOM, STICK_MARGIN, TINY,
                                            TOUCH_ULPS)
-
-
-#: The impact law (:func:`vibroimpact.model.rebound_velocity`), compiled into the kernels.
-rebound = kernel(rebound_velocity)
 
 
 @kernel
@@ -217,7 +213,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             continue
         _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, sg * u)
         cnt[CNT_IMPACTS] += 1
-        v = sg * rebound(Pw[P_EPS], u)      # the law of the wall just met
+        v = sg * rebound_velocity(Pw[P_EPS], u)      # the law of the wall just met
         just_hit = True
 
 
