@@ -10,7 +10,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from vibroimpact.plotting._common import (_attr, _header, _nearest, _same_system, _styled,
-                                          _system_text, axis_label)
+                                          _system_text, axis_label, motion_title)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -333,7 +333,7 @@ def fig16(orbits, boundaries=None):
         if boundaries is None:
             overview.add_collection(LineCollection(cell_outline(x, y, stable), colors=[color],
                                                    linewidths=1.3, capstyle="projecting"))
-        overview.plot([], [], color=color, lw=1.8, label=f"({name})")
+        overview.plot([], [], color=color, lw=1.8, label=motion_title(name))
         ax = axes[i + 1]
         reason = sel["reason"].values
         ax.pcolormesh(xe, ye, np.ma.masked_where(stable, reason).T, cmap=reason_cmap,
@@ -361,7 +361,7 @@ def fig16(orbits, boundaries=None):
                                              linewidths=EDGE_WIDTH, capstyle="projecting",
                                              gid="stable-edge"))
         regions.append((ax, reason, stable))
-        ax.set_title(f"({name})")
+        ax.set_title(motion_title(name))
     kinds, marked = ([], False) if boundaries is None else _draw_boundaries(overview, panels,
                                                                             boundaries)
     overview.set_title("(a) stable domains")
