@@ -377,11 +377,19 @@ def orbit_tile(entry, tile, out, threads=None):
     if threads is not None:
         numba.set_num_threads(int(threads))
     rows, n_tiles = orbit_rows(entry)
-    result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
-                       types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
-                       eps=float(entry["eps"]))
+    gap, eps_lower = walls(entry, "orbits")
+    if gap is None:
+        result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
+                           types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
+                           eps=float(entry["eps"]))
+    else:       # a clearance: the shooting solver, cell by cell
+        from vibroimpact.pipeline.cells import two_wall_orbit_map
+
+        result = two_wall_orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
+                                    entry["types"], zeta=float(entry["zeta"]),
+                                    eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower)
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
-                 amplitude=1.0)
+                 amplitude=1.0, **_wall_attrs(gap, eps_lower))
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
 
@@ -410,6 +418,12 @@ def boundaries(entry, orbits_path, out, threads=None):
         # every impact ends at rest on the wall: a flight's maximum is its start, and no
         # boundary condition is regular there (domain_boundaries refuses eps = 0)
         attrs.update(traced=0, not_traced="eps = 0: the edges are the map's cell edges")
+        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
+        return
+    if entry.get("gap") is not None:
+        # the boundary tracer continues the closed-form (m/n) solutions: one wall only
+        attrs.update(_wall_attrs(*walls(entry, "orbits")), traced=0,
+                     not_traced="two walls: the edges are the map's cell edges")
         io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
         return
     import numba
