@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from vibroimpact.model import Model
 from vibroimpact.orbits import orbit_map, periodic_orbits
@@ -163,3 +164,14 @@ def test_type_errors():
         orbit_plane("eps", [0.5], "delta", [0.0], {**fixed, "gap": 1.0}, types=["1/1"])
     with pytest.raises(ValueError, match="at least one motion type"):
         orbit_plane("eps", [0.5], "delta", [0.0], fixed, types=[])
+
+
+def test_tiles_over_the_other_axis_join_to_the_whole_plane():
+    fixed = {"zeta": 0.05, "inv_beta": 1.1}
+    eps = [0.2, 0.4, 0.6, 0.8]
+    whole = orbit_plane("eps", eps, "delta", DELTA, fixed, types=TYPES)
+    tiles = [orbit_plane("eps", eps[k::2], "delta", DELTA, fixed, types=TYPES)
+             for k in range(2)]
+    joined = xr.concat(tiles, dim="eps").sortby("eps")
+    for name in VARIABLES:
+        assert _same(joined[name].values, whole[name].values), name

@@ -197,6 +197,11 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
     The module docstring: one column along delta per `orbit_map` call when delta is an axis
     (exactly `orbit_map` over ``(inv_beta, delta)``), `periodic_orbits` per cell otherwise,
     the amplitude scaled out (``delta / A``), `periodic_motions` per cell for two walls.
+
+    Tiles: the columns along delta are independent, the cells along delta within one are not
+    (branch following). A plane may be split into tiles over its other axis and the tiles
+    joined, bit for bit the whole plane's result; a tile over delta gives other results near
+    folds (the branches start again at its first delta).
     """
     import xarray as xr
 
