@@ -18,6 +18,7 @@ Datasets and the figures that read them (docs/figures.md)::
     results/datasets/{study}_spectra.nc fig06, fig11, fig12    (random, harmonic)
     results/datasets/{study}_events.nc  fig07, fig08, fig09, fig13, fig14
     results/datasets/{study}_map.nc     fig15, fig15_vs_fig16, residence  (harmonic)
+                                        map_stack (a sweep's maps over one plane)
     results/datasets/{study}_escape.nc  escape_vs_noise        (harmonic)
     results/orbits/{name}.nc            fig16, fig15_vs_fig16  (orbits), basins (attractors)
     results/orbits/{name}_boundaries.nc fig16                  (orbits)
@@ -25,6 +26,12 @@ Datasets and the figures that read them (docs/figures.md)::
     results/orbits/{name}_lyapunov.nc   lyapunov               (attractors)
     results/validation/work_precision.nc   work_precision      (validation)
     results/validation/stress_sample.nc    stress              (validation)
+
+A map may run over any two parameters (issue 36): its dataset names them in
+``attrs["axes"]`` (x first) and what it holds fixed in ``attrs["fixed"]`` (JSON); the map
+figures read the axes by name, label them from `LABELS` (every parameter's symbol,
+`vibroimpact._symbols`) and print the fixed caption. A dataset without ``axes`` is the
+paper's (1/beta, delta) plane, drawn as it always was.
 
 Plotting never imports the simulator or the orbit solver; it may use small helpers of
 `vibroimpact.stats`.
@@ -38,6 +45,7 @@ from vibroimpact.plotting.escape import escape_vs_noise
 from vibroimpact.plotting.harmonic import fig10, fig11, fig12, fig13, fig14
 from vibroimpact.plotting.maps import fig15, fig15_vs_fig16, map_agreement, residence
 from vibroimpact.plotting.orbits import fig16
+from vibroimpact.plotting.planes import map_stack
 from vibroimpact.plotting.random import (critical_delta, fig03, fig04, fig05, fig06, fig07,
                                          fig08, fig09)
 from vibroimpact.plotting.validation import stress, work_precision
@@ -49,5 +57,5 @@ __all__ = [
     "fig03", "fig04", "fig05", "fig06", "fig07", "fig08", "fig09",
     "fig10", "fig11", "fig12", "fig13", "fig14", "fig15", "fig15_vs_fig16", "fig16",
     "map_agreement", "basins", "lyapunov", "work_precision", "stress", "residence",
-    "escape_vs_noise",
+    "escape_vs_noise", "map_stack",
 ]
