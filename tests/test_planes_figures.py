@@ -188,6 +188,9 @@ def test_fig15_vs_fig16_needs_one_plane(tmp_path):
 def test_stack_one_column_per_swept_value_on_one_colour_scale(tmp_path):
     maps = [_plane_map(tmp_path, rms=r, name=f"m{k}") for k, r in enumerate((0.4, 0.1, 0.2))]
     assert swept_parameter(maps) == ("rms", [0.4, 0.1, 0.2])
+    reached = maps[0]["reached"].copy()
+    reached.loc[dict(eps=EPS[4], delta=DELTA[7])] = 0           # capped: a dot, rms = 0.4
+    maps[0] = maps[0].assign(reached=reached)
     fig = map_stack(*maps)
     titles = [ax.get_title() for ax in fig.axes if ax.get_title()]
     assert titles == [r"(1/1),  $\sigma_r$ = 0.1", r"(1/1),  $\sigma_r$ = 0.2",
@@ -197,6 +200,9 @@ def test_stack_one_column_per_swept_value_on_one_colour_scale(tmp_path):
     fills = [ax.collections[0] for ax in panels]
     assert all(list(f.levels) == list(fills[0].levels) for f in fills)
     assert {f.norm.vmin for f in fills} == {-10} and {f.norm.vmax for f in fills} == {100}
+    dots = [[(line.get_xdata()[0], line.get_ydata()[0]) for line in ax.get_lines()
+             if line.get_marker() == "."] for ax in panels]
+    assert dots == [[], [], [(EPS[4], DELTA[7])], [], [], [(EPS[4], DELTA[7])]]
     colourbars = [ax for ax in fig.axes if ax.get_ylabel() == "probability of the motion (%)"]
     assert len(colourbars) == 1
     header = fig.get_suptitle()

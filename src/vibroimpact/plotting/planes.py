@@ -13,6 +13,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from vibroimpact._symbols import PARAMETERS, fixed_caption, format_value, parameter_symbol
 from vibroimpact.plotting._common import (_header, _styled, motion_title, on_plane, plane_axes,
@@ -97,7 +98,8 @@ def map_stack(*maps, motions=None, levels=PROBABILITY_LEVELS):
     matplotlib.figure.Figure
         Filled bands of the probability (%) on one colour scale for every panel (one colour
         bar), its contours labelled where apart and each cliff one line, as in Fig. 15;
-        whole cells hatched where the record switched too few times. The swept value heads
+        whole cells hatched where the record switched too few times, dots where the cap
+        stopped a cell before the target precision. The swept value heads
         each column, the motion each row; the header names the plane, the sweep and what
         every map holds fixed.
     """
@@ -118,11 +120,13 @@ def map_stack(*maps, motions=None, levels=PROBABILITY_LEVELS):
     FigureCanvasAgg(fig)
     axes = fig.subplots(nrows, ncols, sharex=True, sharey=True, squeeze=False)
     fill_levels = [0.0, *levels, 100.0]
-    shaded, few_any = None, False
+    shaded, few_any, short_any = None, False, False
     for c, (ds, value) in enumerate(zip(maps, values)):
         x, y = _grid(ds)
         few = on_plane(ds["few_switches"], ds).values.astype(bool)
         few_any |= bool(few.any())
+        short = ~on_plane(ds["reached"], ds).values.astype(bool)
+        short_any |= bool(short.any())
         for r, motion in enumerate(motions):
             ax = axes[r, c]
             p = 100.0 * on_plane(ds["probability"].sel(motion=motion), ds).values
@@ -134,13 +138,19 @@ def map_stack(*maps, motions=None, levels=PROBABILITY_LEVELS):
                               autolim=False)
             label_contours(ax, lines, "%d", avoid=cliff)
             mark_few_switches(ax, x, y, few)
+            if short.any():
+                i, j = np.nonzero(short)
+                ax.plot(x[i], y[j], ls="none", marker=".", ms=1.5, color="C3")
             ax.set_title(f"{motion_title(motion)},  {_swept_title(name, value)}", fontsize=9)
         _finish_axes(axes[:, c], ds)
     fig.colorbar(shaded, ax=axes.ravel().tolist(), label="probability of the motion (%)",
                  shrink=0.7, pad=0.02, aspect=30)
-    if few_any:
-        fig.legend(handles=[few_switches_handle(maps[0])], loc="outside lower center",
-                   fontsize=7)
+    handles = [few_switches_handle(maps[0])] if few_any else []
+    if short_any:
+        handles.append(Line2D([], [], ls="none", marker=".", color="C3",
+                              label="target precision not reached (cap)"))
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7)
     common = {k: v for k, v in plane_fixed(maps[0]).items() if k != name}
     x_name, y_name = plane_axes(maps[0])
     plane = ", ".join(_symbol(a) for a in (x_name, y_name))
