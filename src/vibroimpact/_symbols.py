@@ -10,8 +10,9 @@ dimension names, the keys of ``ds.attrs["fixed"]``).
 """
 from __future__ import annotations
 
-__all__ = ["PARAMETERS", "PLANE_PARAMETERS", "parameter_symbol", "parameter_label",
-           "fixed_caption", "format_value"]
+__all__ = ["PARAMETERS", "PLANE_PARAMETERS", "HARMONIC_PARAMETERS", "TWO_WALL_PARAMETERS",
+           "NOISE_PARAMETERS", "parameter_symbol", "parameter_label", "fixed_caption",
+           "format_value"]
 
 #: ``name: (symbol in mathtext, symbol in plain text, axis label in mathtext)``. The paper
 #: writes zeta (eq. 1), eps (eq. 2), delta (Fig. 1), the harmonic force ``sin(beta_f tau)``
@@ -31,6 +32,13 @@ PARAMETERS = {
 }
 #: The names a plane's axes may take, in the order a caption lists them.
 PLANE_PARAMETERS = tuple(PARAMETERS)
+#: The parameters of the periodic motions under the harmonic force alone (Fig. 16,
+#: `vibroimpact.orbits.plane.orbit_plane`): one wall, and with a second wall.
+HARMONIC_PARAMETERS = ("zeta", "eps", "delta", "inv_beta", "amplitude")
+TWO_WALL_PARAMETERS = HARMONIC_PARAMETERS + ("gap", "eps_lower")
+#: Parameters of the random force: a plane over one has no Fig. 16 (a config check can say
+#: so from this table, before any job, without loading a kernel).
+NOISE_PARAMETERS = ("rms",)
 
 
 def _known(name):

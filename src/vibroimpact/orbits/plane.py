@@ -42,17 +42,11 @@ import math
 import numpy as np
 
 from vibroimpact import _checks
-from vibroimpact._symbols import PARAMETERS
+from vibroimpact._symbols import (HARMONIC_PARAMETERS, NOISE_PARAMETERS, PARAMETERS,
+                                  TWO_WALL_PARAMETERS)
 from vibroimpact.orbits.api import Reason, orbit_map, periodic_orbits
 
 __all__ = ["orbit_plane", "HARMONIC_PARAMETERS", "TWO_WALL_PARAMETERS", "NOISE_PARAMETERS"]
-
-#: The parameters of the one-wall harmonic-force problem (Fig. 16's).
-HARMONIC_PARAMETERS = ("zeta", "eps", "delta", "inv_beta", "amplitude")
-#: With a second wall, also its distance below the first and its restitution.
-TWO_WALL_PARAMETERS = HARMONIC_PARAMETERS + ("gap", "eps_lower")
-#: Parameters of the random force: a plane over one has no Fig. 16; fixed, they are ignored.
-NOISE_PARAMETERS = ("rms",)
 #: Fixed values taken when `fixed` does not give them: Fig. 16's force is ``sin(beta tau)``.
 DEFAULT_FIXED = {"amplitude": 1.0}
 #: Variables of the result, as `orbit_map` returns them.
