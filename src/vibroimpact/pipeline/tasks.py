@@ -409,21 +409,21 @@ BOUNDARY_TOL = 1e-9
 def boundaries(entry, orbits_path, out, threads=None):
     """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
     the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
-    seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
-    box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
-               delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                  traced=1)
-    if float(entry["eps"]) == 0.0:
-        # every impact ends at rest on the wall: a flight's maximum is its start, and no
-        # boundary condition is regular there (domain_boundaries refuses eps = 0)
-        attrs.update(traced=0, not_traced="eps = 0: the edges are the map's cell edges")
-        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
-        return
     if entry.get("gap") is not None:
         # the boundary tracer continues the closed-form (m/n) solutions: one wall only
         attrs.update(_wall_attrs(*walls(entry, "orbits")), traced=0,
                      not_traced="two walls: the edges are the map's cell edges")
+        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
+        return
+    seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
+    box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
+               delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
+    if float(entry["eps"]) == 0.0:
+        # every impact ends at rest on the wall: a flight's maximum is its start, and no
+        # boundary condition is regular there (domain_boundaries refuses eps = 0)
+        attrs.update(traced=0, not_traced="eps = 0: the edges are the map's cell edges")
         io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
         return
     import numba
