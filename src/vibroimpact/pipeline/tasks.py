@@ -377,17 +377,26 @@ def orbit_tile(entry, tile, out, threads=None):
     if threads is not None:
         numba.set_num_threads(int(threads))
     rows, n_tiles = orbit_rows(entry)
-    gap, eps_lower = walls(entry, "orbits")
-    if gap is None:
-        result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
-                           types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
-                           eps=float(entry["eps"]))
-    else:       # a clearance: the shooting solver, cell by cell
-        from vibroimpact.pipeline.cells import two_wall_orbit_map
+    result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
+                       types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
+                       eps=float(entry["eps"]))
+    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                 amplitude=1.0)
+    io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
-        result = two_wall_orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
-                                    entry["types"], zeta=float(entry["zeta"]),
-                                    eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower)
+
+def clearance_orbit_tile(entry, tile, out):
+    """Rule ``solve_clearance_orbit_tile``: the stable periodic motions of a two-wall
+    ``orbits`` entry on some 1/beta rows (`pipeline.cells.two_wall_orbit_map`: the shooting
+    solver, seeded by the simulator; a rule of its own, so that the one-wall orbit tiles'
+    code reaches no simulator)."""
+    from vibroimpact.pipeline.cells import two_wall_orbit_map
+
+    rows, n_tiles = orbit_rows(entry)
+    gap, eps_lower = walls(entry, "orbits")
+    result = two_wall_orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
+                                entry["types"], zeta=float(entry["zeta"]),
+                                eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower)
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                  amplitude=1.0, **_wall_attrs(gap, eps_lower))
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
