@@ -45,7 +45,8 @@ def _benchmark_sums(workdir):
     """``(s, cpu_time, {rule: [n, s, cpu_time]})`` over every benchmark file of the build."""
     rules = defaultdict(lambda: [0, 0.0, 0.0])
     for path in sorted((workdir / "results" / "benchmarks").rglob("*.tsv")):
-        rule = path.relative_to(workdir / "results" / "benchmarks").parts[0]
+        parts = path.relative_to(workdir / "results" / "benchmarks").parts
+        rule = parts[0] if len(parts) > 1 else path.stem   # benchmarks/<rule>.tsv: one job
         with path.open() as f:
             for row in csv.DictReader(f, delimiter="\t"):
                 entry = rules[rule]
