@@ -235,6 +235,17 @@ def test_the_summary_for_snakemakes_report_has_no_image_but_says_which(tmp_path)
     assert "fig.png" in text and "<table>" in text and fetched(text) == []
 
 
+def test_one_call_renders_both_files_as_two_calls_would(tmp_path):
+    """`--summary` (the report rules' single rendering process) writes the same two files."""
+    ipynb = str(_notebook(tmp_path))
+    notebook.main([ipynb, str(tmp_path / "a.html")])
+    notebook.main([ipynb, str(tmp_path / "a.summary.html"), "--no-figures"])
+    notebook.main([ipynb, str(tmp_path / "b.html"), "--summary", str(tmp_path / "b.summary.html")])
+    for name in ("html", "summary.html"):
+        assert (tmp_path / f"b.{name}").read_text() == (tmp_path / f"a.{name}").read_text()
+    assert "<img" in (tmp_path / "b.html").read_text()
+
+
 def _paper_captions():
     """``(target, caption rst)`` of every figure of every entry of the paper's config."""
     config, _ = configuration.load(root=ROOT)

@@ -7,6 +7,7 @@
 # The HTML reads offline: `vibroimpact.reports.notebook` renders it with nbconvert's template
 # minus what it loads from the network, the maths turned into MathML at build time. Snakemake's
 # report shows a rendering without the images (`.summary.html`): it holds every figure once.
+# Both renderings come from one process (`--summary`): nbconvert's start-up is paid once.
 localrules:
     study_report,
     orbits_report,
@@ -23,10 +24,8 @@ REPORT_SHELL = (
     "trap 'rm -rf \"$tmp\"' EXIT; "
     "{params.python} -m papermill {input.notebook} $tmp/report.ipynb --kernel python3 --log-output "
     "--no-progress-bar {params.arguments} > {log} 2>&1; "
-    "{params.python} -m vibroimpact.reports.notebook $tmp/report.ipynb $tmp/report.html "
-    ">> {log} 2>&1; "
-    "{params.python} -m vibroimpact.reports.notebook --no-figures $tmp/report.ipynb "
-    "$tmp/summary.html >> {log} 2>&1; "
+    "{params.python} -m vibroimpact.reports.notebook --summary $tmp/summary.html "
+    "$tmp/report.ipynb $tmp/report.html >> {log} 2>&1; "
     "mv $tmp/summary.html {output.summary}; mv $tmp/report.html {output.html}; "
     "mv $tmp/report.ipynb {output.ipynb}"
 )

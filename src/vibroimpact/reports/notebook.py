@@ -542,7 +542,12 @@ def render_html(ipynb, html, figures=True):
 
 
 def main(argv=None):
-    """``python -m vibroimpact.reports.notebook [--no-figures] REPORT.ipynb REPORT.html``."""
+    """``python -m vibroimpact.reports.notebook [--no-figures] [--summary SUMMARY.html]
+    REPORT.ipynb REPORT.html``.
+
+    ``--summary`` also writes the rendering without images (Snakemake's report's copy) in
+    the same process: the report rules render both from one start-up of nbconvert.
+    """
     import argparse
 
     parser = argparse.ArgumentParser(prog="python -m vibroimpact.reports.notebook",
@@ -552,8 +557,12 @@ def main(argv=None):
     parser.add_argument("html")
     parser.add_argument("--no-figures", dest="figures", action="store_false",
                         help="leave the images out (Snakemake's report shows them once)")
+    parser.add_argument("--summary", metavar="SUMMARY.html",
+                        help="also write the rendering without images to this file")
     args = parser.parse_args(argv)
     render_html(args.ipynb, args.html, figures=args.figures)
+    if args.summary:
+        render_html(args.ipynb, args.summary, figures=False)
 
 
 if __name__ == "__main__":
