@@ -1,5 +1,5 @@
-"""`make`'s Snakemake part for the default config, from a fresh results folder: this tree
-against a peer revision, in turn.
+"""`make`'s Snakemake part (``--make``: all of what `make` runs after installation) for the
+default config, from a fresh results folder: this tree against a peer revision, in turn.
 
 Each side builds in a folder of its own under a temporary directory: this tree's tracked and
 new files (tests/helpers.py ``copy_tree``, as ``benchmarks/job_costs.py``), the peer a
@@ -18,6 +18,7 @@ loaded machine. A whole default build is minutes of both cores: run it sparingly
 
     python benchmarks/bench_make.py                     # both sides, 1 round, --cores 2
     python benchmarks/bench_make.py --side this --keep /tmp/bench_make
+    python benchmarks/bench_make.py --make        # what `make` runs: run, then report
 """
 import argparse
 import csv
@@ -57,29 +58,47 @@ def _benchmark_sums(workdir):
     return (sum(v[1] for v in rules.values()), sum(v[2] for v in rules.values()), dict(rules))
 
 
-def build(workdir, cores, cache, fresh=True):
-    """One default build in ``workdir``: ``{wall, cpu, bench_s, bench_cpu, rules}``."""
+def _commands(cores, make):
+    """What one build runs: Snakemake alone, or (``make``) what ``make`` runs after
+    installation, ``python -m vibroimpact run`` (the config checked, the plan printed, the
+    recovery, then Snakemake) and ``python -m vibroimpact report`` (Snakemake's report)."""
+    if not make:
+        return [[SNAKEMAKE, "--cores", str(cores), "-q"]]
+    return [[sys.executable, "-m", "vibroimpact", "run", "--cores", str(cores)],
+            [sys.executable, "-m", "vibroimpact", "report"]]
+
+
+def build(workdir, cores, cache, fresh=True, make=False):
+    """One default build in ``workdir``: ``{wall, cpu, bench_s, bench_cpu, rules}`` (with
+    ``make``, ``steps``: the wall time of each of its two commands)."""
     if fresh:
         for name in ("results", ".snakemake"):
             shutil.rmtree(workdir / name, ignore_errors=True)
     env = dict(os.environ, PYTHONPATH=str(workdir / "src"), NUMBA_CACHE_DIR=str(cache))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    out = subprocess.run([SNAKEMAKE, "--cores", str(cores), "-q"], cwd=workdir, env=env,
-                         capture_output=True, text=True)
+    steps = []
+    for cmd in _commands(cores, make):
+        step = time.perf_counter()
+        out = subprocess.run(cmd, cwd=workdir, env=env, capture_output=True, text=True)
+        steps.append(time.perf_counter() - step)
+        if out.returncode != 0:
+            raise SystemExit(f"FAIL: {' '.join(cmd[-3:])} in {workdir} exited with "
+                             f"{out.returncode}:\n{out.stdout[-2000:]}\n{out.stderr[-3000:]}")
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
-    if out.returncode != 0:
-        raise SystemExit(f"FAIL: snakemake in {workdir} exited with {out.returncode}:\n"
-                         f"{out.stdout[-2000:]}\n{out.stderr[-3000:]}")
     cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
     bench_s, bench_cpu, rules = _benchmark_sums(workdir)
-    return dict(wall=wall, cpu=cpu, bench_s=bench_s, bench_cpu=bench_cpu, rules=rules)
+    return dict(wall=wall, cpu=cpu, bench_s=bench_s, bench_cpu=bench_cpu, rules=rules,
+                steps=steps)
 
 
 def _print(label, r):
     print(f"  {label}: wall {r['wall']:.1f} s, CPU {r['cpu']:.1f} s (snakemake and its jobs); "
           f"benchmark files: s {r['bench_s']:.1f}, cpu_time {r['bench_cpu']:.1f}", flush=True)
+    if len(r["steps"]) > 1:
+        print(f"      wall of `vibroimpact run` {r['steps'][0]:.1f} s, of `vibroimpact report` "
+              f"{r['steps'][1]:.1f} s", flush=True)
     top = sorted(r["rules"].items(), key=lambda kv: -kv[1][2])[:5]
     for rule, (n, s, cpu) in top:
         print(f"      {rule:28s} {n:3d} jobs  s {s:7.1f}  cpu_time {cpu:7.1f}", flush=True)
@@ -93,6 +112,9 @@ def main(argv=None):
     parser.add_argument("--side", choices=("both", "this", "peer"), default="both")
     parser.add_argument("--warm", action="store_true",
                         help="keep each side's numba cache between rounds (after installation)")
+    parser.add_argument("--make", action="store_true",
+                        help="run what `make` runs (python -m vibroimpact run, then report) "
+                        "instead of Snakemake alone")
     parser.add_argument("--keep", metavar="DIR", help="build here and keep it (default: a "
                         "temporary directory, removed)")
     args = parser.parse_args(argv)
@@ -106,7 +128,8 @@ def main(argv=None):
                             args.peer], cwd=ROOT, check=True, capture_output=True)
     if args.side in ("both", "this"):
         sides["this"] = copy_tree(tmp / "this")
-    print(f"bench_make: default config, --cores {args.cores}, peer = {args.peer}, "
+    print(f"bench_make: default config, {'make' if args.make else 'snakemake'}, "
+          f"--cores {args.cores}, peer = {args.peer}, "
           f"this = {ROOT} (working tree); in {tmp}")
     runs = defaultdict(list)
     try:
@@ -115,7 +138,7 @@ def main(argv=None):
             for side in order:
                 cache = tmp / f"numba-{side}" / ("warm" if args.warm else f"round{i}")
                 print(f"round {i + 1} {side}: {_uptime()}", flush=True)
-                r = build(sides[side], args.cores, cache)
+                r = build(sides[side], args.cores, cache, make=args.make)
                 runs[side].append(r)
                 _print(side, r)
     finally:

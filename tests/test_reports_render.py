@@ -422,3 +422,23 @@ def test_snakemake_report_has_each_figure_once_and_no_docutils_error(built):
     assert len(paper) == len(copies) and all(p.startswith("results/figures/") for p in paper)
     reports = [p for p in shown if p.startswith("results/reports/")]
     assert len(reports) == len(REPORTS) and all(p.endswith(".summary.html") for p in reports)
+
+
+def test_report_parameters_are_typed_as_papermills_command_line_types_them():
+    """The report rules run the notebook with papermill's Python API in the rendering process
+    (`notebook.main --execute`): each ``-p NAME VALUE`` must reach the notebook as papermill's
+    own command line would pass it (its `_resolve_type`, the reference here)."""
+    from papermill.cli import _resolve_type
+
+    values = ["True", "False", "None", "0", "-3", "1.1", "-0.5", "1e-3", "nan", "",
+              "results/datasets/random_events.nc", "a b", "0.5 0.0", "true"]
+    for value in values:
+        got, want = notebook.parameter_value(value), _resolve_type(value)
+        assert type(got) is type(want) and (got == want or (got != got and want != want)), value
+
+
+def test_report_parameters_need_a_notebook_to_execute(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        notebook.main(["-p", "study", "random", str(tmp_path / "r.ipynb"),
+                       str(tmp_path / "r.html")])
+    assert "--execute" in capsys.readouterr().err
