@@ -36,14 +36,14 @@ BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 #: (each drawn alone as its job does, 2 cores under load; h37a, issue 37).
 FIGURE_S = 1.0
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
-#: twice (nbconvert) in one job, besides its start-up: 1.8 to 2.1 CPU-s a job measured for
-#: the reports that show no map (random_force, performance, stability).
-REPORT_S = 0.7
+#: twice (nbconvert) in one job, besides its start-up: 1.9 to 2.4 CPU-s a job (best of 2,
+#: load ~7) for the reports that show no map (random_force, performance, stability).
+REPORT_S = 0.8
 #: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
-#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``): 5.9 CPU-s for the default map's
-#: harmonic report against 2.0 for one without. Three default reports show the map (the
-#: motion_map and harmonic studies' and the orbits entry's), each computing the same.
-MAP_REPORT_S = 3.9
+#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``): 6.6 to 7.5 CPU-s for the three
+#: default reports that show the map (the motion_map and harmonic studies' and the orbits
+#: entry's, each computing the same predictors) against 2.1 for one without.
+MAP_REPORT_S = 4.8
 #: The work-precision run and the stress sample together, wall time (the work-precision job
 #: holds every core while it times): 44 + 21 s on the default build.
 VALIDATION_S = 65.0
