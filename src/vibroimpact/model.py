@@ -2,7 +2,7 @@
 
 A :class:`Model` is resolved once (from a study's config, or from the public functions'
 loose arguments) and carried down to the kernels, which receive it compiled into their
-parameter vector (:meth:`Model.kernel_parameters`, slots in
+parameter vector (:func:`vibroimpact.impact.simulate.model_parameters`, slots in
 :mod:`vibroimpact.impact.layout`). The dimensionless equation of motion is (docs/model.md)
 
     x'' + 2 zeta x' + x = f(tau) = r(tau) + amplitude sin(beta tau)
@@ -18,13 +18,14 @@ A machine designer's symmetric stops at ``+-g/2`` about an offset ``x_c`` are
 
 Each wall has its own impact law. The law is :class:`Restitution` (Newton's law, the
 paper's eq. 7: the velocity after impact is ``-eps`` times the velocity before); it is the
-one place that law is written (:func:`rebound_velocity` is its numba form, which the
-simulator's kernel calls).
+one place that law is written: :func:`rebound_velocity`, with its derivative
+:func:`rebound_derivative` and its ratio :func:`rebound_ratio` beside it (plain Python;
+:mod:`vibroimpact._law` compiles them once for the kernels, docs/architecture.md "Adding
+physics").
 """
 from dataclasses import dataclass, field
 import math
 
-import numpy as np
 
 from vibroimpact import _checks
 
@@ -41,6 +42,27 @@ def rebound_velocity(eps, u):
     so numba compiles it into the kernels as it is (``vibroimpact.impact.stepping``).
     """
     return -eps * u
+
+
+def rebound_derivative(eps, u):
+    """``d rebound_velocity / du`` at the approach velocity ``u``: the impact's tangent
+    (the orbit solver's and the attractors' Jacobians, the saltation matrix).
+
+    Newton's law: ``-eps``. A new law edits this beside :func:`rebound_velocity`
+    (tests/test_impact_law.py holds the pair to a finite difference).
+    """
+    return -eps
+
+
+def rebound_ratio(eps, u):
+    """``rebound_velocity(eps, u) / u``: the saltation matrix's position entry, and the
+    orbit solver's ``-v_+ = -rebound_ratio * u`` in its Jacobians' ``d/dtau`` entries.
+
+    Newton's law: ``-eps``, written out so that it is ``-eps`` to the last bit (the quotient
+    ``(-eps * u) / u`` is not). A new law edits this beside :func:`rebound_velocity`
+    (tests/test_impact_law.py holds the three to one another).
+    """
+    return -eps
 
 
 @dataclass(frozen=True)
@@ -174,44 +196,3 @@ class Model:
         if self.n_walls == 2:
             out.update(gap=self.gap, eps_lower=self.eps_lower)
         return out
-
-    def kernel_parameters(self, dt):
-        """The parameter vector ``P`` the simulator's kernels read, for sample step ``dt``.
-
-        One wall: the ``N_PARAMS`` slots of :mod:`vibroimpact.impact.layout`, exactly as
-        before models existed. Two walls: twice as many; the second half is the lower wall
-        seen in the mirrored frame ``x -> -x`` (force and harmonic amplitude negated, wall
-        at ``-(delta - gap)`` hit from below, its own restitution), so that every search of
-        :mod:`vibroimpact.impact.events` serves both walls unchanged.
-        """
-        from vibroimpact.impact import layout
-        from vibroimpact.impact.motion import two_prod
-
-        dt = _checks.real("dt", dt, low=0.0, low_open=True)
-        zeta, beta, amplitude = self.zeta, self.beta, self.amplitude
-        omega = math.sqrt(1.0 - zeta * zeta)
-        q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
-        phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
-        E = math.exp(-zeta * dt)
-        C, S = math.cos(omega * dt), math.sin(omega * dt)
-        bh_hi, bh_lo = two_prod(beta, dt)
-        P = np.empty(layout.N_PARAMS * self.n_walls)
-        P[[layout.P_ZETA, layout.P_OMEGA, layout.P_EPS, layout.P_DELTA, layout.P_DT]] = (
-            zeta, omega, self.eps, self.delta, dt)
-        P[[layout.P_A, layout.P_BETA, layout.P_AQ, layout.P_PHI]] = (
-            amplitude, beta, amplitude * q, phi)
-        P[[layout.P_COS_PHI, layout.P_SIN_PHI]] = math.cos(phi), math.sin(phi)
-        P[[layout.P_BH_HI, layout.P_BH_LO]] = bh_hi, bh_lo
-        P[[layout.P_M11, layout.P_M12, layout.P_M21, layout.P_M22]] = (
-            E * (C + zeta * S / omega), E * S / omega, -E * S / omega,
-            E * (C - zeta * S / omega))
-        P[[layout.P_INV_DT, layout.P_INV_OMEGA, layout.P_COS_BH, layout.P_SIN_BH]] = (
-            1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt))
-        if self.n_walls == 2:
-            n = layout.N_PARAMS
-            P[n:] = P[:n]
-            P[n + layout.P_EPS] = self.eps_lower
-            P[n + layout.P_DELTA] = -self.lower
-            P[n + layout.P_A] = -amplitude
-            P[n + layout.P_AQ] = -P[layout.P_AQ]
-        return P

@@ -8,7 +8,7 @@ runs in the slow suite; a few cases of each run in the fast suite to keep the ma
 """
 import pytest
 
-from vibroimpact.validation.families import FAMILIES, FULL_CASES as FULL, run_family
+from vibroimpact.validation.families import FAMILIES, FULL_CASES as FULL, WALLS, run_family
 
 SEED = 20261122
 
@@ -25,15 +25,19 @@ def test_every_family_has_a_full_size():
     assert set(FULL) == set(FAMILIES)
 
 
+@pytest.mark.parametrize("wall", WALLS)
 @pytest.mark.parametrize("name", sorted(FAMILIES))
-def test_family_quick_sample(name):
-    _check(run_family(name, 4, SEED), 4)
+def test_family_quick_sample(name, wall):
+    _check(run_family(name, 4, SEED, wall), 4)
 
 
 @pytest.mark.slow
+@pytest.mark.parametrize("wall", WALLS)
 @pytest.mark.parametrize("name", sorted(FAMILIES))
-def test_family_full_size(name):
-    _check(run_family(name, FULL[name], SEED), FULL[name])
+def test_family_full_size(name, wall):
+    """Every family at full size at both walls: at the lower wall of a clearance (the case
+    mirrored onto it, the upper wall out of reach) with the same counts and allowances."""
+    _check(run_family(name, FULL[name], SEED, wall), FULL[name])
 
 
 def test_same_seed_same_cases():
@@ -44,3 +48,5 @@ def test_same_seed_same_cases():
 def test_unknown_family_is_named():
     with pytest.raises(ValueError, match="family must be one of"):
         run_family("releases", 1, 0)
+    with pytest.raises(ValueError, match="wall must be one of"):
+        run_family("release", 1, 0, "left")

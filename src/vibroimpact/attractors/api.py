@@ -93,17 +93,18 @@ def clopper_pearson(k, n, confidence=CONFIDENCE):
     return lo, hi
 
 
-def stable_orbits(inv_beta, delta, types, zeta, eps):
+def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf):
     """Stable admissible solver orbits per cell and type (arrays of
     :func:`kernels.cell_orbits`): ``n_stable (n_types, nb, nd)``, and per cell,
-    type and orbit the phases, approach velocities, intervals and ``ln max|mu|``."""
+    type and orbit the phases, approach velocities, intervals and ``ln max|mu|``. With a
+    finite ``clearance`` only the orbits that stay above the wall below."""
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
     shape = (nb, nd, nt, ak.K_ORBITS, ak.M_COLS)
     n_stable = np.zeros((nt, nb, nd), np.int64)
     oph, ou, oz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     lnmu = np.full(shape[:4], np.nan)
     ak.cell_orbits(inv_beta, delta, types, float(zeta), float(eps), n_stable, oph, ou, oz,
-                   lnmu)
+                   lnmu, float(clearance))
     return n_stable, oph, ou, oz, lnmu
 
 
@@ -135,7 +136,7 @@ def _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_ti
 
 def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=64,
                   gap=(0.0, 4.0), velocity=(-4.0, 4.0), max_time=DEFAULT_MAX_TIME,
-                  match_tol=DEFAULT_MATCH_TOL, seed=0):
+                  match_tol=DEFAULT_MATCH_TOL, seed=0, clearance=None, eps_lower=None):
     """Basins of the stable (m/n) motions and the largest Lyapunov exponent over a grid.
 
     Parameters
@@ -164,6 +165,12 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         ``T_f`` and velocities over ``1 + u`` must agree to it (default 1e-6).
     seed : int, keyword-only
         Seed of the Sobol scrambling.
+    clearance : float, optional, keyword-only
+        A second wall at ``x = delta - clearance`` (> 0), hit from above: the clearance
+        between two stops (``simulate``'s ``gap``; here ``gap`` already names the starts'
+        range, which must then lie within it: ``gap[1] <= clearance``). Default: one wall.
+    eps_lower : float, optional, keyword-only
+        Restitution coefficient of that wall, in [0, 1] (default ``eps``).
 
     Returns
     -------
@@ -189,6 +196,8 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
           standard error among the unsettled starts (NaN where all settled);
         - ``impact_rate`` (nb, nd): mean collisions per unit time over the starts' final
           windows (a settled start's period, an unsettled one's Benettin window);
+          ``impact_rate_lower`` (nb, nd): the mean rate of impacts at the lower wall
+          (with a ``clearance``; 0 with one wall);
         - ``settle_time`` (n_starts, nb, nd), NaN if not settled; ``motion_start`` int
           (n_starts, nb, nd): index into ``motions``; ``class_start`` int8 (n_starts, nb,
           nd); ``period_start`` int (2, n_starts, nb, nd): (m', k) of a settled periodic
@@ -267,13 +276,25 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
 
     ``impact_rate`` counts collisions; for an unsettled start whose window holds sticking it
     approximates them by counting every run of shrinking rebounds as one collision.
+
+    **Two walls** (``clearance``). The simulator follows both walls (impacts, chatter,
+    sticking at either); the tangent crosses an impact at the lower wall by the same saltation
+    in the mirrored frame ``x -> -x`` (approach speed ``-x'``, force ``-f``, wall at
+    ``-(delta - clearance)``, restitution ``eps_lower``), so the exponents' sum is
+    ``-2 zeta + 2 sum_w nu_w ln eps_w`` over the walls. The closed-form solver knows one wall:
+    its orbits whose flights stay above the wall below (``min x >= delta - clearance``) are
+    orbits of the two-wall oscillator with the same multipliers, and are listed
+    (``n_stable`` counts those); a motion that meets both walls settles as "periodic_other",
+    with its exponents from its own last period. An impact at the other wall always starts a
+    new collision.
     """
     (inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time, match_tol,
      seed) = _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,
                        match_tol, seed)
+    clearance, eps_lower = _validate_walls(clearance, eps_lower, eps, gap)
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
     raw = _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
-                           max_time, match_tol, seed)
+                           max_time, match_tol, seed, clearance=clearance, eps_lower=eps_lower)
     outf, outi = raw["outf"], raw["outi"]
     # per start, (n_starts, nb, nd)
     shape_s = (nb, nd, n_starts)
@@ -308,6 +329,7 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         unsettled = (cls == ak.CHAOTIC) | (cls == ak.UNDECIDED)
         lyap_se = np.nanmax(np.where(unsettled, stderr, np.nan), axis=0)
         rate = np.nanmean(to_s(outf[:, ak.F_RATE]), axis=0)
+        rate_lo = np.nanmean(to_s(outf[:, ak.F_IMPACTS_LO] / outf[:, ak.F_WINDOW]), axis=0)
     return {
         "inv_beta": inv_beta, "delta": delta,
         "motions": [f"{m}/{n}" for m, n in types] + ["other"],
@@ -319,15 +341,29 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         "cell_class": np.argmax(class_count, axis=0).astype(np.int8),
         "lyapunov": lyap, "lyapunov_class": lyap_class, "lyapunov_start": lyap1,
         "lyapunov_second_start": lyap2,
-        "lyapunov_stderr": lyap_se, "impact_rate": rate,
+        "lyapunov_stderr": lyap_se, "impact_rate": rate, "impact_rate_lower": rate_lo,
         "settle_time": to_s(outf[:, ak.F_SETTLE]),
         "motion_start": motion, "class_start": cls,
         "period_start": np.stack([to_s(outi[:, ak.I_PERIOD_M]), to_s(outi[:, ak.I_PERIOD_P])]),
     }
 
 
+def _validate_walls(clearance, eps_lower, eps, gap):
+    """``(clearance, eps_lower)`` for the kernels: ``(inf, eps)`` with one wall."""
+    if clearance is None:
+        if eps_lower is not None:
+            raise ValueError("eps_lower needs a second wall: give clearance as well")
+        return math.inf, eps
+    clearance = _checks.real("clearance", clearance, low=0.0, low_open=True)
+    eps_lower = eps if eps_lower is None else _checks.eps(eps_lower, "eps_lower")
+    if gap[1] > clearance:
+        raise ValueError(f"gap (the starts' distance below the wall at delta) must lie within "
+                         f"the clearance: gap[1] <= clearance = {clearance!r}, got {gap!r}")
+    return clearance, eps_lower
+
+
 def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,
-                     match_tol, seed):
+                     match_tol, seed, *, clearance=math.inf, eps_lower=None):
     """Every start of every cell (validated input); the kernels' raw per-start records
     ``outf (n, N_F)``, ``outi (n, N_I)`` (start ``i`` of cell ``c = ib nd + id`` at row
     ``c n_starts + i``), the starts, the solver orbits and the kernels' times."""
@@ -335,7 +371,7 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
 
     nb, nd = inv_beta.size, delta.size
     t_a = time.perf_counter()
-    n_stable, oph, ou, oz, lnmu = stable_orbits(inv_beta, delta, types, zeta, eps)
+    n_stable, oph, ou, oz, lnmu = stable_orbits(inv_beta, delta, types, zeta, eps, clearance)
     t_b = time.perf_counter()
     u, theta, g, v0 = sobol_starts(n_starts, gap, velocity, seed)
     n_cells = nb * nd
@@ -352,6 +388,7 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
     outi = np.empty((n, ak.N_I), np.int64)
     n_blocks = min(n, 8 * numba.get_num_threads())
     ak.run_starts(cell_beta, cell_delta, cell_of, th, x0, vv, float(zeta), float(eps),
+                  float(clearance), float(eps if eps_lower is None else eps_lower),
                   float(max_time), float(match_tol), types, np.ascontiguousarray(orb_n),
                   oph.reshape(shape), ou.reshape(shape), oz.reshape(shape), n_blocks, outf,
                   outi)
@@ -362,15 +399,17 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
 
 
 def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYPES, *,
-                    max_time=DEFAULT_MAX_TIME, match_tol=DEFAULT_MATCH_TOL, trace=0):
+                    max_time=DEFAULT_MAX_TIME, match_tol=DEFAULT_MATCH_TOL, trace=0,
+                    clearance=None, eps_lower=None):
     """Given starts ``(theta, x0, v0)`` (arrays) at one cell, through the same kernels as
     :func:`attractor_map`: the raw records ``outf (n, N_F)``, ``outi (n, N_I)`` (slots
     ``kernels.F_*, I_*``) and, with ``trace > 0``, the first ``trace`` impacts
     ``(step, offset, velocity)`` of the first start, run serially (tests, brute force)."""
     types = _types(types)
+    clearance, eps_lower = _validate_walls(clearance, eps_lower, eps, (0.0, 0.0))
     ib = np.array([float(inv_beta)])
     dd = np.array([float(delta)])
-    n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps)
+    n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps, clearance)
     theta, x0, v0 = (np.ascontiguousarray(a, dtype=float).ravel() for a in (theta, x0, v0))
     n = theta.size
     outf = np.empty((n, ak.N_F))
@@ -378,12 +417,14 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
     orb_n = np.ascontiguousarray(n_stable[:, 0, 0])
     if trace:
         tk, ts, tu = np.zeros(trace, np.int64), np.full(trace, np.nan), np.full(trace, np.nan)
-        ak.trace_start(1.0 / ib[0], dd[0], float(zeta), float(eps), theta[0], x0[0], v0[0],
+        ak.trace_start(1.0 / ib[0], dd[0], float(zeta), float(eps), clearance, eps_lower,
+                       theta[0], x0[0], v0[0],
                        float(max_time), float(match_tol), types, orb_n, oph[0, 0], ou[0, 0],
                        oz[0, 0], outf[0], outi[0], tk, ts, tu)
         return outf[:1], outi[:1], (tk, ts, tu)
     ak.run_starts(np.repeat(1.0 / ib, 1), dd, np.zeros(n, np.int64), theta, x0, v0,
-                  float(zeta), float(eps), float(max_time), float(match_tol), types,
+                  float(zeta), float(eps), clearance, eps_lower, float(max_time),
+                  float(match_tol), types,
                   orb_n[None, :], oph[0], ou[0], oz[0], min(n, 8 * numba.get_num_threads()),
                   outf, outi)
     return outf, outi, None

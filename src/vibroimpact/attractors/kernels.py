@@ -20,18 +20,20 @@ from numba import njit, prange
 import numpy as np
 
 from vibroimpact._kernel_cache import kernel_decorator
+from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
 from vibroimpact.impact import _jit as _impact_jit
 from vibroimpact.impact.layout import (BUFFER_FULL, FREE, N_COUNTERS, N_FTOT, N_PARAMS,
                                        N_STATE, OK, P_A, P_AQ, P_BETA, P_BH_HI, P_BH_LO,
                                        P_COS_BH, P_COS_PHI, P_DELTA, P_DT, P_EPS, P_INV_DT,
                                        P_INV_OMEGA, P_M11, P_M12, P_M21, P_M22, P_OMEGA,
                                        P_PHI, P_SIN_BH, P_SIN_PHI, P_ZETA, S_COS_PSI, S_MODE,
-                                       S_SIN_PSI, S_W, S_WV, STUCK)
+                                       S_SIN_PSI, S_W, S_WV, STICK_LO, STICK_ON, STUCK,
+                                       STUCK_LO)
 from vibroimpact.impact.motion import phase, two_prod
 from vibroimpact.impact.stepping import run_steps
 from vibroimpact.impact.tolerances import STEP_HEADROOM
 from vibroimpact.orbits import _jit as _orbits_jit
-from vibroimpact.orbits.flight import lam_of, monodromy, orbit_margin, propagator
+from vibroimpact.orbits.flight import flight_max, lam_of, monodromy, orbit_margin, propagator
 from vibroimpact.orbits.solve import solve_type
 from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, MAX_SOLUTIONS,
                                            SCAN_STEP_M2, SCAN_STEP_M3)
@@ -82,19 +84,43 @@ CHAOS_SIGMAS = 3.0
 # classes (attractors.CLASSES); the wall-free response came last, so codes 0-4 kept their meaning
 LISTED, PERIODIC_OTHER, STICKING, CHAOTIC, UNDECIDED, WALL_FREE = 0, 1, 2, 3, 4, 5
 # per-start float results
-(F_SETTLE, F_LYAP1, F_LYAP2, F_STDERR, F_RATE, F_IMPACTS, F_WINDOW, F_STEP, F_T0) = range(9)
-N_F = 9
+# F_IMPACTS_LO: of F_IMPACTS, those at the lower wall (0 with one wall)
+(F_SETTLE, F_LYAP1, F_LYAP2, F_STDERR, F_RATE, F_IMPACTS, F_WINDOW, F_STEP, F_T0,
+ F_IMPACTS_LO) = range(10)
+N_F = 10
 # per-start integer results
 I_MOTION, I_CLASS, I_STICK_M, I_STICK_P, I_STATUS, I_PERIOD_M, I_PERIOD_P = range(7)
 N_I = 7
 
 
 @kernel
-def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z, orb_lnmu):
+def orbit_floor(y, m, z, beta, delta, zeta, eps, stack):
+    """Lowest point ``min x`` over the flights of the solver orbit ``y`` (``inf`` if none has
+    an interior minimum): :func:`vibroimpact.orbits.flight.flight_max` in the mirrored frame.
+
+    ``-x`` is the flight of the same oscillator under ``sin(beta (tau + pi / beta))`` from
+    the wall at ``-delta`` with approach velocity ``-u`` (Newton's law is odd in ``u``).
+    """
+    shift = math.pi / beta
+    worst = -np.inf
+    for j in range(1, m + 1):
+        a = j - 1
+        b = j % m
+        tb = y[b] + (z if j == m else 0.0)
+        worst = max(worst, flight_max(y[a] + shift, -y[m + a], tb - y[a], beta, -delta, zeta,
+                                      eps, stack))
+    return -worst
+
+
+@kernel
+def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z, orb_lnmu,
+                clearance):
     """The stable admissible solver orbits of every cell and type (parallel over cells).
 
     As :func:`vibroimpact.periodic_orbits`: ``solve_type`` with the same scan steps, admissible
-    when ``orbit_margin >= -ADMISSIBLE_TOL``, stable when ``lam_of(T) < 1``. Per orbit:
+    when ``orbit_margin >= -ADMISSIBLE_TOL``, stable when ``lam_of(T) < 1``; with a finite
+    ``clearance``, also above the wall at ``delta - clearance`` (:func:`orbit_floor`), so
+    that the orbit is one of the two-wall oscillator, with the same multipliers. Per orbit:
     ``orb_ph`` the impact phases ``(tau_j mod T_f) / T_f``, ``orb_u`` the approach velocities,
     ``orb_z`` the interval from impact j to j + 1, ``orb_lnmu`` ``ln max|mu|``.
     """
@@ -121,6 +147,9 @@ def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb
                 y = sols[s, :2 * m]
                 if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
                     continue
+                if clearance < np.inf and (orbit_floor(y, m, z, beta, delta, zeta, eps, stack)
+                                           < delta - clearance + ADMISSIBLE_TOL):
+                    continue
                 monodromy(y, m, z, beta, delta, zeta, eps, tmat)
                 lam = lam_of(tmat, m)
                 if not lam < 1.0:
@@ -138,8 +167,26 @@ def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb
 
 
 @kernel
-def _params(zeta, eps, delta, h, beta):
-    """The simulator's parameter vector (``simulate.kernel_parameters``) for A = 1."""
+def _params(zeta, eps, delta, h, beta, clearance, eps_lower):
+    """The simulator's parameter vector (:meth:`vibroimpact.impact.simulate.model_parameters`)
+    for A = 1: one wall when ``clearance`` is infinite, else twice the slots, the second half
+    the wall at ``delta - clearance`` in the mirrored frame ``x -> -x``."""
+    P1 = _params_upper(zeta, eps, delta, h, beta)
+    if not clearance < np.inf:
+        return P1
+    P = np.empty(2 * N_PARAMS)
+    P[:N_PARAMS] = P1
+    P[N_PARAMS:] = P1
+    P[N_PARAMS + P_EPS] = eps_lower
+    P[N_PARAMS + P_DELTA] = -(delta - clearance)
+    P[N_PARAMS + P_A] = -P1[P_A]
+    P[N_PARAMS + P_AQ] = -P1[P_AQ]
+    return P
+
+
+@kernel
+def _params_upper(zeta, eps, delta, h, beta):
+    """The wall at ``delta``'s slots of :func:`_params`."""
     P = np.empty(N_PARAMS)
     omega = math.sqrt(1.0 - zeta * zeta)
     q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
@@ -273,6 +320,12 @@ def _period_of(rk, rs, ru, n_imp, h, tf, t_now_k, p, tol):
 
 
 @kernel
+def _is_onset(kind):
+    """A sticking event's kind is an onset (at either wall), not a release."""
+    return kind == STICK_ON or kind == STICK_ON + STICK_LO
+
+
+@kernel
 def _hop(ta, tb, beta, delta):
     """The flight ``[ta, tb]`` is pressed throughout by the push ``sin(beta tau) - delta``
     (amplitude 1, no random force): its minimum is -1 - delta where ``beta tau`` passes
@@ -286,7 +339,8 @@ def _hop(ta, tb, beta, delta):
 
 
 @kernel
-def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk, beta, delta):
+def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk, beta, delta,
+                       lower):
     """Collisions per period of a periodic motion (period ``zp``, ``mm`` impacts): the
     grouping of :func:`vibroimpact.stats.group_collisions` (the physical rule: a run of hops,
     flights the push presses throughout, ending in sticking joins the impact that starts it)
@@ -307,7 +361,7 @@ def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk, beta,
     ends = np.zeros(L, np.bool_)
     for j in range(L):
         for e in range(max(0, n_stk - STICK_RING), n_stk):
-            if skind[e % STICK_RING] == 1.0:
+            if _is_onset(skind[e % STICK_RING]):
                 ts = sk[e % STICK_RING] * h + ss[e % STICK_RING]
                 if ts < t[0] - zp:
                     continue            # before the verified periodic stretch
@@ -318,7 +372,13 @@ def _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk, beta,
                     break
     cont = np.zeros(L, np.bool_)
     for j in range(L):
-        cont[j] = (not ends[j]) and _hop(t[j], t[j + 1], beta, delta)
+        if u[j] > 0.0 or not lower > -np.inf:
+            cont[j] = (not ends[j]) and _hop(t[j], t[j + 1], beta, delta)
+        else:
+            # a flight from the lower wall, pressed onto it: the mirrored frame's push
+            # -sin(beta tau) + lower is sin(beta (tau + pi / beta)) - (-lower)
+            sh = math.pi / beta
+            cont[j] = (not ends[j]) and _hop(t[j] + sh, t[j + 1] + sh, beta, -lower)
     n_coll = 0
     for j in range(mm, 2 * mm):
         # impact j joins j - 1 when j - 1 lies on a shrinking run ending in sticking
@@ -353,32 +413,71 @@ def _moduli(a11, a12, a21, a22, det):
 
 
 @kernel
-def _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta):
+def _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta, eps_lower, lower):
     """Eigenvalue moduli ``(|mu_max|, |mu_min|)`` of the tangent map over the last ``mm``
     impacts: from just after impact ``n - mm - 1`` to just after impact ``n - 1``, the
-    product of flight propagators ``P(s)`` and impact saltation matrices."""
+    product of flight propagators ``P(s)`` and impact saltation matrices (at either wall:
+    the sign of the recorded velocity says which)."""
     a11, a12, a21, a22 = 1.0, 0.0, 0.0, 1.0
     span = 0.0
+    n_lo = 0
     for i in range(n_imp - mm, n_imp):
         s = _dt(rk, rs, i, i - 1, h)
         span += s
         f = math.sin(phase(rk[i % RING], rs[i % RING], P[P_BH_HI], P[P_BH_LO], P[P_BETA]))
         a11, a12, a21, a22 = _flight_impact(a11, a12, a21, a22, s, f, ru[i % RING], zeta,
-                                            omega, eps, delta)
-    return _moduli(a11, a12, a21, a22, eps ** (2 * mm) * math.exp(-2.0 * zeta * span))
+                                            omega, eps, delta, eps_lower, lower)
+        if ru[i % RING] < 0.0:
+            n_lo += 1
+    # det S = eps_w^2 at each impact (Newton's law); eps_lower^0 = 1 with one wall
+    return _moduli(a11, a12, a21, a22, eps ** (2 * (mm - n_lo)) * eps_lower ** (2 * n_lo)
+                   * math.exp(-2.0 * zeta * span))
 
 
 @kernel
-def _flight_impact(a11, a12, a21, a22, s, f, u, zeta, omega, eps, delta):
-    """``S P(s) A``: a flight of length ``s``, then the saltation of an impact with approach
-    velocity ``u`` where the force is ``f``."""
+def wall_saltation(eps, u, f, delta, eps_lower, lower, zeta):
+    """:func:`saltation` of an impact at either wall, told by the sign of the lab-frame
+    velocity ``u`` (the simulator's ``imp_u``: > 0 at the wall at ``delta``, < 0 at the wall
+    at ``lower``). The lower wall's is the upper wall's formula in the mirrored frame
+    ``x -> -x`` (approach ``-u``, force ``-f``, wall at ``-lower``, its own law), and a
+    saltation matrix is the same in both frames (the mirror is ``-I``)."""
+    if u > 0.0:
+        return saltation(eps, u, f, delta, zeta)
+    return saltation(eps_lower, -u, -f, -lower, zeta)
+
+
+@kernel
+def _flight_impact(a11, a12, a21, a22, s, f, u, zeta, omega, eps, delta, eps_lower, lower):
+    """``S P(s) A``: a flight of length ``s``, then the saltation of an impact with lab-frame
+    velocity ``u`` (its sign the wall, :func:`wall_saltation`) where the force is ``f``."""
     p11, p12, p21, p22 = propagator(s, zeta, omega)
     b11 = p11 * a11 + p12 * a21
     b12 = p11 * a12 + p12 * a22
     b21 = p21 * a11 + p22 * a21
     b22 = p21 * a12 + p22 * a22
-    g = (1.0 + eps) * (f - delta) / u
-    return -eps * b11, -eps * b12, g * b11 - eps * b21, g * b12 - eps * b22
+    s11, s21, s22 = wall_saltation(eps, u, f, delta, eps_lower, lower, zeta)
+    return s11 * b11, s11 * b12, s21 * b11 + s22 * b21, s21 * b12 + s22 * b22
+
+
+@kernel
+def saltation(eps, u, f, delta, zeta):
+    """Saltation matrix ``S = [[s11, 0], [s21, s22]]`` of an impact on the wall at ``x = delta``
+    met at approach velocity ``u > 0`` where the force is ``f``: the tangent map from just
+    before to just after the impact, ``S = Dg + (F_+ - Dg F_-) e_x^T / u`` with the reset
+    ``g(x, v) = (x, rebound_velocity(eps, v))`` and the flows before and after.
+
+    Notes
+    -----
+    ``s11 = v_+ / u``, ``s22 = d v_+ / du``, ``s21 = (a_+ - s22 a_-) / u`` with the
+    accelerations ``a_-+ = f - 2 zeta v_-+ - delta``, written as
+    ``((1 - s22) (f - delta) - 2 zeta (v_+ - s22 u)) / u`` for any law. Newton's law makes the
+    last term exactly 0 (``v_+ = s22 u`` to the bit), leaving the classic ``(1 + eps) (f -
+    delta) / u`` rounded exactly as before.
+    """
+    v_plus = rebound_velocity(eps, u)
+    s22 = rebound_derivative(eps, u)
+    s21 = ((1.0 - s22) * (f - delta) - 2.0 * zeta * (v_plus - s22 * u)) / u
+    return rebound_ratio(eps, u), s21, s22
 
 
 @kernel
@@ -392,7 +491,7 @@ def _orbit_tangent_product(oph, ou, oz, m, z, zeta, omega, eps, delta):
         j = l % m
         f = math.sin(2.0 * math.pi * oph[j])
         a11, a12, a21, a22 = _flight_impact(a11, a12, a21, a22, oz[(l - 1) % m], f, ou[j],
-                                            zeta, omega, eps, delta)
+                                            zeta, omega, eps, delta, eps, -np.inf)
     return _moduli(a11, a12, a21, a22, eps ** (2 * m) * math.exp(-2.0 * zeta * z))
 
 
@@ -447,15 +546,21 @@ def _carry(q, acc, seg, t_to, t_b, zeta, omega):
 
 
 @kernel
-def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_n, oph, ou,
-               oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf, outi, trace_k,
-               trace_s, trace_u):
+def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_time, tol,
+               types, orb_n, oph, ou, oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf,
+               outi, trace_k, trace_s, trace_u):
     """One start until it settles or reaches ``max_time``; results into ``outf``/``outi``
-    (slots ``F_*``, ``I_*``). ``trace_*`` (length > 0) receive its first impacts."""
+    (slots ``F_*``, ``I_*``). ``trace_*`` (length > 0) receive its first impacts.
+
+    A finite ``clearance`` adds the wall at ``lower = delta - clearance`` (restitution
+    ``eps_lower``): the simulator follows both walls, impacts there are recorded with their
+    lab-frame velocity ``< 0`` (``ru``, ``trace_u``) and the tangent crosses them by their own
+    saltation (:func:`wall_saltation`)."""
     tf = 2.0 * math.pi / beta
     omega = math.sqrt(1.0 - zeta * zeta)
+    lower = delta - clearance                   # -inf with one wall
     h, k0, t0 = start_step(beta, theta)
-    P = _params(zeta, eps, delta, h, beta)
+    P = _params(zeta, eps, delta, h, beta, clearance, eps_lower)
     q = P[P_AQ]
     psi0 = phase(k0, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
     state = np.empty(N_STATE)
@@ -488,10 +593,12 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
     n_imp = 0
     n_stk = 0
     n_imp_win = 0
+    n_lo_win = 0
     n_coll_win = 0
     last_stick = -np.inf                        # instant of the last sticking event
     after_release = True
     u_prev = np.inf
+    lo_prev = False
     z_prev = np.inf
     n_trace = 0
     ip = 0
@@ -534,12 +641,13 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                     u = imp_u[ip]
                     if not tan_dead:
                         f = math.sin(phase(ek, es, P[P_BH_HI], P[P_BH_LO], beta))
-                        g = (1.0 + eps) * (f - delta) / u
+                        s11, s21, s22 = wall_saltation(eps, u, f, delta, eps_lower, lower,
+                                                       zeta)
                         for cc in range(2):
                             a = qm[0, cc]
                             b = qm[1, cc]
-                            qm[0, cc] = -eps * a
-                            qm[1, cc] = g * a - eps * b
+                            qm[0, cc] = s11 * a
+                            qm[1, cc] = s21 * a + s22 * b
                         before0, before1 = acc[0], acc[1]
                         _qr(qm, acc)
                         if tau >= t_b:
@@ -555,12 +663,19 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                     rph[slot] = ph - math.floor(ph)
                     z_here = (ek - rk[(n_imp - 1) % RING]) * h + (
                         es - rs[(n_imp - 1) % RING]) if n_imp > 0 else np.inf
+                    lo = u < 0.0
                     if tau >= t_b:
                         n_imp_win += 1
-                        if after_release or u >= u_prev or z_here >= z_prev:
+                        if lo:
+                            n_lo_win += 1
+                        # a new collision: after a release, at the other wall, or not
+                        # shrinking (a chatter run's rebounds shrink in speed and interval)
+                        if (after_release or lo != lo_prev or abs(u) >= abs(u_prev)
+                                or z_here >= z_prev):
                             n_coll_win += 1
                     after_release = False
                     u_prev = u
+                    lo_prev = lo
                     z_prev = z_here
                     if n_trace < trace_k.shape[0]:
                         trace_k[n_trace] = ek
@@ -577,7 +692,7 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                     skind[slot] = kind
                     n_stk += 1
                     last_stick = tau
-                    if kind == 1.0:
+                    if _is_onset(kind):
                         tan_dead = True
                         if tau >= t_b:
                             stick_in_win = True
@@ -609,10 +724,13 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
         mode = int(state[S_MODE])
         # (a) no impact ever again: the free response has decayed below the wall's margin
         # and the motion tends to the linear steady response q sin(beta tau - phi), q < delta
+        # (and above the lower wall, q < -lower, when there is one)
         if mode == FREE:
             w = state[S_W]
             c2 = (state[S_WV] + zeta * w) / omega
-            if q + math.sqrt(w * w + c2 * c2) < delta - 1e-9 * (1.0 + abs(delta)):
+            reach = q + math.sqrt(w * w + c2 * c2)
+            if reach < delta - 1e-9 * (1.0 + abs(delta)) and (
+                    not lower > -np.inf or -reach > lower + 1e-9 * (1.0 + abs(lower))):
                 outf[F_SETTLE] = t_now - t0
                 outf[F_LYAP1] = -zeta
                 outf[F_LYAP2] = -zeta
@@ -623,8 +741,9 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
         # (b) resting or sliding on the wall for REPEATS + 1 periods without an impact
         t_last_imp = (rk[(n_imp - 1) % RING] * h + rs[(n_imp - 1) % RING]
                       if n_imp > 0 else t0)
+        stuck = mode == STUCK or mode == STUCK_LO
         if t_now - t_last_imp > (REPEATS + 1) * tf and (
-                mode == STUCK or last_stick > t_now - (REPEATS + 1) * tf):
+                stuck or last_stick > t_now - (REPEATS + 1) * tf):
             outf[F_SETTLE] = max(t_last_imp, t0) - t0
             outf[F_LYAP1] = -np.inf
             outf[F_LYAP2] = -np.inf
@@ -648,6 +767,7 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                     outf[F_LYAP2] = math.log(small) / z
                     outf[F_RATE] = m / z
                     outf[F_IMPACTS] = m
+                    outf[F_IMPACTS_LO] = 0.0
                     outf[F_WINDOW] = z
                     outi[I_MOTION] = t
                     outi[I_CLASS] = LISTED
@@ -674,9 +794,9 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
             outf[F_SETTLE] = rk[i0 % RING] * h + rs[i0 % RING] - t0
             outi[I_PERIOD_M] = mm
             outi[I_PERIOD_P] = p
-            if mode == STUCK or last_stick > t_last - zp:
+            if stuck or last_stick > t_last - zp:
                 mc = _period_collisions(rk, rs, ru, n_imp, mm, h, zp, sk, ss, skind, n_stk,
-                                        beta, delta)
+                                        beta, delta, lower)
                 outf[F_LYAP1] = -np.inf
                 outf[F_LYAP2] = -np.inf
                 outf[F_RATE] = mc / zp
@@ -687,11 +807,17 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
                     if types[t, 0] == mc and types[t, 1] == p:
                         outi[I_MOTION] = -2 - t          # impact-stick variant of type t
                 return
-            big, small = _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta)
+            big, small = _tangent_product(rk, rs, ru, n_imp, mm, h, P, zeta, omega, eps, delta,
+                                          eps_lower, lower)
             outf[F_LYAP1] = math.log(big) / zp
             outf[F_LYAP2] = math.log(small) / zp
             outf[F_RATE] = mm / zp
             outf[F_IMPACTS] = mm
+            n_lo = 0
+            for i in range(n_imp - mm, n_imp):
+                if ru[i % RING] < 0.0:
+                    n_lo += 1
+            outf[F_IMPACTS_LO] = n_lo
             outf[F_WINDOW] = zp
             outi[I_CLASS] = PERIODIC_OTHER
             return
@@ -700,6 +826,7 @@ def _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_
     win = t_end - t_b
     outf[F_WINDOW] = win
     outf[F_IMPACTS] = n_imp_win
+    outf[F_IMPACTS_LO] = n_lo_win
     outf[F_RATE] = (n_imp_win if not stick_in_win else n_coll_win) / win
     if stick_in_win or tan_dead:
         outf[F_LYAP1] = -np.inf
@@ -729,8 +856,8 @@ def _alloc_ring():
 
 
 @kernel(parallel=True)
-def run_starts(cell_beta, cell_delta, cell_of, theta, x0, v0, zeta, eps, max_time, tol, types,
-               orb_n, oph, ou, oz, n_blocks, outf, outi):
+def run_starts(cell_beta, cell_delta, cell_of, theta, x0, v0, zeta, eps, clearance, eps_lower,
+               max_time, tol, types, orb_n, oph, ou, oz, n_blocks, outf, outi):
     """Every start ``i`` (cell ``cell_of[i]``) through :func:`_run_start`; ``n_blocks``
     parallel blocks, block ``b`` taking the starts ``b, b + n_blocks, ...`` (so that the cost,
     which varies across the plane, is shared evenly), each with its own buffers."""
@@ -743,18 +870,19 @@ def run_starts(cell_beta, cell_delta, cell_of, theta, x0, v0, zeta, eps, max_tim
         tr_s = np.empty(0)
         for i in range(b, n, n_blocks):
             c = cell_of[i]
-            _run_start(cell_beta[c], cell_delta[c], zeta, eps, theta[i], x0[i], v0[i],
-                       max_time, tol, types, orb_n[c], oph[c], ou[c], oz[c], bufs_i, bufs_f,
-                       rk, rs, ru, rph, sk, ss, skind, outf[i], outi[i], tr_k, tr_s, tr_s)
+            _run_start(cell_beta[c], cell_delta[c], zeta, eps, clearance, eps_lower, theta[i],
+                       x0[i], v0[i], max_time, tol, types, orb_n[c], oph[c], ou[c], oz[c],
+                       bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf[i], outi[i], tr_k,
+                       tr_s, tr_s)
 
 
 @kernel
-def trace_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_n, oph, ou,
-                oz, outf, outi, trace_k, trace_s, trace_u):
+def trace_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_time, tol,
+                types, orb_n, oph, ou, oz, outf, outi, trace_k, trace_s, trace_u):
     """One start, serially, recording its first impacts (tests)."""
     bufs_i = np.empty((2, CAPACITY), np.int64)
     bufs_f = np.empty((4, CAPACITY))
     rk, rs, ru, rph, sk, ss, skind = _alloc_ring()
-    _run_start(beta, delta, zeta, eps, theta, x0, v0, max_time, tol, types, orb_n, oph, ou, oz,
-               bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf, outi, trace_k, trace_s,
-               trace_u)
+    _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_time, tol,
+               types, orb_n, oph, ou, oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf,
+               outi, trace_k, trace_s, trace_u)

@@ -5,6 +5,10 @@ impacts and sticking phases (docs/model.md, section 7.1), walked step by step in
 instead of gathered into arrays: the numpy function stays the reference (the tests hold this
 one to it) and the statement of the rules; this is the one the events cells run.
 
+With a second wall (``gap``) the events carry their wall: an impact at the lower wall leaves
+``x = delta - gap`` at ``+eps_lower V``, a piece resting there adds its push
+``(delta - gap) - f`` and its tails to the rows of ``stats.identities.MOMENTS_LOWER``.
+
 Its kernels use no simulator kernel and no constant of another module (the Gauss-Legendre
 rule, the tail threshold and the whole-step forms come in as arguments), so their numba cache
 is stamped with this file alone and an edit here recompiles nothing of the simulator.
@@ -15,7 +19,8 @@ import numpy as np
 from numba import njit
 
 from vibroimpact._kernel_cache import kernel_decorator
-from vibroimpact.stats.identities import GAUSS_NODES, MOMENTS, TAIL_REBOUND, step_forms
+from vibroimpact.stats.identities import (GAUSS_NODES, TAIL_REBOUND, moment_rows, step_forms,
+                                         wall_arrays)
 
 kernel = kernel_decorator(njit, __file__, ("audit.py",), error_model="numpy")
 
@@ -32,7 +37,8 @@ _SAMPLE, _IMPACT, _ONSET = 0, 1, 2
 
 def audit_moments(k_first, a, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                   impact_time=(), impact_velocity=(), stick_start=(), stick_end=(),
-                  batch_bounds=None):
+                  batch_bounds=None, gap=None, eps_lower=None, impact_wall=None,
+                  stick_wall=None):
     """:func:`vibroimpact.stats.flight_moments` of the simulator's record ``a = delta - x``.
 
     Parameters
@@ -51,10 +57,12 @@ def audit_moments(k_first, a, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta
     batch_bounds : array_like of int, shape (B + 1,), optional
         Contiguous batches: batch ``j`` holds the steps from sample ``batch_bounds[j]`` up to
         ``batch_bounds[j + 1]`` (nondecreasing, covering the steps). Default: one batch.
+    gap, eps_lower, impact_wall, stick_wall
+        A second wall, as :func:`vibroimpact.stats.flight_moments` (all or none).
 
     Returns
     -------
-    ndarray, shape (len(MOMENTS), B)
+    ndarray, shape (len(MOMENTS), B), or (len(MOMENTS + MOMENTS_LOWER), B) with two walls
         The per-batch sums of :func:`vibroimpact.stats.flight_moments` with ``batch`` the
         batch of each step, equal to round-off (the order of the sums differs;
         tests/test_audit_kernel.py).
@@ -71,14 +79,20 @@ def audit_moments(k_first, a, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta
             or bounds[-1] < k_first + n):
         raise ValueError(f"batch_bounds must be nondecreasing sample indices from at most "
                          f"{k_first} to at least {k_first + n}, got {bounds}")
-    out = np.zeros((len(MOMENTS), bounds.size - 1))
+    as_f = lambda e: np.ascontiguousarray(e, dtype=float).reshape(-1)
+    t_imp, s0 = as_f(impact_time), as_f(stick_start)
+    walls = wall_arrays(gap, eps_lower, delta, impact_wall, stick_wall, t_imp.size, s0.size)
+    out = np.zeros((len(moment_rows(walls is not None)), bounds.size - 1))
+    if walls is None:    # one wall: every event at the wall at delta
+        walls = (0.0, 0.0, np.zeros(t_imp.size, np.int8), np.zeros(s0.size, np.int8))
+    x_lower, e_lower, iw, sw = walls
     if n:
-        as_f = lambda e: np.ascontiguousarray(e, dtype=float).reshape(-1)
         _moments(int(k_first), a, v, r, float(dt), float(zeta), float(eps), float(delta),
-                 float(amplitude), float(beta_f), as_f(impact_time), as_f(impact_velocity),
-                 as_f(stick_start), as_f(stick_end), bounds,
+                 float(amplitude), float(beta_f), t_imp, as_f(impact_velocity),
+                 s0, as_f(stick_end), bounds,
                  np.ascontiguousarray(step_forms(dt, zeta, amplitude, beta_f)), _XI, _W,
-                 TAIL_REBOUND, out)
+                 TAIL_REBOUND, float(x_lower), float(e_lower), np.ascontiguousarray(iw),
+                 np.ascontiguousarray(sw), out)
     return out
 
 
@@ -95,10 +109,12 @@ def _step_of(t, k_first, n, dt):
 
 
 @kernel
-def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1):
+def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1, delta, x_lower, eps_lower, iw, sw):
     """Impacts, sticking onsets and releases inside the steps, sorted by (time, kind).
 
-    Returns the times, kinds, velocities leaving them (``-eps V``, 0, 0) and steps."""
+    Returns the times, kinds, velocities leaving them (``-eps V``, 0, 0 at the upper wall;
+    ``+eps_lower V`` after an impact at the lower one), positions (the event's wall) and
+    steps."""
     t_lo, t_hi = k_first * dt, (k_first + n) * dt
     lists = (t_imp, s0, s1)
     firsts = np.zeros(3, np.int64)
@@ -116,6 +132,7 @@ def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1):
     ev_t = np.empty(m)
     ev_kind = np.empty(m, np.int64)
     ev_v = np.zeros(m)
+    ev_x = np.full(m, delta)
     ev_step = np.empty(m, np.int64)
     heads = firsts.copy()
     for e in range(m):
@@ -125,13 +142,16 @@ def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1):
                 t = lists[kind][heads[kind]]
                 if best < 0 or t < best_t:
                     best, best_t = kind, t
+        at_lower = (iw[heads[0]] if best == 0 else sw[heads[best]]) == 1
         if best == 0:
-            ev_v[e] = -eps * u_imp[heads[0]]
+            ev_v[e] = eps_lower * u_imp[heads[0]] if at_lower else -eps * u_imp[heads[0]]
+        if at_lower:
+            ev_x[e] = x_lower
         ev_t[e] = best_t
         ev_kind[e] = best + 1
         ev_step[e] = _step_of(best_t, k_first, n, dt)
         heads[best] += 1
-    return ev_t, ev_kind, ev_v, ev_step
+    return ev_t, ev_kind, ev_v, ev_x, ev_step
 
 
 @kernel
@@ -146,9 +166,10 @@ def _phase_after(t, s0, p):
 
 
 @kernel
-def _add_resting(out, b, s_a, L, k, r0, r1, dt, delta, A, beta):
-    """Integrals of x^2, x f and the push f - delta over a piece resting on the wall (offset
-    ``s_a`` in step ``k``, length ``L``), added to batch ``b``."""
+def _add_resting(out, b, s_a, L, k, r0, r1, dt, delta, A, beta, lower):
+    """Integrals of x^2, x f and the push f - delta over a piece resting on the wall at
+    ``delta`` (offset ``s_a`` in step ``k``, length ``L``), added to batch ``b``; ``lower``:
+    the wall is the lower one, at ``delta``, and its push ``delta - f`` goes to its row."""
     slope = (r1 - r0) / dt
     f_int = L * (r0 + slope * (s_a + 0.5 * L))
     if A != 0.0:
@@ -156,7 +177,10 @@ def _add_resting(out, b, s_a, L, k, r0, r1, dt, delta, A, beta):
         f_int = f_int + A / beta * (math.cos(beta * tau) - math.cos(beta * (tau + L)))
     out[1, b] += delta * delta * L
     out[3, b] += delta * f_int
-    out[4, b] += f_int - delta * L
+    if lower:
+        out[7, b] += delta * L - f_int
+    else:
+        out[4, b] += f_int - delta * L
 
 
 @kernel
@@ -236,12 +260,13 @@ def _add_free(out, b, s_a, L, k, x0, v0, r0, r1, dt, zeta, A, beta, xi, wi):
 
 
 @kernel
-def _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_step, k_first, a, v, r, b, dt, zeta,
-               delta, A, beta, s0, s1, xi, wi, tail_rebound):
+def _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_x, ev_step, k_first, a, v, r, b, dt,
+               zeta, delta, A, beta, s0, s1, xi, wi, tail_rebound, x_lower, sw):
     """The pieces of step ``i``, whose events start at ``e``; returns the next step's first
     event and :func:`_phase_after` of its last piece (from ``p``). As stats.flight_moments:
     a piece resting at its midpoint, or running from a last chatter rebound slower than
-    ``tail_rebound`` to a sticking onset, is resting."""
+    ``tail_rebound`` to a sticking onset, is resting (at its phase's wall; a tail at its
+    impact's)."""
     k = k_first + i
     t_a, kind, x0, v0 = k * dt, _SAMPLE, delta - a[i], v[i]
     while True:
@@ -251,20 +276,26 @@ def _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_step, k_first, a, v, r, b, 
         t_mid = t_a + 0.5 * length
         p = _phase_after(t_mid, s0, p)
         stuck = p > 0 and t_mid < s1[p - 1]
-        if kind == _IMPACT and same and ev_kind[e] == _ONSET and -v0 < tail_rebound:
-            stuck = True
-            w = -v0
-            out[5, b] += w
-            out[6, b] += w * w
+        lower = stuck and sw[p - 1] == 1
+        if kind == _IMPACT and same and ev_kind[e] == _ONSET:
+            # a rebound leaves the upper wall downwards (v0 <= 0), the lower one upwards
+            at_lower = x0 != delta
+            w = v0 if at_lower else -v0
+            if w < tail_rebound:
+                stuck, lower = True, at_lower
+                row = 8 if lower else 5
+                out[row, b] += w
+                out[row + 1, b] += w * w
         offset = t_a - k * dt
         if stuck:
-            _add_resting(out, b, offset, length, k, r[i], r[i + 1], dt, delta, A, beta)
+            _add_resting(out, b, offset, length, k, r[i], r[i + 1], dt,
+                         x_lower if lower else delta, A, beta, lower)
         else:
             _add_free(out, b, offset, length, k, x0, v0, r[i], r[i + 1], dt, zeta, A, beta, xi,
                       wi)
         if not same:
             return e, p
-        t_a, kind, x0, v0 = ev_t[e], ev_kind[e], delta, ev_v[e]
+        t_a, kind, x0, v0 = ev_t[e], ev_kind[e], ev_x[e], ev_v[e]
         e += 1
 
 
@@ -338,12 +369,15 @@ def _free_run(a, v, r, i0, i1, k_first, dt, zeta, delta, A, beta, q, cos_phi, si
 
 @kernel
 def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, s1, bounds,
-             M, xi, wi, tail_rebound, out):
+             M, xi, wi, tail_rebound, x_lower, eps_lower, iw, sw, out):
     """Add the moments of the steps ``k_first .. k_first + n - 1`` to ``out`` (see
-    :func:`audit_moments`); ``M``: the whole-step forms of ``stats.identities.step_forms``."""
+    :func:`audit_moments`); ``M``: the whole-step forms of ``stats.identities.step_forms``;
+    ``iw``, ``sw``: the wall of each impact and sticking phase (1: the lower wall, at
+    ``x_lower``, restitution ``eps_lower``)."""
     n = a.size
     m = M.shape[1]
-    ev_t, ev_kind, ev_v, ev_step = _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1)
+    ev_t, ev_kind, ev_v, ev_x, ev_step = _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1,
+                                                 delta, x_lower, eps_lower, iw, sw)
     q = phi = 0.0
     if A != 0.0:
         q = A / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
@@ -356,15 +390,18 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
         while k_first + i >= bounds[b + 1]:
             b += 1
         if e < ev_t.size and ev_step[e] == i:
-            e, p = _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_step, k_first, a, v, r, b,
-                              dt, zeta, delta, A, beta, s0, s1, xi, wi, tail_rebound)
+            e, p = _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_x, ev_step, k_first, a, v,
+                              r, b, dt, zeta, delta, A, beta, s0, s1, xi, wi, tail_rebound,
+                              x_lower, sw)
             i += 1
             continue
         k = k_first + i
         t_mid = k * dt + 0.5 * dt
         p = _phase_after(t_mid, s0, p)
         if p > 0 and t_mid < s1[p - 1]:
-            _add_resting(out, b, 0.0, dt, k, r[i], r[i + 1], dt, delta, A, beta)
+            lower = sw[p - 1] == 1
+            _add_resting(out, b, 0.0, dt, k, r[i], r[i + 1], dt, x_lower if lower else delta,
+                         A, beta, lower)
             i += 1
             continue
         # a run of free steps: up to the next event's step, the next sticking phase's

@@ -7,6 +7,10 @@ every candidate flight in arrays: the numpy function stays the reference and the
 the rule (tests/test_collisions.py holds this one to it); this is the one the simulator's
 results and the streaming cells run.
 
+With two walls a flight between two impacts at the lower wall is examined in the mirrored
+frame ``x -> -x`` (force samples and amplitude negated, the wall at ``-(delta - gap)``), and a
+flight between the walls never is (``stats.pressed_flights``).
+
 Its kernel uses no simulator kernel and no constant of another module, so its numba cache is
 stamped with this file alone.
 """
@@ -21,37 +25,47 @@ kernel = kernel_decorator(njit, __file__, ("hops.py",), error_model="numpy")
 
 
 @kernel
-def _push(r, i, k, s, dt, delta, amplitude, beta):
-    """The push at ``k dt + s`` (``i = k - k_lo`` its index in ``r``)."""
-    value = r[i] + (r[i + 1] - r[i]) / dt * s - delta
+def _push(r, i, k, s, dt, delta, amplitude, beta, mirror):
+    """The push at ``k dt + s`` (``i = k - k_lo`` its index in ``r``); ``mirror = -1.0``:
+    in the lower wall's mirrored frame (``delta``, ``amplitude`` given in it), else 1.0
+    (the product is then exact: the one-wall push to the bit)."""
+    r0, r1 = mirror * r[i], mirror * r[i + 1]
+    value = r0 + (r1 - r0) / dt * s - delta
     if amplitude != 0.0:
         value += amplitude * math.sin(beta * (k * dt + s))
     return value
 
 
 @kernel
-def _pressed(step, offset, r, k_lo, dt, delta, amplitude, beta, examine, out):
+def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_upper, beta,
+             examine, lower, out):
     two_pi = 2.0 * math.pi
-    sign = 1.0 if amplitude > 0.0 else -1.0
     for j in range(step.size - 1):
         out[j] = False
         if not examine[j]:
             continue
+        # the wall's frame: the lower wall's mirrored (x -> -x)
+        if lower[j]:
+            mirror, delta, amplitude = -1.0, delta_lower, -amplitude_upper
+        else:
+            mirror, delta, amplitude = 1.0, delta_upper, amplitude_upper
+        sign = 1.0 if amplitude > 0.0 else -1.0
         ka, kb = step[j], step[j + 1]
-        if (_push(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta) <= 0.0
-                or _push(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta) <= 0.0):
+        if (_push(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta, mirror) <= 0.0
+                or _push(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta,
+                         mirror) <= 0.0):
             continue
         ok = True
         for k in range(ka, kb + 1):
             i = k - k_lo
             s_lo = offset[j] if k == ka else 0.0
             s_hi = offset[j + 1] if k == kb else dt
-            if _push(r, i, k, s_hi, dt, delta, amplitude, beta) <= 0.0:
+            if _push(r, i, k, s_hi, dt, delta, amplitude, beta, mirror) <= 0.0:
                 ok = False
                 break
             if amplitude != 0.0:
                 # interior minima: cos(beta tau) = c where amplitude sin(beta tau) < 0
-                c = -(r[i + 1] - r[i]) / dt / (amplitude * beta)
+                c = -(mirror * r[i + 1] - mirror * r[i]) / dt / (amplitude * beta)
                 if abs(c) <= 1.0:
                     theta0 = -sign * math.acos(c)
                     th_lo = beta * (k * dt + s_lo)
@@ -61,7 +75,7 @@ def _pressed(step, offset, r, k_lo, dt, delta, amplitude, beta, examine, out):
                         theta = theta0 + two_pi * n_turn
                         if th_lo <= theta <= th_hi:
                             s = min(max(s_lo + (theta - th_lo) / beta, s_lo), s_hi)
-                            if _push(r, i, k, s, dt, delta, amplitude, beta) <= 0.0:
+                            if _push(r, i, k, s, dt, delta, amplitude, beta, mirror) <= 0.0:
                                 ok = False
                 if not ok:
                     break
@@ -69,8 +83,11 @@ def _pressed(step, offset, r, k_lo, dt, delta, amplitude, beta, examine, out):
 
 
 def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0,
-                    flights=None):
+                    flights=None, wall=None, gap=None):
     """:func:`vibroimpact.stats.pressed_flights` compiled (same arguments and result)."""
+    from vibroimpact.stats.collisions import _flight_sides
+
+    sides = _flight_sides(impact_step, wall, gap, flights)
     step = np.ascontiguousarray(impact_step, dtype=np.int64)
     offset = np.ascontiguousarray(impact_offset, dtype=np.float64)
     n = step.size
@@ -83,9 +100,14 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
         r = np.ascontiguousarray(noise[k_lo : min(k_hi, len(noise))], dtype=np.float64)
         if r.size < k_hi - k_lo:     # an impact on the record's last sample: no slope needed
             r = np.append(r, np.full(k_hi - k_lo - r.size, r[-1]))
-    examine = (np.ones(n - 1, np.bool_) if flights is None
-               else np.ascontiguousarray(flights, dtype=np.bool_))
+    if sides is None:
+        examine = (np.ones(n - 1, np.bool_) if flights is None
+                   else np.ascontiguousarray(flights, dtype=np.bool_))
+        lower, delta_lower = np.zeros(n - 1, np.bool_), 0.0
+    else:
+        examine = np.ascontiguousarray(sides[0] | sides[1])
+        lower, delta_lower = np.ascontiguousarray(sides[1]), -(float(delta) - float(gap))
     out = np.empty(n - 1, np.bool_)
-    _pressed(step, offset, r, k_lo, float(dt), float(delta), float(amplitude), float(beta),
-             examine, out)
+    _pressed(step, offset, r, k_lo, float(dt), float(delta), delta_lower, float(amplitude),
+             float(beta), examine, lower, out)
     return out

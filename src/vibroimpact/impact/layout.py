@@ -113,6 +113,18 @@ STUCK = 1
 #: or a release fell on the end of the previous step. Kept apart from FREE so that the state
 #: is handed on exactly, not through the round-off of ``w = x - p_h``.
 WALL = 2
+#: The same two modes at the second wall of a clearance (x = delta - gap, below the mass).
+STUCK_LO = 3
+WALL_LO = 4
+
+# the two walls: the parameter vector ``P`` holds N_PARAMS slots per wall, the upper wall's
+# (the paper's, at x = delta) first; the lower wall's half is that wall in the mirrored frame
+# x -> -x (vibroimpact.impact.simulate.model_parameters), so every search serves both walls.
+# In the event buffers the wall is the sign of ``imp_u`` (the lab-frame velocity x' at the
+# impact: > 0 at the upper wall, < 0 at the lower) and the kind of a sticking event:
+STICK_OFF = 0.0      # release from the upper wall
+STICK_ON = 1.0       # sticking onset at the upper wall
+STICK_LO = 2.0       # added to the kind at the lower wall (2: release, 3: onset)
 
 # search results of first_contact
 NO_ROOT = 0

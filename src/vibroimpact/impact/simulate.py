@@ -14,6 +14,7 @@ import numpy as np
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
 from vibroimpact.impact.hops import pressed_flights
+from vibroimpact.model import Model
 from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR, Collisions,
                                           close_open_phase, group_collisions)
 
@@ -72,6 +73,13 @@ class SimulationResult:
         Index of the collision each impact belongs to.
     rebound_floor : float
         The velocity floor of ``collision_rebounds``.
+    impact_wall : ndarray of int8, shape (n,)
+        The wall each impact hit: 0 the wall at ``x = delta``, 1 the second wall at
+        ``x = delta - gap`` (only with ``gap``; all zeros with one wall).
+    stick_wall : ndarray of int8, shape (n_stick,)
+        The wall each sticking interval rests on.
+    model : vibroimpact.model.Model
+        The oscillator, its walls and its harmonic force.
     params : dict
         The physical inputs.
     force_record : array_like or None
@@ -104,6 +112,16 @@ class SimulationResult:
     stuck_since: float
     params: dict = field(default_factory=dict)
     force_record: object = field(default=None, repr=False, compare=False)
+    impact_wall: np.ndarray = None
+    stick_wall: np.ndarray = None
+    model: Model = field(default=None, compare=False)
+
+    def __post_init__(self):
+        # results built without walls (one wall): every event at the wall at delta
+        for name, like in (("impact_wall", "impact_step"), ("stick_wall", "stick_start")):
+            if getattr(self, name) is None:
+                object.__setattr__(self, name,
+                                   np.zeros(np.shape(getattr(self, like)), np.int8))
 
     # The collision fields are computed on first use (most streaming consumers group the
     # impacts of many chunks themselves) and cached; a frozen dataclass keeps a __dict__.
@@ -118,16 +136,31 @@ class SimulationResult:
         """The impacts grouped by ``rule`` (:data:`vibroimpact.stats.RULES`; the default,
         the physical rule, is :attr:`collisions`)."""
         p = self.params
-        start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
-                                      self.t_end)
+        if "gap" not in p:
+            start, end = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                          self.t_end)
+            pressed = None
+            if rule == "physical":
+                pressed = pressed_flights(self.impact_step, self.impact_offset,
+                                          self.force_record, p["dt"], delta=p["delta"],
+                                          amplitude=p["amplitude"], beta=p["beta"])
+            return group_collisions(self.impact_step, self.impact_offset,
+                                    self.impact_velocity, start, end, dt=p["dt"],
+                                    eps=p["eps"], floor=p["rebound_floor"], pressed=pressed,
+                                    rule=rule)
+        # two walls: a rest still going on at the end is on the wall the mass ends on
+        start, end, wall = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
+                                            self.t_end, self.stick_wall,
+                                            int(self.x_end != p["delta"]))
         pressed = None
         if rule == "physical":
             pressed = pressed_flights(self.impact_step, self.impact_offset, self.force_record,
                                       p["dt"], delta=p["delta"], amplitude=p["amplitude"],
-                                      beta=p["beta"])
+                                      beta=p["beta"], wall=self.impact_wall, gap=p["gap"])
         return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
                                 start, end, dt=p["dt"], eps=p["eps"], floor=p["rebound_floor"],
-                                pressed=pressed, rule=rule)
+                                pressed=pressed, rule=rule, wall=self.impact_wall,
+                                stick_wall=wall, eps_lower=p["eps_lower"])
 
     n_collisions = property(lambda self: int(self.collisions.first.size))
     collision_time = property(lambda self: self.collisions.time)
@@ -138,22 +171,34 @@ class SimulationResult:
     collision_stuck = property(lambda self: self.collisions.stuck)
     collision_stick_time = property(lambda self: self.collisions.stick_time)
     collision_duration = property(lambda self: self.collisions.duration)
+    collision_wall = property(lambda self: self.collisions.wall)
     impact_collision = property(lambda self: self.collisions.impact_collision)
     rebound_floor = property(lambda self: self.params["rebound_floor"])
 
 
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
-                  chunk_size):
+                  chunk_size, gap=None, eps_lower=None):
     zeta = _checks.zeta(zeta)
     eps = _checks.eps(eps)
     delta = _checks.real("delta", delta)
-    dt = _checks.real("dt", dt, low=0.0, low_open=True)
     amplitude = _checks.real("amplitude", amplitude)
     beta = _checks.real("beta", beta, low=0.0, low_open=True)
-    x0 = min(0.0, delta) if x0 is None else _checks.real("x0", x0)
+    model = Model.paper(zeta, eps, delta, amplitude, beta, gap=gap, eps_lower=eps_lower)
+    return (model,) + _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size)
+
+
+def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size):
+    """The run's own arguments (everything but the model), checked against its walls."""
+    delta, lower = model.delta, model.lower
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    # the static position, on the nearer wall when the walls leave it out
+    x0 = max(lower, min(0.0, delta)) if x0 is None else _checks.real("x0", x0)
     if x0 > delta:
         raise ValueError(f"x0 must satisfy x0 <= delta (the mass lives in x <= delta), "
                          f"got x0={x0!r} > delta={delta!r}")
+    if x0 < lower:
+        raise ValueError(f"x0 must satisfy x0 >= delta - gap (the mass lives between the "
+                         f"walls), got x0={x0!r} < delta - gap={lower!r}")
     v0 = _checks.real("v0", v0)
     if noise is not None:
         if getattr(noise, "ndim", 1) != 1 or len(noise) < 2:
@@ -168,28 +213,51 @@ def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, r
                          f"{(len(noise) - 1) * dt!r}, got {t_end!r}")
     record_every = _checks.integer("record_every", record_every, low=0)
     chunk_size = _checks.integer("chunk_size", chunk_size, low=1)
-    return zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size
+    return dt, x0, v0, t_end, record_every, chunk_size
 
 
 def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
-    """The parameter vector ``P`` read by the kernels (see :mod:`vibroimpact.impact.kernels`)."""
+    """The parameter vector ``P`` read by the kernels for the one-wall oscillator
+    (:func:`model_parameters` of the paper's model)."""
+    return model_parameters(Model.paper(zeta, eps, delta, amplitude, beta), dt)
+
+
+def model_parameters(model, dt):
+    """The parameter vector ``P`` the simulator's kernels read, for sample step ``dt``.
+
+    One wall: the ``N_PARAMS`` slots of :mod:`vibroimpact.impact.layout`, exactly as
+    before models existed. Two walls: twice as many; the second half is the lower wall
+    seen in the mirrored frame ``x -> -x`` (force and harmonic amplitude negated, wall
+    at ``-(delta - gap)`` hit from below, its own restitution), so that every search of
+    :mod:`vibroimpact.impact.events` serves both walls unchanged.
+    """
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    zeta, beta, amplitude = model.zeta, model.beta, model.amplitude
     omega = math.sqrt(1.0 - zeta * zeta)
     q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
     phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
     E = math.exp(-zeta * dt)
     C, S = math.cos(omega * dt), math.sin(omega * dt)
     bh_hi, bh_lo = kernels.two_prod(beta, dt)
-    P = np.empty(kernels.N_PARAMS)
+    P = np.empty(kernels.N_PARAMS * model.n_walls)
     P[[kernels.P_ZETA, kernels.P_OMEGA, kernels.P_EPS, kernels.P_DELTA, kernels.P_DT]] = (
-        zeta, omega, eps, delta, dt)
+        zeta, omega, model.eps, model.delta, dt)
     P[[kernels.P_A, kernels.P_BETA, kernels.P_AQ, kernels.P_PHI]] = (
         amplitude, beta, amplitude * q, phi)
     P[[kernels.P_COS_PHI, kernels.P_SIN_PHI]] = math.cos(phi), math.sin(phi)
     P[[kernels.P_BH_HI, kernels.P_BH_LO]] = bh_hi, bh_lo
     P[[kernels.P_M11, kernels.P_M12, kernels.P_M21, kernels.P_M22]] = (
-        E * (C + zeta * S / omega), E * S / omega, -E * S / omega, E * (C - zeta * S / omega))
+        E * (C + zeta * S / omega), E * S / omega, -E * S / omega,
+        E * (C - zeta * S / omega))
     P[[kernels.P_INV_DT, kernels.P_INV_OMEGA, kernels.P_COS_BH, kernels.P_SIN_BH]] = (
         1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt))
+    if model.n_walls == 2:
+        n = kernels.N_PARAMS
+        P[n:] = P[:n]
+        P[n + kernels.P_EPS] = model.eps_lower
+        P[n + kernels.P_DELTA] = -model.lower
+        P[n + kernels.P_A] = -amplitude
+        P[n + kernels.P_AQ] = -P[kernels.P_AQ]
     return P
 
 
@@ -254,7 +322,7 @@ def _raise_status(status, k, dt, r, k0, diag, P):
 
 def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None,
                     v0=0.0, t_end=None, *, record_every=0, chunk_size=2**20,
-                    rebound_floor=DEFAULT_REBOUND_FLOOR):
+                    rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None):
     """Simulate chunk by chunk; yield one :class:`SimulationResult` per chunk of samples.
 
     Same arguments as :func:`simulate`. Each chunk carries the events of its stretch of
@@ -267,12 +335,23 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     close the generator there. Chunk boundaries never change the motion: the samples are
     taken one by one by the same kernel whatever the chunking.
     """
-    zeta, eps, delta, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size = _check_inputs(
-        zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size)
+    model, dt, x0, v0, t_end, record_every, chunk_size = _check_inputs(
+        zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size,
+        gap, eps_lower)
     rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
-    P = kernel_parameters(zeta, eps, delta, dt, amplitude, beta)
-    params = dict(zeta=zeta, eps=eps, delta=delta, dt=dt, amplitude=amplitude, beta=beta,
-                  x0=x0, v0=v0, rebound_floor=rebound_floor)
+    yield from _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size,
+                               rebound_floor)
+
+
+def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, rebound_floor):
+    """:func:`simulate_chunks` once its arguments are checked and resolved into ``model``."""
+    delta, beta = model.delta, model.beta
+    P = model_parameters(model, dt)
+    params = dict(zeta=model.zeta, eps=model.eps, delta=delta, dt=dt,
+                  amplitude=model.amplitude, beta=beta, x0=x0, v0=v0,
+                  rebound_floor=rebound_floor)
+    if model.n_walls == 2:
+        params.update(gap=model.gap, eps_lower=model.eps_lower)
     Aq, phi = P[kernels.P_AQ], P[kernels.P_PHI]
     state = np.empty(kernels.N_STATE)
     state[[kernels.S_W, kernels.S_WV, kernels.S_MODE, kernels.S_SIN_PSI, kernels.S_COS_PSI]] = (
@@ -281,7 +360,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     n_full, rem = _split_steps(t_end, dt)
     stride = int(record_every)
     zeros = None if noise is not None else np.zeros(min(chunk_size, n_full + 1) + 1)
-    stick_open = [None]  # start time of an unfinished sticking interval
+    stick_open = [None, 0]  # start time and wall of an unfinished sticking interval
     buf = _Buffers(chunk_size // stride + 2 if stride else 0)   # reused by every chunk
     k0 = 0
     size = chunk_size
@@ -321,7 +400,8 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
                 if not all(map(math.isfinite, r_last)):
                     raise ValueError(f"noise must be finite near sample {n_full}")
             b = (r_last[1] - r_last[0]) / dt
-            mode = kernels.FREE if mode == kernels.WALL else mode   # x = delta, v is x' itself
+            if mode in (kernels.WALL, kernels.WALL_LO):
+                mode = kernels.FREE     # x on the wall, v is x' itself
             x, v, mode, status = kernels.slow_step(
                 n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
                 buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
@@ -330,7 +410,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
             t_chunk = t_end
         buf.drain(parts)
         requested = yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode,
-                                stick_open, final, noise)
+                                stick_open, final, noise, model)
         k0 = k1
         if final:
             return
@@ -345,6 +425,8 @@ def _state_at(state, P, k):
     mode = int(state[kernels.S_MODE])
     if mode == kernels.STUCK:
         return delta, 0.0, kernels.STUCK
+    if mode == kernels.STUCK_LO:
+        return -P[kernels.N_PARAMS + kernels.P_DELTA], 0.0, kernels.STUCK_LO
     if Aq == 0.0:
         x, v = state[kernels.S_W], state[kernels.S_WV]
     else:
@@ -354,45 +436,60 @@ def _state_at(state, P, k):
         v = state[kernels.S_WV] + Aq * beta * math.cos(psi)
     if mode == kernels.WALL:
         x = delta       # exactly on the wall, not through the round-off of w + p_h
+    elif mode == kernels.WALL_LO:
+        x = -P[kernels.N_PARAMS + kernels.P_DELTA]
     return x, v, mode
 
 
 def _pair_sticking(time, kind, stick_open):
-    """Sticking intervals from the kernel's onsets (kind 1) and releases (kind 0) in time
-    order; ``stick_open[0]`` holds an onset whose release is still to come (or None)."""
-    onset = kind == 1.0
+    """Sticking intervals and their walls from the kernel's onsets and releases in time
+    order (kinds :data:`~vibroimpact.impact.layout.STICK_ON`/``STICK_OFF``, plus ``STICK_LO``
+    at the lower wall); ``stick_open`` holds an onset whose release is still to come (its
+    time, or None, and its wall)."""
+    wall = (kind >= kernels.STICK_LO).astype(np.int8)
+    onset = (kind - kernels.STICK_LO * wall) == kernels.STICK_ON
     first_open = stick_open[0] is not None
     # onsets and releases alternate, starting with an onset or, with one open, a release
     if onset.size and np.array_equal(onset, (np.arange(onset.size) + first_open) % 2 == 0):
         on = np.concatenate([[stick_open[0]] if first_open else [], time[onset]])
+        on_wall = np.concatenate([[stick_open[1]] if first_open else [], wall[onset]])
         off = time[~onset]
         stick_open[0] = float(on[-1]) if on.size > off.size else None
-        return list(on[:off.size]), list(off)
-    starts, ends = [], []
-    for t, k in zip(time, kind):
-        if k == 1.0:
-            stick_open[0] = t
+        stick_open[1] = int(on_wall[-1]) if on.size > off.size else 0
+        return list(on[:off.size]), list(off), list(on_wall[:off.size])
+    starts, ends, walls = [], [], []
+    for t, k, w in zip(time, onset, wall):
+        if k:
+            stick_open[0], stick_open[1] = t, int(w)
         elif stick_open[0] is not None:
             starts.append(stick_open[0])
             ends.append(t)
+            walls.append(stick_open[1])
             stick_open[0] = None
-    return starts, ends
+    return starts, ends, walls
 
 
 def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final,
-          noise):
+          noise, model):
     cat = lambda key, dtype: np.concatenate(parts[key]) if parts[key] else np.empty(0, dtype)
     imp_step = cat("imp_step", np.int64)
     imp_off = cat("imp_off", np.float64)
     imp_u = cat("imp_u", np.float64)
+    if model.n_walls == 2:
+        # the kernel writes the lab-frame velocity: < 0 at the wall below the mass
+        imp_wall = (imp_u < 0.0).astype(np.int8)
+        imp_u = np.abs(imp_u)
+    else:
+        imp_wall = np.zeros(imp_u.size, np.int8)
     stk_time = cat("stk_step", np.int64) * dt + cat("stk_off", np.float64)
     stk_kind = cat("stk_kind", np.float64)
-    starts, ends = _pair_sticking(stk_time, stk_kind, stick_open)
-    stuck = mode == kernels.STUCK
+    starts, ends, walls = _pair_sticking(stk_time, stk_kind, stick_open)
+    stuck = mode in (kernels.STUCK, kernels.STUCK_LO)
     stuck_since = stick_open[0] if stick_open[0] is not None else math.nan
     if final and stick_open[0] is not None:
         starts.append(stick_open[0])   # still resting on the wall at the record's end
         ends.append(t_chunk)
+        walls.append(stick_open[1])
         stick_open[0] = None
     n = int(buf.grid_n[0])
     grid_time = ((np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt
@@ -418,12 +515,15 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         stuck_since=float(stuck_since),
         params=params,
         force_record=noise,
+        impact_wall=imp_wall,
+        stick_wall=np.asarray(walls, dtype=np.int8),
+        model=model,
     )
 
 
 def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None, v0=0.0,
              t_end=None, *, record_every=0, chunk_size=2**20,
-             rebound_floor=DEFAULT_REBOUND_FLOOR):
+             rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None):
     """Exact motion of the impact oscillator under a sampled random force plus a harmonic force.
 
     Parameters
@@ -456,6 +556,12 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
         Velocity floor (``>= 1e-4``: the kernel resolves every faster rebound) of
         ``collision_rebounds``: rebounds leaving the wall slower are not counted (default
         0.01, :data:`vibroimpact.stats.DEFAULT_REBOUND_FLOOR`).
+    gap : float, keyword-only
+        A second wall at ``x = delta - gap`` (``gap > 0``), hit from above: the mass then
+        moves in the clearance ``delta - gap <= x <= delta`` (docs/model.md, "A clearance
+        between two walls"). ``None`` (the default): the paper's one wall.
+    eps_lower : float, keyword-only
+        Restitution coefficient of the second wall, ``0 <= eps_lower <= 1`` (default ``eps``).
 
     Returns
     -------
@@ -481,8 +587,19 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
     chunks = list(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                   beta=beta, x0=x0, v0=v0, t_end=t_end,
                                   record_every=record_every, chunk_size=chunk_size,
-                                  rebound_floor=rebound_floor))
+                                  rebound_floor=rebound_floor, gap=gap, eps_lower=eps_lower))
     return concatenate_results(chunks)
+
+
+def simulate_model(model, noise=None, dt=0.1, x0=None, v0=0.0, t_end=None, *, record_every=0,
+                   chunk_size=2**20, rebound_floor=DEFAULT_REBOUND_FLOOR):
+    """:func:`simulate` of a :class:`vibroimpact.model.Model` (its walls placed exactly where
+    the model puts them); the other arguments as for :func:`simulate`."""
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a vibroimpact.model.Model, got {type(model).__name__}")
+    run = _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size)
+    rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
+    return concatenate_results(list(_simulate_model(model, noise, *run, rebound_floor)))
 
 
 def concatenate_results(chunks):
@@ -499,4 +616,5 @@ def concatenate_results(chunks):
         contact_time=float(sum(c.contact_time for c in chunks)),
         t_end=last.t_end, x_end=last.x_end, v_end=last.v_end, stuck_end=last.stuck_end,
         stuck_since=last.stuck_since, params=last.params, force_record=last.force_record,
+        impact_wall=cat("impact_wall"), stick_wall=cat("stick_wall"), model=last.model,
     )

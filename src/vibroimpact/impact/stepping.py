@@ -13,13 +13,16 @@ from vibroimpact.impact.events import (chatter_tail, first_contact, release_time
 from vibroimpact.impact.layout import (BAD_NOISE, BUFFER_FULL, C_DF0, C_F0, C_R,
                                        CNT_CHATTER, CNT_IMPACTS, CNT_STICK_EVENTS,
                                        FREE, FT_CONTACT_TIME, FT_GAP, FT_IMPACTS, FT_MODE,
-                                       FT_OFFSET, FT_STICK_EVENTS, FT_V, NO_ROOT, OK, P_A,
+                                       FT_OFFSET, FT_STICK_EVENTS, FT_V, N_PARAMS, NO_ROOT,
+                                       OK, P_A,
                                        P_AQ, P_BETA, P_BH_HI, P_BH_LO, P_COS_BH, P_COS_PHI,
                                        P_DELTA, P_DT, P_EPS, P_INV_DT, P_INV_OMEGA, P_M11,
                                        P_M12, P_M21, P_M22, P_PHI, P_SIN_BH, P_SIN_PHI,
                                        P_ZETA, PRESSED, ROOT, S_COS_PSI, S_MODE, S_SIN_PSI,
-                                       S_W, S_WV, STUCK, TOO_MANY_EVENTS, TOUCH, WALL)
+                                       S_W, S_WV, STICK_LO, STICK_OFF, STICK_ON, STUCK,
+                                       STUCK_LO, TOO_MANY_EVENTS, TOUCH, WALL, WALL_LO)
 from vibroimpact.impact.motion import phase, segment
+from vibroimpact._law import rebound_velocity
 from vibroimpact.impact.tolerances import (BOUND_SAFETY, CHATTER_ESTIMATE_TOL,
                                            ELASTIC_MICRO_FLIGHT, EPS64,
                                            EXCLUSION_MARGIN_REL, MANY_EVENTS,
@@ -36,123 +39,181 @@ def _record_event(buf_step, buf_off, buf_val, n, k, s, val):
 
 
 @kernel
+def _wall_position(P, side):
+    """Lab-frame position of wall ``side`` (0: the wall at delta; 1: the wall below the mass,
+    whose half of ``P`` holds minus its position)."""
+    return P[P_DELTA] if side == 0 else -P[N_PARAMS + P_DELTA]
+
+
+@kernel
 def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
               stk_kind, cnt, ftot):
     """Advance one force sample step ``[k h, k h + H]`` through every event in it.
 
-    ``x, v, mode`` is the state at the step's start (in mode ``WALL``, ``v`` is
-    ``w' = x' - p_h'``, as :func:`run_steps` keeps it). Impacts are appended to
-    ``imp_*``, sticking starts (kind 1) and ends (kind 0) to ``stk_*``; ``cnt`` holds the
-    counters (``CNT_*``) and ``ftot[FT_CONTACT_TIME]`` the time in contact.
+    ``x, v, mode`` is the state at the step's start (in mode ``WALL`` or ``WALL_LO``, ``v`` is
+    ``w' = x' - p_h'``, as :func:`run_steps` keeps it). Impacts are appended to ``imp_*``,
+    sticking starts and ends to ``stk_*`` (kinds :data:`~vibroimpact.impact.layout.STICK_ON`,
+    ``STICK_OFF``, plus ``STICK_LO`` at the lower wall); ``cnt`` holds the counters
+    (``CNT_*``) and ``ftot[FT_CONTACT_TIME]`` the time in contact.
     Returns the state at the step's end and a status. An event that falls on the step's end
     (``s = H`` after rounding) leaves the rest to the next step, which starts in mode
     ``WALL``: a release, sticking onset, impact or touch at a sample point goes through the
     same logic as anywhere else. With ``TOO_MANY_EVENTS``, ``ftot[FT_DIAGNOSTICS]`` receives
     what the step saw (:data:`vibroimpact.impact.layout.FT_FIELDS`: the offset reached,
     ``x - delta``, ``x'``, the mode, impacts and sticking events written in the step).
+
+    With a second wall (``P`` of ``2 N_PARAMS`` slots) the step is walked in the frame of the
+    wall the mass is at or last met (``sg = +1``: the wall at delta; ``sg = -1``: the lower
+    wall, seen from above in the mirrored frame ``x -> -x``, where it is a wall hit from
+    below like the first): the chatter, sticking and release logic is the one-wall logic
+    in that frame, and every free flight also searches the other wall's first contact (in
+    its own frame, from a point off it), the earlier of the two ending the flight.
     """
-    zeta, eps, delta = P[P_ZETA], P[P_EPS], P[P_DELTA]
+    delta = P[P_DELTA]
+    two = P.shape[0] > N_PARAMS
     theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
     s = 0.0
     n_events = 0
-    if mode == WALL:
+    side = 1 if (mode == WALL_LO or mode == STUCK_LO) else 0
+    if mode == WALL or mode == WALL_LO:
         # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
         if P[P_A] != 0.0:
             v += P[P_AQ] * P[P_BETA] * math.cos(theta_k - P[P_PHI])
         mode = FREE
+    elif mode == STUCK_LO:
+        mode = STUCK
     at_wall = x >= delta
     if at_wall:
         x = delta
+        side = 0
+    elif two:
+        lower = _wall_position(P, 1)
+        if x <= lower:
+            x = lower
+            side = 1
+            at_wall = True
+        elif mode == FREE and x - lower < delta - x:
+            # a flight is followed in the frame of the nearer wall: its end state is
+            # x - wall in difference form there, accurate to the distance from that wall
+            side = 1
     just_hit = False
     imp0, stk0 = cnt[CNT_IMPACTS], cnt[CNT_STICK_EVENTS]
     while True:
         if s >= H:
-            # nothing of the step is left: every path here has set x = delta
-            return delta, v, (STUCK if mode == STUCK else WALL), OK
+            # nothing of the step is left: every path here has set x on the wall
+            if side == 0:
+                return delta, v, (STUCK if mode == STUCK else WALL), OK
+            return _wall_position(P, 1), v, (STUCK_LO if mode == STUCK else WALL_LO), OK
         n_events += 1
         if n_events > STEP_HEADROOM - 2:
             ftot[FT_OFFSET] = s
             ftot[FT_GAP] = x - delta
             ftot[FT_V] = v
-            ftot[FT_MODE] = mode
+            ftot[FT_MODE] = mode if side == 0 else mode + STUCK_LO - STUCK
             ftot[FT_IMPACTS] = cnt[CNT_IMPACTS] - imp0
             ftot[FT_STICK_EVENTS] = cnt[CNT_STICK_EVENTS] - stk0
             return x, v, mode, TOO_MANY_EVENTS
-        c = segment(x, v, s, r0, b, theta_k, P)
+        # the frame of the wall the mass is at (or last met): the one-wall logic runs in it
+        Pw = P[N_PARAMS:] if side == 1 else P
+        sg = -1.0 if side == 1 else 1.0
+        eps = Pw[P_EPS]
+        c = segment(sg * x, sg * v, s, sg * r0, sg * b, theta_k, Pw)
+        vf = sg * v
         Hs = H - s
-        if just_hit and v < 0.0 and c[C_F0] > 0.0:
+        if just_hit and vf < 0.0 and c[C_F0] > 0.0:
             # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
             # the tail is summed in closed form as soon as chatter_tail proves where it ends
-            wv, F, dF = -v, c[C_F0], c[C_DF0]
+            wv, F, dF = -vf, c[C_F0], c[C_DF0]
             if eps < 1.0:
                 n = cnt[CNT_IMPACTS] - 1    # the impact just recorded, and the one before it
                 prev = ((imp_step[n] - imp_step[n - 1]) * P[P_DT]
                         + (imp_off[n] - imp_off[n - 1]) if n >= 1 else 0.0)
-                tail = chatter_tail(wv, F, dF, prev, Hs, P)
+                tail = chatter_tail(wv, F, dF, prev, Hs, Pw)
                 ok = tail >= 0.0
                 F_end = 1.0
                 if not ok:
                     # no bracket inside the step (a tail across a sample point, eps near 1):
                     # the first-order estimate once its neglected terms are below round-off
                     tail = 2.0 * wv / (F * (1.0 - eps))
-                    ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_ESTIMATE_TOL
+                    ok = (tail * (2.0 * Pw[P_ZETA] * wv + abs(dF) * tail) / F
+                          <= CHATTER_ESTIMATE_TOL)
                     F_end = (F + dF * tail
-                             - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail)
+                             - 0.5 * abs(Pw[P_A]) * Pw[P_BETA] * Pw[P_BETA] * tail * tail)
             else:
                 tail = 2.0 * wv / F
                 ok = tail <= ELASTIC_MICRO_FLIGHT
-                F_end = F + dF * tail - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail
+                F_end = F + dF * tail - 0.5 * abs(Pw[P_A]) * Pw[P_BETA] * Pw[P_BETA] * tail * tail
+            if two:
+                # the summed rebounds (speeds below 2 wv over the tail, chatter_tail's bound)
+                # must stay clear of the other wall
+                ok = ok and 2.0 * wv * tail * BOUND_SAFETY < (
+                    P[P_DELTA] + P[N_PARAMS + P_DELTA])
             micro = n_events >= MANY_EVENTS and (
-                wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
+                wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(Pw[P_DELTA]))
                 or 2.0 * wv / F <= MICRO_FLIGHTS_PER_HEADROOM * H / STEP_HEADROOM)
             if (ok and tail <= Hs and F_end > 0.0) or micro:
                 if not micro:
                     s = s + tail
                 cnt[CNT_CHATTER] += 1
                 mode = STUCK
-                _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s, 1.0)
+                _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s,
+                              STICK_ON + STICK_LO * side)
                 cnt[CNT_STICK_EVENTS] += 1
                 v = 0.0
                 just_hit = False
                 continue
         just_hit = False
         if mode == STUCK:
-            sig = release_time(c, P, Hs)
+            sig = release_time(c, Pw, Hs)
             if sig < 0.0:
                 ftot[FT_CONTACT_TIME] += Hs
-                return delta, 0.0, STUCK, OK
+                if side == 0:
+                    return delta, 0.0, STUCK, OK
+                return _wall_position(P, 1), 0.0, STUCK_LO, OK
             ftot[FT_CONTACT_TIME] += sig
             s = min(s + sig, H)
-            _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s, 0.0)
+            _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s,
+                          STICK_OFF + STICK_LO * side)
             cnt[CNT_STICK_EVENTS] += 1
             mode = FREE
-            x = delta
+            x = _wall_position(P, side)
             v = 0.0
             at_wall = True
             continue
-        code, sig, u, gH = first_contact(c, P, Hs, at_wall)
+        code, sig, u, gH = first_contact(c, Pw, Hs, at_wall)
+        if two and code != PRESSED:
+            # the other wall, seen from off it: the earlier contact ends the flight
+            o = 1 - side
+            Po = P[N_PARAMS:] if o == 1 else P
+            co = segment(-sg * x, -sg * v, s, -sg * r0, -sg * b, theta_k, Po)
+            code2, sig2, u2, gH2 = first_contact(co, Po, Hs, False)
+            if code2 != NO_ROOT and (code == NO_ROOT or sig2 < sig):
+                side, sg, Pw, c = o, -sg, Po, co
+                code, sig, u, gH = code2, sig2, u2, gH2
+                at_wall = False
         if code == NO_ROOT:
-            return gH + delta, u, FREE, OK
+            return sg * (gH + Pw[P_DELTA]), sg * u, FREE, OK
         if code == PRESSED:
             mode = STUCK
             s = min(s + sig, H)
-            _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s, 1.0)
+            _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s,
+                          STICK_ON + STICK_LO * side)
             cnt[CNT_STICK_EVENTS] += 1
-            x = delta
+            x = _wall_position(P, side)
             v = 0.0
             continue
         s = min(s + sig, H)
-        x = delta
+        x = _wall_position(P, side)
         at_wall = True
         if code == ROOT and u <= TOUCH_ULPS * EPS64 * (abs(b) + abs(P[P_AQ]) * P[P_BETA]
                                                        + c[C_R] + abs(v)):
             code = TOUCH          # arrives with zero velocity within round-off: grazing touch
         if code == TOUCH:
-            v = min(u, 0.0)
+            v = sg * min(u, 0.0)
             continue
-        _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, u)
+        _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, sg * u)
         cnt[CNT_IMPACTS] += 1
-        v = -eps * u
+        v = sg * rebound_velocity(Pw[P_EPS], u)      # the law of the wall just met
         just_hit = True
 
 
@@ -215,6 +276,11 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
     MF_h2_8 = abs(A) * beta * beta * BOUND_SAFETY * h2_8
     abs_A_delta = abs(A) + abs(delta) + TINY
     has_h = Aq != 0.0
+    # a second wall below the mass (P holds its mirrored half): the exclusion test of a free
+    # step also bounds x from below, and a step resting on it has its own stay test
+    two = P.shape[0] > N_PARAMS
+    lower = -P[N_PARAMS + P_DELTA] if two else -math.inf
+    abs_A_lower = abs(A) + abs(lower) + TINY if two else 0.0
     w = state[S_W]
     wv = state[S_WV]
     mode = int(state[S_MODE])
@@ -231,7 +297,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
         if stride > 0 and k % stride == 0:
             if mode != FREE:
                 # on the wall; STUCK keeps w' = -p_h' exactly, so x' = 0 there
-                grid[grid_n[0]] = 0.0
+                grid[grid_n[0]] = 0.0 if (mode == STUCK or mode == WALL) else delta - lower
                 grid_v[grid_n[0]] = wv + Aq * beta * cp
             elif has_h:
                 psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
@@ -264,6 +330,14 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             if not clear and xmax + margin < delta:
                 acc = max(abs(r0 - 2.0 * zeta * wv - w), abs(r1 - 2.0 * zeta * wv1 - w1))
                 clear = xmax + (M0 + acc + 0.5 * h * R) * BOUND_SAFETY * h2_8 + margin < delta
+            if clear and two:
+                # the same two tiers, mirrored, against the wall below
+                xmin = min(w + Aq * sp, w1 + Aq * sp1)
+                clear = xmin - (M0 + R) * h2_8 - margin > lower
+                if not clear and xmin - margin > lower:
+                    acc = max(abs(r0 - 2.0 * zeta * wv - w), abs(r1 - 2.0 * zeta * wv1 - w1))
+                    clear = (xmin - (M0 + acc + 0.5 * h * R) * BOUND_SAFETY * h2_8 - margin
+                             > lower)
             if clear:
                 w = w1
                 wv = wv1
@@ -291,7 +365,18 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                     sp = sp1
                     cp = cp1
                     continue
-            x = delta
+            elif mode == STUCK_LO:
+                # resting on the wall below: the same test on the push into it, lower - f
+                F0 = lower - (r0 + A * (sp * cos_phi + cp * sin_phi))
+                F1 = lower - (r1 + A * (sp1 * cos_phi + cp1 * sin_phi))
+                if min(F0, F1) - MF_h2_8 > STICK_MARGIN * (abs(r0) + abs(r1) + abs_A_lower):
+                    ftot[FT_CONTACT_TIME] += h
+                    w = lower - Aq * sp1
+                    wv = -Aq * beta * cp1
+                    sp = sp1
+                    cp = cp1
+                    continue
+            x = delta if (mode == STUCK or mode == WALL) else lower
             v = wv          # w': slow_step adds p_h' in mode WALL, ignores it when STUCK
         # a non-finite sample always fails the exclusion test, so it is caught here at no cost
         if not (math.isfinite(r0) and math.isfinite(r1)):

@@ -17,11 +17,17 @@ parameter, or a second test function (a codimension-two point).
 Why numba: one Newton iteration costs ~2m + 3 evaluations of the orbit equations and of a
 test function (central differences), each a few microseconds of scalar arithmetic; from
 Python the call overhead alone (~1 us per scalar operation) would be larger than the work.
+
+The impact law enters as in :mod:`vibroimpact.orbits.flight` (``rebound_velocity``,
+``rebound_derivative``, ``rebound_ratio``); only ``det T = eps^(2m) exp(-2 zeta z)`` of the
+fold and period-doubling conditions is Newton's law written out (docs/architecture.md, "Adding
+physics").
 """
 from math import ceil, cos, exp, pi, sin
 
 import numpy as np
 
+from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import _flight_xv, flight, flight_max, harmonic_constants
 from vibroimpact.orbits.linalg import _solve_inplace
@@ -55,14 +61,15 @@ def scaled_trace(y, m, z, beta, delta, zeta, eps):
         ub = y[m + b]
         x, v, acc, p11, p12, p21, p22 = flight(ta, ua, tb - ta, beta, delta, zeta, eps, wd, q,
                                                phi)
-        g_a = delta - sin(beta * ta) - 2.0 * zeta * eps * ua
-        dx_dta = p11 * eps * ua + p12 * g_a
-        dv_dta = p21 * eps * ua + p22 * g_a
+        e_a = -rebound_ratio(eps, ua)                 # -v_+ = e_a ua
+        g_a = delta - sin(beta * ta) - 2.0 * zeta * e_a * ua
+        dx_dta = p11 * e_a * ua + p12 * g_a
+        dv_dta = p21 * e_a * ua + p22 * g_a
         a_b = sin(beta * tb) - 2.0 * zeta * ub - delta
         s11 = -dx_dta
-        s12 = eps * p12
+        s12 = -rebound_derivative(eps, ua) * p12
         s21 = ub * dv_dta + a_b * s11
-        s22 = -eps * p22 * ub + a_b * s12
+        s22 = rebound_derivative(eps, ua) * p22 * ub + a_b * s12
         r11, r12, r21, r22 = (s11 * r11 + s12 * r21, s11 * r12 + s12 * r22,
                               s21 * r11 + s22 * r21, s21 * r12 + s22 * r22)
         prod_u *= ub
@@ -126,7 +133,7 @@ def flight_peak(tau_a, u_a, s_end, beta, delta, zeta, eps, hint, skip):
     wd, q, phi = harmonic_constants(beta, zeta)
     psi = beta * tau_a - phi
     a_coef = delta - q * sin(psi)
-    b_coef = -eps * u_a - q * beta * cos(psi)
+    b_coef = rebound_velocity(eps, u_a) - q * beta * cos(psi)
     c_coef = (b_coef + zeta * a_coef) / wd
     d_coef = -(zeta * c_coef + wd * a_coef)
     fast = max(beta, wd)

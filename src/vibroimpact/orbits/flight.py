@@ -10,11 +10,19 @@ leaving with ``-eps*u_a``) is, with ``psi = beta*tau_a - phi`` and ``s = tau - t
     v(s) = q beta cos(beta s + psi) + P21(s) A + P22(s) B,   B = -eps u_a - q beta cos psi,
 
 where ``P(s)`` is the damped free propagator of ``y'' + 2 zeta y' + y = 0``.
+
+The impact law enters through :mod:`vibroimpact._law` only: the velocity leaving the wall is
+``rebound_velocity(eps, u_a)``, the Jacobians' ``d/du_a`` entries carry
+``rebound_derivative(eps, u_a)``, and their ``d/dtau_a`` entries, the shift ``-(v_+, a_+)`` of
+the start state when the impact instant moves, write ``-v_+`` as
+``-rebound_ratio(eps, u_a) * u_a`` (for Newton's law ``eps * u_a``, rounded as it always was).
+So the flight, its Jacobian and the monodromy hold for any law of :mod:`vibroimpact.model`.
 """
 from math import atan2, ceil, cos, exp, hypot, sin, sqrt
 
 import numpy as np
 
+from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.tolerances import (FLIGHT_MAX_MAXIT, FLIGHT_MAX_XTOL, FLIGHT_MIN_BRACKETS,
                                            FLIGHT_MIN_STEP, FLIGHT_PHASE_STEP)
@@ -46,7 +54,7 @@ def flight(tau_a, u_a, s, beta, delta, zeta, eps, wd, q, phi):
     """
     psi = beta * tau_a - phi
     a_coef = delta - q * sin(psi)
-    b_coef = -eps * u_a - q * beta * cos(psi)
+    b_coef = rebound_velocity(eps, u_a) - q * beta * cos(psi)
     p11, p12, p21, p22 = propagator(s, zeta, wd)
     th = beta * s + psi
     x = q * sin(th) + p11 * a_coef + p12 * b_coef
@@ -62,19 +70,22 @@ def impact_map_jacobian(tau_a, u_a, tau_b, u_b, beta, delta, zeta, eps, wd, q, p
     Notes
     -----
     Implicit differentiation of ``x(tau_j; tau_{j-1}, u_{j-1}) = delta``. Moving the start by
-    ``d tau`` perturbs the state by ``(eps u_a, delta - f(tau_a) - 2 zeta eps u_a) d tau``, which
-    the propagator carries to the impact; ``det T_j = eps^2 (u_{j-1}/u_j) exp(-2 zeta z_j)``.
+    ``d tau`` perturbs the state by ``-(v_+, a_+) d tau = (e u_a, delta - f(tau_a) - 2 zeta e
+    u_a) d tau`` with ``e = -rebound_ratio(eps, u_a)`` (``eps`` for Newton's law), which the
+    propagator carries to the impact; for Newton's law
+    ``det T_j = eps^2 (u_{j-1}/u_j) exp(-2 zeta z_j)``.
     """
     x, v, acc, p11, p12, p21, p22 = flight(tau_a, u_a, tau_b - tau_a, beta, delta, zeta, eps,
                                            wd, q, phi)
-    g_a = delta - sin(beta * tau_a) - 2.0 * zeta * eps * u_a
-    dx_dta = p11 * eps * u_a + p12 * g_a
-    dv_dta = p21 * eps * u_a + p22 * g_a
+    e_a = -rebound_ratio(eps, u_a)                        # -v_+ = e_a u_a
+    g_a = delta - sin(beta * tau_a) - 2.0 * zeta * e_a * u_a
+    dx_dta = p11 * e_a * u_a + p12 * g_a
+    dv_dta = p21 * e_a * u_a + p22 * g_a
     a_b = sin(beta * tau_b) - 2.0 * zeta * u_b - delta   # x'' just before the impact
     t11 = -dx_dta / u_b
-    t12 = eps * p12 / u_b
+    t12 = -rebound_derivative(eps, u_a) * p12 / u_b
     t21 = dv_dta + a_b * t11
-    t22 = -eps * p22 + a_b * t12
+    t22 = rebound_derivative(eps, u_a) * p22 + a_b * t12
     return t11, t12, t21, t22
 
 
@@ -144,7 +155,7 @@ def flight_max(tau_a, u_a, s_end, beta, delta, zeta, eps, stack):
     wd, q, phi = harmonic_constants(beta, zeta)
     psi = beta * tau_a - phi
     a_coef = delta - q * sin(psi)
-    b_coef = -eps * u_a - q * beta * cos(psi)
+    b_coef = rebound_velocity(eps, u_a) - q * beta * cos(psi)
     c_coef = (b_coef + zeta * a_coef) / wd
     d_coef = -(zeta * c_coef + wd * a_coef)
     amp = hypot(a_coef, c_coef)          # amplitude of every derivative of the free part

@@ -1,5 +1,10 @@
 """The (m/n) equations at fixed intervals: linear in the impact phase's ``(sin, cos)`` and
 the velocities; their null vector, the circle condition on it, and a Newton start from it.
+
+Linear *because* Newton's law is (``v_+ = -eps u``): the ``-eps`` entries of ``kmat`` are that
+law's coefficient, not a call of :mod:`vibroimpact._law`. A velocity-dependent law makes the
+system nonlinear in the velocities; these starts then only seed the general Newton
+(docs/architecture.md, "Adding physics").
 """
 from math import atan2, cos, hypot, pi, sin
 

@@ -1,4 +1,9 @@
 """The (1/n) motions in closed form: both roots of ``cos(psi_0 - chi) = kappa``.
+
+Closed form *because* Newton's law is linear in the velocity (``v_+ = -eps u``): the
+equations are linear in ``(sin psi_0, cos psi_0, u)``. A velocity-dependent law has no such
+form; its (1/n) motions come from the general Newton of :mod:`vibroimpact.orbits.newton`
+seeded elsewhere (docs/architecture.md, "Adding physics").
 """
 from math import acos, atan2, cos, exp, floor, hypot, pi, sin
 

@@ -1,10 +1,16 @@
 """Newton on the full 2m-equation system of an (m/n) motion (paper eqs. 10-11), with
 its analytic Jacobian, and the uncertainty of a solution from the conditioning there.
+
+The Jacobian's ``d/du_a`` columns carry the impact law's ``rebound_derivative``; its
+``d/tau_a`` columns write the start's shift with ``-rebound_ratio(eps, ua) * ua`` for the
+velocity ``-v_+`` (as :func:`vibroimpact.orbits.flight.impact_map_jacobian`), so they hold for
+any law of :mod:`vibroimpact.model`.
 """
 from math import sin
 
 import numpy as np
 
+from vibroimpact._law import rebound_derivative, rebound_ratio
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import flight, harmonic_constants
 from vibroimpact.orbits.linalg import _norm, _solve_inplace
@@ -39,11 +45,12 @@ def _residual_jacobian(y, m, z, beta, delta, zeta, eps, wd, q, phi, res, jac):
         r2 = r1 + 1
         res[r1] = x - delta
         res[r2] = v - y[m + b]
-        g_a = delta - sin(beta * ta) - 2.0 * zeta * eps * ua
-        jac[r1, a] += p11 * eps * ua + p12 * g_a
-        jac[r2, a] += p21 * eps * ua + p22 * g_a
-        jac[r1, m + a] += -eps * p12
-        jac[r2, m + a] += -eps * p22
+        e_a = -rebound_ratio(eps, ua)                 # -v_+ = e_a ua
+        g_a = delta - sin(beta * ta) - 2.0 * zeta * e_a * ua
+        jac[r1, a] += p11 * e_a * ua + p12 * g_a
+        jac[r2, a] += p21 * e_a * ua + p22 * g_a
+        jac[r1, m + a] += rebound_derivative(eps, ua) * p12
+        jac[r2, m + a] += rebound_derivative(eps, ua) * p22
         jac[r1, b] += v
         jac[r2, b] += acc
         jac[r2, m + b] += -1.0

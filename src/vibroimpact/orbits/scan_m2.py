@@ -1,6 +1,10 @@
 """m = 2: every (2/n) motion from the circle condition along ``0 < z_1 < z``, its roots
 solved exactly (Brent) and its dips toward zero minimized, so that both orbits next to a fold
 are found; for even n in a symmetric form regular at the doubled (1/(n/2)) motion.
+
+The scan is the linear algebra of :mod:`vibroimpact.orbits.intervals` (the ``-eps`` entries of
+its ``kmat`` are Newton's law's coefficient, linear in the velocities); a velocity-dependent law
+does not have it (docs/architecture.md, "Adding physics").
 """
 from math import ceil, cos, cosh, exp, pi, sin, sinh
 

@@ -6,14 +6,14 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
 
 - `spectra`: Welch PSDs in the paper's convention (eqs. 8, 9) and the one conversion helper;
 - `events`: intervals, velocities after impact, densities, batch means, event rates and
-  means of few, clustered events;
+  means of few, clustered events, and all of them per wall;
 - `collisions`: impacts grouped with the chatter and sticking they start (the unit of every
   impact statistic);
 - `motions`: the (m/n) classification of intervals and the probabilities of motions;
 - `residence`: residence times in the motions and the rates of switching between them;
 - `escape`: the Arrhenius fit of residence times against the noise level;
-- `theory`: the wall-free linear response, elastic impacts under white noise, and the
-  energy-envelope averaging for eps near 1;
+- `theory`: the wall-free linear response, elastic impacts under white noise (one wall, or
+  a clearance between two), and the energy-envelope averaging for eps near 1;
 - `identities`: the power balance and the virial of a stationary record (a self-audit);
 - `centroid`: the centroid of a spectrum over a band (finding 5, Fig. 12's header), imported
   from its module (not re-exported: the simulation jobs do not reach it).
@@ -33,7 +33,8 @@ _WHERE = {
     "velocity_after_impact": "events", "interval_ratio": "events", "Density": "events",
     "density": "events", "BatchMeans": "events", "batch_means": "events", "t_quantile": "events",
     "poisson_interval": "events", "EventRate": "events", "event_rate": "events",
-    "MarkMean": "events", "mark_mean": "events",
+    "MarkMean": "events", "mark_mean": "events", "WALLS": "events",
+    "wall_statistics": "events",
     "DEFAULT_REBOUND_FLOOR": "collisions", "MIN_REBOUND_FLOOR": "collisions",
     "Collisions": "collisions",
     "group_collisions": "collisions", "close_open_phase": "collisions",
@@ -52,10 +53,12 @@ _WHERE = {
     "upcrossing_rate": "theory", "rayleigh_pdf": "theory",
     "truncated_gaussian_pdf": "theory", "EnvelopeTheory": "theory",
     "energy_envelope": "theory", "envelope_v_after_pdf": "theory",
-    "envelope_energy_pdf": "theory",
+    "envelope_energy_pdf": "theory", "clearance_mass": "theory",
+    "clearance_impact_rates": "theory", "clearance_pdf": "theory",
     "ENVELOPE_EPS_MIN": "theory", "ENVELOPE_DELTA_MIN": "theory",
     "flight_moments": "identities", "identity_residuals": "identities",
-    "IdentityResiduals": "identities",
+    "IdentityResiduals": "identities", "MOMENTS_LOWER": "identities",
+    "moment_rows": "identities",
 }
 __all__ = list(_WHERE)
 

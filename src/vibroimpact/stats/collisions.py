@@ -45,6 +45,15 @@ in sticking joins the impact that starts it), which folds some free flights into
 and ``rule="rebounds"``, every rebound leaving the wall at speed ``>= floor`` an event of its
 own (the per-rebound view; the slower ones join the event before them).
 
+With a second wall (a clearance, docs/model.md) every impact has a wall (0: the wall at
+``x = delta``, hit moving up; 1: the wall at ``delta - gap``, hit moving down). The rule is
+the same at each wall with its own sign: the push towards the wall a hop is at is
+``f - delta`` at the upper wall and ``(delta - gap) - f`` at the lower one, and a flight
+from one wall to the other is never a hop (the mass crossed the clearance: it was pulled
+away from the first wall). A collision never spans the two walls: under every rule an
+impact at the other wall than the impact before it starts a new collision. With one wall
+(``wall`` None, or all zeros) every result is the one-wall result, bit for bit.
+
 Pure numpy on the simulator's event arrays and the force record: :func:`group_collisions`,
 :func:`pressed_flights`.
 """
@@ -91,11 +100,34 @@ class Collisions(NamedTuple):
     duration: np.ndarray    #: (n_c,) first impact to the release (stuck) or to the last impact
     floor: float            #: the velocity floor of ``rebounds``
     dt: float               #: the sample step of ``step``
+    wall: np.ndarray        #: (n_c,) int8 wall of the collision (0: at delta, 1: delta - gap)
 
     @property
     def intervals(self) -> np.ndarray:
-        """Intervals between collisions, first impact to first impact, in full precision."""
+        """Intervals between collisions, first impact to first impact, in full precision
+        (between collisions at the same wall: ``at_wall(w).intervals``)."""
         return np.diff(self.step).astype(float) * self.dt + np.diff(self.offset)
+
+    def at_wall(self, wall: int) -> "Collisions":
+        """The collisions at one wall (0: the wall at delta, 1: the wall at delta - gap);
+        their ``intervals`` run between consecutive collisions at that wall.
+        ``impact_collision`` is renumbered, -1 for impacts of the other wall's collisions."""
+        if wall not in (0, 1):
+            raise ValueError(f"wall must be 0 (the wall at delta) or 1 (the wall at "
+                             f"delta - gap), got {wall!r}")
+        return self._select(self.wall == wall)
+
+    def _select(self, keep):
+        """The collisions where ``keep``, impacts renumbered (-1: a dropped collision's)."""
+        new = np.where(keep, np.cumsum(keep) - 1, -1)
+        ic = self.impact_collision
+        impact_collision = np.where(ic >= 0, new[np.maximum(ic, 0)] if new.size else -1, -1)
+        return self._replace(
+            first=self.first[keep], impact_collision=impact_collision.astype(ic.dtype),
+            step=self.step[keep], offset=self.offset[keep], time=self.time[keep],
+            velocity=self.velocity[keep], rebounds=self.rebounds[keep], stuck=self.stuck[keep],
+            stick_time=self.stick_time[keep], duration=self.duration[keep],
+            wall=self.wall[keep])
 
     def after(self, t0: float) -> "Collisions":
         """The collisions whose first impact is at or after ``t0`` (``impact_collision`` is
@@ -107,16 +139,24 @@ class Collisions(NamedTuple):
             impact_collision=np.maximum(self.impact_collision - n_before, -1),
             step=self.step[keep], offset=self.offset[keep], time=self.time[keep],
             velocity=self.velocity[keep], rebounds=self.rebounds[keep], stuck=self.stuck[keep],
-            stick_time=self.stick_time[keep], duration=self.duration[keep])
+            stick_time=self.stick_time[keep], duration=self.duration[keep],
+            wall=self.wall[keep])
 
 
-def close_open_phase(stick_start, stick_end, stuck_since, t_end):
+def close_open_phase(stick_start, stick_end, stuck_since, t_end, stick_wall=None,
+                     stuck_wall=0):
     """The sticking phases of a record with one still going on at its end (begun at
-    ``stuck_since``, NaN if none, and not yet among them) ending at ``t_end``."""
+    ``stuck_since``, NaN if none, and not yet among them) ending at ``t_end``.
+
+    With ``stick_wall`` (the wall of each phase, two walls) the walls are returned too,
+    ``(start, end, wall)``, the open phase's wall being ``stuck_wall``."""
     start, end = np.asarray(stick_start, dtype=float), np.asarray(stick_end, dtype=float)
+    wall = None if stick_wall is None else np.asarray(stick_wall, dtype=np.int8)
     if np.isfinite(stuck_since) and not (start.size and start[-1] == stuck_since):
         start, end = np.append(start, stuck_since), np.append(end, t_end)
-    return start, end
+        if wall is not None:
+            wall = np.append(wall, np.int8(stuck_wall))
+    return (start, end) if wall is None else (start, end, wall)
 
 
 def _next_true(mask):
@@ -127,7 +167,7 @@ def _next_true(mask):
 
 
 def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0,
-                    flights=None):
+                    flights=None, wall=None, gap=None):
     """Which flights between consecutive impacts are pressed throughout (the hops).
 
     ``out[j]`` is True when the push ``f(tau) - delta`` is ``> 0`` at every instant of
@@ -138,6 +178,11 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
     ``r' + amplitude beta cos(beta tau) = 0`` where the curvature is positive. It reads the
     force only, never a tolerance of the simulator. The work is proportional to the steps of
     the flights whose two impacts are pressed.
+
+    With two walls (``wall`` and ``gap`` given) a flight between two impacts at the lower
+    wall is pressed when ``(delta - gap) - f > 0`` throughout (the same test in the mirrored
+    frame ``x -> -x``: force and amplitude negated, wall at ``-(delta - gap)``), and a flight
+    between the two walls never is.
 
     Parameters
     ----------
@@ -152,11 +197,51 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
     flights : array_like of bool, shape (n - 1,), optional
         Only these flights are examined (the others are reported False), e.g. leaving out
         the flights with a sticking phase, which are never hops.
+    wall : array_like of int, shape (n,), optional
+        The wall of each impact (0: at ``delta``, 1: at ``delta - gap``); needs ``gap``.
+    gap : float, optional
+        Width of the clearance (the second wall at ``delta - gap``); needs ``wall``.
 
     Returns
     -------
     ndarray of bool, shape (max(n - 1, 0),)
     """
+    sides = _flight_sides(impact_step, wall, gap, flights)
+    if sides is None:
+        return _pressed(impact_step, impact_offset, noise, dt, delta, amplitude, beta, flights)
+    upper, lower = sides
+    out = _pressed(impact_step, impact_offset, noise, dt, delta, amplitude, beta, upper)
+    if lower.any():
+        out |= _pressed(impact_step, impact_offset, noise, dt, -(delta - gap), -amplitude,
+                        beta, lower, sign=-1.0)
+    return out
+
+
+def _flight_sides(impact_step, wall, gap, flights):
+    """None with one wall; else the flights to examine at the upper and at the lower wall
+    (both impacts at that wall, and among ``flights``), checked."""
+    if wall is None and gap is None:
+        return None
+    if wall is None or gap is None:
+        raise ValueError("wall and gap go together: give the wall of each impact and the gap "
+                         "of the clearance, or neither (one wall)")
+    gap = _checks.real("gap", gap, low=0.0, low_open=True)
+    wall = np.asarray(wall)
+    n = np.shape(impact_step)[0] if np.ndim(impact_step) else 0
+    if wall.shape != (n,) or not np.all((wall == 0) | (wall == 1)):
+        raise ValueError(f"wall must hold one value per impact, each 0 (the wall at delta) "
+                         f"or 1 (the wall at delta - gap), shape ({n},), got shape "
+                         f"{wall.shape}")
+    base = (np.ones(max(n - 1, 0), bool) if flights is None
+            else np.asarray(flights, dtype=bool))
+    return (base & (wall[:-1] == 0) & (wall[1:] == 0),
+            base & (wall[:-1] == 1) & (wall[1:] == 1))
+
+
+def _pressed(impact_step, impact_offset, noise, dt, delta, amplitude, beta, flights,
+             sign=1.0):
+    """:func:`pressed_flights` at one wall; ``sign = -1``: the force samples negated (the
+    mirrored frame of the lower wall, ``delta`` and ``amplitude`` given in it)."""
     step = np.asarray(impact_step, dtype=np.int64)
     offset = np.asarray(impact_offset, dtype=float)
     n = step.size
@@ -169,6 +254,8 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
         r = np.asarray(noise[k_lo : min(k_hi, len(noise))], dtype=float)
         if r.size < k_hi - k_lo:     # an impact on the record's last sample: no slope needed
             r = np.append(r, np.full(k_hi - k_lo - r.size, r[-1]))
+        if sign < 0.0:
+            r = -r
     harmonic = amplitude != 0.0
 
     def push(k, s):
@@ -216,7 +303,8 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
 
 def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *,
                      dt: float, eps: float, floor: float = DEFAULT_REBOUND_FLOOR,
-                     pressed=None, rule: str = "physical") -> Collisions:
+                     pressed=None, rule: str = "physical", wall=None, stick_wall=None,
+                     eps_lower=None) -> Collisions:
     """Group a record's impacts into collisions (definition: module docstring).
 
     Parameters
@@ -231,7 +319,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     dt : float
         Sample step.
     eps : float
-        Restitution coefficient (rebound speed ``eps * u``).
+        Restitution coefficient (rebound speed ``eps * u``) of the wall at ``delta``.
     floor : float
         Rebounds leaving the wall at speed ``>= floor`` are counted in ``rebounds``
         (default `DEFAULT_REBOUND_FLOOR`; ``>= MIN_REBOUND_FLOOR``).
@@ -242,10 +330,24 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         The grouping (module docstring): the physical rule, the earlier impacts-only rule,
         or every rebound above ``floor`` on its own (impacts before the first such rebound
         then belong to no event, ``impact_collision = -1``).
+    wall : array_like of int, shape (n,), optional
+        The wall of each impact (0: at ``delta``, 1: at ``delta - gap``; the simulator's
+        ``impact_wall``). An impact at the other wall than the one before it always starts
+        a new collision. Default: all at the wall at ``delta`` (one wall).
+    stick_wall : array_like of int, shape (m,) or (m - 1,), optional
+        The wall of each sticking phase (the simulator's ``stick_wall``; a phase still open
+        at a chunk's end, appended by :func:`close_open_phase`, may lack its own). Checked
+        against the impacts: a phase rests on the wall of the last impact before it, so
+        its time counts for the collision at that wall; a record where it does not is
+        refused.
+    eps_lower : float, optional
+        Restitution of the wall at ``delta - gap`` (default ``eps``): the rebound speed of
+        an impact there is ``eps_lower * u``.
 
     Returns
     -------
     Collisions
+        ``wall`` holds each collision's wall (all 0 with one wall).
     """
     step = np.asarray(impact_step, dtype=np.int64)
     offset = np.asarray(impact_offset, dtype=float)
@@ -263,6 +365,13 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     if start.shape != end.shape or start.ndim != 1:
         raise ValueError(f"stick_start and stick_end must be 1-D of one length, got "
                          f"{start.shape} and {end.shape}")
+    wall = _impact_walls(wall, step.size)
+    if stick_wall is not None:
+        _check_stick_walls(stick_wall, start, step * dt + offset, wall)
+    # the rebound speed's coefficient, per impact where a second wall has its own
+    if eps_lower is not None:
+        eps_lower = _checks.eps(eps_lower, "eps_lower")
+        eps = np.where(wall == 1, eps_lower, eps)
     n = step.size
     t = step * dt + offset
     if rule == "physical":
@@ -278,7 +387,8 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     if n == 0:
         e_i, e_f = np.empty(0, np.int64), np.empty(0)
         return Collisions(e_i, e_i.copy(), e_i.copy(), e_f, e_f.copy(), e_f.copy(), e_i.copy(),
-                          np.empty(0, bool), e_f.copy(), e_f.copy(), floor, dt)
+                          np.empty(0, bool), e_f.copy(), e_f.copy(), floor, dt,
+                          np.empty(0, np.int8))
     # the first sticking phase that begins at or after each impact, and whether it begins
     # before the next impact
     k = np.searchsorted(start, t, side="left")
@@ -296,6 +406,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         first_mask = eps * u >= floor
     else:
         first_mask[1:] = ~_impacts_only_joins(step, offset, u, ends, dt)
+    first_mask[1:] |= wall[1:] != wall[:-1]          # a collision stays at one wall
     first = np.flatnonzero(first_mask)
     impact_collision = np.cumsum(first_mask) - 1     # -1 before a first rebound (rule "rebounds")
     # sticking phases that begin inside each collision [t_first, t_next_first)
@@ -311,7 +422,39 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     duration = np.where(stuck, release - t[first], duration)
     rebounds = np.add.reduceat((eps * u >= floor).astype(np.int64), first)
     return Collisions(first, impact_collision, step[first], offset[first], t[first], u[first],
-                      rebounds, stuck, stick_time, duration, floor, dt)
+                      rebounds, stuck, stick_time, duration, floor, dt, wall[first])
+
+
+def _check_stick_walls(stick_wall, start, t, wall):
+    """Refuse sticking phases whose wall is not that of the last impact before them."""
+    sw = np.asarray(stick_wall)
+    if sw.ndim != 1 or sw.size not in (start.size, start.size - 1) or not np.all(
+            (sw == 0) | (sw == 1)):
+        raise ValueError(f"stick_wall must hold one value per sticking phase (the last may "
+                         f"be missing), each 0 or 1, shape ({start.size},), got shape "
+                         f"{sw.shape}")
+    if t.size == 0:
+        return
+    last = np.searchsorted(t, start[:sw.size], side="right") - 1
+    seen = last >= 0
+    bad = np.flatnonzero(seen & (sw != wall[np.maximum(last, 0)]))
+    if bad.size:
+        i = int(bad[0])
+        raise ValueError(f"sticking phase {i} (from {start[i]!r}) rests on wall {sw[i]} but "
+                         f"the impact before it hit wall {wall[last[i]]}: stick_wall and "
+                         f"wall disagree")
+
+
+def _impact_walls(wall, n):
+    """The wall of each of ``n`` impacts as int8 (zeros when None), checked."""
+    if wall is None:
+        return np.zeros(n, np.int8)
+    wall = np.asarray(wall)
+    if wall.shape != (n,) or not np.all((wall == 0) | (wall == 1)):
+        raise ValueError(f"wall must hold one value per impact, each 0 (the wall at delta) "
+                         f"or 1 (the wall at delta - gap), shape ({n},), got shape "
+                         f"{wall.shape}")
+    return wall.astype(np.int8)
 
 
 def _impacts_only_joins(step, offset, u, ends, dt):

@@ -1,5 +1,12 @@
 """Impact events: intervals, velocities after impact, densities, batch means, event rates
-with intervals honest for few and clustered events (Figs. 7-9, 13, 14)."""
+with intervals honest for few and clustered events (Figs. 7-9, 13, 14).
+
+With a second wall (a clearance, docs/model.md) every statistic exists per wall: the
+velocity after impact is ``eps_w u`` with the restitution of the wall hit
+(:func:`velocity_after_impact` with ``wall``), intervals run between impacts or collisions
+at the same wall (:func:`impact_intervals` with ``at``, ``Collisions.at_wall``), and
+:func:`wall_statistics` gives a cell's rates, means and densities along a ``wall``
+dimension (docs/datasets.md, "Per wall")."""
 from __future__ import annotations
 
 from typing import NamedTuple
@@ -10,13 +17,17 @@ from vibroimpact import _checks
 
 __all__ = ["DEFAULT_N_BATCHES", "impact_intervals", "velocity_after_impact", "interval_ratio",
            "Density", "density", "t_quantile", "BatchMeans", "batch_means", "poisson_interval",
-           "EventRate", "event_rate", "MarkMean", "mark_mean"]
+           "EventRate", "event_rate", "MarkMean", "mark_mean", "WALLS", "wall_statistics"]
+
+#: The walls, in the order of a ``wall`` dimension: the wall at ``x = delta`` (hit moving up),
+#: the wall at ``x = delta - gap`` (hit moving down).
+WALLS = ("upper", "lower")
 
 #: Batches in a batch-means standard error; >= 20 keeps the t-quantile close to the normal one.
 DEFAULT_N_BATCHES = 20
 
 
-def impact_intervals(step, offset, dt: float) -> np.ndarray:
+def impact_intervals(step, offset, dt: float, *, wall=None, at=None) -> np.ndarray:
     """Intervals between adjacent impacts, z_j, from the simulator's split impact times.
 
     Parameters
@@ -27,6 +38,11 @@ def impact_intervals(step, offset, dt: float) -> np.ndarray:
         ``SimulationResult.impact_offset`` (0 <= offset <= dt).
     dt : float
         The simulation's sample step.
+    wall : array_like of int, shape (n,), optional
+        The wall of each impact (``SimulationResult.impact_wall``); needs ``at``.
+    at : int, optional
+        Only the impacts at this wall (0: at delta, 1: at delta - gap): the intervals
+        between consecutive impacts at the same wall.
 
     Returns
     -------
@@ -40,16 +56,45 @@ def impact_intervals(step, offset, dt: float) -> np.ndarray:
     if step.shape != offset.shape or step.ndim != 1:
         raise ValueError(f"step and offset must be 1-D of equal length, got {step.shape} "
                          f"and {offset.shape}")
+    if (wall is None) != (at is None):
+        raise ValueError("wall (the wall of each impact) and at (the wall selected) go "
+                         "together")
+    if at is not None:
+        keep = _wall_mask(wall, step.size, at)
+        step, offset = step[keep], offset[keep]
     return np.diff(step).astype(float) * float(dt) + np.diff(offset)
 
 
-def velocity_after_impact(u_minus, eps: float) -> np.ndarray:
+def velocity_after_impact(u_minus, eps: float, *, wall=None, eps_lower=None) -> np.ndarray:
     """Speed just after impact, ``eps * u_{j-0}`` (paper eq. 7: u_{j+0} = -eps u_{j-0}).
 
-    Returned as a positive speed (the rebound velocity itself is its negative).
+    Returned as a positive speed (the rebound velocity itself is its negative). With two
+    walls, ``wall`` (0 or 1 per impact) and ``eps_lower`` give each impact its wall's
+    restitution: ``eps_w u`` (``eps`` at the wall at delta, ``eps_lower`` at delta - gap).
     """
     _checks.eps(eps)
-    return eps * np.asarray(u_minus, dtype=float)
+    u = np.asarray(u_minus, dtype=float)
+    if wall is None and eps_lower is None:
+        return eps * u
+    if wall is None or eps_lower is None:
+        raise ValueError("wall (the wall of each impact) and eps_lower (the restitution of "
+                         "the wall at delta - gap) go together")
+    _checks.eps(eps_lower, "eps_lower")
+    lower = _wall_mask(wall, u.size, 1)
+    return np.where(lower, eps_lower, eps) * u
+
+
+def _wall_mask(wall, n, at):
+    """``wall == at`` for the checked wall array of ``n`` events."""
+    if at not in (0, 1):
+        raise ValueError(f"the wall selected must be 0 (the wall at delta) or 1 (the wall "
+                         f"at delta - gap), got {at!r}")
+    wall = np.asarray(wall)
+    if wall.shape != (n,) or not np.all((wall == 0) | (wall == 1)):
+        raise ValueError(f"wall must hold one value per event, each 0 (the wall at delta) "
+                         f"or 1 (the wall at delta - gap), shape ({n},), got shape "
+                         f"{wall.shape}")
+    return wall == at
 
 
 def interval_ratio(intervals, beta: float) -> np.ndarray:
@@ -468,3 +513,79 @@ def mark_mean(values, times, t0: float, t1: float, n_batches: int = DEFAULT_N_BA
     dof = max(1.0, min(n_batches - 1.0, n * n / float(np.dot(counts, counts)) - 1.0))
     half = float(stdtrit(dof, 0.5 + 0.5 * level)) * stderr
     return MarkMean(mean, stderr, mean - half, mean + half, dof)
+
+
+def wall_statistics(collisions, t0: float, t1: float, *, eps: float, eps_lower: float,
+                    bins, n_batches: int = DEFAULT_N_BATCHES, beta_f=None) -> dict:
+    """A cell's collision statistics per wall, along a ``wall`` dimension (`WALLS`).
+
+    Parameters
+    ----------
+    collisions : vibroimpact.stats.Collisions
+        The collisions of the record in ``[t0, t1]`` (``Collisions.after(t0)``), with their
+        ``wall``.
+    t0, t1 : float
+        The record observed (the transient and the record's end).
+    eps, eps_lower : float
+        Restitution of the wall at delta and of the wall at delta - gap.
+    bins : mapping
+        Bin edges (or counts) of the densities: ``"v_after"``, ``"interval"`` and, with
+        ``beta_f``, ``"ratio"``.
+    n_batches : int
+        Equal stretches of time B of the intervals and errors (`event_rate`, `mark_mean`,
+        `density`).
+    beta_f : float, optional
+        Frequency ratio of a harmonic force: adds the density of ``z_j / z``.
+
+    Returns
+    -------
+    dict
+        Arrays with the wall first, shape (2,) or (2, nbins), under the names of the events
+        dataset with a ``wall_`` prefix (docs/datasets.md, "Per wall"):
+        ``wall_n_collisions, wall_collision_rate, wall_collision_rate_lo,
+        wall_collision_rate_hi, wall_count_dispersion, wall_interval_mean,
+        wall_interval_mean_lo, wall_interval_mean_hi, wall_interval_stderr,
+        wall_v_after_mean, wall_v_after_stderr, wall_v_after_mean_lo, wall_v_after_mean_hi,
+        wall_stuck_fraction, wall_v_after_density(_stderr), wall_v_after_beyond,
+        wall_interval_density(_stderr), wall_interval_beyond`` and, with ``beta_f``,
+        ``wall_ratio_density(_stderr), wall_ratio_beyond``.
+
+    Notes
+    -----
+    The estimators are the cell's own (``pipeline.cells.event_statistics``) applied to the
+    collisions at one wall: the rate ``N_w / T`` and its interval (`event_rate`), the mean
+    interval ``T / N_w`` (the mean interval between collisions at the same wall, the
+    reciprocal of that wall's rate), the mean speed after impact ``eps_w u`` batched in time
+    (`mark_mean`), densities with batch-means errors of the speed after impact and of the
+    intervals between consecutive collisions at that wall.
+    """
+    rows = []
+    for w, e in enumerate((eps, eps_lower)):
+        c = collisions.at_wall(w)
+        v_after = velocity_after_impact(c.velocity, e)
+        z = c.intervals
+        rate = event_rate(c.time, t0, t1, n_batches)
+        mark = mark_mean(v_after, c.time, t0, t1, n_batches)
+        v_dens = density(v_after, bins["v_after"], total=v_after.size, n_batches=n_batches)
+        z_dens = density(z, bins["interval"], total=z.size, n_batches=n_batches)
+        row = dict(
+            wall_n_collisions=rate.count, wall_collision_rate=rate.rate,
+            wall_collision_rate_lo=rate.rate_lo, wall_collision_rate_hi=rate.rate_hi,
+            wall_count_dispersion=rate.dispersion, wall_interval_mean=rate.mean_interval,
+            wall_interval_mean_lo=rate.mean_interval_bounds[0],
+            wall_interval_mean_hi=rate.mean_interval_bounds[1],
+            wall_interval_stderr=rate.mean_interval_stderr,
+            wall_v_after_mean=mark.mean, wall_v_after_stderr=mark.stderr,
+            wall_v_after_mean_lo=mark.lo, wall_v_after_mean_hi=mark.hi,
+            wall_stuck_fraction=float(c.stuck.mean()) if c.stuck.size else np.nan,
+            wall_v_after_density=v_dens.density, wall_v_after_density_stderr=v_dens.stderr,
+            wall_v_after_beyond=v_dens.beyond,
+            wall_interval_density=z_dens.density, wall_interval_density_stderr=z_dens.stderr,
+            wall_interval_beyond=z_dens.beyond)
+        if beta_f is not None:
+            r_dens = density(interval_ratio(z, beta_f), bins["ratio"], total=z.size,
+                             n_batches=n_batches)
+            row.update(wall_ratio_density=r_dens.density,
+                       wall_ratio_density_stderr=r_dens.stderr, wall_ratio_beyond=r_dens.beyond)
+        rows.append(row)
+    return {name: np.array([row[name] for row in rows]) for name in rows[0]}

@@ -8,7 +8,16 @@ boundary terms that fall as 1/T and for any delta and eps,
     virial:  <v^2> - <x^2> + <x f> = delta [(1 + eps) / T sum_j V_j + <(f - delta) 1_stuck>]
 
 with ``V_j`` the approach velocity of every impact (every rebound of a chatter sequence,
-not only a collision's first) and ``1_stuck`` the time resting on the wall. A chatter tail
+not only a collision's first) and ``1_stuck`` the time resting on the wall.
+
+With a second wall at ``x_L = delta - gap`` (restitution ``eps_L``, hit moving down) each
+wall has its own impact term (docs/model.md, section 7.1, "Two walls"):
+
+    power:   ... + (1 - eps_L^2) / (2 T) sum_{j at L} V_j^2
+    virial:  ... - x_L [(1 + eps_L) / T sum_{j at L} V_j + <(x_L - f) 1_stuck at L>]
+
+the wall's position times the rate of momentum it gives the mass, with the lower wall's
+sign (it pushes up, the upper wall down). A chatter tail
 the simulator summed in closed form adds, per tail, ``w^2 / 2`` to the power's loss and
 ``-w`` to the virial's impulse, ``w`` its last resolved rebound (:func:`flight_moments`).
 The averages of the motion are exact integrals of the closed-form motion between events,
@@ -19,6 +28,8 @@ Pure numpy: no simulation; :mod:`vibroimpact.pipeline.cells` feeds it chunk by c
 from typing import NamedTuple
 
 import numpy as np
+
+from vibroimpact import _checks
 
 #: Gauss-Legendre nodes per piece of motion between events. A piece is at most one force
 #: step long (h = 0.1 in the studies); its integrands are x, v, f and their products, entire
@@ -37,13 +48,45 @@ TAIL_REBOUND = 1e-4
 #: v^2, x^2, f v, x f, of the wall's reaction f - delta while resting, and the sums of the
 #: speeds w and of w^2 of the last rebounds of chatter tails.
 MOMENTS = ("v2", "x2", "fv", "xf", "push", "tail", "tail2")
+#: With a second wall, the rows that follow `MOMENTS`: the lower wall's reaction
+#: ``(delta - gap) - f`` while resting on it, and its chatter tails' ``w`` and ``w^2``
+#: (`push`, `tail`, `tail2` are then the upper wall's).
+MOMENTS_LOWER = ("push_lower", "tail_lower", "tail2_lower")
+
+
+def moment_rows(two_walls: bool) -> tuple:
+    """The names of the rows of :func:`flight_moments` for one wall or for two."""
+    return MOMENTS + MOMENTS_LOWER if two_walls else MOMENTS
+
+
+def wall_arrays(gap, eps_lower, delta, impact_wall, stick_wall, n_impacts, n_phases):
+    """None with one wall; else ``(lower, eps_lower, impact_wall, stick_wall)`` checked
+    (positions ``delta - gap``; int8 walls of the impacts and of the sticking phases)."""
+    if gap is None:
+        if eps_lower is not None or impact_wall is not None or stick_wall is not None:
+            raise ValueError("eps_lower, impact_wall and stick_wall need a second wall: give "
+                             "gap as well")
+        return None
+    gap = _checks.real("gap", gap, low=0.0, low_open=True)
+    eps_lower = _checks.eps(eps_lower, "eps_lower")
+    out = []
+    for name, wall, n in (("impact_wall", impact_wall, n_impacts),
+                          ("stick_wall", stick_wall, n_phases)):
+        wall = np.zeros(n, np.int8) if wall is None and n == 0 else np.asarray(wall)
+        if wall.shape != (n,) or not np.all((wall == 0) | (wall == 1)):
+            raise ValueError(f"{name} must hold one value per event, each 0 (the wall at "
+                             f"delta) or 1 (the wall at delta - gap), shape ({n},), got "
+                             f"{np.shape(wall)}")
+        out.append(wall.astype(np.int8))
+    return float(delta) - gap, eps_lower, out[0], out[1]
 
 _XI, _W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 
 
 def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                    impact_time=(), impact_velocity=(), stick_start=(), stick_end=(),
-                   batch=None, n_batches=1):
+                   batch=None, n_batches=1, gap=None, eps_lower=None, impact_wall=None,
+                   stick_wall=None):
     """Exact integrals of v^2, x^2, f v, x f and the wall's push over force steps.
 
     Parameters
@@ -69,14 +112,22 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
         Batch of each step (default: all in batch 0).
     n_batches : int
         Number of batches of the output.
+    gap, eps_lower : float, optional
+        A second wall at ``delta - gap`` with restitution ``eps_lower`` (both or neither).
+    impact_wall, stick_wall : array_like of int, optional
+        With a second wall: the wall of each impact and of each sticking phase (0: at
+        delta, 1: at delta - gap; the simulator's ``impact_wall``, ``stick_wall``). An
+        impact at the lower wall leaves at ``+eps_lower V``.
 
     Returns
     -------
-    ndarray, shape (len(MOMENTS), n_batches)
+    ndarray, shape (len(MOMENTS), n_batches), or (len(MOMENTS + MOMENTS_LOWER), n_batches)
         Per batch (rows in the order of :data:`MOMENTS`): the integrals over its steps of
         ``v^2``, ``x^2``, ``f v``, ``x f`` and of the push ``f - delta`` while resting on the
         wall (the wall's reaction there), and the sums of ``w`` and ``w^2`` over the chatter
-        tails that begin in it.
+        tails that begin in it. With a second wall these three are the upper wall's and
+        the rows of :data:`MOMENTS_LOWER` follow: the push ``(delta - gap) - f`` while
+        resting on the lower wall, its tails' ``w`` and ``w^2``.
 
     Notes
     -----
@@ -106,21 +157,31 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
     u_imp = np.asarray(impact_velocity, dtype=float)
     s0 = np.asarray(stick_start, dtype=float)
     s1 = np.asarray(stick_end, dtype=float)
+    walls = wall_arrays(gap, eps_lower, delta, impact_wall, stick_wall, t_imp.size, s0.size)
     t_lo, t_hi = tk[0] if n else 0.0, (k_first + n) * dt
     hit = (t_imp >= t_lo) & (t_imp <= t_hi)
-    on = s0[(s0 >= t_lo) & (s0 <= t_hi)]
-    off = s1[(s1 >= t_lo) & (s1 <= t_hi)]
+    on_mask = (s0 >= t_lo) & (s0 <= t_hi)
+    off_mask = (s1 >= t_lo) & (s1 <= t_hi)
+    on, off = s0[on_mask], s1[off_mask]
     # events: impacts (kind 1), sticking onsets (2) and releases (3), each in the step of the
     # last sample at or before it; at equal times the sample comes first, so an event at a
     # sample sets the state after it
     ev_t = np.concatenate([t_imp[hit], on, off])
     ev_kind = np.repeat([1.0, 2.0, 3.0], [np.count_nonzero(hit), on.size, off.size])
     ev_v = np.concatenate([-eps * u_imp[hit], np.zeros(on.size + off.size)])
+    ev_x = np.full(ev_t.size, delta)
+    if walls is not None:
+        # the lower wall's events: at x_L, leaving an impact upwards at eps_L V
+        x_lower, e_lower, iw, sw = walls
+        ev_lower = np.concatenate([iw[hit], sw[on_mask], sw[off_mask]]) == 1
+        ev_x[ev_lower] = x_lower
+        i_lower = np.flatnonzero(ev_lower[:np.count_nonzero(hit)])
+        ev_v[i_lower] = e_lower * u_imp[hit][i_lower]
     ev_step = np.searchsorted(tk, ev_t, side="right") - 1
     busy = np.zeros(n, bool)
     busy[ev_step] = True
     held = _resting(tk + 0.5 * dt, s0, s1)
-    out = np.zeros((len(MOMENTS), int(n_batches)))
+    out = np.zeros((len(moment_rows(walls is not None)), int(n_batches)))
 
     def add(rows, st, values):                  # per-step values into their batches
         for row, value in zip(rows, values):
@@ -140,14 +201,19 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
             out[:4, batch[i[lo]]] += np.einsum("mij,ij->m", M, zs @ zs.T)
     # steps without events, resting on the wall: x = delta, v = 0
     st = np.flatnonzero(~busy & held)
-    add((1, 3, 4), st, _resting_integrals(np.zeros(st.size), dt, st, r, k_first, dt, delta,
-                                          amplitude, beta_f))
+    if walls is None:
+        add((1, 3, 4), st, _resting_integrals(np.zeros(st.size), dt, st, r, k_first, dt,
+                                              delta, amplitude, beta_f))
+    else:
+        lower = walls[3][_phase_of(tk[st] + 0.5 * dt, s0)] == 1
+        _add_resting_walls(add, lower, np.zeros(st.size), np.full(st.size, dt), st, r,
+                           k_first, dt, delta, walls[0], amplitude, beta_f)
     # steps with events: cut into pieces at every event
     bs = np.flatnonzero(busy)
     times = np.concatenate([tk[bs], ev_t])
     kind = np.concatenate([np.zeros(bs.size), ev_kind])
     step = np.concatenate([bs, ev_step])
-    x0 = np.concatenate([x[bs], np.full(ev_t.size, delta)])
+    x0 = np.concatenate([x[bs], ev_x])
     v0 = np.concatenate([v[bs], ev_v])
     order = np.lexsort((kind, times, step))
     times, kind, step, x0, v0 = times[order], kind[order], step[order], x0[order], v0[order]
@@ -156,14 +222,25 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
     length = np.maximum(end - times, 0.0)
     stuck = _resting(times + 0.5 * length, s0, s1)
     # the closed-form end of a chatter sequence: from its last resolved rebound to the onset
-    tail = (kind == 1) & same & (np.append(kind[1:], 0) == 2) & (-v0 < TAIL_REBOUND)
+    # (a rebound leaves the upper wall downwards, the lower one upwards: w = |v0|)
+    tail = (kind == 1) & same & (np.append(kind[1:], 0) == 2) & (np.abs(v0) < TAIL_REBOUND)
     stuck |= tail
-    w = -v0[tail]
-    add((5, 6), step[tail], (w, w * w))
+    w = np.abs(v0[tail])
     offset = times - (step + k_first) * dt
     j = np.flatnonzero(stuck)
-    add((1, 3, 4), step[j], _resting_integrals(offset[j], length[j], step[j], r, k_first, dt,
-                                               delta, amplitude, beta_f))
+    if walls is None:
+        add((5, 6), step[tail], (w, w * w))
+        add((1, 3, 4), step[j], _resting_integrals(offset[j], length[j], step[j], r, k_first,
+                                                   dt, delta, amplitude, beta_f))
+    else:
+        # a tail rests at its impact's wall; any other resting piece at its phase's
+        tail_lower = x0[tail] != delta
+        add((5, 6), step[tail][~tail_lower], (w[~tail_lower], w[~tail_lower] ** 2))
+        add((8, 9), step[tail][tail_lower], (w[tail_lower], w[tail_lower] ** 2))
+        lower = np.where(tail[j], x0[j] != delta,
+                         walls[3][_phase_of(times[j] + 0.5 * length[j], s0)] == 1)
+        _add_resting_walls(add, lower, offset[j], length[j], step[j], r, k_first, dt, delta,
+                           walls[0], amplitude, beta_f)
     j = np.flatnonzero(~stuck)
     for lo in range(0, j.size, BLOCK):
         sl = j[lo:lo + BLOCK]
@@ -182,6 +259,20 @@ def _resting_integrals(s_a, L, st, r, k_first, dt, delta, A, beta):
         tau = (st + k_first) * dt + s_a
         f_int = f_int + A / beta * (np.cos(beta * tau) - np.cos(beta * (tau + L)))
     return np.broadcast_to(delta * delta * L, f_int.shape), delta * f_int, f_int - delta * L
+
+
+def _add_resting_walls(add, lower, s_a, L, st, r, k_first, dt, delta, x_lower, A, beta):
+    """The resting integrals of pieces at the upper wall (rows x2, xf, push) and at the
+    lower one (rows x2, xf, push_lower, whose push is ``x_lower - f``)."""
+    for at, x_w, rows, sign in ((~lower, delta, (1, 3, 4), 1.0),
+                                (lower, x_lower, (1, 3, 7), -1.0)):
+        x2, xf, push = _resting_integrals(s_a[at], L[at], st[at], r, k_first, dt, x_w, A, beta)
+        add(rows, st[at], (x2, xf, sign * push))
+
+
+def _phase_of(t, s0):
+    """The sticking phase begun last at or before each instant ``t`` (0 if none)."""
+    return np.maximum(np.searchsorted(s0, t, side="right") - 1, 0)
 
 
 def _resting(t, s0, s1):
@@ -291,7 +382,8 @@ class IdentityResiduals(NamedTuple):
     n_batches: int          #: batches B
 
 
-def identity_residuals(moments, impact_sum, impact_sum2, durations, *, zeta, eps, delta):
+def identity_residuals(moments, impact_sum, impact_sum2, durations, *, zeta, eps, delta,
+                       gap=None, eps_lower=None):
     """Residuals of the two exact identities and their batch-means standard errors.
 
     Parameters
@@ -305,6 +397,10 @@ def identity_residuals(moments, impact_sum, impact_sum2, durations, *, zeta, eps
         Length of each batch (contiguous stretches of the record).
     zeta, eps, delta : float
         Physical parameters.
+    gap, eps_lower : float, optional
+        A second wall at ``delta - gap`` with restitution ``eps_lower``: ``moments`` then
+        has the rows of ``MOMENTS + MOMENTS_LOWER`` and ``impact_sum``, ``impact_sum2`` have
+        shape (2, B), the upper wall's sums first.
 
     Returns
     -------
@@ -317,9 +413,28 @@ def identity_residuals(moments, impact_sum, impact_sum2, durations, *, zeta, eps
     m = np.asarray(moments, dtype=float)
     su, su2 = np.asarray(impact_sum, dtype=float), np.asarray(impact_sum2, dtype=float)
     T = np.asarray(durations, dtype=float)
-    v2, x2, fv, xf, push, tail, tail2 = m
+    two = gap is not None
+    if two != (eps_lower is not None):
+        raise ValueError("gap and eps_lower go together: give both for a second wall")
+    rows = moment_rows(two)
+    if m.shape[0] != len(rows) or su.shape != su2.shape or su.shape != (
+            (2,) if two else ()) + T.shape:
+        raise ValueError(f"moments must have the rows {rows} and the impact sums shape "
+                         f"{'(2, B)' if two else '(B,)'} with B = {T.size}, got "
+                         f"{m.shape}, {su.shape} and {su2.shape}")
+    v2, x2, fv, xf, push, tail, tail2 = m[:len(MOMENTS)]
+    if two:
+        su, su_lower = su
+        su2, su2_lower = su2
     power = fv - 2.0 * zeta * v2 - 0.5 * (1.0 - eps * eps) * su2 - 0.5 * tail2
     virial = v2 - x2 + xf - delta * ((1.0 + eps) * su - tail + push)
+    if two:
+        # the lower wall: its loss, and its position times the momentum it gives (upwards)
+        x_lower = delta - gap
+        push_lower, tail_lower, tail2_lower = m[len(MOMENTS):]
+        power = (power - 0.5 * (1.0 - eps_lower * eps_lower) * su2_lower
+                 - 0.5 * tail2_lower)
+        virial = virial + x_lower * ((1.0 + eps_lower) * su_lower - tail_lower + push_lower)
     total = T.sum()
     B = T.size
     err = lambda a: float(np.std(a / T, ddof=1) / np.sqrt(B)) if B >= 2 else np.nan

@@ -1,5 +1,6 @@
 """Closed-form results: the wall-free linear response and elastic impacts under white noise
-(exact, used as oracles), and the energy-envelope averaging for eps near 1 (approximate)."""
+(exact, used as oracles) at one wall or in a clearance between two, and the energy-envelope
+averaging for eps near 1 (approximate)."""
 from __future__ import annotations
 
 from typing import Callable, NamedTuple
@@ -9,7 +10,8 @@ import numpy as np
 from vibroimpact import _checks
 
 __all__ = ["linear_response_std", "elastic_impact_rate", "rayleigh_pdf", "truncated_gaussian_pdf",
-           "upcrossing_rate", "EnvelopeTheory", "energy_envelope", "envelope_v_after_pdf",
+           "upcrossing_rate", "clearance_mass", "clearance_impact_rates", "clearance_pdf",
+           "EnvelopeTheory", "energy_envelope", "envelope_v_after_pdf",
            "envelope_energy_pdf", "ENVELOPE_EPS_MIN", "ENVELOPE_DELTA_MIN"]
 
 
@@ -158,6 +160,111 @@ def truncated_gaussian_pdf(x, sigma_x: float, delta: float):
     log_p = -0.5 * z * z - 0.5 * np.log(2.0 * np.pi) - np.log(sigma_x) - _log_ndtr(
         delta / sigma_x)
     p = np.where(x <= delta, np.exp(log_p), 0.0)
+    return p if p.ndim else float(p)
+
+
+def _log_mass(upper, lower):
+    """``log(Phi(upper) - Phi(lower))`` for ``lower < upper`` (standardised), stable in
+    both tails: written with the tail that keeps its digits (``Phi(-lower) - Phi(-upper)``
+    when both lie above 0)."""
+    from scipy.special import log_ndtr
+
+    hi, lo = np.broadcast_arrays(np.asarray(upper, dtype=float), np.asarray(lower, dtype=float))
+    flip = lo > 0.0
+    a = np.where(flip, -lo, hi)          # the larger end of the piece that is kept
+    b = np.where(flip, -hi, lo)
+    la, lb = log_ndtr(a), log_ndtr(b)
+    with np.errstate(divide="ignore"):
+        return la + np.log1p(-np.exp(lb - la))
+
+
+def _clearance_args(delta, gap, sigma_x):
+    d = np.asarray(delta, dtype=float)
+    g = np.asarray(gap, dtype=float)
+    if not np.all(np.isfinite(d)):
+        raise ValueError(f"delta must be finite, got {delta!r}")
+    if not np.all(g > 0.0):
+        raise ValueError(f"gap must be > 0 (the clearance delta - gap <= x <= delta), got "
+                         f"{gap!r}")
+    sigma_x = _checks.real("sigma_x", sigma_x, low=0.0, low_open=True)
+    return d, d - g, sigma_x
+
+
+def clearance_mass(delta, gap, sigma_x: float):
+    """``Z_x = Phi(delta / sigma_x) - Phi((delta - gap) / sigma_x)``: the wall-free Gaussian's
+    mass inside the clearance ``delta - gap <= x <= delta``.
+
+    Returns a float or an array shaped as the broadcast of ``delta`` and ``gap``; ``gap``
+    may be ``inf`` (one wall: ``Phi(delta / sigma_x)``).
+    """
+    upper, lower, sigma_x = _clearance_args(delta, gap, sigma_x)
+    z = np.exp(_log_mass(upper / sigma_x, lower / sigma_x))
+    return z if z.ndim else float(z)
+
+
+def clearance_impact_rates(delta, gap, sigma_x: float, sigma_v: float):
+    """Impact rates at the two walls of a clearance, both elastic, under white noise; exact.
+
+    Parameters
+    ----------
+    delta : float or array_like
+        Position of the upper wall (hit moving up).
+    gap : float or array_like
+        Width of the clearance: the lower wall stands at ``delta - gap`` (hit moving down);
+        ``inf`` gives the one-wall rate (`elastic_impact_rate`) and a lower rate 0.
+    sigma_x, sigma_v : float
+        Wall-free response std's of the same force (`linear_response_std`).
+
+    Returns
+    -------
+    nu_upper, nu_lower : float or ndarray
+        ``nu_w = p_x(x_w) sigma_v / sqrt(2 pi) / Z_x`` impacts per unit tau at the wall at
+        ``x_w`` (``delta``, ``delta - gap``), with ``p_x`` the wall-free ``N(0, sigma_x^2)``
+        density and ``Z_x`` = :func:`clearance_mass`; the mean interval between impacts at
+        wall w is ``1 / nu_w``, and the approach speed at either wall has the Rayleigh
+        density `rayleigh_pdf` (docs/model.md, section 7, "A clearance between two walls").
+
+    Notes
+    -----
+    The wall-free stationary density ``p(x, v) = N(x; 0, sigma_x^2) N(v; 0, sigma_v^2)``
+    solves the Fokker-Planck equation of ``(x, v)`` under white force and is even in v.
+    An elastic wall at ``x_w`` sends ``(x_w, v)`` to ``(x_w, -v)`` with unit Jacobian, so
+    the probability flux ``|v| p(x_w, v)`` arriving at speed ``u`` leaves at speed ``u``
+    with the same density: the boundary condition ``p(x_w, v) = p(x_w, -v)`` holds at each
+    wall. The free density cut to the strip and divided by ``Z_x`` is therefore stationary
+    (and, the motion being ergodic, the stationary density). The flux into wall w is
+    ``int_0^inf u p(x_w, u) du = p_x(x_w) / Z_x * sigma_v / sqrt(2 pi)``. Conditions:
+    ``eps = 1`` at both walls (any ``eps < 1`` breaks the evenness at the wall), a force
+    white on the time scale of the motion (``(x, v)`` Markov; the repository's piecewise
+    linear white force is white to ``1 - sinc^4(beta dt / 2)``), no harmonic part, and
+    the stationary state (a record long against ``1 / zeta``). Computed in logarithms
+    (``log_ndtr``), finite however far out the walls stand.
+    """
+    upper, lower, sigma_x = _clearance_args(delta, gap, sigma_x)
+    sigma_v = _checks.real("sigma_v", sigma_v, low=0.0, low_open=True)
+    log_z = _log_mass(upper / sigma_x, lower / sigma_x)
+    scale = (sigma_v / sigma_x) / (2.0 * np.pi)
+    with np.errstate(over="ignore"):
+        rates = tuple(scale * np.exp(-0.5 * (x / sigma_x) ** 2 - log_z)
+                      for x in (upper, lower))
+    return tuple(r if r.ndim else float(r) for r in rates)
+
+
+def clearance_pdf(x, delta, gap, sigma_x: float):
+    """Stationary displacement density in a clearance of two elastic walls under white noise.
+
+    ``p(x) = phi(x / sigma_x) / (sigma_x Z_x)`` on ``delta - gap <= x <= delta``, else 0:
+    the wall-free Gaussian cut to the clearance (:func:`clearance_impact_rates`, Notes).
+    The velocity keeps its wall-free density ``N(0, sigma_v^2)``, independent of x.
+    """
+    if np.ndim(delta) or np.ndim(gap):
+        raise ValueError(f"delta and gap must be numbers, got {delta!r} and {gap!r}")
+    upper, lower, sigma_x = _clearance_args(delta, gap, sigma_x)
+    x = np.asarray(x, dtype=float)
+    z = x / sigma_x
+    log_p = (-0.5 * z * z - 0.5 * np.log(2.0 * np.pi) - np.log(sigma_x)
+             - _log_mass(upper / sigma_x, lower / sigma_x))
+    p = np.where((x >= lower) & (x <= upper), np.exp(log_p), 0.0)
     return p if p.ndim else float(p)
 
 

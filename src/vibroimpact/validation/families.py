@@ -31,12 +31,15 @@ kernel's step ends:
 
 :func:`run_family` returns a :class:`~vibroimpact.validation.report.FamilyReport`.
 """
+import dataclasses
 import math
 import time
 
 import numpy as np
 
 from vibroimpact.impact import simulate
+from vibroimpact.impact.simulate import simulate_model
+from vibroimpact.model import ABOVE, BELOW, Model, Restitution, Wall
 from vibroimpact.validation import compare
 from vibroimpact.validation.reference import linear_peak, reference_impacts
 from vibroimpact.validation.report import FamilyReport
@@ -49,6 +52,12 @@ MAX_REF_IMPACTS = 400
 #: Grid tolerance of ``x <= delta``, per unit of the problem's scale: the round-off of a
 #: sample that lies on the wall (a release or touch exactly at a sample point).
 GRID_TOL = 1e-12
+#: The walls a family's singular configuration is built at: ``upper``, the paper's wall at
+#: delta; ``lower``, the second wall of a clearance (the case mirrored, x -> -x, onto the
+#: wall at -delta below the mass, the wall above kept out of reach at FAR_WALL x the case's
+#: scale: its response stays below ~1 / (2 zeta) x the force, < 500 x).
+WALLS = ("upper", "lower")
+FAR_WALL = 1e4
 
 
 def _log_uniform(rng, lo, hi):
@@ -308,19 +317,51 @@ def force_of(case):
     return force
 
 
-def run_case(case, report):
-    """Simulate one case, compare it with the reference and record the outcome in ``report``."""
+def _run_at_lower_wall(kw, scale):
+    """The case mirrored onto the lower wall of a clearance, and its result seen back in the
+    case's frame (the lower wall's impacts and rests as the case's own; ``a`` and ``v`` of the
+    mirrored grid, ``x_end``), with the far wall's rounding in the grid's tolerance."""
+    far = FAR_WALL * scale
+    eps, delta = kw["eps"], kw["delta"]
+    model = Model(kw["zeta"], (Wall(far, ABOVE, Restitution(eps)),
+                               Wall(-delta, BELOW, Restitution(eps))),
+                  -kw.get("amplitude", 0.0), kw.get("beta", 1.0))
+    noise = kw["noise"]
+    x0 = kw.get("x0")
+    res = simulate_model(model, noise=None if noise is None else -np.asarray(noise),
+                         dt=kw["dt"], x0=None if x0 is None else -x0, v0=-kw.get("v0", 0.0),
+                         t_end=kw.get("t_end"), record_every=1)
+    if np.any(res.impact_wall == 0):
+        raise RuntimeError(f"the far wall at {far!r} was reached: the lower-wall run is not "
+                           f"the case's")
+    x = far - res.a
+    view = dataclasses.replace(res, a=delta + x, v=-res.v, x_end=-res.x_end,
+                               params={**res.params, "delta": delta,
+                                       "amplitude": kw.get("amplitude", 0.0),
+                                       "x0": -res.params["x0"], "v0": -res.params["v0"]})
+    return view, 4.0 * np.spacing(far)
+
+
+def run_case(case, report, wall="upper"):
+    """Simulate one case, compare it with the reference and record the outcome in ``report``;
+    ``wall="lower"`` builds the case at the lower wall of a clearance (:data:`WALLS`)."""
     kw = {k: v for k, v in case.items() if k != "note"}
-    show = dict(case, noise=None if case["noise"] is None else case["noise"].tolist())
+    show = dict(case, noise=None if case["noise"] is None else case["noise"].tolist(),
+                wall=wall)
     report.cases += 1
+    scale, u_scale = _scales(case)
+    grid_tol = GRID_TOL * scale
     try:
-        res = simulate(**kw, record_every=1)
+        if wall == "lower":
+            res, rounding = _run_at_lower_wall(kw, scale)
+            grid_tol += rounding
+        else:
+            res = simulate(**kw, record_every=1)
     except Exception as err:        # any exception is a finding
         report.exceptions += 1
         report.fail(show, f"{type(err).__name__}: {err}")
         return
-    scale, u_scale = _scales(case)
-    problems = compare.invariant_problems(res, case["delta"], case["eps"], GRID_TOL * scale)
+    problems = compare.invariant_problems(res, case["delta"], case["eps"], grid_tol)
     ref = reference_impacts(**kw, max_impacts=MAX_REF_IMPACTS, record=True)
     force = force_of(case)
     cmp = compare.compare_events(res, ref, force, scale=scale, u_scale=u_scale)
@@ -343,7 +384,7 @@ def run_case(case, report):
         report.fail(show, "; ".join(problems + ([cmp.first_problem] if cmp.first_problem else [])))
 
 
-def run_family(name, n_cases, seed):
+def run_family(name, n_cases, seed, wall="upper"):
     """Run ``n_cases`` seeded random cases of one family; return its :class:`FamilyReport`.
 
     Parameters
@@ -354,9 +395,13 @@ def run_family(name, n_cases, seed):
         Cases to run (a draw that cannot build its singular configuration is drawn again).
     seed : int
         Seed of ``numpy.random.default_rng``: the same seed gives the same cases.
+    wall : {"upper", "lower"}
+        The wall the cases are built at (:data:`WALLS`): the same cases either way.
     """
     if name not in FAMILIES:
         raise ValueError(f"family must be one of {sorted(FAMILIES)}, got {name!r}")
+    if wall not in WALLS:
+        raise ValueError(f"wall must be one of {WALLS}, got {wall!r}")
     draw = FAMILIES[name]
     rng = np.random.default_rng([seed, sum(map(ord, name))])
     report = FamilyReport(family=name, tolerance=1.0, measure=compare.MEASURE)
@@ -364,6 +409,6 @@ def run_family(name, n_cases, seed):
     while report.cases < n_cases:
         case = draw(rng)
         if case is not None:
-            run_case(case, report)
+            run_case(case, report, wall)
     report.seconds = time.perf_counter() - start
     return report

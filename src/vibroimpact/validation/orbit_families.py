@@ -18,7 +18,8 @@ compared orbit by orbit with an independent solver written here:
     other side it must not be.
 
 The independent solver shares no code with ``vibroimpact.orbits`` or
-``vibroimpact.orbits.kernels`` (nothing of the package is imported but the function under test):
+``vibroimpact.orbits.kernels`` (nothing of the package is imported but the function under test
+and the impact law, :func:`vibroimpact.model.rebound_velocity`, the physics both solve):
 
 - flight: the textbook closed form ``x = q sin(beta tau - phi) + exp(-zeta s)(c1 cos wd s +
   c2 sin wd s)``;
@@ -69,6 +70,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, linear_sum_assignment, minimize_scalar
 
+from vibroimpact.model import rebound_velocity
 from vibroimpact.validation.report import FamilyReport
 
 __all__ = ["FAMILIES", "run_orbit_family", "check_case", "reference_orbits", "RefOrbit",
@@ -200,7 +202,7 @@ def flight_state(tau_a, u_a, s, beta, delta, zeta, eps, extended=False):
     beta, delta, zeta, eps = dtype(beta), dtype(delta), dtype(zeta), dtype(eps)
     psi = beta * tau_a - phi
     y0 = delta - q * np.sin(psi)                      # free part of the start state
-    v0 = -eps * u_a - q * beta * np.cos(psi)
+    v0 = rebound_velocity(eps, u_a) - q * beta * np.cos(psi)
     e, c, sn = np.exp(-zeta * s), np.cos(wd * s), np.sin(wd * s)
     th = psi + beta * s
     x = q * np.sin(th) + e * (y0 * c + (v0 + zeta * y0) / wd * sn)
@@ -583,8 +585,8 @@ def dop853_return(taus, us, m, n, beta, delta, zeta, eps, max_step=None):
     t, u = float(taus[0]), float(us[0])
     worst = 0.0
     for j in range(m):
-        sol = solve_ivp(rhs, (t, t + 1.5 * z), [delta, -eps * u], method="DOP853", rtol=1e-12,
-                        atol=1e-12, events=hit, max_step=max_step,
+        sol = solve_ivp(rhs, (t, t + 1.5 * z), [delta, rebound_velocity(eps, u)],
+                        method="DOP853", rtol=1e-12, atol=1e-12, events=hit, max_step=max_step,
                         first_step=1e-6)
         if sol.t_events[0].size == 0:
             return math.inf

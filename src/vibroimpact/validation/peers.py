@@ -29,6 +29,15 @@ import scipy.integrate
 import scipy.linalg
 from numba import njit
 
+from vibroimpact import _law
+from vibroimpact._kernel_cache import kernel_decorator
+from vibroimpact.model import rebound_velocity
+
+#: ``njit(cache=True)`` stamped with this file and the impact law (the event peers rebound by
+#: it: :mod:`vibroimpact._law`), so that an edit of the law recompiles them.
+_kernel = kernel_decorator(njit, __file__,
+                           ("peers.py",) + tuple(f"../{m}" for m in _law.LAW_MODULES))
+
 V_STICK = 1e-7
 """Rebound speed below which the event-locating peers leave the mass at rest on the wall.
 
@@ -179,7 +188,7 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
             times.append(t)
             velocities.append(u)
             x = delta
-            v = -eps * u
+            v = rebound_velocity(eps, u)
             if -v < v_stick:
                 v = 0.0
                 resting = True
@@ -190,7 +199,7 @@ def solve_ivp_impacts(zeta, eps, delta, noise, dt, method="DOP853", rtol=1e-10, 
 # Fixed-step RK4 with event location (cubic Hermite interpolant) and restart at the impact
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@_kernel
 def _rk4_step(x, v, s, f0, b, two_zeta):
     """One classical RK4 step of length s from (x, v); the force is f0 + b * (elapsed time)."""
     f_half = f0 + 0.5 * b * s
@@ -213,12 +222,12 @@ def _rk4_step(x, v, s, f0, b, two_zeta):
             v + s / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v))
 
 
-@njit(cache=True)
+@_kernel
 def _cubic(c0, c1, c2, c3, theta):
     return c0 + theta * (c1 + theta * (c2 + theta * c3))
 
 
-@njit(cache=True)
+@_kernel
 def _upcrossing(c0, c1, c2, c3, a, b):
     """Zero of the cubic on [a, b] if it is <= 0 at a and > 0 at b (bisection to the last bit,
     the cubic being monotone there), else -1."""
@@ -235,7 +244,7 @@ def _upcrossing(c0, c1, c2, c3, a, b):
     return b
 
 
-@njit(cache=True)
+@_kernel
 def _first_upcrossing(p0, m0, p1, m1, lo):
     """First upward zero in [lo, 1] of the cubic Hermite interpolant of a step, or -1.
 
@@ -270,7 +279,7 @@ def _first_upcrossing(p0, m0, p1, m1, lo):
     return -1.0
 
 
-@njit(cache=True)
+@_kernel
 def _rk4_event_kernel(noise, dt, m, n_intervals, t_end, zeta, eps, delta, x0, v0, v_stick,
                       impact_time, impact_velocity):
     """RK4 with m steps per sample, impacts located on the step's cubic Hermite interpolant.
@@ -340,7 +349,7 @@ def _rk4_event_kernel(noise, dt, m, n_intervals, t_end, zeta, eps, delta, x0, v0
                 impact_velocity[n_impacts] = u
             n_impacts += 1
             x = delta
-            v = -eps * u
+            v = _law.rebound_velocity(eps, u)
             if -v < v_stick:
                 v = 0.0
                 resting = True
@@ -405,7 +414,7 @@ def rk4_event_impacts(zeta, eps, delta, noise, dt, steps_per_sample=1, x0=None, 
 # Fixed-step RK4 with clamping at the wall
 # ---------------------------------------------------------------------------------------------
 
-@njit(cache=True)
+@_kernel
 def _rk4_clamp_kernel(noise, dt, m, n_intervals, zeta, eps, delta, x0, v0,
                       impact_time, impact_velocity):
     """RK4 with m steps per sample; x > delta is clamped to delta, and v > 0 there reversed."""
@@ -428,7 +437,7 @@ def _rk4_clamp_kernel(noise, dt, m, n_intervals, zeta, eps, delta, x0, v0,
                         impact_time[n_impacts] = k * dt + s + h
                         impact_velocity[n_impacts] = v
                     n_impacts += 1
-                    v = -eps * v
+                    v = _law.rebound_velocity(eps, v)
     return n_impacts, x, v
 
 
@@ -489,7 +498,7 @@ def linear_propagator(zeta, dt):
     return phi, np.ascontiguousarray(g0), np.ascontiguousarray(g1)
 
 
-@njit(cache=True)
+@_kernel
 def _recurrence_kernel(noise, p00, p01, p10, p11, g00, g01, g10, g11, x, v):
     for k in range(noise.size - 1):
         r0 = noise[k]

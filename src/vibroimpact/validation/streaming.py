@@ -59,6 +59,7 @@ from pathlib import Path
 
 import numpy as np
 
+from vibroimpact.model import rebound_velocity
 from vibroimpact.validation.report import FamilyReport
 
 FAMILY = "streamed_record"
@@ -568,7 +569,7 @@ def _replay_flight(record, imp, j, params, tol, dps=REPLAY_DPS):
         t = k * h + mpf(float(imp["offset"][j]))
         t_next = int(imp["step"][j + 1]) * h + mpf(float(imp["offset"][j + 1]))
         u_next = mpf(float(imp["u"][j + 1]))
-        x, v = P.delta, -P.eps * mpf(float(imp["u"][j]))       # the reset under test
+        x, v = P.delta, rebound_velocity(P.eps, mpf(float(imp["u"][j])))   # the reset
         while True:
             tk = k * h
             end = min((k + 1) * h, t_next)
