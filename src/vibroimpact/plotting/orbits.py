@@ -77,14 +77,11 @@ def _on_cells(orbits, name):
     return np.full(shape, float(fixed[name]))
 
 
-def type_counts(name):
-    """``(m, n, m_lower)`` of a motion type's name: ``"2/1"`` is (2, 1, 0), a two-wall
-    ``"(1,1)/1"`` is (2, 1, 1) (m counts the impacts on both walls)."""
+def _type_counts(name):
+    """``(m, m_lower, n)`` of a type named ``"m/n"`` (``m_lower`` 0) or ``"(m,m_lower)/n"``."""
     counts, n = name.rsplit("/", 1)
-    if counts.startswith("("):
-        upper, lower = (int(k) for k in counts.strip("()").split(","))
-        return upper + lower, int(n), lower
-    return int(counts), int(n), 0
+    parts = [int(k) for k in counts.strip("()").split(",")]
+    return (parts + [0])[:2] + [int(n)] if len(parts) == 1 else parts + [int(n)]
 
 
 def complex_multipliers(orbits, m, n, m_lower=0):
@@ -97,9 +94,10 @@ def complex_multipliers(orbits, m, n, m_lower=0):
         of ``attrs["axes"]``); zeta, eps and 1/beta from the axes or the fixed values
         (global attributes ``zeta``, ``eps`` on the paper's plane).
     m, n : int
-        The motion type (m impacts in all, per n forcing periods).
+        The motion type.
     m_lower : int
-        Of the m impacts, those on a second wall (restitution ``eps_lower``).
+        Impacts per period at the lower wall of a two-wall type ``(m, m_lower)/n`` (``m`` then
+        those at the upper wall; ``det T = eps^2m eps_lower^2m_lower e^(-2 zeta z)``).
 
     Returns
     -------
@@ -112,22 +110,27 @@ def complex_multipliers(orbits, m, n, m_lower=0):
     1/beta alone (``z = 2 pi n / beta``): contours of S are vertical lines there. Where the
     multipliers turn real, S leaves that value with infinite slope (a square-root branch), so
     contour levels interpolated across the switch are artefacts of the grid. With two walls
-    ``det T = eps^(2 m_u) eps_l^(2 m_l) e^(-2 zeta z)``, so ``eps`` above becomes
-    ``(eps^m_u eps_l^m_l)^(1/m)``.
+    ``det T = eps^(2 m) eps_lower^(2 m_lower) e^(-2 zeta z)``, so ``eps`` and ``m`` above
+    become ``(eps^m eps_lower^m_lower)^(1/(m + m_lower))`` and ``m + m_lower``.
     """
+    total = m + m_lower
     if not custom_plane(orbits):
         zeta, eps = float(_attr(orbits, "zeta")), float(_attr(orbits, "eps"))
         z = 2.0 * np.pi * n * np.asarray(orbits["inv_beta"], dtype=float)
-        lam_c = (eps * np.exp(-zeta * z / m))[:, None]
-    else:
+        if m_lower:     # two walls: m upper and m_lower lower impacts, |mu|^2 = det T
+            eps_l = float(_attr(orbits, "eps_lower"))
+            lam_c = (eps ** m * eps_l ** m_lower) ** (1.0 / total) * np.exp(-zeta * z / total)
+        else:
+            lam_c = eps * np.exp(-zeta * z / m)
+        lam_c = lam_c[:, None]
+    else:               # a named plane: zeta, eps, eps_lower, 1/beta per cell
         zeta, eps = _on_cells(orbits, "zeta"), _on_cells(orbits, "eps")
         if m_lower:
-            fixed = plane_fixed(orbits)
             lower = (_on_cells(orbits, "eps_lower") if "eps_lower" in plane_axes(orbits)
-                     or "eps_lower" in fixed else eps)
-            eps = (eps ** (m - m_lower) * lower ** m_lower) ** (1.0 / m)
+                     or "eps_lower" in plane_fixed(orbits) else eps)
+            eps = (eps ** m * lower ** m_lower) ** (1.0 / total)
         z = 2.0 * np.pi * n * _on_cells(orbits, "inv_beta")
-        lam_c = eps * np.exp(-zeta * z / m)
+        lam_c = eps * np.exp(-zeta * z / total)
     lam = on_plane(orbits["lam"], orbits).values.astype(float)
     with np.errstate(invalid="ignore"):
         return lam <= lam_c * (1.0 + COMPLEX_RTOL)
@@ -397,7 +400,7 @@ def fig16(orbits, boundaries=None):
         shaded = ax.pcolormesh(xe, ye, np.ma.masked_invalid(S).T, cmap="viridis_r", vmin=0.0,
                                vmax=100.0, rasterized=True)
         if stable.any():
-            m, n, m_lower = type_counts(name)
+            m, m_lower, n = _type_counts(name)
             cplx = complex_multipliers(sel, m, n, m_lower) & stable
             real = np.where(cplx, np.nan, S).T
             if np.isfinite(real).any():
