@@ -1,15 +1,17 @@
 """Fig. 16 over any plane (issue 36): `orbit_plane` against `orbit_map`, `periodic_orbits` and
-`periodic_motions`, the amplitude scaled out, and its error messages."""
+`periodic_motions`, the amplitude scaled out, and its error messages. One wall:
+`vibroimpact.orbits.plane`; two walls: `vibroimpact.attractors.plane` (the same call)."""
 import json
 
 import numpy as np
 import pytest
 import xarray as xr
 
+from vibroimpact.attractors import plane as any_walls
+from vibroimpact.attractors.shooting import periodic_motions
 from vibroimpact.model import Model
 from vibroimpact.orbits import orbit_map, periodic_orbits
 from vibroimpact.orbits.plane import orbit_plane
-from vibroimpact.orbits.shooting import periodic_motions
 
 PAPER = {"zeta": 0.05, "eps": 0.5}
 TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))
@@ -29,6 +31,9 @@ def _same(a, b):
 
 def test_the_paper_plane_is_orbit_map_exactly():
     ds = orbit_plane("inv_beta", INV_BETA, "delta", DELTA, PAPER, types=TYPES)
+    # any layout's call hands a one-wall plane to the closed form unchanged
+    assert any_walls.orbit_plane("inv_beta", INV_BETA, "delta", DELTA, PAPER,
+                                 types=TYPES).identical(ds)
     ref = orbit_map(INV_BETA, DELTA, types=TYPES, **PAPER)
     assert ds["n_stable"].dims == ("type", "inv_beta", "delta")
     assert list(ds["type"].values) == ["1/1", "2/1", "1/2", "1/3", "3/1"]
@@ -108,8 +113,8 @@ def test_the_amplitude_scales_out_as_delta_over_a():
 def test_two_walls_run_periodic_motions_per_cell():
     gap, inv_beta = [1.0, 3.0], [0.8]
     fixed = {"zeta": 0.05, "eps": 0.5, "delta": 0.5}
-    ds = orbit_plane("gap", gap, "inv_beta", inv_beta, fixed,
-                     types=["(1,1)/1", (1, 0, 1)])
+    ds = any_walls.orbit_plane("gap", gap, "inv_beta", inv_beta, fixed,
+                               types=["(1,1)/1", (1, 0, 1)])
     assert ds.attrs["solver"] == "periodic_motions" and ds.attrs["n_walls"] == 2
     assert list(ds["type"].values) == ["(1,1)/1", "(1,0)/1"]
     for i, g in enumerate(gap):
@@ -149,7 +154,7 @@ def test_two_walls_run_periodic_motions_per_cell():
 ])
 def test_errors_name_the_problem(args, message):
     if message is None:
-        ds = orbit_plane(*args, types=["(1,1)/1"])
+        ds = any_walls.orbit_plane(*args, types=["(1,1)/1"])
         assert "rms" not in json.loads(ds.attrs["fixed"])     # the noise has no Fig. 16 part
         return
     with pytest.raises(ValueError, match=message):
@@ -161,7 +166,10 @@ def test_type_errors():
     with pytest.raises(ValueError, match=r"types must be \(m, n\) pairs"):
         orbit_plane("eps", [0.5], "delta", [0.0], fixed, types=["(1,1)/1"])
     with pytest.raises(ValueError, match="named '\\(m_upper,m_lower\\)/n'"):
-        orbit_plane("eps", [0.5], "delta", [0.0], {**fixed, "gap": 1.0}, types=["1/1"])
+        any_walls.orbit_plane("eps", [0.5], "delta", [0.0], {**fixed, "gap": 1.0},
+                              types=["1/1"])
+    with pytest.raises(ValueError, match="solved by vibroimpact.attractors.plane.orbit_plane"):
+        orbit_plane("eps", [0.5], "delta", [0.0], {**fixed, "gap": 1.0}, types=["(1,1)/1"])
     with pytest.raises(ValueError, match="at least one motion type"):
         orbit_plane("eps", [0.5], "delta", [0.0], fixed, types=[])
 

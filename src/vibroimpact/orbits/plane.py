@@ -28,11 +28,10 @@ velocities times A, and the same one-period Jacobian up to the similarity ``diag
 ``delta / A`` with the unit force. (A < 0 is the force shifted by half a period, A = 0 has no
 impact motion: the amplitude must be > 0.)
 
-Two walls, Newton shooting on the exact flow (`vibroimpact.orbits.shooting.periodic_motions`)
-at every cell, seeded by settled starts: the motions found are those whose basin the grid of
-starts meets (every stable one in practice, docs/model.md 8.8); an unstable motion is found
-only when Newton happens to converge on it. A type is named by its impacts on each wall,
-``"(1,1)/1"``; ``reason`` 1 then means "none found", not "none exists".
+Two walls: `vibroimpact.attractors.plane.orbit_plane` (the same call), Newton shooting on the
+exact flow at every cell, whose seeds the simulator settles: it lives a floor up, beside the
+shooting solver, so that a one-wall plane loads no simulator. This module holds what both
+share (the checks, the classification of a cell, the dataset).
 """
 from __future__ import annotations
 
@@ -46,7 +45,8 @@ from vibroimpact._symbols import (HARMONIC_PARAMETERS, NOISE_PARAMETERS, PARAMET
                                   TWO_WALL_PARAMETERS)
 from vibroimpact.orbits.api import Reason, orbit_map, periodic_orbits
 
-__all__ = ["orbit_plane", "HARMONIC_PARAMETERS", "TWO_WALL_PARAMETERS", "NOISE_PARAMETERS"]
+__all__ = ["orbit_plane", "plane_dataset", "check_plane", "classify",
+           "HARMONIC_PARAMETERS", "TWO_WALL_PARAMETERS", "NOISE_PARAMETERS"]
 #: Fixed values taken when `fixed` does not give them: Fig. 16's force is ``sin(beta tau)``.
 DEFAULT_FIXED = {"amplitude": 1.0}
 #: Variables of the result, as `orbit_map` returns them.
@@ -164,8 +164,9 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
     ----------
     x_name, y_name : str
         The plane's axes, two different parameters among ``zeta``, ``eps``, ``delta``,
-        ``inv_beta``, ``amplitude`` and, with a second wall (``gap`` on an axis or fixed),
-        ``gap`` and ``eps_lower``. ``rms`` raises: a plane over the noise has no Fig. 16.
+        ``inv_beta``, ``amplitude``. ``rms`` raises: a plane over the noise has no Fig. 16.
+        A second wall (``gap`` on an axis or fixed; then also ``eps_lower``) raises here:
+        `vibroimpact.attractors.plane.orbit_plane` solves it (same call).
     x_values, y_values : array_like, shape (nx,), (ny,)
         Values along each axis, each within its parameter's range (zeta in (0, 1), eps in
         [0, 1], inv_beta, amplitude and gap > 0).
@@ -190,17 +191,34 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
     -----
     The module docstring: one column along delta per `orbit_map` call when delta is an axis
     (exactly `orbit_map` over ``(inv_beta, delta)``), `periodic_orbits` per cell otherwise,
-    the amplitude scaled out (``delta / A``), `periodic_motions` per cell for two walls.
+    the amplitude scaled out (``delta / A``).
 
     Tiles: the columns along delta are independent, the cells along delta within one are not
     (branch following). A plane may be split into tiles over its other axis and the tiles
     joined, bit for bit the whole plane's result; a tile over delta gives other results near
     folds (the branches start again at its first delta).
     """
-    import xarray as xr
+    xs, ys, fixed, parsed, two_walls = check_plane(x_name, x_values, y_name, y_values, fixed,
+                                                   types)
+    if two_walls:
+        raise ValueError("a plane with a second wall (gap) is solved by "
+                         "vibroimpact.attractors.plane.orbit_plane (Newton shooting seeded by "
+                         "the simulator); this one is the one-wall closed form")
+    if "delta" in (x_name, y_name):
+        result, solver = _columns(x_name, xs, y_name, ys, fixed, parsed), "orbit_map"
+    else:
+        result, solver = _cells(x_name, xs, y_name, ys, fixed, parsed), "periodic_orbits"
+    return plane_dataset(x_name, xs, y_name, ys, fixed, parsed, result, solver, n_walls=1)
 
+
+def check_plane(x_name, x_values, y_name, y_values, fixed, types):
+    """``(xs, ys, fixed, types, two_walls)`` of an `orbit_plane` call, checked: the axes'
+    values as arrays, the fixed values completed (`DEFAULT_FIXED`, noise ones dropped), the
+    types as ``[(label, key)]``; a ValueError naming the problem otherwise."""
     if x_name == y_name:
         raise ValueError(f"the plane's two axes must differ, got {x_name!r} twice")
+    if not isinstance(fixed, dict):
+        raise ValueError(f"fixed must be a dict {{parameter: value}}, got {type(fixed).__name__}")
     two_walls = "gap" in (x_name, y_name) or "gap" in fixed
     allowed = TWO_WALL_PARAMETERS if two_walls else HARMONIC_PARAMETERS
     xs = _axis(x_name, x_values, allowed, two_walls)
@@ -213,14 +231,14 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
                          f"problem that is not on an axis")
     if not two_walls and "eps_lower" in fixed:
         raise ValueError("eps_lower needs a second wall: give gap as well")
-    parsed = _parse_types(types, two_walls)
+    return xs, ys, fixed, _parse_types(types, two_walls), two_walls
+
+
+def plane_dataset(x_name, xs, y_name, ys, fixed, parsed, result, solver, n_walls):
+    """The Dataset of `orbit_plane` from the arrays of `VARIABLES` (shape (types, nx, ny))."""
+    import xarray as xr
+
     shape = (len(parsed), xs.size, ys.size)
-    if two_walls:
-        result, solver = _two_walls(x_name, xs, y_name, ys, fixed, parsed), "periodic_motions"
-    elif "delta" in (x_name, y_name):
-        result, solver = _columns(x_name, xs, y_name, ys, fixed, parsed), "orbit_map"
-    else:
-        result, solver = _cells(x_name, xs, y_name, ys, fixed, parsed), "periodic_orbits"
     dims = ("type", x_name, y_name)
     ds = xr.Dataset({k: (dims, result[k].reshape(shape)) for k in VARIABLES},
                     coords={"type": [label for label, _ in parsed], x_name: xs, y_name: ys})
@@ -231,22 +249,22 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
         ds[name].attrs.update(long_name=PARAMETERS[name][2], units="1")
     ds.attrs.update({k: float(v) for k, v in fixed.items()})
     ds.attrs.update(axes=[x_name, y_name], fixed=json.dumps(fixed, sort_keys=True),
-                    n_walls=2 if two_walls else 1, solver=solver)
+                    n_walls=n_walls, solver=solver)
     return ds
 
 
-def _empty(shape):
+def empty(shape):
     return {"exists": np.zeros(shape, bool), "n_solutions": np.zeros(shape, np.int64),
             "n_stable": np.zeros(shape, np.int64), "lam": np.full(shape, np.nan),
             "reason": np.zeros(shape, np.int8)}
 
 
-def _finish(out):
+def finish(out):
     out["S"] = 100.0 * (1.0 - out["lam"])
     return out
 
 
-def _value(name, k_x, k_y, x_name, xs, y_name, ys, fixed):
+def value_at(name, k_x, k_y, x_name, xs, y_name, ys, fixed):
     """A parameter's value at cell ``(k_x, k_y)``."""
     if name == x_name:
         return float(xs[k_x])
@@ -289,19 +307,19 @@ def _columns(x_name, xs, y_name, ys, fixed, parsed):
 def _cells(x_name, xs, y_name, ys, fixed, parsed):
     """One wall, no delta axis: `periodic_orbits` at every cell."""
     shape = (len(parsed), xs.size, ys.size)
-    out = _empty(shape)
+    out = empty(shape)
     for i in range(xs.size):
         for j in range(ys.size):
-            p = {k: _value(k, i, j, x_name, xs, y_name, ys, fixed)
+            p = {k: value_at(k, i, j, x_name, xs, y_name, ys, fixed)
                  for k in HARMONIC_PARAMETERS}
             for t, (_, (m, n)) in enumerate(parsed):
                 orbits = periodic_orbits(m, n, 1.0 / p["inv_beta"], p["delta"] / p["amplitude"],
                                          p["zeta"], p["eps"], include_inadmissible=True)
-                _classify(out, (t, i, j), orbits, [o.admissible for o in orbits])
-    return _finish(out)
+                classify(out, (t, i, j), orbits, [o.admissible for o in orbits])
+    return finish(out)
 
 
-def _classify(out, idx, found, admissible):
+def classify(out, idx, found, admissible):
     """Fill one cell of one type from its solutions (`Reason` as the map kernel does)."""
     adm = [o for o, a in zip(found, admissible) if a]
     n_stable = sum(bool(o.stable) for o in adm)
@@ -311,27 +329,3 @@ def _classify(out, idx, found, admissible):
     out["lam"][idx] = min(o.lam for o in adm) if adm else math.nan
     out["reason"][idx] = (Reason.STABLE if n_stable else Reason.NO_SOLUTION if not found
                           else Reason.INADMISSIBLE if not adm else Reason.UNSTABLE)
-
-
-def _two_walls(x_name, xs, y_name, ys, fixed, parsed):
-    """Two walls: `periodic_motions` (Newton shooting from settled starts) at every cell."""
-    from vibroimpact.model import Model
-    from vibroimpact.orbits.shooting import periodic_motions
-
-    shape = (len(parsed), xs.size, ys.size)
-    out = _empty(shape)
-    ns = sorted({key[2] for _, key in parsed})
-    for i in range(xs.size):
-        for j in range(ys.size):
-            p = {k: _value(k, i, j, x_name, xs, y_name, ys, fixed)
-                 for k in TWO_WALL_PARAMETERS if k != "eps_lower"}
-            eps_lower = (_value("eps_lower", i, j, x_name, xs, y_name, ys, fixed)
-                         if "eps_lower" in (x_name, y_name) or "eps_lower" in fixed
-                         else p["eps"])
-            model = Model.paper(p["zeta"], p["eps"], p["delta"], p["amplitude"],
-                                1.0 / p["inv_beta"], gap=p["gap"], eps_lower=eps_lower)
-            motions = periodic_motions(model, ns).motions
-            for t, (label, _) in enumerate(parsed):
-                found = [mo for mo in motions if mo.name == label]
-                _classify(out, (t, i, j), found, [mo.admissible for mo in found])
-    return _finish(out)
