@@ -19,7 +19,6 @@ from vibroimpact.pipeline.provenance import code_digest
 from vibroimpact.pipeline.study import (
     JOB_KEYS,
     ORBIT_JOB_KEYS,
-    Study,
     attractor_rows,
     grid_values,
     orbit_rows,
@@ -43,7 +42,9 @@ wildcard_constraints:
     paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence|escape_vs_noise",
 
 
-STUDIES = {name: Study.from_config(name, entry) for name, entry in config["studies"].items()}
+# every study resolved once, by `configuration.load` (the Snakefile's PLAN): its grids are
+# those the config checks expanded
+STUDIES = PLAN.studies
 
 
 def script_code(rule):
@@ -302,9 +303,15 @@ def simulate_runtime(kind):
         if kind == "trace":
             return costs.simulate_runtime_min(0, 0)
         entry = config["studies"][wildcards.study]
-        steps = costs.study_steps(kind, entry, _study_noise_entry(wildcards.study))
+        study = STUDIES[wildcards.study]
+        steps = costs.study_steps(
+            kind,
+            entry,
+            _study_noise_entry(wildcards.study),
+            float(study.inv_beta.max()) if kind == "map" else None,
+        )
         grid = "events" if kind == "map" else kind
-        cells = len(STUDIES[wildcards.study].tile(int(wildcards.tile), grid))
+        cells = len(study.tile(int(wildcards.tile), grid))
         return costs.simulate_runtime_min(cells, steps, audit=kind == "events")
 
     return runtime

@@ -14,6 +14,7 @@ from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
+from vibroimpact.model import Model
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
 log = logging.getLogger("vibroimpact")
@@ -52,10 +53,40 @@ def _lag1_check(name, result, cell):
                     cell, name, result.lag1, limit, result.n_batches)
 
 
+#: The walls of a two-wall dataset, in the order of its ``wall`` dimension (the simulator's
+#: ``impact_wall``: 0 the wall at delta, 1 the wall at delta - gap).
+WALLS = ("upper", "lower")
+
+
+def study_model(study, cell):
+    """The resolved :class:`vibroimpact.model.Model` of one cell of ``study``
+    (`pipeline.study.Study`): its oscillator and walls at the cell's play, forced by
+    ``amplitude sin(tau / inv_beta)``. Here, beside the simulator, not on `Study`: reading a
+    config or drawing a figure loads no kernel (the import contracts, pyproject.toml)."""
+    return Model.paper(study.zeta, study.eps, cell.delta, study.amplitude,
+                       1.0 / cell.inv_beta, **study.walls())
+
+
+def _walls(gap, eps_lower, eps=None):
+    """The second wall as `simulate_chunks` keywords: ``{}`` with one wall (``gap`` None), so
+    a one-wall cell makes the call it always made; ``eps_lower`` None is ``eps``."""
+    if gap is None:
+        if eps_lower is not None:
+            raise ValueError("eps_lower needs a second wall: give gap as well")
+        return {}
+    return dict(gap=float(gap), eps_lower=float(eps if eps_lower is None else eps_lower))
+
+
+def _rebound_eps(eps, walls, wall):
+    """Restitution of each collision's wall (``wall``: 0 or 1 per collision)."""
+    return np.where(wall == 0, eps, walls["eps_lower"])
+
+
 def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                      transient=0.0, t_end=None, bins, n_batches=stats.DEFAULT_N_BATCHES,
                      motion_window=stats.DEFAULT_MOTION_WINDOW, motions=stats.DEFAULT_MOTIONS,
-                     rebound_floor=stats.DEFAULT_REBOUND_FLOOR, chunk_size=2**20):
+                     rebound_floor=stats.DEFAULT_REBOUND_FLOOR, chunk_size=2**20, gap=None,
+                     eps_lower=None):
     """Collision statistics of one cell (Figs. 7-9, 13, 14).
 
     Every statistic counts collisions (:mod:`vibroimpact.stats.collisions`): an impact after
@@ -70,6 +101,9 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     zeta, eps, delta, amplitude, beta_f : float
         Physical parameters (``beta_f``: frequency ratio of ``amplitude * sin(beta_f tau)``;
         unused when ``amplitude == 0``).
+    gap, eps_lower : float, optional
+        A second wall at ``x = delta - gap`` with restitution ``eps_lower`` (default
+        ``eps``); None: one wall.
     transient : float
         Time discarded before statistics (collisions that begin before it are dropped).
     t_end : float, optional
@@ -110,6 +144,12 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         ``rule_motion_probability, rule_motion_stick_probability`` (rules x motions); the
         physical row equals the statistics above.
 
+        With two walls (``gap``) the statistics above are over the collisions at either wall
+        (a velocity after impact is ``eps_w u`` with its wall's restitution), the motions
+        are classified with the collisions' walls (two-wall motions ``(m_upper, m_lower,
+        n)``, `stats.motions`), the per-wall statistics of `stats.wall_statistics` are added
+        (arrays over `WALLS`) and the self-audit has a term per wall.
+
     Notes
     -----
     The mean interval is ``T / N`` (record length after the transient over the collisions in
@@ -131,18 +171,21 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
     n_batches = int(n_batches)
     harmonic = amplitude != 0.0
-    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f)
+    walls = _walls(gap, eps_lower, eps)
+    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, zeta=zeta, eps=eps,
-                            delta=delta, amplitude=amplitude, beta_f=beta_f)
+                            delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=t_end, record_every=1,
-                                 chunk_size=chunk_size):
+                                 chunk_size=chunk_size, **walls):
         events.add(chunk)
         audit.add(chunk)
     col = events.collisions(eps, rebound_floor, transient)
-    contact = _clipped_contact(*events.sticking(), transient)
+    contact = _clipped_contact(*events.sticking()[:2], transient)
     duration = t_end - transient
-    v_after = stats.velocity_after_impact(col.velocity, eps)
+    wall = events.collision_walls(col) if walls else None
+    v_after = (stats.velocity_after_impact(col.velocity, eps) if not walls
+               else _rebound_eps(eps, walls, wall) * col.velocity)
     z = col.intervals
     cell = (f"cell delta={delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
     v_stats = stats.batch_means(v_after, n_batches) if v_after.size else None
@@ -155,6 +198,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     z_dens = stats.density(z, bins["interval"], total=z.size, n_batches=n_batches)
     rebound_v = events.rebound_speeds(eps, rebound_floor, transient)
     nan = math.nan
+    motion_walls = {} if not walls else dict(walls=wall)
     mean = lambda a: float(a.mean()) if a.size else nan
     out = dict(
         n_collisions=int(v_after.size),
@@ -184,6 +228,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         interval_beyond=z_dens.beyond,
     )
     out.update(audit.result())
+    if walls:
+        out.update(stats.wall_statistics(col, transient, t_end, eps=eps,
+                                         eps_lower=walls["eps_lower"], bins=bins,
+                                         n_batches=n_batches,
+                                         beta_f=beta_f if harmonic else None))
     out.update(_rule_statistics(events, col, eps=eps, floor=rebound_floor, transient=transient,
                                 duration=duration, n_batches=n_batches,
                                 beta_f=beta_f if harmonic else None,
@@ -191,9 +240,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     if harmonic:
         ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
                                    n_batches=n_batches)
+        if walls:
+            motion_walls["walls"] = wall[:-1]
         motion = list(stats.impact_motion_probabilities(
             z, beta_f, motion_window, total_time=duration, motions=motions,
-            stuck=col.stuck[:-1]).values())           # the motions, then their stick variants
+            stuck=col.stuck[:-1], **motion_walls).values())   # the motions, then stick variants
         out.update(ratio_density=ratio_dens.density, ratio_density_stderr=ratio_dens.stderr,
                    ratio_beyond=ratio_dens.beyond,
                    motion_probability=np.array(motion[:len(motions)]),
@@ -213,17 +264,19 @@ def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches,
     for rule in stats.RULES:
         c = col if rule == "physical" else events.collisions(eps, floor, transient, rule=rule)
         z = c.intervals
+        walls = {} if not events.walls else dict(walls=events.collision_walls(c)[:-1])
+        v_after = (stats.velocity_after_impact(c.velocity, eps) if not events.walls else
+                   _rebound_eps(eps, events.walls, events.collision_walls(c)) * c.velocity)
         # the same estimators as the cell's own: T/N and the mean of every value
         row = dict(rule_n_events=c.time.size, rule_collision_rate=c.time.size / duration,
                    rule_v_after_mean=stats.mark_mean(
-                       stats.velocity_after_impact(c.velocity, eps), c.time, transient,
-                       transient + duration, n_batches).mean,
+                       v_after, c.time, transient, transient + duration, n_batches).mean,
                    rule_interval_mean=stats.event_rate(
                        c.time, transient, transient + duration, n_batches).mean_interval)
         if beta_f is not None:
             p = list(stats.impact_motion_probabilities(
                 z, beta_f, motion_window, total_time=duration, motions=motions,
-                stuck=c.stuck[:-1]).values())
+                stuck=c.stuck[:-1], **walls).values())
             row.update(rule_motion_probability=np.array(p[:len(motions)]),
                        rule_motion_stick_probability=np.array(p[len(motions):]))
         rows.append(row)
@@ -236,15 +289,23 @@ class _EventRecord:
     Collisions are grouped on the whole record at the end (a chatter sequence may cross a
     chunk boundary). Impacts are kept from the start of the record, so that a collision that
     begins before the transient is grouped as it happened and then dropped. The physical rule
-    reads the force (``noise``, ``delta``, ``amplitude``, ``beta_f``) along each flight.
+    reads the force (``noise``, ``delta``, ``amplitude``, ``beta_f``) along each flight. With
+    a second wall (``gap``) the walls of the impacts and of the sticking phases are gathered
+    too, and the grouping is per wall (`stats.group_collisions` with ``wall``: a collision
+    never spans the two walls, a hop is pressed onto the wall it is at).
     """
 
-    def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0):
+    def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0, gap=None,
+                 eps_lower=None):
         self.dt = dt
         self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
+        #: the second wall (``{}``: one wall)
+        self.walls = _walls(gap, eps_lower)
         self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
+        self.stuck_wall = 0      # the wall of a rest still going on at the last chunk's end
         self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
+        self.wall, self.stick_wall = [], []
         self.t_end = 0.0
 
     def add(self, chunk):
@@ -253,27 +314,46 @@ class _EventRecord:
         self.u.append(chunk.impact_velocity)
         self.starts.append(chunk.stick_start)
         self.ends.append(chunk.stick_end)
+        names = ("steps", "offsets", "u", "starts", "ends")
+        if self.walls:
+            self.wall.append(np.asarray(chunk.impact_wall, dtype=np.int8))
+            self.stick_wall.append(np.asarray(chunk.stick_wall, dtype=np.int8))
+            self.stuck_wall = int(chunk.x_end != self.force["delta"])
+            names += ("wall", "stick_wall")
         self.t_end = chunk.t_end
         self.stuck_since = chunk.stuck_since
         if len(self.steps) > 1:           # keep one array per kind: checks regroup each time
-            for name in ("steps", "offsets", "u", "starts", "ends"):
+            for name in names:
                 setattr(self, name, [np.concatenate(getattr(self, name))])
 
+    def collision_walls(self, col):
+        """The wall of each collision of ``col`` (int8, 0: at delta, 1: at delta - gap)."""
+        return np.asarray(col.wall, dtype=np.int8)
+
     def sticking(self):
-        """Sticking phases so far; one still open ends at the last chunk's end."""
+        """Sticking phases so far; one still open ends at the last chunk's end. With two
+        walls ``(start, end, wall)``, the open one on the wall the mass rests on."""
+        if not self.walls:
+            return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                          self.t_end)
         return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
-                                      self.t_end)
+                                      self.t_end, stick_wall=self.stick_wall[0],
+                                      stuck_wall=self.stuck_wall)
 
     def rebound_speeds(self, eps, floor, transient):
-        """Speeds ``eps u`` of the rebounds at or after ``transient`` that reach ``floor``."""
+        """Speeds ``eps u`` (two walls: ``eps_w u``) of the rebounds at or after
+        ``transient`` that reach ``floor``."""
         t = self.steps[0] * self.dt + self.offsets[0]
+        if self.walls:      # each rebound with its wall's restitution
+            eps = _rebound_eps(eps, self.walls, self.wall[0])[t >= transient]
         v = eps * self.u[0][t >= transient]
         return v[v >= floor]
 
     def pressed(self):
         """The flights between the record's impacts that the push presses throughout
-        (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`); those of earlier
-        checks are kept, only new ones computed."""
+        (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`; with two walls, onto
+        the wall the flight is at); those of earlier checks are kept, only new ones
+        computed."""
         n = self.steps[0].size if self.steps else 0
         if n > self._n_pressed:
             i = max(self._n_pressed - 1, 0)          # from the last impact already seen
@@ -285,19 +365,28 @@ class _EventRecord:
             k = np.searchsorted(start, t[:-1], side="left")
             free = k < start.size
             free[free] = start[k[free]] < t[1:][free]
+            walls = {} if not self.walls else dict(wall=self.wall[0][i:],
+                                                   gap=self.walls["gap"])
             new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
-                                  amplitude=f["amplitude"], beta=f["beta"], flights=~free)
+                                  amplitude=f["amplitude"], beta=f["beta"], flights=~free,
+                                  **walls)
             self._pressed, self._n_pressed = np.append(self._pressed, new), n
         return self._pressed
 
     def collisions(self, eps, floor, transient, rule="physical"):
         """Collisions of the record so far that begin at or after ``transient``, grouped by
         ``rule`` (:data:`vibroimpact.stats.RULES`)."""
-        start, end = self.sticking()
         pressed = self.pressed() if rule == "physical" else None
+        if not self.walls:
+            start, end = self.sticking()
+            return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
+                                          end, dt=self.dt, eps=eps, floor=floor,
+                                          pressed=pressed, rule=rule).after(transient)
+        start, end, wall = self.sticking()
         return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
-                                      rule=rule).after(transient)
+                                      rule=rule, wall=self.wall[0], stick_wall=wall,
+                                      eps_lower=self.walls["eps_lower"]).after(transient)
 
 
 class _IdentityRecord:
@@ -307,11 +396,14 @@ class _IdentityRecord:
     ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. Each chunk
     brings the state at its samples (``record_every=1``) and its impacts and sticking
     phases; :func:`vibroimpact.impact.audit.audit_moments` (the compiled
-    :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly.
+    :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly. With a second
+    wall (``gap``, ``eps_lower`` in ``params``) the identities have a term per wall
+    (docs/model.md, "Two walls"): the impact sums are kept per wall.
     """
 
     def __init__(self, noise, dt, transient, t_end, n_batches, **params):
         self.noise, self.dt, self.params = noise, dt, params
+        self.two = params.get("gap") is not None
         self.k_start = int(math.ceil(transient / dt - 1e-9))
         self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
         self.n_batches = n_batches
@@ -319,9 +411,11 @@ class _IdentityRecord:
         # the first sample of each batch of _batch, and the window's end
         self.bounds = self.k_start + (np.arange(n_batches + 1) * n + n_batches - 1) // n_batches
         self.steps = np.diff(self.bounds)
-        self.moments = np.zeros((len(stats.identities.MOMENTS), n_batches))
-        self.sum_u = np.zeros(n_batches)
-        self.sum_u2 = np.zeros(n_batches)
+        rows = len(stats.moment_rows(True)) if self.two else len(stats.identities.MOMENTS)
+        self.moments = np.zeros((rows, n_batches))
+        shape = (2, n_batches) if self.two else n_batches
+        self.sum_u = np.zeros(shape)
+        self.sum_u2 = np.zeros(shape)
 
     def _batch(self, k):
         n = self.k_stop - self.k_start
@@ -335,18 +429,33 @@ class _IdentityRecord:
         if hi > lo:
             keep = slice(lo - k0, hi - k0)
             r = np.asarray(self.noise[lo : hi + 1], dtype=float)
-            start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
-                                                chunk.stuck_since, chunk.t_end)
+            if not self.two:
+                start, end = stats.close_open_phase(chunk.stick_start, chunk.stick_end,
+                                                    chunk.stuck_since, chunk.t_end)
+                walls = {}
+            else:   # a rest open at the chunk's end: on the wall the mass rests on
+                start, end, stick_wall = stats.close_open_phase(
+                    chunk.stick_start, chunk.stick_end, chunk.stuck_since, chunk.t_end,
+                    stick_wall=chunk.stick_wall,
+                    stuck_wall=int(chunk.x_end != self.params["delta"]))
+                walls = dict(impact_wall=chunk.impact_wall, stick_wall=stick_wall)
             self.moments += audit_moments(
                 lo, chunk.a[keep], chunk.v[keep], r, self.dt,
                 **self.params, impact_time=chunk.impact_time,
                 impact_velocity=chunk.impact_velocity, stick_start=start, stick_end=end,
-                batch_bounds=self.bounds)
+                batch_bounds=self.bounds, **walls)
         step = chunk.impact_step
         hit = (step >= self.k_start) & (step < self.k_stop)
         u, b = chunk.impact_velocity[hit], self._batch(step[hit])
-        self.sum_u += np.bincount(b, weights=u, minlength=self.n_batches)
-        self.sum_u2 += np.bincount(b, weights=u * u, minlength=self.n_batches)
+        if not self.two:
+            self.sum_u += np.bincount(b, weights=u, minlength=self.n_batches)
+            self.sum_u2 += np.bincount(b, weights=u * u, minlength=self.n_batches)
+            return
+        wall = np.asarray(chunk.impact_wall)[hit]
+        for w in (0, 1):
+            at = wall == w
+            self.sum_u[w] += np.bincount(b[at], weights=u[at], minlength=self.n_batches)
+            self.sum_u2[w] += np.bincount(b[at], weights=u[at] ** 2, minlength=self.n_batches)
 
     def result(self):
         """The residuals and their errors, as ``event_statistics`` keys (NaN: no batches)."""
@@ -355,9 +464,10 @@ class _IdentityRecord:
             nan = math.nan
             return dict(power_residual=nan, power_residual_stderr=nan, power_input=nan,
                         virial_residual=nan, virial_residual_stderr=nan, virial_scale=nan)
+        walls = {} if not self.two else dict(gap=p["gap"], eps_lower=p["eps_lower"])
         res = stats.identity_residuals(self.moments, self.sum_u, self.sum_u2,
                                        self.steps * self.dt, zeta=p["zeta"], eps=p["eps"],
-                                       delta=p["delta"])
+                                       delta=p["delta"], **walls)
         return dict(power_residual=res.power, power_residual_stderr=res.power_stderr,
                     power_input=res.power_input, virial_residual=res.virial,
                     virial_residual_stderr=res.virial_stderr, virial_scale=res.virial_scale)
@@ -369,7 +479,8 @@ def _clipped_contact(start, end, transient):
 
 
 def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
-                       transient=0.0, t_end=None, nperseg=4096, chunk_size=2**20):
+                       transient=0.0, t_end=None, nperseg=4096, chunk_size=2**20, gap=None,
+                       eps_lower=None):
     """Welch PSDs of a(tau) and of the random input r(tau) for one cell (Figs. 6, 11, 12).
 
     a(tau) is recorded at every sample and fed segment by segment to a
@@ -382,14 +493,16 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
         ``n_segments``. ``S_f`` is the random part r(tau) of the input only: the harmonic
         part ``amplitude sin(beta_f tau)`` is a spectral line of power ``amplitude**2 / 2``,
         which a Welch estimate would smear over its window's main lobe (Fig. 11 draws it as
-        the line it is).
+        the line it is). ``gap, eps_lower``: a second wall (`event_statistics`); a(tau) is
+        measured from the wall at delta whatever the walls.
     """
     t_end = _record_end(noise, dt, t_end)
     skip = int(math.ceil(transient / dt - 1e-9))
     acc_a = stats.WelchAccumulator(dt, nperseg)
     acc_f = stats.WelchAccumulator(dt, nperseg)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                 beta=beta_f, t_end=t_end, record_every=1, chunk_size=chunk_size):
+                                 beta=beta_f, t_end=t_end, record_every=1, chunk_size=chunk_size,
+                                 **_walls(gap, eps_lower, eps)):
         k = np.rint(chunk.grid_time / dt).astype(np.int64)
         keep = k >= skip
         if not keep.any():
@@ -402,28 +515,34 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     return dict(beta=beta, S_a=S_a, S_f=S_f, n_segments=acc_a.n_segments)
 
 
-def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end):
+def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=None,
+          eps_lower=None):
     """A short sampled record from rest (Figs. 3 and 10): force, a(tau), impacts and the
-    collision of each impact.
+    collision of each impact; with a second wall (``gap``) also the wall of each impact
+    (``impact_wall``).
 
     ``t_end`` longer than the noise record raises ValueError.
     """
     t_end = _record_end(noise, dt, t_end)
+    walls = _walls(gap, eps_lower, eps)
     res = next(iter(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                     beta=beta_f, t_end=t_end, record_every=1,
-                                    chunk_size=int(math.ceil(t_end / dt)) + 1)))
+                                    chunk_size=int(math.ceil(t_end / dt)) + 1, **walls)))
     k = np.rint(res.grid_time / dt).astype(np.int64)
     r = np.asarray(noise[k[0] : k[-1] + 1], dtype=float)
     f = r + amplitude * np.sin(beta_f * res.grid_time)
-    return dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
-                impact_time=res.impact_time, impact_velocity=res.impact_velocity,
-                impact_collision=res.impact_collision)
+    out = dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
+               impact_time=res.impact_time, impact_velocity=res.impact_velocity,
+               impact_collision=res.impact_collision)
+    if walls:
+        out["impact_wall"] = np.asarray(res.impact_wall, dtype=np.int8)
+    return out
 
 
 def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
                     motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
                     n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
-                    max_periods=8000, min_switches=10, growth=1.1):
+                    max_periods=8000, min_switches=10, growth=1.1, gap=None, eps_lower=None):
     """Probabilities of the (m/n) motions of one cell of the Fig. 15 map, to a target precision.
 
     The cell is simulated from rest over the common record ``noise`` (every cell of a map
@@ -453,6 +572,10 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         Switches between motions that make a mixed record trustworthy.
     growth : float
         Safety factor on the predicted record length (the error falls as 1/sqrt(time)).
+    gap, eps_lower : float, optional
+        A second wall (`event_statistics`): the collisions' walls classify the two-wall
+        motions ``(m_upper, m_lower, n)`` of ``motions``, and ``wall_n_collisions,
+        wall_collision_rate, wall_v_after_mean`` (over `WALLS`) are added.
 
     Returns
     -------
@@ -485,9 +608,14 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     """
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
+    walls = _walls(gap, eps_lower, eps)
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                          beta=beta_f, t_end=n_cap * dt, chunk_size=n_next)
-    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f)
+                          beta=beta_f, t_end=n_cap * dt, chunk_size=n_next, **walls)
+    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
+
+    def wall_of(c):
+        return {} if not walls else dict(walls=events.collision_walls(c))
+
     k, n_checks, request = 0, 0, None
     try:
         while True:
@@ -498,7 +626,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
             res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
                                           window=window, motions=motions, n_batches=n_batches,
-                                          stuck=col.stuck)
+                                          stuck=col.stuck, **wall_of(col))
             worst = float(max(res.stderr.max(), res.stick_stderr.max()))
             reached = worst <= target_stderr
             mixed_ok = res.n_switches == 0 or res.n_switches >= min_switches
@@ -516,9 +644,19 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     by_rule = [res] + [
         stats.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
-                                motions=motions, n_batches=n_batches, stuck=c.stuck)
+                                motions=motions, n_batches=n_batches, stuck=c.stuck,
+                                **wall_of(c))
         for c in (events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient, rule=rule)
                   for rule in stats.RULES[1:])]
+    per_wall = {}
+    if walls:
+        wall = events.collision_walls(col)
+        v_after = _rebound_eps(eps, walls, wall) * col.velocity
+        n_w = np.array([np.count_nonzero(wall == w) for w in range(len(WALLS))])
+        per_wall = dict(
+            wall_n_collisions=n_w, wall_collision_rate=n_w / duration,
+            wall_v_after_mean=np.array([float(v_after[wall == w].mean()) if n_w[w]
+                                        else math.nan for w in range(len(WALLS))]))
     return dict(probability=res.probability, stderr=res.stderr,
                 rule_probability=np.stack([r.probability for r in by_rule]),
                 rule_stick_probability=np.stack([r.stick_probability for r in by_rule]),
@@ -529,7 +667,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
                 v_after_mean=float(eps * col.velocity.mean()) if col.time.size else math.nan,
                 simulated_time=duration, record_end=k * dt, reached=bool(reached),
                 few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks,
-                **stays)
+                **stays, **per_wall)
 
 
 def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
@@ -545,7 +683,7 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
 
 def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
                 record_length, motions=stats.DEFAULT_MOTIONS,
-                window=stats.DEFAULT_MOTION_WINDOW):
+                window=stats.DEFAULT_MOTION_WINDOW, gap=None, eps_lower=None):
     """Residence times of one cell on a record of fixed length (escape against noise level).
 
     The labelling of `motion_map_cell` (the same collisions, classification and
@@ -585,15 +723,18 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         raise ValueError(f"record_length = {record_length!r} after the transient "
                          f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
                          f"holds {len(noise)}")
-    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f)
+    walls = _walls(gap, eps_lower, eps)
+    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     k = 0
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                 beta=beta_f, t_end=n_end * dt):
+                                 beta=beta_f, t_end=n_end * dt, **walls):
         events.add(chunk)
         k += chunk.n_steps
     col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
     res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
-                                  window=window, motions=motions, stuck=col.stuck)
+                                  window=window, motions=motions, stuck=col.stuck,
+                                  **({} if not walls else
+                                     dict(walls=events.collision_walls(col))))
     share = res.probability + res.stick_probability
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     return dict(probability=np.append(share, max(0.0, 1.0 - float(share.sum()))),

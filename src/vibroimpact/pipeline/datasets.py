@@ -8,6 +8,7 @@ import pandas as pd
 import xarray as xr
 
 from vibroimpact import stats
+from vibroimpact.stats.motions import motion_key
 
 #: long_name and units of every variable the datasets hold.
 META = {
@@ -136,6 +137,49 @@ META = {
     "impact_time": ("impact instant", "1"),
     "impact_velocity": ("approach velocity at impact", "1"),
     "impact_collision": ("collision of the impact (index; its first impact starts it)", "1"),
+    # two walls only (a study with a gap): docs/datasets.md, "Two walls"
+    "wall": ("wall: upper (x = delta, hit from below) or lower (x = delta - gap, hit from "
+             "above)", "1"),
+    "impact_wall": ("wall of the impact (0: upper, at delta; 1: lower, at delta - gap)", "1"),
+    "wall_n_collisions": ("number of collisions at the wall", "1"),
+    "wall_collision_rate_lo": ("lower end of the 95 % interval of the wall's collision rate",
+                               "1"),
+    "wall_collision_rate_hi": ("upper end of the 95 % interval of the wall's collision rate",
+                               "1"),
+    "wall_count_dispersion": ("index of dispersion of the wall's collision counts in B equal "
+                              "stretches of time", "1"),
+    "wall_interval_stderr": ("standard error of the wall's mean interval T/N_w", "1"),
+    "wall_v_after_stderr": ("standard error of the wall's mean velocity after impact", "1"),
+    "wall_v_after_beyond": ("fraction of the wall's velocities after impact beyond the last "
+                            "bin", "1"),
+    "wall_interval_beyond": ("fraction of the wall's intervals beyond the last bin", "1"),
+    "wall_ratio_density": ("probability density of z_j / z between collisions at the wall",
+                           "1"),
+    "wall_ratio_density_stderr": ("batch-means standard error of the wall's density of "
+                                  "z_j / z", "1"),
+    "wall_ratio_beyond": ("fraction of the wall's ratios z_j / z beyond the last bin", "1"),
+    "wall_collision_rate": ("collisions at the wall per unit time", "1"),
+    "wall_v_after_mean": ("mean velocity after impact at the wall (eps_w u, per collision)",
+                          "1"),
+    "wall_v_after_mean_lo": ("lower end of the 95 % interval of the wall's mean velocity "
+                             "after impact", "1"),
+    "wall_v_after_mean_hi": ("upper end of the 95 % interval of the wall's mean velocity "
+                             "after impact", "1"),
+    "wall_interval_mean": ("mean interval between collisions at the wall T/N_w (the "
+                           "reciprocal of its rate)", "1"),
+    "wall_interval_mean_lo": ("lower end of the 95 % interval of the wall's mean interval",
+                              "1"),
+    "wall_interval_mean_hi": ("upper end of the 95 % interval of the wall's mean interval "
+                              "(inf: no collision)", "1"),
+    "wall_stuck_fraction": ("fraction of the wall's collisions that end sticking on it", "1"),
+    "wall_v_after_density": ("probability density of the velocity after impact at the wall",
+                             "1"),
+    "wall_v_after_density_stderr": ("batch-means standard error of the wall's velocity "
+                                    "density", "1"),
+    "wall_interval_density": ("probability density of the interval between collisions at "
+                              "the wall (one of its collisions to its next)", "1"),
+    "wall_interval_density_stderr": ("batch-means standard error of the wall's interval "
+                                     "density", "1"),
 }
 
 _EVENT_SCALARS = ("n_collisions", "collision_rate", "simulated_time", "n_batches",
@@ -184,7 +228,30 @@ def _cell_coords(cells):
 
 
 def _motion_names(motions):
-    return [f"{m}/{n}" for m, n in motions]
+    """``"m/n"``, or ``"(m_upper,m_lower)/n"`` for a two-wall motion (`stats.motions`)."""
+    return [motion_key(m) for m in motions]
+
+
+#: The walls of a two-wall dataset's ``wall`` dimension (`stats.WALLS`).
+WALLS = ("upper", "lower")
+#: The bins of each per-wall density (`stats.wall_statistics`: ``wall_<quantity>_density``).
+_WALL_BINS = {"wall_v_after": "v_after", "wall_interval": "interval", "wall_ratio": "ratio"}
+
+
+def _add_walls(data, coords, results):
+    """The per-wall variables of a two-wall tile (the results' ``wall_*`` arrays, wall
+    first): scalars over ``(cell, wall)``, densities over ``(cell, wall, <their bins>)``."""
+    names = [k for k in results[0] if k.startswith("wall_")]
+    if not names:
+        return
+    for name in names:
+        values = np.stack([np.asarray(r[name]) for r in results])
+        if values.ndim == 2:
+            data[name] = (("cell", "wall"), values)
+        else:
+            dim = _WALL_BINS[name.removesuffix("_stderr").removesuffix("_density")]
+            data[name] = (("cell", "wall", dim), values)
+    coords["wall"] = list(WALLS)
 
 
 def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
@@ -218,6 +285,7 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
             for name in ("rule_motion_probability", "rule_motion_stick_probability"):
                 data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
+    _add_walls(data, coords, results)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
@@ -258,12 +326,14 @@ def map_tile(cells, results, motions, attrs):
         for name in ("rule_probability", "rule_stick_probability"):
             data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
+    _add_walls(data, coords, results)
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
-def aggregate_map(tiles, study, attrs):
-    """Probability-map dataset of a study (``docs/datasets.md``) from its tiles."""
-    ds = _to_grid(tiles, study.inv_beta, study.delta).transpose(
+def aggregate_map(tiles, study, attrs, n_cells=None):
+    """Probability-map dataset of a study (``docs/datasets.md``) from its tiles (the axes
+    the study's, or with ``study=None`` the tiles' own, `tile_axes`)."""
+    ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells)).transpose(
         "motion", "from_motion", "to_motion", "inv_beta", "delta", ..., missing_dims="ignore")
     ds.attrs = dict(attrs)
     return _annotate(ds)
@@ -278,6 +348,46 @@ def spectra_tile(cells, results, attrs):
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
+def tile_axes(tiles, n_cells=None):
+    """``(inv_beta, delta)``: the axes of a study's grid, read from its tiles' cells.
+
+    A tile stores each cell's index (``cell = i * n_delta + j``, inv_beta-major,
+    `pipeline.study.Study.cells`) with its values ``inv_beta_cell`` and ``delta_cell``, so
+    the aggregate needs no config to rebuild the axes (they are the values the cells ran
+    with, bit for bit).
+
+    ``n_cells``: the grid's number of cells, when known (a missing tile is then an error).
+
+    Raises
+    ------
+    ValueError
+        If the cells are not ``0 .. n_cells - 1`` or do not form an ``inv_beta x delta``
+        grid in that order.
+    """
+    cell = np.concatenate([np.asarray(t["cell"]) for t in tiles])
+    order = np.argsort(cell, kind="stable")
+    n = cell.size if n_cells is None else int(n_cells)
+    if not np.array_equal(cell[order], np.arange(n)):
+        raise ValueError(f"tiles cover cells {cell[order].tolist()}, expected 0..{n - 1}")
+    ib = np.concatenate([np.asarray(t["inv_beta_cell"], dtype=float) for t in tiles])[order]
+    d = np.concatenate([np.asarray(t["delta_cell"], dtype=float) for t in tiles])[order]
+    other = np.flatnonzero(ib != ib[0])
+    n_delta = int(other[0]) if other.size else ib.size
+    inv_beta, delta = ib[::n_delta], d[:n_delta]
+    if (ib.size % n_delta or not np.array_equal(ib, np.repeat(inv_beta, n_delta))
+            or not np.array_equal(d, np.tile(delta, inv_beta.size))):
+        raise ValueError("the tiles' cells do not form an inv_beta x delta grid "
+                         "(cell = i * n_delta + j)")
+    return inv_beta, delta
+
+
+def _axes(tiles, study, kind="events", n_cells=None):
+    """The grid's axes: the study's when given, else the tiles' (`tile_axes`)."""
+    if study is None:
+        return tile_axes(tiles, n_cells)
+    return study.inv_beta, study.spectra_delta if kind == "spectra" else study.delta
+
+
 def _to_grid(tiles, inv_beta, delta):
     """Concatenate tiles along ``cell`` and reshape to ``(inv_beta, delta, ...)``."""
     ds = xr.concat(tiles, dim="cell").sortby("cell")
@@ -290,21 +400,26 @@ def _to_grid(tiles, inv_beta, delta):
     return ds.transpose("inv_beta", "delta", ...)
 
 
-def aggregate_events(tiles, study, attrs):
-    """Events dataset of a study (``docs/datasets.md``) from its tiles."""
-    ds = _to_grid(tiles, study.inv_beta, study.delta)
+def aggregate_events(tiles, study, attrs, n_cells=None):
+    """Events dataset of a study (``docs/datasets.md``) from its tiles (the axes the
+    study's, or with ``study=None`` the tiles' own, `tile_axes`)."""
+    ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells))
     ds.attrs = dict(attrs)
     return _annotate(ds)
 
 
-def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
+def aggregate_spectra(tiles, study, spec, attrs, input_correlation, zeta=None, n_cells=None):
     """Spectra dataset of a study, with the linear reference ``S_lin = |H|^2 S_f``.
+
+    ``study`` gives the axes and ``zeta``; with ``study=None`` the axes are the tiles' own
+    (`tile_axes`) and ``zeta`` is given.
 
     ``spec`` is the :class:`~vibroimpact.noise.NoiseSpec` of the random force; the reference
     uses the spectrum of the piecewise-linear force the simulator integrates.
     ``input_correlation`` is ``(lag, estimate, target)`` of the random input (eq. 8).
     """
-    ds = _to_grid(tiles, study.inv_beta, study.spectra_delta)
+    ds = _to_grid(tiles, *_axes(tiles, study, "spectra", n_cells))
+    zeta = study.zeta if study is not None else zeta
     # every cell of a row estimates S_f from the same stretch of the same input: keep one
     S_f = ds["S_f"]
     if not (S_f == S_f.isel(delta=0)).all():
@@ -313,7 +428,7 @@ def aggregate_spectra(tiles, study, spec, attrs, input_correlation):
     ds["S_f"] = S_f.isel(delta=0, drop=True)
     beta = ds["beta"].values
     S_r = spec.psd_piecewise_linear(beta)
-    ds["S_lin"] = ("beta", stats.linear_psd_response(beta, S_r, study.zeta))
+    ds["S_lin"] = ("beta", stats.linear_psd_response(beta, S_r, zeta))
     ds["S_r_target"] = ("beta", S_r)
     lag, phi, phi_target = input_correlation
     ds = ds.assign_coords(lag=lag)
@@ -331,6 +446,8 @@ def trace_dataset(tr, attrs):
              impact_velocity=("impact", tr["impact_velocity"]),
              impact_collision=("impact", tr["impact_collision"])),
         coords=dict(tau=tr["tau"]), attrs=attrs)
+    if "impact_wall" in tr:         # two walls
+        ds["impact_wall"] = ("impact", np.asarray(tr["impact_wall"], dtype=np.int8))
     return _annotate(ds)
 
 

@@ -30,7 +30,11 @@ def grid_decimals(scale):
 #: key of a study is read before any job (``rms``, ``seed``: its noise record, by the sweep
 #: expansion), by a figure (``figures`` and the figure options of `pipeline.figures`) or by
 #: its report (``report_with``); a test holds the schema's study keys to exactly these.
-_PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size", "sweep")
+#: ``gap`` and ``eps_lower`` (the second wall) are job keys of every kind that simulates; a
+#: one-wall entry has neither, so its params are those it had before walls could be two.
+_WALLS = ("gap", "eps_lower")
+_PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size",
+            "sweep") + _WALLS
 JOB_KEYS = {
     "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins",
                           "rebound_floor"),
@@ -40,15 +44,15 @@ JOB_KEYS = {
     # its own records (no noise file, no grid): the noise entry's spectrum and seed reach the
     # job as a param of their own (common.smk, ``escape_noise``)
     "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
-               "motions", "escape"),
+               "motions", "escape") + _WALLS,
 }
 
 #: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns
 #: only figures): the map's tiles, the boundary curves seeded from the map, the attractors.
 ORBIT_JOB_KEYS = {
-    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows"),
-    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types"),
-    "attractors": ("zeta", "eps", "types", "attractors"),
+    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows") + _WALLS,
+    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types") + _WALLS,
+    "attractors": ("zeta", "eps", "types", "attractors") + _WALLS,
 }
 
 
@@ -116,24 +120,54 @@ class Study:
     spectra_delta: np.ndarray
     tile_size: int
     motions: tuple = ()
+    #: the second wall: the clearance below the wall at delta (None: one wall) and its
+    #: restitution (None: eps)
+    gap: float | None = None
+    eps_lower: float | None = None
 
     @classmethod
-    def from_config(cls, name, entry):
+    def from_config(cls, name, entry, grids=None):
         """Build from a validated config entry ``studies[name]`` (the schema's defaults
         filled in), or the part of it a job reads: an entry without ``delta`` has an empty
-        events grid, one without ``motions`` classifies none (a spectra or trace job)."""
+        events grid, one without ``motions`` classifies none (a spectra or trace job).
+
+        ``grids``: the entry's grids already expanded (``{"inv_beta", "delta",
+        "spectra_delta"}``, as `pipeline.config.checks.check` returns them), used as they
+        are instead of expanding them again."""
+        grids = grids or {}
         amplitude = float(entry["amplitude"])
-        inv_beta = grid_values(entry["inv_beta"]) if amplitude != 0.0 else np.array([1.0])
+        inv_beta = (np.array([1.0]) if amplitude == 0.0 else grids["inv_beta"]
+                    if grids.get("inv_beta") is not None else grid_values(entry["inv_beta"]))
         if np.any(inv_beta <= 0.0):
             raise ValueError(f"studies.{name}.inv_beta must hold values > 0, got {inv_beta!r}")
         spectra = entry.get("spectra") or {}
+        gap, eps_lower = walls(entry, f"studies.{name}")
+
+        def grid(key, spec):
+            return grids[key] if grids.get(key) is not None else grid_values(spec)
+
         return cls(name=name, zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                    amplitude=amplitude, inv_beta=inv_beta,
-                   delta=grid_values(entry["delta"]) if "delta" in entry else np.empty(0),
-                   spectra_delta=(grid_values(spectra["delta"]) if spectra.get("delta")
-                                  else np.empty(0)),
+                   delta=grid("delta", entry["delta"]) if "delta" in entry else np.empty(0),
+                   spectra_delta=(grid("spectra_delta", spectra["delta"])
+                                  if spectra.get("delta") else np.empty(0)),
                    tile_size=int(entry["tile_size"]),
-                   motions=tuple((int(m), int(n)) for m, n in entry.get("motions", ())))
+                   motions=tuple(tuple(int(k) for k in m) for m in entry.get("motions", ())),
+                   gap=gap, eps_lower=eps_lower)
+
+    @property
+    def n_walls(self):
+        """1, or 2 with a ``gap``."""
+        return 1 if self.gap is None else 2
+
+    def walls(self):
+        """``{"gap": ..., "eps_lower": ...}`` for a two-wall study (the keywords of
+        `vibroimpact.simulate` and of `pipeline.cells`), ``{}`` for one wall (so a one-wall
+        call is the call it always was)."""
+        if self.gap is None:
+            return {}
+        return dict(gap=self.gap, eps_lower=self.eps_lower)
+
 
     def cells(self, kind="events"):
         """All cells of the events grid (``inv_beta x delta``; also the map's) or of the
@@ -156,6 +190,31 @@ class Study:
         if not 0 <= t < n:
             raise ValueError(f"tile must lie in [0, {n - 1}], got {t!r}")
         return self.cells(kind)[t::n]
+
+
+def walls(entry, where):
+    """``(gap, eps_lower)`` of a study or ``orbits`` entry: ``(None, None)`` with one wall;
+    with a ``gap``, ``eps_lower`` defaults to the entry's ``eps``.
+
+    Raises
+    ------
+    ValueError
+        For ``eps_lower`` without ``gap`` (naming ``where``), a gap not > 0 or an
+        ``eps_lower`` outside [0, 1] (the schema checks these first; jobs read blocks too).
+    """
+    gap, eps_lower = entry.get("gap"), entry.get("eps_lower")
+    if gap is None:
+        if eps_lower is not None:
+            raise ValueError(f"{where}.eps_lower = {eps_lower!r} needs a second wall: give "
+                             f"{where}.gap (> 0) as well, or leave eps_lower out")
+        return None, None
+    gap = float(gap)
+    if not (gap > 0.0 and math.isfinite(gap)):
+        raise ValueError(f"{where}.gap must be a finite number > 0, got {gap!r}")
+    eps_lower = float(entry["eps"] if eps_lower is None else eps_lower)
+    if not 0.0 <= eps_lower <= 1.0:
+        raise ValueError(f"{where}.eps_lower must lie in [0, 1], got {eps_lower!r}")
+    return gap, eps_lower
 
 
 def escape_seed(seed, index):

@@ -14,7 +14,8 @@ from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
-                                        grid_values, map_cap_steps, orbit_rows)
+                                        grid_size, grid_values, map_cap_steps, orbit_rows,
+                                        walls)
 
 log = logging.getLogger("vibroimpact")
 
@@ -96,7 +97,18 @@ def _study_attrs(study, block, noise_attrs):
                  zeta=study.zeta, eps=study.eps, amplitude=study.amplitude,
                  noise=block["noise"], dt=float(noise_attrs["dt"]))
     attrs.update(noise)
+    attrs.update(_wall_attrs(study.gap, study.eps_lower))
     return attrs
+
+
+def _wall_attrs(gap, eps_lower):
+    """The second wall's attributes of a two-wall dataset (none for one wall: its attributes
+    are those it always had)."""
+    if gap is None:
+        return {}
+    return dict(gap=float(gap), eps_lower=float(eps_lower), n_walls=2,
+                walls="upper: x = delta (hit from below, eps); lower: x = delta - gap (hit "
+                      "from above, eps_lower)")
 
 
 def _record_attrs(block, t_end, n_samples, dt):
@@ -114,8 +126,12 @@ def _rebound_floor(block):
 
 
 def _physics(study, cell):
-    return dict(zeta=study.zeta, eps=study.eps, delta=cell.delta, amplitude=study.amplitude,
-                beta_f=1.0 / cell.inv_beta)
+    """The cell's resolved model (`cells.study_model`) as the keywords of `pipeline.cells`."""
+    from vibroimpact.pipeline.cells import study_model    # the jobs that simulate only
+
+    params = study_model(study, cell).params()
+    params["beta_f"] = params.pop("beta")
+    return params
 
 
 def _tile_job(study, tile, grid, what, run_cell, to_dataset, out):
@@ -235,7 +251,8 @@ def trace(name, block, noise_path, out):
     spec = block["trace"]
     inv_beta = float(spec.get("inv_beta", study.inv_beta[0]))
     tr = cells.trace(samples, dt, zeta=study.zeta, eps=study.eps, delta=float(spec["delta"]),
-                     amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
+                     amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]),
+                     **study.walls())
     attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
                  beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
@@ -250,7 +267,8 @@ def _escape_attrs(name, block, noise):
     return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])), study=name,
                 zeta=float(block["zeta"]), eps=float(block["eps"]),
                 amplitude=float(block["amplitude"]), noise=block["noise"],
-                dt=float(noise["dt"]), **spec, transient=float(block["transient"]),
+                dt=float(noise["dt"]), **spec, **_wall_attrs(*walls(block, f"studies.{name}")),
+                transient=float(block["transient"]),
                 record_length=float(escape["record_length"]),
                 motion_window=float(block["motion_window"]),
                 seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
@@ -275,6 +293,8 @@ def escape_level(name, block, noise, index, out):
     log.info("level %d: rms %g, %d samples of %s", index, rms, n, spec)
     samples = generate_array(spec, n, escape_seed(noise["seed"], index))
     motions = [tuple(int(k) for k in m) for m in block["motions"]]
+    gap, eps_lower = walls(block, f"studies.{name}")
+    second = {} if gap is None else dict(gap=gap, eps_lower=eps_lower)
     progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]))
     results = []
     for inv_beta, delta in escape["cells"]:
@@ -282,7 +302,7 @@ def escape_level(name, block, noise, index, out):
             samples, spec.dt, zeta=float(block["zeta"]), eps=float(block["eps"]),
             delta=float(delta), beta_f=1.0 / float(inv_beta),
             amplitude=float(block["amplitude"]), transient=transient, record_length=length,
-            motions=motions, window=float(block["motion_window"])))
+            motions=motions, window=float(block["motion_window"]), **second))
         progress.cell_done(results[-1])
     io.write_dataset(datasets.escape_part(index, rms, escape["cells"], results, motions,
                                           _escape_attrs(name, block, noise)), out)
@@ -301,8 +321,12 @@ def aggregate_escape(name, block, noise, parts, out):
 
 def aggregate(name, block, kind, tiles, out, noise_path=None):
     """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: a study's
-    dataset."""
-    study = Study.from_config(name, block)
+    dataset. The grid's axes are the tiles' own (`datasets.tile_axes`: the values their
+    cells ran with), not the config's grid expanded once more."""
+    zeta = float(block["zeta"])
+    # the grid's size (counted, not expanded): a missing tile is an error
+    rows = grid_size(block["inv_beta"]) if float(block["amplitude"]) != 0.0 else 1
+    n_cells = rows * grid_size((block["spectra"] if kind == "spectra" else block)["delta"])
     parts = [io.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)
     attrs.update(provenance(block, attrs.get("seed")))
@@ -310,15 +334,16 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
         if float(attrs.get("amplitude", 0.0)) == 0.0:
             # the wall-free response's std's: fig09 draws Rice's large-play asymptotes
             sigma_x, sigma_v = stats.linear_response_std(
-                io.noise_spec(attrs).psd_piecewise_linear, study.zeta)
+                io.noise_spec(attrs).psd_piecewise_linear, zeta)
             attrs.update(linear_sigma_x=sigma_x, linear_sigma_v=sigma_v)
-        ds = datasets.aggregate_events(parts, study, attrs)
+        ds = datasets.aggregate_events(parts, None, attrs, n_cells=n_cells)
     elif kind == "map":
-        ds = datasets.aggregate_map(parts, study, attrs)
+        ds = datasets.aggregate_map(parts, None, attrs, n_cells=n_cells)
     else:
         spec = io.noise_spec(io.read_noise_attrs(noise_path))
-        ds = datasets.aggregate_spectra(parts, study, spec, attrs,
-                                        input_correlation=io.read_input_correlation(noise_path))
+        ds = datasets.aggregate_spectra(parts, None, spec, attrs,
+                                        input_correlation=io.read_input_correlation(noise_path),
+                                        zeta=zeta, n_cells=n_cells)
     io.write_dataset(ds, out)
 
 

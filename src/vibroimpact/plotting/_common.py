@@ -304,7 +304,17 @@ def no_collision_text(ds, where="in this record at any $\\delta$"):
 # --------------------------------------------------------------------------------------------
 
 def _system_text(ds):
-    return rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
+    text = rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
+    if "gap" in ds.attrs:       # two walls: the second wall's place and restitution
+        text += (rf";  lower wall at $\delta$ - {_num(ds.attrs['gap'])}, "
+                 rf"$\varepsilon_l$ = {_num(ds.attrs['eps_lower'])}")
+    return text
+
+
+def motion_title(name):
+    """A motion's name as the figures print it: ``(1/1)``, and a two-wall motion
+    ``(1,1)/1`` as it is (already bracketed)."""
+    return name if name.startswith("(") or name == "none" else f"({name})"
 
 
 #: How a figure names each noise kind (`vibroimpact.noise.KINDS`), never the config key.
@@ -396,8 +406,15 @@ def _trace_figure(trace, title, harmonic):
     _panel_tag(ax_f, "(a)")
 
     ax_a.plot(tau, trace["a"], color="C0", lw=1.0)
-    ax_a.axhline(0.0, color="0.2", lw=1.4, label=r"wall ($a = 0$)")
+    # two walls: the lower wall at a = gap, its impacts drawn there
+    gap = float(trace.attrs["gap"]) if "impact_wall" in trace and "gap" in trace.attrs else 0.0
+    ax_a.axhline(0.0, color="0.2", lw=1.4,
+                 label=r"upper wall ($a = 0$)" if gap else r"wall ($a = 0$)")
     t_imp = np.asarray(trace["impact_time"])
+    at = (np.where(np.asarray(trace["impact_wall"]) == 1, gap, 0.0) if gap
+          else np.zeros(t_imp.size))
+    if gap:
+        ax_a.axhline(gap, color="0.2", lw=1.4, ls="--", label=r"lower wall ($a = g$)")
     shown = (t_imp >= float(tau[0])) & (t_imp <= float(tau[-1]))
     if "impact_collision" in trace:
         # a collision's first impact, and the rebounds of its chatter apart (docs/figures.md)
@@ -406,7 +423,7 @@ def _trace_figure(trace, title, harmonic):
         first[1:] = col[1:] != col[:-1]
         rebound = shown & ~first
         if rebound.any():
-            ax_a.plot(t_imp[rebound], np.zeros(int(rebound.sum())), ls="none", marker="|",
+            ax_a.plot(t_imp[rebound], at[rebound], ls="none", marker="|",
                       color="0.35", markersize=7, label=f"chatter rebound ({int(rebound.sum())})")
         shown &= first
         label = f"collision: first impact ({int(shown.sum())})"
@@ -414,7 +431,7 @@ def _trace_figure(trace, title, harmonic):
         label = f"impact ({int(shown.sum())})"
     if not shown.any():
         label = "no collision in this stretch"
-    ax_a.plot(t_imp[shown], np.zeros(int(shown.sum())), ls="none", marker="v", color="C3",
+    ax_a.plot(t_imp[shown], at[shown], ls="none", marker="v", color="C3",
               markersize=5, label=label)
     a = np.asarray(trace["a"], dtype=float)
     if np.ptp(np.append(a, 0.0)) > 0.0:
@@ -823,7 +840,13 @@ def _events_params(events, i_beta, drawn=tuple(COLLISION_QUANTITIES)):
     if "n_collisions" not in events:
         return line
     return line + "\n" + ";  ".join([COLLISION_NOTE]
-                                    + [COLLISION_QUANTITIES[name] for name in drawn])
+                                    + [_two_wall_note(events, COLLISION_QUANTITIES[name])
+                                       for name in drawn])
+
+
+def _two_wall_note(ds, text):
+    """A quantity's definition with its wall's restitution ``eps_w`` when there are two."""
+    return text.replace(r"\varepsilon u", r"\varepsilon_w u") if "gap" in ds.attrs else text
 
 
 # --------------------------------------------------------------------------------------------

@@ -15,7 +15,8 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
 from vibroimpact.plotting._common import (CONFIDENCE, _attr, _header, _num, _spectrum_parts,
-                                          _styled, _system_text, note_on_axes)
+                                          _styled, _system_text, motion_title,
+                                          note_on_axes)
 from vibroimpact.plotting.maps import TYPE_COLORS
 from vibroimpact.stats.events import t_quantile
 
@@ -30,7 +31,7 @@ OUTSIDE_FIT_STYLE = dict(color="0.9", zorder=0, linewidth=0)
 
 
 def _state_label(name):
-    return "none" if name == "none" else f"({name})"
+    return motion_title(name)
 
 
 def _interval_text(value, lo, hi):

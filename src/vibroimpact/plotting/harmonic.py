@@ -7,6 +7,7 @@ from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
     _num, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
     axis_label)
+from vibroimpact.plotting.walls import two_walls, wall_density_figure
 from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 
 
@@ -120,6 +121,10 @@ def _centroid_note(spectra, i_beta):
                  for k in (0, -1))
     if not (np.isfinite(at_small) and np.isfinite(at_large)):
         return ""
+    if "gap" in spectra.attrs:      # two walls: the paper's finding (one wall) is no reference
+        return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
+                f"$\\delta$ = {_num(float(row.delta[-1]))}, {at_small:.2f} at $\\delta$ = "
+                f"{_num(float(row.delta[0]))}")
     way = ("falls as $\\delta$ decreases, as in the paper" if at_small < at_large else
            "rises as $\\delta$ decreases: the frequency shift runs opposite to the paper's")
     return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
@@ -177,10 +182,15 @@ def fig14(events, inv_beta, density_delta=None):
     """Fig. 14: density of the velocity after impact under sin(tau/inv_beta) + r(tau).
 
     As :func:`fig07`, at the ``inv_beta`` of the dataset nearest to the one given; a
-    non-harmonic study raises ValueError (its velocity density is fig07).
+    non-harmonic study raises ValueError (its velocity density is fig07). A two-wall
+    dataset: one panel per wall (`plotting.walls.wall_density_figure`).
     """
     _require_harmonic(events, "fig14")
     i = _nearest(events["inv_beta"], inv_beta)
+    if two_walls(events):
+        return wall_density_figure(events, i, "v_after", "Fig. 14 (two walls)  Probability "
+                                   "density of the velocity after impact, per wall",
+                                   density_delta)
     fig, _ = _density_figure(events, i, "v_after_density",
                              "Fig. 14  Probability density of the velocity after impact",
                              _events_params(events, i, ("v_after",)), density_delta,

@@ -19,7 +19,7 @@ from matplotlib.path import Path
 from vibroimpact import stats
 from vibroimpact.plotting._common import (_attr, _header, _noise_text, _num, _same_system,
                                           _styled, _system_text, axis_label,
-                                          no_collision_text, note_on_axes)
+                                          motion_title, no_collision_text, note_on_axes)
 
 #: Probability contours (%) of Fig. 15 (the paper draws 10 % steps).
 PROBABILITY_LEVELS = (10, 20, 30, 40, 50, 60, 70, 80, 90)
@@ -387,9 +387,10 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         cap stopped the cell before the target precision.
     """
     motions = [str(m) for m in motion_map["motion"].values]
-    panels = [(f"({m})", motion_map["probability"].sel(motion=m).values) for m in motions]
+    panels = [(motion_title(m), motion_map["probability"].sel(motion=m).values)
+              for m in motions]
     if "stick_probability" in motion_map:
-        panels.append((" + ".join(f"({m})" for m in motions) + " with sticking",
+        panels.append((" + ".join(motion_title(m) for m in motions) + " with sticking",
                        motion_map["stick_probability"].sum("motion").values))
     x, y = _grid(motion_map)
     # two panels a row: at a page's width four in a row left the labels tiny
@@ -525,7 +526,7 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
         ax.text(0.98, 0.02, _agreement_text(agreement[name]), transform=ax.transAxes,
                 ha="right", va="bottom", fontsize=6.5,
                 bbox=dict(facecolor="white", edgecolor="0.7", alpha=0.85, pad=2))
-        ax.set_title(f"({name})")
+        ax.set_title(motion_title(name))
     _finish_axes(axes, motion_map)
     handles = [Patch(facecolor="0.88", edgecolor="0.3",
                      label=r"stable under $\sin(\beta_f\tau)$ alone (Fig. 16)"),
@@ -606,7 +607,7 @@ def residence(motion_map, min_stretches=RESIDENCE_MIN_STRETCHES):
         if cut[k].any():
             ax.add_patch(PathPatch(cells_path(x, y, cut[k]), gid="only_cut",
                                    **ONLY_CUT_STYLE))
-        ax.set_title("none" if name == "none" else f"({name})")
+        ax.set_title(motion_title(name))
     _finish_axes(axes, motion_map)
     for ax in axes:                       # cells drawn whole: the extent is the cells' edges
         ax.set_xlim(xe[0], xe[-1])

@@ -10,6 +10,7 @@ from vibroimpact.plotting._common import (
     _events_params, _figure, _header, _headroom, _num, _padded, _panel_tag, _psd_label, _require,
     _density_deltas, _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label,
     family_styles, no_collision_text, note_on_axes, t_quantile)
+from vibroimpact.plotting.walls import two_walls, wall_density_figure, wall_means_figure
 from vibroimpact.stats.theory import (
     ENVELOPE_DELTA_MIN, ENVELOPE_EPS_MIN, energy_envelope, envelope_v_after_pdf,
     upcrossing_rate)
@@ -165,8 +166,13 @@ def fig07(events, density_delta=None, envelope="auto"):
     matplotlib.figure.Figure
         (a) log and (b) linear density axes, one line per (distinct) density delta with a
         shaded 95 % band; sparse bins merged (`MIN_BIN_COUNT`). The theory, when drawn, is a
-        thin line of its delta's colour (gid ``"envelope"``).
+        thin line of its delta's colour (gid ``"envelope"``). A two-wall dataset: one panel
+        per wall (`plotting.walls.wall_density_figure`; the one-wall theory is not drawn).
     """
+    if two_walls(events):
+        return wall_density_figure(events, 0, "v_after", "Fig. 7 (two walls)  Probability "
+                                   "density of the velocity after impact, per wall",
+                                   density_delta)
     fig, axes = _density_figure(events, 0, "v_after_density",
                                 "Fig. 7  Probability density of the velocity after impact",
                                 _events_params(events, 0, ("v_after",)), density_delta,
@@ -220,8 +226,14 @@ def fig08(events, density_delta=None, zoom=FIG08_ZOOM):
     matplotlib.figure.Figure
         Two log-density axes: (a) up to the last drawn bin, so the long waits of the
         smallest plays (the tail that grows again as delta falls below about -0.2) are
-        seen whole; (b) the bulk, ``0 <= z_j <= zoom``.
+        seen whole; (b) the bulk, ``0 <= z_j <= zoom``. A two-wall dataset: one panel per
+        wall, the interval from a collision at the wall to its next there
+        (`plotting.walls.wall_density_figure`).
     """
+    if two_walls(events):
+        return wall_density_figure(events, 0, "interval", "Fig. 8 (two walls)  Probability "
+                                   "density of the interval between collisions, per wall",
+                                   density_delta)
     fig, _ = _density_figure(events, 0, "interval_density",
                              "Fig. 8  Probability density of the interval between collisions",
                              _events_params(events, 0, ("interval",)), density_delta,
@@ -300,7 +312,12 @@ def fig09(events, envelope="auto"):
         collision in the record are shaded (gid ``"no_collision"``), from
         :func:`critical_delta` on: a property of this record, not a threshold. The
         energy-envelope theory (gid ``"envelope"``): (a) ``eps <V>``, (b) ``1 / nu``.
+        A two-wall dataset: the means of each wall, one colour each
+        (`plotting.walls.wall_means_figure`; the one-wall asymptotes are not drawn).
     """
+    if two_walls(events):
+        return wall_means_figure(events, "Fig. 9 (two walls)  Mean velocity after impact and "
+                                 "mean interval against $\\delta$, per wall")
     fig, axes = _figure(2)
     fig.set_figheight(FIG09_HEIGHT)
     ds = events.isel(inv_beta=0).sortby("delta")

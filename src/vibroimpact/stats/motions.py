@@ -9,7 +9,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 from vibroimpact import _checks
 from vibroimpact.stats.events import interval_ratio
 
-__all__ = ["DEFAULT_MOTION_WINDOW", "DEFAULT_MOTIONS", "classify_impact_intervals",
+__all__ = ["DEFAULT_MOTION_WINDOW", "DEFAULT_MOTIONS", "classify_impact_intervals", "motion_key",
            "impact_motion_probabilities", "count_motion_switches", "MotionStatistics",
            "motion_statistics", "motion_map_agreement"]
 
@@ -20,33 +20,70 @@ DEFAULT_MOTIONS = ((1, 1), (2, 1), (1, 2))
 
 
 def _motion_key(motion) -> str:
+    """``"m/n"`` of a one-wall motion, ``"(m_upper,m_lower)/n"`` of a two-wall one."""
+    if len(motion) == 3:
+        return f"({motion[0]},{motion[1]})/{motion[2]}"
     return f"{motion[0]}/{motion[1]}"
 
 
-def _check_motions(motions):
-    motions = tuple((int(m), int(n)) for m, n in motions)
-    if not motions or any(m < 1 or n < 1 for m, n in motions):
-        raise ValueError(f"motions must be (m, n) pairs of positive integers, got {motions!r}")
-    return motions
+def motion_key(motion) -> str:
+    """The name of a motion: ``"1/1"`` for ``(1, 1)`` (m collisions per n forcing periods,
+    whatever the wall), ``"(1,1)/1"`` for ``(1, 1, 1)`` (one collision at each wall per
+    forcing period: ``(m_upper, m_lower, n)``, two walls)."""
+    return _motion_key(_check_motions([motion])[0])
 
 
-def _match_masks(ratio: np.ndarray, window: float, motions) -> np.ndarray:
+def _check_motions(motions, walls=None):
+    """Motions as tuples: ``(m, n)`` (m collisions per n periods, any wall) or
+    ``(m_upper, m_lower, n)`` (a two-wall motion: that many at each wall); the latter need
+    ``walls`` (the wall of each collision) when classifying (``walls`` not None here)."""
+    out = []
+    for motion in motions:
+        motion = tuple(int(k) for k in motion)
+        if len(motion) == 2 and motion[0] >= 1 and motion[1] >= 1:
+            out.append(motion)
+        elif len(motion) == 3 and min(motion) >= 0 and motion[0] + motion[1] >= 1 \
+                and motion[2] >= 1:
+            out.append(motion)
+        else:
+            raise ValueError(f"motions must be (m, n) pairs of positive integers or "
+                             f"(m_upper, m_lower, n) triples (m_upper, m_lower >= 0, their sum "
+                             f">= 1, n >= 1), got {motion!r}")
+    if not out:
+        raise ValueError("motions must hold at least one motion, got none")
+    if walls is False and any(len(m) == 3 for m in out):
+        raise ValueError("a two-wall motion (m_upper, m_lower, n) needs the wall of each "
+                         "collision (walls=)")
+    return tuple(out)
+
+
+def _length(motion):
+    """Collisions (intervals) of one group of the motion."""
+    return motion[0] + motion[1] if len(motion) == 3 else motion[0]
+
+
+def _match_masks(ratio: np.ndarray, window: float, motions, walls=None) -> np.ndarray:
     """match[i, j]: intervals j .. j+m_i-1 form motion i (see `classify_impact_intervals`)."""
     match = np.zeros((len(motions), ratio.size), dtype=bool)
-    for i, (m, n) in enumerate(motions):
+    for i, motion in enumerate(motions):
+        m, n = _length(motion), motion[-1]
         if ratio.size < m:
             continue
         if m == 1:
             match[i] = np.abs(ratio - n) < window
-            continue
-        groups = sliding_window_view(ratio, m)
-        match[i, :groups.shape[0]] = ((groups.max(axis=1) < n - window)
-                                      & (np.abs(groups.sum(axis=1) - n) < window))
+        else:
+            groups = sliding_window_view(ratio, m)
+            match[i, :groups.shape[0]] = ((groups.max(axis=1) < n - window)
+                                          & (np.abs(groups.sum(axis=1) - n) < window))
+        if len(motion) == 3:
+            # the walls of the group's collisions: m_lower of them at the lower wall
+            lower = sliding_window_view((walls == 1).astype(np.int64), m).sum(axis=1)
+            match[i, :lower.size] &= lower == motion[1]
     return match
 
 
 def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
-                              motions=DEFAULT_MOTIONS) -> np.ndarray:
+                              motions=DEFAULT_MOTIONS, walls=None) -> np.ndarray:
     """Label each interval with the impact motion it belongs to (fig15 definition).
 
     Parameters
@@ -55,8 +92,14 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
         ``r_j = z_j / z`` in time order (see `interval_ratio`).
     window : float, optional
         Half-width w, 0 < w <= 0.5 (default 0.1, `DEFAULT_MOTION_WINDOW`).
-    motions : sequence of (m, n), optional
-        Candidate (m/n) motions, in priority order (default (1/1), (2/1), (1/2)).
+    motions : sequence of (m, n) or (m_upper, m_lower, n), optional
+        Candidate (m/n) motions, in priority order (default (1/1), (2/1), (1/2)). A triple
+        is a two-wall motion: ``m_upper + m_lower`` collisions per n periods, that many at
+        each wall (``(1, 1, 1)``, "(1,1)/1": one at each wall per period); it needs `walls`.
+    walls : array_like of int, shape (N,), optional
+        The wall of the collision that starts each interval (0: the wall at delta, 1: the
+        wall at delta - gap; `Collisions.wall`). A pair (m, n) ignores it: with two walls it
+        counts the collisions at either wall.
 
     Returns
     -------
@@ -71,7 +114,9 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
     - m = 1: ``|r_j - n| < w``;
     - m >= 2: every ``r_{j+i} < n - w`` and ``|r_j + ... + r_{j+m-1} - n| < w``
 
-    which for (1/1), (1/2), (2/1) is the definition of docs/figures.md. Groups may overlap (three
+    which for (1/1), (1/2), (2/1) is the definition of docs/figures.md; a two-wall motion
+    ``(m_u, m_l, n)`` asks the same of its ``m = m_u + m_l`` intervals and, besides, that
+    ``m_l`` of the m collisions starting them are at the lower wall. Groups may overlap (three
     intervals of 0.5 hold two candidate (2/1) pairs), and an interval is counted at most once,
     so groups are taken greedily left to right: at the first unassigned interval j that starts
     some matching group, the first motion in `motions` that matches there claims its m
@@ -80,18 +125,32 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
     matters for user-supplied motions; the greedy pairing reads a (2/1) record in time order
     and pairs a run of short intervals (r1, r2), (r3, r4), ...
     """
-    return _classify(ratio, window, motions)[0]
+    return _classify(ratio, window, motions, walls)[0]
 
 
-def _classify(ratio, window, motions):
+def _walls(walls, n):
+    """The walls of the intervals' first collisions as int8 (None stays None)."""
+    if walls is None:
+        return None
+    walls = np.asarray(walls)
+    if walls.shape != (n,):
+        raise ValueError(f"walls must hold one wall per interval ({n}), got shape "
+                         f"{walls.shape}")
+    if walls.size and not np.isin(walls, (0, 1)).all():
+        raise ValueError("walls must be 0 (the wall at delta) or 1 (the wall at delta - gap)")
+    return walls.astype(np.int8)
+
+
+def _classify(ratio, window, motions, walls=None):
     """Labels (as `classify_impact_intervals`) and the first interval of each one's group."""
     ratio = np.asarray(ratio, dtype=float)
     _checks.real("window", window, low=0.0, high=0.5, low_open=True)
-    motions = _check_motions(motions)
-    match = _match_masks(ratio, window, motions)
+    walls = _walls(walls, ratio.size)
+    motions = _check_motions(motions, walls=walls is not None)
+    match = _match_masks(ratio, window, motions, walls)
     labels = np.full(ratio.size, -1, dtype=np.int64)
     group = np.arange(ratio.size)
-    lengths = np.array([m for m, _ in motions])
+    lengths = np.array([_length(m) for m in motions])
     candidates = np.flatnonzero(match.any(axis=0))
     first = np.argmax(match[:, candidates], axis=0)       # the first motion matching there
     if (lengths == 1).all():
@@ -160,7 +219,8 @@ def _group_ends(group):
 
 def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_MOTION_WINDOW,
                                 total_time: float | None = None,
-                                motions=DEFAULT_MOTIONS, stuck=None) -> dict[str, float]:
+                                motions=DEFAULT_MOTIONS, stuck=None,
+                                walls=None) -> dict[str, float]:
     """Probability of each impact motion: fraction of the recorded time it covers (fig15).
 
     Parameters
@@ -182,6 +242,10 @@ def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_
         (`Collisions.stuck`). Given, a motion whose group holds such a collision is the
         *impact-stick* variant of the motion, reported apart under the key ``"m/n stick"``,
         and ``"m/n"`` keeps the motions with free flights only (those of Fig. 16).
+    walls : array_like of int, shape (N,), optional
+        The wall of the collision that starts each interval (two walls; needed by the
+        two-wall motions ``(m_upper, m_lower, n)``, keys ``"(m_upper,m_lower)/n"``: see
+        `classify_impact_intervals`).
 
     Returns
     -------
@@ -198,14 +262,14 @@ def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_
     pipeline's definition (docs/figures.md, "The probability of an impact motion").
     """
     intervals = np.asarray(intervals, dtype=float)
-    motions = _check_motions(motions)
+    motions = _check_motions(motions, walls=walls is not None)
     covered = float(intervals.sum())
     if total_time is None:
         total_time = covered
     elif not np.isfinite(total_time) or total_time < covered * (1.0 - 1e-12):
         raise ValueError(f"total_time must be >= the sum of the intervals ({covered!r}), "
                          f"got {total_time!r}")
-    labels, group = _classify(interval_ratio(intervals, beta), window, motions)
+    labels, group = _classify(interval_ratio(intervals, beta), window, motions, walls)
     keys = list(map(_motion_key, motions))
     if stuck is None:
         return dict(zip(keys, _fractions(intervals, labels, len(motions), total_time)))
@@ -266,7 +330,7 @@ class MotionStatistics(NamedTuple):
 
 def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_stop: float, *,
                       window: float = DEFAULT_MOTION_WINDOW, motions=DEFAULT_MOTIONS,
-                      n_batches: int = 20, stuck=None) -> MotionStatistics:
+                      n_batches: int = 20, stuck=None, walls=None) -> MotionStatistics:
     """Probabilities of the (m/n) motions over ``[t_start, t_stop]`` with standard errors.
 
     Parameters
@@ -288,6 +352,9 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
         is not used). Given, the impact-stick variants are counted apart
         (`impact_motion_probabilities`): ``probability`` keeps the motions with free flights
         and ``stick_probability`` holds the variants.
+    walls : array_like of int, shape (N + 1,) or (N,), optional
+        The wall of each collision (two walls: `Collisions.wall`; the last one's is not
+        used), for the two-wall motions ``(m_upper, m_lower, n)``.
 
     Returns
     -------
@@ -306,7 +373,9 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     """
     t = np.asarray(impact_time, dtype=float)
     z = np.asarray(intervals, dtype=float)
-    motions = _check_motions(motions)
+    if walls is not None:
+        walls = np.asarray(walls)[: z.size]
+    motions = _check_motions(motions, walls=walls is not None)
     n_batches = _checks.integer("n_batches", n_batches, low=2)
     duration = float(t_stop) - float(t_start)
     if not duration > 0.0:
@@ -314,7 +383,7 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     if t.size != z.size + 1 and not (t.size == 0 and z.size == 0):
         raise ValueError(f"impact_time must hold one more value than intervals, got "
                          f"{t.size} and {z.size}")
-    labels, group = _classify(interval_ratio(z, beta), window, motions)
+    labels, group = _classify(interval_ratio(z, beta), window, motions, walls)
     n_motions = len(motions)
     classes, n_classes = labels, n_motions
     if stuck is not None:

@@ -28,6 +28,7 @@ from vibroimpact.pipeline.config.messages import (VERBOSE_ENV, ConfigError, non_
                                                   validate)
 from vibroimpact.pipeline.config.messages import _short  # noqa: F401 (how a value is shown)
 from vibroimpact.pipeline.config.plan import Plan, make_plan
+from vibroimpact.pipeline.study import Study
 from vibroimpact.pipeline.config.sweeps import (SWEEP_KEYS, Sweeps, drawn_sweeps,
                                                 expand_sweeps, sweep_figures, sweep_label,
                                                 sweep_labels)
@@ -72,8 +73,12 @@ def load(user=None, *, root=".", user_files=()):
     try:
         validate(config, schema)
         config["sweeps"] = sweeps.record    # after the schema, which knows only the user's keys
-        check(config, schema, own)
-        plan = make_plan(config, own, results=root / "results")
+        grids = check(config, schema, own)
+        # each study resolved once, from the grids the checks expanded (the plan and the
+        # workflow's rules read these: `plan.studies`)
+        studies = {name: Study.from_config(name, entry, grids=grids.get(name))
+                   for name, entry in config["studies"].items()}
+        plan = make_plan(config, own, results=root / "results", studies=studies)
         plan.refuse_beyond_limits()
     except ConfigError as err:
         raise sweeps.relabel(err) from None

@@ -245,11 +245,15 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                      "an `orbits` entry (none defined)")
         return
     other = config["orbits"][orbits]
-    for key in ("zeta", "eps"):
-        if float(other[key]) != float(entry[key]):
+    for key in ("zeta", "eps", "gap", "eps_lower"):
+        if other.get(key) != entry.get(key) and (
+                other.get(key) is None or entry.get(key) is None
+                or float(other[key]) != float(entry[key])):
             problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = "
-                         f"{_num(other[key])}, the study {key} = {_num(entry[key])}",
-                         "an `orbits` entry of the same zeta and eps")
+                         f"{_num(other[key]) if other.get(key) is not None else 'none'}, the "
+                         f"study {key} = "
+                         f"{_num(entry[key]) if entry.get(key) is not None else 'none'}",
+                         "an `orbits` entry of the same zeta and eps (and walls)")
     types = {tuple(t) for t in other["types"]}
     missing = [m for m in entry["motions"] if tuple(m) not in types]
     if missing:
@@ -258,8 +262,20 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                      "include every motion of the study")
 
 
+def _check_walls(where, entry, problems):
+    """A second wall: ``eps_lower`` only with a ``gap``; True for a two-wall entry."""
+    if entry.get("gap") is None:
+        if entry.get("eps_lower") is not None:
+            problems.add(f"{where}.eps_lower", entry["eps_lower"], "the restitution of a "
+                         "second wall, and this entry has one wall (no gap)",
+                         f"leave it out, or give {where}.gap > 0 (the wall at x = delta - gap)")
+        return False
+    return True
+
+
 def _check_study(config, name, entry, problems, limits, unforced):
     where = f"studies.{name}"
+    two_walls = _check_walls(where, entry, problems)
     siblings = {name}           # itself, or every study of its sweep
     if "sweep" in entry:
         siblings = set(config.get("sweeps", {}).get(entry["sweep"]["name"], {}).get(
@@ -275,6 +291,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
     n, dt, tau = noise_record(config["noises"][entry["noise"]])
     record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
     grids = {"delta": _grid(problems, f"{where}.delta", entry["delta"], limits["max_cells"])}
+    resolved = {}       # the grids, and the spectra's plays: what the study resolves to
     harmonic = float(entry["amplitude"]) != 0.0
     grids["inv_beta"] = (_grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_cells"], positive=True)
@@ -340,6 +357,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
                              f"transient to t_end)",
                              f"16 <= nperseg <= {samples}, or a longer spectra.t_end")
         sgrid = _grid(problems, f"{where}.spectra.delta", spectra["delta"], limits["max_cells"])
+        resolved["spectra_delta"] = sgrid
         if sgrid is not None and grids["delta"] is not None:
             for j, v in enumerate(sgrid):
                 if not _on_grid(v, grids["delta"]):
@@ -362,12 +380,21 @@ def _check_study(config, name, entry, problems, limits, unforced):
                 problems.add(f"{where}.density_delta[{j}]", v, "not on the delta grid",
                              _grid_text(grids["delta"]))
     motions = [tuple(m) for m in entry["motions"]]
+    walled = [list(m) for m in motions if len(m) == 3]
+    if walled and not two_walls:
+        problems.add(f"{where}.motions", walled, "two-wall motions [m_upper, m_lower, n], "
+                     "and this study has one wall (no gap)", "[m, n] pairs, or give "
+                     f"{where}.gap > 0")
+    for m in walled:
+        if m[0] + m[1] < 1:
+            problems.add(f"{where}.motions", m, "a motion without a collision",
+                         "[m_upper, m_lower, n] with m_upper + m_lower >= 1")
     if len(set(motions)) != len(motions):
         problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
                      "distinct [m, n] pairs")
     else:
         ratios = {}
-        for m, n_ in motions:
+        for m, n_ in (m for m in motions if len(m) == 2):
             first = ratios.setdefault(Fraction(n_, m), (m, n_))
             if first != (m, n_):
                 problems.add(f"{where}.motions", entry["motions"],
@@ -391,7 +418,8 @@ def _check_study(config, name, entry, problems, limits, unforced):
         _check_escape(where, entry, grids, harmonic, dt, problems)
     if all(g is not None for g in grids.values()):
         _check_figures(config, "studies", name, entry, problems, grids)
-    return grids
+    resolved.update(grids)
+    return resolved
 
 
 #: Shortest batch of the batch-means standard errors: a natural period 2 pi (time units),
@@ -482,6 +510,11 @@ def _check_orbits(config, name, entry, problems, limits):
         problems.add(where, name, "ends like a dataset an orbits entry derives "
                      "(results/orbits/<name>_basins.nc ...)",
                      f"a name not ending in {', '.join(DERIVED_SUFFIXES)}")
+    if _check_walls(where, entry, problems):
+        problems.add(f"{where}.gap", entry["gap"], "the closed-form (m/n) orbit map knows "
+                     "one wall (the two-wall motions come from the shooting solver, "
+                     "vibroimpact.orbits.shooting, not yet a workflow job)",
+                     "an orbits entry without gap")
     grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_orbit_cells"], positive=True),
              "delta": _grid(problems, f"{where}.delta", entry["delta"],
@@ -557,6 +590,13 @@ def check(config, schema, own=None):
     ``config`` has passed `~vibroimpact.pipeline.config.messages.validate` against
     ``schema``; ``own`` is from `~vibroimpact.pipeline.config.layering.compose`.
 
+    Returns
+    -------
+    dict
+        ``{study: {"inv_beta", "delta", "spectra_delta"}}``: each study's grids, expanded
+        here once (`pipeline.study.Study.from_config` takes them as ``grids``, so the plan
+        and the workflow expand none again).
+
     Raises
     ------
     ConfigError
@@ -567,8 +607,9 @@ def check(config, schema, own=None):
     _check_noises(config, problems)
     # a random study's inv_beta left out (the schema's default) is not one it ignores
     unforced = schema["$defs"]["study"]["properties"]["inv_beta"]["default"]
+    resolved = {}
     for name, entry in config["studies"].items():
-        _check_study(config, name, entry, problems, limits, unforced)
+        resolved[name] = _check_study(config, name, entry, problems, limits, unforced)
     for name, entry in config["orbits"].items():
         _check_orbits(config, name, entry, problems, limits)
     _check_paper_figures(config, problems, None if own is None else own["paper_figures"])
@@ -577,3 +618,4 @@ def check(config, schema, own=None):
                      "paper: false with at least one study or orbits entry that lists figures")
     if problems:
         raise ConfigError(problems)
+    return resolved

@@ -5,7 +5,7 @@ what a build costs, printed and checked against ``limits`` before it runs) and f
 resources each rule asks of a scheduler (``workflow/rules/common.smk``). The costs were
 measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job costs").
 """
-from vibroimpact.pipeline.study import Study, escape_samples, map_cap_steps
+from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps
 
 __all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simulate_runtime_min",
            "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
@@ -77,8 +77,9 @@ def study_steps(kind, entry, noise, inv_beta=None):
     (None: the study's longest forcing period, the dearest cell)."""
     n, dt = int(noise["n_samples"]), float(noise["dt"])
     if kind == "map":
-        if inv_beta is None:
-            inv_beta = float(Study.from_config("", entry).inv_beta.max())
+        if inv_beta is None:        # the study's longest forcing period (its inv_beta grid)
+            inv_beta = (float(grid_values(entry["inv_beta"]).max())
+                        if float(entry["amplitude"]) != 0.0 else 1.0)
         return map_steps(n, dt, float(entry["transient"]), int(entry["map"]["max_periods"]),
                          inv_beta)
     block = entry["spectra"] if kind == "spectra" else entry

@@ -46,6 +46,9 @@ class Plan:
     free_bytes: float | None = None
     results: str = "results"
     drawn: dict = field(default_factory=dict)    # built_entries(...)[0]: what `rule all` draws
+    #: every study of the config resolved once (`pipeline.study.Study`, its grids expanded
+    #: by the checks): the workflow's rules read these (common.smk, ``STUDIES``)
+    studies: dict = field(default_factory=dict, repr=False)
 
     @property
     def cells(self):
@@ -197,11 +200,17 @@ def built_entries(config, own=None):
     return drawn, build
 
 
-def make_plan(config, own=None, *, results="results"):
+def make_plan(config, own=None, *, results="results", studies=None):
     """The :class:`Plan` of ``rule all``: cells, jobs, bytes and CPU seconds per entry, of
-    every job the build runs (:func:`built_entries`)."""
+    every job the build runs (:func:`built_entries`). ``studies``: the config's studies
+    already resolved (``{name: Study}``); the others are resolved here."""
     drawn, build = built_entries(config, own)
-    plan = Plan(limits=dict(config["limits"]), results=str(results), drawn=drawn)
+    studies = dict(studies or {})
+    for name, entry in config["studies"].items():
+        if name not in studies:
+            studies[name] = Study.from_config(name, entry)
+    plan = Plan(limits=dict(config["limits"]), results=str(results), drawn=drawn,
+                studies=studies)
     for name in sorted(build["noises"]):
         entry = config["noises"][name]
         n = int(entry["n_samples"])
@@ -211,7 +220,7 @@ def make_plan(config, own=None, *, results="results"):
                                              if not o.startswith("orbits/")})
     for name in owners:
         entry = config["studies"][name]
-        study = Study.from_config(name, entry)
+        study = studies[name]
         noise = config["noises"][entry["noise"]]
         needs = build["studies"].get(name, set())
         row = Row(f"studies.{name}", "")
