@@ -7,8 +7,8 @@ measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job c
 """
 from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps
 
-__all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simulate_runtime_min",
-           "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
+__all__ = ["record_steps", "map_steps", "plane_cap_steps", "study_steps", "simulate_cpu_s",
+           "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
@@ -86,6 +86,19 @@ def study_steps(kind, entry, noise, inv_beta=None):
     return record_steps(n, dt, block.get("t_end"))
 
 
+def plane_cap_steps(study, entry, noise):
+    """Sample steps of every map cell of a study with a ``plane``, each run to its cap at
+    its own forcing period (`map_steps`; the rms, the walls and the restitution do not move
+    the cap, only how soon a cell reaches its precision)."""
+    n, dt = int(noise["n_samples"]), float(noise["dt"])
+    transient, max_periods = float(entry["transient"]), int(entry["map"]["max_periods"])
+    per_period = {}
+    for cell in study.cells():
+        if cell.inv_beta not in per_period:
+            per_period[cell.inv_beta] = map_steps(n, dt, transient, max_periods, cell.inv_beta)
+    return float(sum(per_period[cell.inv_beta] for cell in study.cells()))
+
+
 def simulate_cpu_s(cells, steps, audit=False):
     """CPU seconds of ``cells`` cells of ``steps`` sample steps each (``audit``: events cells,
     which also integrate the power balance and the virial over every step)."""
@@ -97,9 +110,11 @@ def simulate_runtime_min(cells, steps, audit=False):
     return RUNTIME_FLOOR_MIN + int(simulate_cpu_s(cells, steps, audit) * RUNTIME_MARGIN / 60)
 
 
-def simulate_mem_mb(n_samples):
-    """Memory (MB) of a simulate job over a noise record of ``n_samples`` samples."""
-    return BASE_MEM_MB + SIMULATE_BUFFERS_MB + -(-8 * n_samples // 2**20)
+def simulate_mem_mb(n_samples, records=1):
+    """Memory (MB) of a simulate job over a noise record of ``n_samples`` samples
+    (``records``: copies of it held at once; 2 for a map over the rms, which scales the
+    unit-rms record into a cell's)."""
+    return BASE_MEM_MB + SIMULATE_BUFFERS_MB + records * -(-8 * n_samples // 2**20)
 
 
 def noise_cpu_s(n_samples):
