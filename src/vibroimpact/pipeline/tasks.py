@@ -373,7 +373,7 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
         if float(attrs.get("amplitude", 0.0)) == 0.0:
             # the wall-free response's std's: fig09 draws Rice's large-play asymptotes
             sigma_x, sigma_v = stats.linear_response_std(
-                io.noise_spec(attrs).psd_piecewise_linear, zeta)
+                io.noise_spec(attrs).psd_piecewise_linear, float(block["zeta"]))
             attrs.update(linear_sigma_x=sigma_x, linear_sigma_v=sigma_v)
         ds = datasets.aggregate_events(parts, None, attrs, n_cells=n_cells)
     elif kind == "map":
