@@ -306,16 +306,21 @@ def _check_study(config, name, entry, problems, limits, unforced):
     where = f"studies.{name}"
     if entry.get("plane") is not None:
         return _check_plane_study(config, name, entry, problems, limits, unforced)
+    shapes_ok = True
     for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
         if key in ("inv_beta", "delta"):
             if not isinstance(entry.get(key, []), (list, dict)):
+                shapes_ok = False
                 problems.add(f"{where}.{key}", entry[key], "a number, and this study has no "
                              "plane that fixes it", f"a grid (a list or {{start, stop, step}}), "
                              f"or a `plane` that does not name {key}")
         elif isinstance(entry.get(key), (list, dict)):
+            shapes_ok = False
             problems.add(f"{where}.{key}", entry[key], "a grid, and this study has no plane "
                          "naming it", f"a number, or `plane: [{key}, delta]` (say) to map over "
                          f"it")
+    if not shapes_ok:
+        return None
     two_walls = _check_walls(where, entry, problems)
     siblings = {name}           # itself, or every study of its sweep
     if "sweep" in entry:

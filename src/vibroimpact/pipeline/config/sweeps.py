@@ -15,7 +15,7 @@ import re
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems, _short
 
 __all__ = ["SWEEP_KEYS", "NOISE_KEYS", "Sweeps", "expand_sweeps", "sweep_label", "sweep_labels",
-           "drawn_sweeps", "sweep_figures"]
+           "drawn_sweeps", "sweep_figures", "Member", "sweep_members"]
 
 #: Study keys a list of values sweeps, in the order of the product: the first key varies
 #: slowest, the last fastest (nested loops), so ``eps: [a, b]`` with ``rms: [c, d]`` gives
@@ -315,6 +315,33 @@ class _NoiseCopies:
         """``{"noises.<name>": label}``: each copy in the words of the user's file."""
         return {f"noises.{name}": _noise_label(self.study, self.overrides[name], indices, swept)
                 for name, indices in self.users.items()}
+
+
+@dataclass(frozen=True)
+class Member:
+    """One study of a sweep: its name and its values of the swept keys (`sweep_members`)."""
+
+    study: str
+    values: dict
+
+
+def sweep_members(config, name):
+    """The studies of sweep ``name`` in the sweep's order, each with its values of the swept
+    keys: a sweep over a plane's third parameter (``plane: [eps, delta]`` with ``zeta: [a,
+    b]``) is the stack of maps ``[Member("<name>_0", {"zeta": a}), ...]`` that a figure
+    sets side by side.
+
+    Raises
+    ------
+    KeyError
+        For a name that is no sweep of ``config`` (naming the sweeps there are).
+    """
+    sweeps = config.get("sweeps", {})
+    if name not in sweeps:
+        raise KeyError(f"no sweep {name!r}; the sweeps: {', '.join(sorted(sweeps)) or 'none'}")
+    sweep = sweeps[name]
+    return [Member(study, dict(zip(sweep["keys"], row)))
+            for study, row in zip(sweep["studies"], sweep["values"])]
 
 
 def drawn_sweeps(config, drawn):
