@@ -176,6 +176,13 @@ def map_agreement(motion_map, orbits):
     return agreement(motion_map, orbits)
 
 
+def _plane(motion_map):
+    """The map's two grid dims (`vibroimpact.reports.switching`: its ``axes``)."""
+    from vibroimpact.reports.switching import _plane as plane
+
+    return plane(motion_map)
+
+
 def map_summary(motion_map):
     """Per motion of a probability map (Fig. 15), with free flights and, when the map has
     them, with sticking: cells with probability >= 50 %, the largest probability; and the
@@ -194,7 +201,8 @@ def map_summary(motion_map):
             rows[label.format(m=m)] = {"cells with P >= 50 %": int((p >= 0.5).sum()),
                                        "largest P": f"{float(p.max()):.2f}"}
     table = pd.DataFrame.from_dict(rows, orient="index")
-    cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
+    x, y = _plane(motion_map)
+    cells = motion_map.sizes[x] * motion_map.sizes[y]
     table.attrs["note"] = (f"{cells} cells; {100 * float(motion_map.reached.mean()):.1f} % "
                            f"reached the target standard error, "
                            f"{int(motion_map.few_switches.sum())} hatched (too few switches)")
@@ -799,7 +807,8 @@ def map_audit(motion_map):
     worst = float(motion_map.probability_stderr.where(reached).max()) if bool(
         reached.any()) else np.nan
     flagged = reached & (motion_map.probability_stderr > target).any("motion")
-    cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
+    x, y = _plane(motion_map)
+    cells = motion_map.sizes[x] * motion_map.sizes[y]
     failed = int(outside.sum()) + int(flagged.sum())
     verdict = "**Self-audit passed:**" if failed == 0 else "**Self-audit FAILED:**"
     text = (f"{verdict} a map study keeps no impact record, so the two exact identities of "
@@ -812,8 +821,8 @@ def map_audit(motion_map):
             + (f", {int(flagged.sum())} above the target" if int(flagged.sum()) else "")
             + ".")
     if failed:
-        bad = (outside | flagged).stack(cell=("inv_beta", "delta"))
-        where = [f"(1/beta_f = {ib:.4g}, delta = {d:.4g})"
+        bad = (outside | flagged).transpose(x, y).stack(cell=(x, y))
+        where = [f"({x.replace('inv_beta', '1/beta_f')} = {ib:.4g}, {y} = {d:.4g})"
                  for ib, d in bad.cell.values[bad.values][:AUDIT_WORST]]
         text += " Failing cells: " + ", ".join(where) + "."
     return Markdown(text)
