@@ -227,6 +227,15 @@ def test_a_grid_without_a_plane_is_refused(tmp_path):
     assert "no plane that fixes it" in "\n".join(info.value.problems)
 
 
+def test_fig15_vs_fig16_over_another_plane_is_refused_until_orbits_map_it(tmp_path):
+    text = EPS_DELTA.replace("figures: [fig15]",
+                             "figures: [fig15, {name: fig15_vs_fig16, orbits: harmonic}]")
+    with pytest.raises(configuration.ConfigError) as info:
+        _load(tmp_path, text)
+    text = "\n".join(info.value.problems)
+    assert "studies.plane.figures[1]" in text and "maps (1/beta_f, delta) only" in text, text
+
+
 def test_an_rms_plane_has_no_fig16(tmp_path):
     text = RMS_DELTA.replace("figures: [fig15]",
                              "figures: [fig15, {name: fig15_vs_fig16, orbits: harmonic}]")
