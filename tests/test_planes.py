@@ -96,7 +96,7 @@ def test_the_eps_column_equals_the_default_maps_row_bit_for_bit(tmp_path):
     assert plane["probability"].dims[-2:] == ("eps", "delta")
     assert plane.attrs["axes"] == ["eps", "delta"]
     assert json.loads(plane.attrs["fixed"]) == {"zeta": 0.05, "amplitude": 1.0,
-                                                 "inv_beta": 1.1}
+                                                 "inv_beta": 1.1, "rms": 0.29}
     column, row = plane.sel(eps=0.5), flat.sel(inv_beta=1.1)
     np.testing.assert_array_equal(column["delta"], row["delta"])
     for name in CELL_VARIABLES:
@@ -272,6 +272,7 @@ def test_a_tiny_rms_delta_map_builds(tmp_path):
     snakemake(work, target, config="tiny.yaml")
     ds = xr.load_dataset(work / target)
     assert ds.attrs["axes"] == ["rms", "delta"]
-    assert json.loads(ds.attrs["fixed"])["inv_beta"] == 1.1
+    fixed = json.loads(ds.attrs["fixed"])
+    assert fixed["inv_beta"] == 1.1 and "rms" not in fixed
     assert ds["probability"].sizes == {"motion": 3, "rms": 2, "delta": 3}
     assert (work / "results/noise/noisy_noise0.nc").exists()

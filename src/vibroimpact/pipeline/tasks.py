@@ -114,13 +114,17 @@ def _study_attrs(study, block, noise_attrs):
     return attrs
 
 
-def _plane_attrs(study):
+def _plane_attrs(study, noise_attrs):
     """A plane study's map attributes: ``axes`` (its two parameters, x first) and ``fixed``
-    (JSON text of ``{parameter: value}`` of the others); none for the default plane (its
-    datasets are those they always were)."""
+    (JSON text of ``{parameter: value}`` of the others: the model's and, unless it is an
+    axis, the noise's ``rms``); none for the default plane (its datasets are those they
+    always were)."""
     if study.plane is None:
         return {}
-    attrs = dict(axes=list(study.plane), fixed=json.dumps(study.fixed(), sort_keys=True))
+    fixed = study.fixed()
+    if "rms" not in study.plane and noise_attrs.get("noise_rms") is not None:
+        fixed["rms"] = float(noise_attrs["noise_rms"])
+    attrs = dict(axes=list(study.plane), fixed=json.dumps(fixed, sort_keys=True))
     if "rms" in study.plane:
         attrs["rms_axis"] = ("the noise record is generated at unit rms (noise_rms) and "
                              "scaled by each cell's rms: every cell on the same random numbers")
@@ -245,7 +249,7 @@ def map_tile(name, block, tile, noise_path, out):
         return result
 
     def to_dataset(tile_cells, results):
-        attrs = dict(_study_attrs(study, block, noise_attrs), **_plane_attrs(study),
+        attrs = dict(_study_attrs(study, block, noise_attrs), **_plane_attrs(study, noise_attrs),
                      motion_window=float(block["motion_window"]),
                      n_batches=int(block["n_batches"]),
                      **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods",
