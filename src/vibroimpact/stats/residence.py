@@ -326,9 +326,8 @@ def by_state(motion_map):
     Returns
     -------
     xarray.Dataset
-        Those of the four variables the map holds, over ``("state", "inv_beta", "delta")``
-        (a map over another plane: ``("state", x, y)``, its ``axes``), states named as the
-        map's motions ("1/1", ...) then "none".
+        Those of the four variables the map holds, over ``("state", "inv_beta", "delta")``,
+        states named as the map's motions ("1/1", ...) then "none".
     """
     import xarray as xr
 
@@ -338,6 +337,4 @@ def by_state(motion_map):
         motions = motion_map[name].rename(motion="state")
         none = motion_map[f"{name}_none"].expand_dims(state=["none"])
         parts[name] = xr.concat([motions, none], dim="state")
-    axes = motion_map.attrs.get("axes") or ("inv_beta", "delta")   # a plane's: x, y
-    axes = [axes] if isinstance(axes, str) else [str(a) for a in axes]
-    return xr.Dataset(parts).transpose("state", *axes)
+    return xr.Dataset(parts).transpose("state", "inv_beta", "delta")
