@@ -147,6 +147,10 @@ def test_a_sweep_over_a_planes_third_parameter_is_a_stack_of_maps(tmp_path):
     members = sweep_members(config, "plane")
     assert [(m.study, m.values) for m in members] == [("plane_0", {"zeta": 0.05}),
                                                       ("plane_1", {"zeta": 0.1})]
+    from vibroimpact.pipeline.targets import sweep_inputs
+
+    assert sweep_inputs(config, "plane") == ["results/datasets/plane_0_map.nc",
+                                             "results/datasets/plane_1_map.nc"]
     for m in members:
         study = plan.studies[m.study]
         assert study.plane == ("eps", "delta") and study.zeta == m.values["zeta"]
