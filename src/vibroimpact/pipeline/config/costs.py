@@ -7,7 +7,8 @@ measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job c
 """
 from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps
 
-__all__ = ["record_steps", "map_steps", "plane_cap_steps", "study_steps", "simulate_cpu_s",
+__all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
+           "simulate_cpu_s",
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
 
@@ -30,6 +31,13 @@ US_PER_START = 70.0
 #: map (its `record_end` summed: 1.42e9 steps against 4.18e9 at the caps). A map whose cells
 #: all run to the cap costs up to 1 / 0.34 = 2.9 times the plan's figure.
 MAP_CAP_FRACTION = 0.34
+#: A map cell's CPU besides its sample steps (its precision checks regroup the collisions
+#: and classify the intervals in Python): measured on config/examples/planes.yaml, fresh
+#: builds on a shared 2-core node, 1.8-2.0 s of cell CPU over 153-204 cells of 1e4-7e4 steps
+#: (~10 ms a cell; the steps at NS_PER_STEP give 0.1-0.2 s). Costed for the cells of a plane
+#: (`plane_map_cpu_s`), whose short caps it dominates; the paper's map keeps the model its
+#: README numbers were measured with (its cells are 15-100 times longer).
+MAP_CELL_S = 0.010
 BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 FIGURE_S = 1.5             # one figure, start-up included
 REPORT_S = 4.0             # one report notebook executed and rendered (papermill, nbconvert)
@@ -97,6 +105,14 @@ def plane_cap_steps(study, entry, noise):
         if cell.inv_beta not in per_period:
             per_period[cell.inv_beta] = map_steps(n, dt, transient, max_periods, cell.inv_beta)
     return float(sum(per_period[cell.inv_beta] for cell in study.cells()))
+
+
+def plane_map_cpu_s(study, entry, noise):
+    """CPU seconds of the map cells of a study with a ``plane``: every cell's cap
+    (`plane_cap_steps`) at `MAP_CAP_FRACTION`, plus `MAP_CELL_S` a cell."""
+    cells = len(study.cells())
+    return (simulate_cpu_s(1, plane_cap_steps(study, entry, noise) * MAP_CAP_FRACTION)
+            + cells * MAP_CELL_S)
 
 
 def simulate_cpu_s(cells, steps, audit=False):

@@ -238,14 +238,20 @@ def make_plan(config, own=None, *, results="results", studies=None):
             if study.plane is None:
                 cap = sum(len(study.delta) * costs.study_steps("map", entry, noise, float(ib))
                           for ib in study.inv_beta)
+                cpu = costs.simulate_cpu_s(1, cap * costs.MAP_CAP_FRACTION)
             else:       # any plane: each cell's cap at its own forcing period
-                cap = costs.plane_cap_steps(study, entry, noise)
-            cpu = costs.simulate_cpu_s(1, cap * costs.MAP_CAP_FRACTION)
+                cpu = costs.plane_map_cpu_s(study, entry, noise)
             _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200, cpu)
-            what = "map" if study.plane is None else f"map over ({', '.join(study.plane)})"
-            parts.append(f"{what} {_n(cells, 'cell')} (CPU at {costs.MAP_CAP_FRACTION:g} of "
-                         f"the caps, the paper map's mean; <= x{1 / costs.MAP_CAP_FRACTION:.1f})"
-                         + _hours(cpu, study.n_tiles("events")))
+            if study.plane is None:
+                parts.append(f"map {_n(cells, 'cell')} (CPU at {costs.MAP_CAP_FRACTION:g} of "
+                             f"the caps, the paper map's mean; <= "
+                             f"x{1 / costs.MAP_CAP_FRACTION:.1f})"
+                             + _hours(cpu, study.n_tiles("events")))
+            else:
+                parts.append(f"map over ({', '.join(study.plane)}) {_n(cells, 'cell')}, "
+                             f"~{_time(cpu)} of cell CPU (at {costs.MAP_CAP_FRACTION:g} of the "
+                             f"caps and {costs.MAP_CELL_S * 1e3:g} ms a cell)"
+                             + _hours(cpu, study.n_tiles("events")))
         if "spectra" in needs:
             cells = len(study.cells("spectra"))
             spec = entry["spectra"]
