@@ -506,9 +506,10 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
             ok = False
         elif isinstance(value, (list, dict)):
             problems.add(f"{where}.{key}", value, f"a grid, and {key} is fixed in the plane "
-                         f"{plane} (only its axes are grids; a sweep over {key} would be a "
-                         f"list of studies, which a plane's axes cannot tell from an axis)",
-                         f"a number, or name {key} in the plane")
+                         f"{plane} (only the plane's axes are grids)",
+                         f"a number, or name {key} in the plane (a sweep of maps: a list "
+                         f"under zeta, eps, amplitude, rms or seed that the plane does not "
+                         f"name, one study each)")
             ok = False
     if "amplitude" not in plane and not float(entry["amplitude"]):
         problems.add(f"{where}.amplitude", entry["amplitude"], "a study with a plane draws "
