@@ -313,3 +313,24 @@ def test_the_aggregate_reads_the_axes_from_its_tiles():
     assert np.array_equal(inv_beta, study.inv_beta) and np.array_equal(delta, study.delta)
     with pytest.raises(ValueError, match="expected 0..21"):
         datasets.tile_axes(tiles[1:], n_cells=22)
+
+
+@pytest.mark.slow
+def test_the_two_wall_orbit_map_sees_the_mirror_of_its_cells():
+    """The clearance of the example (stops 2 apart) under sin(tau/0.75): at delta = 1 the
+    stops are symmetric and the (1,1)/1 motion is stable; the cells delta = 0.25 and 1.75 are
+    each other's mirror image (x -> -x with the force's half-period shift), so the (1,0)/1
+    motion of one is the (0,1)/1 motion of the other, with the same degree of stability (to
+    the solver's precision)."""
+    from vibroimpact.pipeline.cells import two_wall_orbit_map
+
+    types = [(1, 1, 1), (1, 0, 1), (0, 1, 1)]
+    out = two_wall_orbit_map([0.75], [0.25, 1.0, 1.75], types, zeta=0.05, eps=0.5, gap=2.0)
+    assert out["S"].shape == (3, 1, 3)
+    assert out["reason"][0, 0, 1] == 0 and out["S"][0, 0, 1] > 0
+    mirror = {0: 0, 1: 2, 2: 1}
+    for k, k_m in mirror.items():
+        assert out["reason"][k, 0, 0] == out["reason"][k_m, 0, 2], types[k]
+        if out["reason"][k, 0, 0] == 0:
+            assert abs(out["S"][k, 0, 0] - out["S"][k_m, 0, 2]) < 1e-6, types[k]
+    assert out["reason"][1, 0, 0] == 0 and out["reason"][2, 0, 2] == 0

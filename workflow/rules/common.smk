@@ -112,9 +112,12 @@ def tiles(kind):
 
 
 def orbit_tiles(wildcards):
-    """The tiles of orbits entry ``{orbits}``."""
-    _, n = orbit_rows(config["orbits"][wildcards.orbits])
-    return [f"results/orbits/{wildcards.orbits}/tiles/{t}.nc" for t in range(n)]
+    """The tiles of orbits entry ``{orbits}`` (a two-wall entry's: rule
+    ``solve_clearance_orbit_tile``'s)."""
+    entry = config["orbits"][wildcards.orbits]
+    _, n = orbit_rows(entry)
+    tiles = "clearance_tiles" if entry.get("gap") is not None else "tiles"
+    return [f"results/orbits/{wildcards.orbits}/{tiles}/{t}.nc" for t in range(n)]
 
 
 def attractor_tiles(wildcards):

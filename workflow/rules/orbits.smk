@@ -27,6 +27,27 @@ rule solve_orbit_tile:
         "../scripts/solve_orbit_tile.py"
 
 
+rule solve_clearance_orbit_tile:
+    """The stable periodic motions of one tile of two-wall orbits entry {orbits}."""
+    output:
+        "results/orbits/{orbits}/clearance_tiles/{tile}.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/solve_clearance_orbit_tile/{orbits}/{tile}.log",
+    benchmark:
+        "results/benchmarks/solve_clearance_orbit_tile/{orbits}/{tile}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB + 200,
+        runtime=30,
+    params:
+        entry=orbits_block("orbits"),
+        code=script_code("solve_clearance_orbit_tile"),
+    script:
+        "../scripts/solve_clearance_orbit_tile.py"
+
+
 rule aggregate_orbits:
     """The orbits dataset of entry {orbits}, from its tiles."""
     input:

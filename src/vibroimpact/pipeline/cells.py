@@ -750,3 +750,67 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
                 record_end=k * dt, residence_time=stays["residence_time"],
                 residence_time_stderr=stays["residence_time_stderr"],
                 n_stretches=stays["n_stretches"], n_censored=stays["n_censored"])
+
+
+def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None):
+    """Stable periodic motions of a clearance over the (1/beta_f, delta) plane (the Fig. 16
+    analogue), under ``sin(beta_f tau)`` alone, from the shooting solver.
+
+    In every cell :func:`vibroimpact.orbits.shooting.periodic_motions` runs from its default
+    settled starts for the periods n of ``types``; each motion found is assigned to the type
+    ``(m_upper, m_lower, n)`` of its impacts per period at each wall.
+
+    Parameters
+    ----------
+    inv_beta, delta : array_like of float
+        The grid's rows and columns.
+    types : sequence of (m_upper, m_lower, n)
+        The motion types mapped.
+    zeta, eps, gap, eps_lower : float
+        The oscillator and its walls (``eps_lower`` None: ``eps``).
+
+    Returns
+    -------
+    dict
+        As :func:`vibroimpact.orbits.orbit_map`: ``exists, n_solutions, n_stable, lam, S,
+        reason`` over ``(type, inv_beta, delta)`` (``lam``, ``S`` of the most stable
+        admissible motion of the type, NaN where none is stable; ``reason`` 0 stable, 1 no
+        solution, 2 only inadmissible, 3 only unstable), ``types``, ``inv_beta``, ``delta``.
+
+    Notes
+    -----
+    A type's motion is found when the basin of a stable motion meets the grid of starts, or
+    Newton converges to an unstable one from a settled start nearby: unstable motions are
+    found only by chance (``n_solutions`` counts what was found, not what exists).
+    """
+    from vibroimpact.orbits.shooting import periodic_motions
+
+    inv_beta = np.asarray(inv_beta, dtype=float)
+    delta = np.asarray(delta, dtype=float)
+    types = [tuple(int(k) for k in t) for t in types]
+    ns = sorted({t[2] for t in types})
+    shape = (len(types), inv_beta.size, delta.size)
+    out = dict(exists=np.zeros(shape, bool), n_solutions=np.zeros(shape, np.int64),
+               n_stable=np.zeros(shape, np.int64), lam=np.full(shape, np.nan),
+               S=np.full(shape, np.nan))
+    index = {t: k for k, t in enumerate(types)}
+    for i, ib in enumerate(inv_beta):
+        for j, d in enumerate(delta):
+            model = Model.paper(zeta, eps, float(d), 1.0, 1.0 / float(ib), gap=gap,
+                                eps_lower=eps_lower)
+            for motion in periodic_motions(model, ns):
+                k = index.get(motion.counts + (motion.n,))
+                if k is None:
+                    continue
+                out["n_solutions"][k, i, j] += 1
+                if not motion.admissible:
+                    continue
+                out["exists"][k, i, j] = True
+                if not motion.stable:
+                    continue
+                out["n_stable"][k, i, j] += 1
+                if not motion.lam >= out["lam"][k, i, j]:      # NaN: the first stable one
+                    out["lam"][k, i, j], out["S"][k, i, j] = motion.lam, motion.S
+    out["reason"] = np.where(out["n_stable"] > 0, 0, np.where(
+        out["exists"], 3, np.where(out["n_solutions"] > 0, 2, 1))).astype(np.int64)
+    return dict(out, types=np.array(types, dtype=np.int64), inv_beta=inv_beta, delta=delta)

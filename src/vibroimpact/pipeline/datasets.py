@@ -501,7 +501,7 @@ ORBIT_META = {
 
 def orbit_map_dataset(result, attrs):
     """Dataset of :func:`vibroimpact.orbits.orbit_map` output over ``(type, inv_beta, delta)``."""
-    types = [f"{m}/{n}" for m, n in result["types"]]
+    types = [motion_key(t) for t in result["types"]]
     dims = ("type", "inv_beta", "delta")
     ds = xr.Dataset({name: (dims, result[name]) for name in ORBIT_META if name != "type"},
                     coords=dict(type=types, inv_beta=result["inv_beta"], delta=result["delta"]),

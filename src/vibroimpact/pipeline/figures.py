@@ -255,6 +255,12 @@ def rest_text(text):
     return _REST_SPECIAL.sub(r"\\\1", str(text))
 
 
+def _type_text(t):
+    """``(m/n)``, or ``(m_upper,m_lower)/n`` for a two-wall type (as `stats.motions` names
+    them; not imported here: reading a config loads no statistics)."""
+    return f"({t[0]}/{t[1]})" if len(t) == 2 else f"({t[0]},{t[1]})/{t[2]}"
+
+
 def caption(kind, name, entry, target):
     """What figure ``target`` of config entry ``name`` shows and with which parameters: one
     paragraph of reStructuredText, escaped (:func:`rest_text`), for the Snakemake report's
@@ -281,7 +287,7 @@ def caption(kind, name, entry, target):
     else:
         parts += [f"1/beta_f = {_values_text(entry['inv_beta'])}",
                   f"delta = {_values_text(entry['delta'])}",
-                  "types " + ", ".join(f"({m}/{n})" for m, n in entry.get("types", []))]
+                  "types " + ", ".join(_type_text(t) for t in entry.get("types", []))]
     sweep = entry.get("sweep")
     if sweep:
         parts.append(f"combination {sweep['index']} of sweep {sweep['name']}")

@@ -428,6 +428,23 @@ def orbit_tile(entry, tile, out, threads=None):
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
 
+def clearance_orbit_tile(entry, tile, out):
+    """Rule ``solve_clearance_orbit_tile``: the stable periodic motions of a two-wall
+    ``orbits`` entry on some 1/beta rows (`pipeline.cells.two_wall_orbit_map`: the shooting
+    solver, seeded by the simulator; a rule of its own, so that the one-wall orbit tiles'
+    code reaches no simulator)."""
+    from vibroimpact.pipeline.cells import two_wall_orbit_map
+
+    rows, n_tiles = orbit_rows(entry)
+    gap, eps_lower = walls(entry, "orbits")
+    result = two_wall_orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
+                                entry["types"], zeta=float(entry["zeta"]),
+                                eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower)
+    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                 amplitude=1.0, **_wall_attrs(gap, eps_lower))
+    io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
+
+
 def aggregate_orbits(entry, tiles, out):
     """Rule ``aggregate_orbits``: the orbit map of one entry from its tiles."""
     ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles])
@@ -444,11 +461,17 @@ BOUNDARY_TOL = 1e-9
 def boundaries(entry, orbits_path, out, threads=None):
     """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
     the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
+    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                 traced=1)
+    if entry.get("gap") is not None:
+        # the boundary tracer continues the closed-form (m/n) solutions: one wall only
+        attrs.update(_wall_attrs(*walls(entry, "orbits")), traced=0,
+                     not_traced="two walls: the edges are the map's cell edges")
+        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
+        return
     seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
     box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
                delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
-    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
-                 traced=1)
     if float(entry["eps"]) == 0.0:
         # every impact ends at rest on the wall: a flight's maximum is its start, and no
         # boundary condition is regular there (domain_boundaries refuses eps = 0)

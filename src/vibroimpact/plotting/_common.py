@@ -303,9 +303,15 @@ def no_collision_text(ds, where="in this record at any $\\delta$"):
 # The parameter line every figure prints
 # --------------------------------------------------------------------------------------------
 
+def two_wall_dataset(ds):
+    """Whether a dataset is a two-wall study's (its attribute ``n_walls`` is 2; the
+    attractor datasets' ``gap`` is their box of starts, not a wall)."""
+    return int(ds.attrs.get("n_walls", 1)) == 2
+
+
 def _system_text(ds):
     text = rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
-    if "gap" in ds.attrs:       # two walls: the second wall's place and restitution
+    if two_wall_dataset(ds):    # two walls: the second wall's place and restitution
         text += (rf";  lower wall at $\delta$ - {_num(ds.attrs['gap'])}, "
                  rf"$\varepsilon_l$ = {_num(ds.attrs['eps_lower'])}")
     return text
@@ -407,7 +413,8 @@ def _trace_figure(trace, title, harmonic):
 
     ax_a.plot(tau, trace["a"], color="C0", lw=1.0)
     # two walls: the lower wall at a = gap, its impacts drawn there
-    gap = float(trace.attrs["gap"]) if "impact_wall" in trace and "gap" in trace.attrs else 0.0
+    gap = (float(trace.attrs["gap"]) if "impact_wall" in trace and two_wall_dataset(trace)
+           else 0.0)
     ax_a.axhline(0.0, color="0.2", lw=1.4,
                  label=r"upper wall ($a = 0$)" if gap else r"wall ($a = 0$)")
     t_imp = np.asarray(trace["impact_time"])
@@ -846,7 +853,7 @@ def _events_params(events, i_beta, drawn=tuple(COLLISION_QUANTITIES)):
 
 def _two_wall_note(ds, text):
     """A quantity's definition with its wall's restitution ``eps_w`` when there are two."""
-    return text.replace(r"\varepsilon u", r"\varepsilon_w u") if "gap" in ds.attrs else text
+    return text.replace(r"\varepsilon u", r"\varepsilon_w u") if two_wall_dataset(ds) else text
 
 
 # --------------------------------------------------------------------------------------------

@@ -7,6 +7,7 @@ from vibroimpact.plotting._common import (
     SPECTRUM_BETA_MAX, _attr, _density_figure, _events_params, _figure, _header, _nearest,
     _num, _require_harmonic, _response_spectra, _styled, _trace_figure, _welch_text,
     axis_label)
+from vibroimpact.plotting._common import two_wall_dataset
 from vibroimpact.plotting.walls import two_walls, wall_density_figure
 from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
 
@@ -121,7 +122,7 @@ def _centroid_note(spectra, i_beta):
                  for k in (0, -1))
     if not (np.isfinite(at_small) and np.isfinite(at_large)):
         return ""
-    if "gap" in spectra.attrs:      # two walls: the paper's finding (one wall) is no reference
+    if two_wall_dataset(spectra):   # two walls: the paper's finding (one wall) is no reference
         return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
                 f"$\\delta$ = {_num(float(row.delta[-1]))}, {at_small:.2f} at $\\delta$ = "
                 f"{_num(float(row.delta[0]))}")

@@ -10,7 +10,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from vibroimpact.plotting._common import (_attr, _header, _nearest, _same_system, _styled,
-                                          _system_text, axis_label)
+                                          _system_text, axis_label, motion_title)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -56,7 +56,14 @@ CODIM2_STYLE = dict(ls="none", marker="o", ms=4.5, mfc="white", mew=1.0, zorder=
 COMPLEX_RTOL = 1e-7
 
 
-def complex_multipliers(orbits, m, n):
+def _type_counts(name):
+    """``(m, m_lower, n)`` of a type named ``"m/n"`` (``m_lower`` 0) or ``"(m,m_lower)/n"``."""
+    counts, n = name.rsplit("/", 1)
+    parts = [int(k) for k in counts.strip("()").split(",")]
+    return (parts + [0])[:2] + [int(n)] if len(parts) == 1 else parts + [int(n)]
+
+
+def complex_multipliers(orbits, m, n, m_lower=0):
     """Where the most stable (m/n) motion has a complex pair of multipliers.
 
     Parameters
@@ -65,6 +72,9 @@ def complex_multipliers(orbits, m, n):
         Orbit map of one type: ``lam(inv_beta, delta)``; global attributes ``zeta``, ``eps``.
     m, n : int
         The motion type.
+    m_lower : int
+        Impacts per period at the lower wall of a two-wall type ``(m, m_lower)/n`` (``m`` then
+        those at the upper wall; ``det T = eps^2m eps_lower^2m_lower e^(-2 zeta z)``).
 
     Returns
     -------
@@ -80,6 +90,13 @@ def complex_multipliers(orbits, m, n):
     """
     zeta, eps = float(_attr(orbits, "zeta")), float(_attr(orbits, "eps"))
     z = 2.0 * np.pi * n * np.asarray(orbits["inv_beta"], dtype=float)
+    if m_lower:     # two walls: m upper and m_lower lower impacts, |mu|^2 = det T
+        eps_l = float(_attr(orbits, "eps_lower"))
+        total = m + m_lower
+        lam_c = (eps ** m * eps_l ** m_lower) ** (1.0 / total) * np.exp(-zeta * z / total)
+        lam = np.asarray(orbits["lam"], dtype=float)
+        with np.errstate(invalid="ignore"):
+            return lam <= lam_c[:, None] * (1.0 + COMPLEX_RTOL)
     lam_c = eps * np.exp(-zeta * z / m)
     lam = np.asarray(orbits["lam"], dtype=float)
     with np.errstate(invalid="ignore"):
@@ -333,7 +350,7 @@ def fig16(orbits, boundaries=None):
         if boundaries is None:
             overview.add_collection(LineCollection(cell_outline(x, y, stable), colors=[color],
                                                    linewidths=1.3, capstyle="projecting"))
-        overview.plot([], [], color=color, lw=1.8, label=f"({name})")
+        overview.plot([], [], color=color, lw=1.8, label=motion_title(name))
         ax = axes[i + 1]
         reason = sel["reason"].values
         ax.pcolormesh(xe, ye, np.ma.masked_where(stable, reason).T, cmap=reason_cmap,
@@ -343,8 +360,8 @@ def fig16(orbits, boundaries=None):
         shaded = ax.pcolormesh(xe, ye, np.ma.masked_invalid(S).T, cmap="viridis_r", vmin=0.0,
                                vmax=100.0, rasterized=True)
         if stable.any():
-            m, n = (int(k) for k in name.split("/"))
-            cplx = complex_multipliers(sel, m, n) & stable
+            m, m_lower, n = _type_counts(name)
+            cplx = complex_multipliers(sel, m, n, m_lower) & stable
             real = np.where(cplx, np.nan, S).T
             if np.isfinite(real).any():
                 lines = ax.contour(x, y, real, levels=S_LEVELS, colors="k", linewidths=0.5)
@@ -361,7 +378,7 @@ def fig16(orbits, boundaries=None):
                                              linewidths=EDGE_WIDTH, capstyle="projecting",
                                              gid="stable-edge"))
         regions.append((ax, reason, stable))
-        ax.set_title(f"({name})")
+        ax.set_title(motion_title(name))
     kinds, marked = ([], False) if boundaries is None else _draw_boundaries(overview, panels,
                                                                             boundaries)
     overview.set_title("(a) stable domains")

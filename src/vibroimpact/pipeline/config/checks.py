@@ -668,18 +668,28 @@ def _check_orbits(config, name, entry, problems, limits):
         problems.add(where, name, "ends like a dataset an orbits entry derives "
                      "(results/orbits/<name>_basins.nc ...)",
                      f"a name not ending in {', '.join(DERIVED_SUFFIXES)}")
-    if _check_walls(where, entry, problems):
-        problems.add(f"{where}.gap", entry["gap"], "the closed-form (m/n) orbit map knows "
-                     "one wall (the two-wall motions come from the shooting solver, "
-                     "vibroimpact.orbits.shooting, not yet a workflow job)",
-                     "an orbits entry without gap")
+    two_walls = _check_walls(where, entry, problems)
+    if two_walls:
+        _check_two_wall_orbits(where, entry, problems)
     grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                limits["max_orbit_cells"], positive=True),
              "delta": _grid(problems, f"{where}.delta", entry["delta"],
                             limits["max_orbit_cells"])}
     if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
         _plane(problems, where, grids, "fig16")
-    for j, (m, n) in enumerate(entry["types"]):
+    for j, t in enumerate(entry["types"]):
+        if len(t) == 3:
+            if not two_walls:
+                problems.add(f"{where}.types[{j}]", t, "a two-wall type [m_upper, m_lower, n], "
+                             "and this entry has one wall (no gap)", "[m, n] pairs, or give "
+                             f"{where}.gap > 0")
+            continue
+        m, n = t
+        if two_walls:
+            problems.add(f"{where}.types[{j}]", t, "an (m/n) pair in a two-wall entry (the "
+                         "shooting solver names a motion by its impacts at each wall)",
+                         "[m_upper, m_lower, n] triples, e.g. [1, 1, 1]")
+            continue
         if m > MAX_M:
             problems.add(f"{where}.types[{j}]", [m, n], f"the orbit solver finds (m/n) motions "
                          f"with m <= {MAX_M} impacts a period only", f"[m, n] with 1 <= m <= "
@@ -691,6 +701,24 @@ def _check_orbits(config, name, entry, problems, limits):
     if entry.get("attractors"):
         _check_attractors(where, entry, problems, limits)
     _check_figures(config, "orbits", name, entry, problems, None)
+
+
+#: Periods n the two-wall orbit map solves for (the shooting solver's cost grows with n).
+MAX_SHOOTING_N = 4
+
+
+def _check_two_wall_orbits(where, entry, problems):
+    """A two-wall ``orbits`` entry: triples of at most `MAX_SHOOTING_N` periods with an
+    impact, fig16 only (no attractors block: its kernels' workflow job knows one wall)."""
+    for j, t in enumerate(entry["types"]):
+        if len(t) == 3 and (t[2] > MAX_SHOOTING_N or t[0] + t[1] < 1):
+            problems.add(f"{where}.types[{j}]", t, "a two-wall type the shooting map does not "
+                         "solve for", f"[m_upper, m_lower, n] with m_upper + m_lower >= 1 and "
+                         f"1 <= n <= {MAX_SHOOTING_N}")
+    if entry.get("attractors"):
+        problems.add(f"{where}.attractors", "...", "basins and Lyapunov exponents of a "
+                     "two-wall entry are not a workflow job yet", "leave the attractors "
+                     "block out of an entry with gap")
 
 
 def _check_attractors(where, entry, problems, limits):
