@@ -235,6 +235,17 @@ def test_the_summary_for_snakemakes_report_has_no_image_but_says_which(tmp_path)
     assert "fig.png" in text and "<table>" in text and fetched(text) == []
 
 
+def test_one_call_renders_both_files_as_two_calls_would(tmp_path):
+    """`--summary` (the report rules' single rendering process) writes the same two files."""
+    ipynb = str(_notebook(tmp_path))
+    notebook.main([ipynb, str(tmp_path / "a.html")])
+    notebook.main([ipynb, str(tmp_path / "a.summary.html"), "--no-figures"])
+    notebook.main([ipynb, str(tmp_path / "b.html"), "--summary", str(tmp_path / "b.summary.html")])
+    for name in ("html", "summary.html"):
+        assert (tmp_path / f"b.{name}").read_text() == (tmp_path / f"a.{name}").read_text()
+    assert "<img" in (tmp_path / "b.html").read_text()
+
+
 def _paper_captions():
     """``(target, caption rst)`` of every figure of every entry of the paper's config."""
     config, _ = configuration.load(root=ROOT)
@@ -411,3 +422,23 @@ def test_snakemake_report_has_each_figure_once_and_no_docutils_error(built):
     assert len(paper) == len(copies) and all(p.startswith("results/figures/") for p in paper)
     reports = [p for p in shown if p.startswith("results/reports/")]
     assert len(reports) == len(REPORTS) and all(p.endswith(".summary.html") for p in reports)
+
+
+def test_report_parameters_are_typed_as_papermills_command_line_types_them():
+    """The report rules run the notebook with papermill's Python API in the rendering process
+    (`notebook.main --execute`): each ``-p NAME VALUE`` must reach the notebook as papermill's
+    own command line would pass it (its `_resolve_type`, the reference here)."""
+    from papermill.cli import _resolve_type
+
+    values = ["True", "False", "None", "0", "-3", "1.1", "-0.5", "1e-3", "nan", "",
+              "results/datasets/random_events.nc", "a b", "0.5 0.0", "true"]
+    for value in values:
+        got, want = notebook.parameter_value(value), _resolve_type(value)
+        assert type(got) is type(want) and (got == want or (got != got and want != want)), value
+
+
+def test_report_parameters_need_a_notebook_to_execute(tmp_path, capsys):
+    with pytest.raises(SystemExit):
+        notebook.main(["-p", "study", "random", str(tmp_path / "r.ipynb"),
+                       str(tmp_path / "r.html")])
+    assert "--execute" in capsys.readouterr().err

@@ -7,6 +7,9 @@
 # The HTML reads offline: `vibroimpact.reports.notebook` renders it with nbconvert's template
 # minus what it loads from the network, the maths turned into MathML at build time. Snakemake's
 # report shows a rendering without the images (`.summary.html`): it holds every figure once.
+# One process a report (`python -m vibroimpact.reports.notebook --execute`): papermill's
+# Python API executes the notebook (its kernel a child process), then nbconvert renders both
+# HTML forms (`--summary`); papermill, nbformat and nbconvert start once.
 localrules:
     study_report,
     orbits_report,
@@ -21,12 +24,9 @@ wildcard_constraints:
 REPORT_SHELL = (
     'tmp=$(mktemp -d "$(dirname {output.ipynb})/.report.XXXXXX"); '
     "trap 'rm -rf \"$tmp\"' EXIT; "
-    "{params.python} -m papermill {input.notebook} $tmp/report.ipynb --kernel python3 --log-output "
-    "--no-progress-bar {params.arguments} > {log} 2>&1; "
-    "{params.python} -m vibroimpact.reports.notebook $tmp/report.ipynb $tmp/report.html "
-    ">> {log} 2>&1; "
-    "{params.python} -m vibroimpact.reports.notebook --no-figures $tmp/report.ipynb "
-    "$tmp/summary.html >> {log} 2>&1; "
+    "{params.python} -m vibroimpact.reports.notebook --execute {input.notebook} "
+    "{params.arguments} --summary $tmp/summary.html $tmp/report.ipynb $tmp/report.html "
+    "> {log} 2>&1; "
     "mv $tmp/summary.html {output.summary}; mv $tmp/report.html {output.html}; "
     "mv $tmp/report.ipynb {output.ipynb}"
 )
@@ -58,7 +58,7 @@ rule study_report:
         "../envs/vibroimpact.yaml"
     params:
         arguments=report_arguments,
-        python=PYTHON,  # papermill and nbconvert of the .venv, whether or not on PATH
+        python=PYTHON,  # the .venv's papermill and nbconvert, whether or not on PATH
         code=report_code,
     shell:
         REPORT_SHELL
@@ -89,7 +89,7 @@ rule orbits_report:
         "../envs/vibroimpact.yaml"
     params:
         arguments=report_arguments,
-        python=PYTHON,  # papermill and nbconvert of the .venv, whether or not on PATH
+        python=PYTHON,  # the .venv's papermill and nbconvert, whether or not on PATH
         code=report_code,
     shell:
         REPORT_SHELL
@@ -120,7 +120,7 @@ rule validation_report:
         "../envs/vibroimpact.yaml"
     params:
         arguments=report_arguments,
-        python=PYTHON,  # papermill and nbconvert of the .venv, whether or not on PATH
+        python=PYTHON,  # the .venv's papermill and nbconvert, whether or not on PATH
         code=report_code,
     shell:
         REPORT_SHELL

@@ -559,8 +559,43 @@ def render_html(ipynb, html, figures=True):
     Path(html).write_text(body, encoding="utf-8")
 
 
+def parameter_value(text):
+    """A ``-p NAME VALUE`` value as papermill's command line reads it: ``True``, ``False``,
+    ``None``, an int, a float, else the string itself."""
+    if text in ("True", "False", "None"):
+        return {"True": True, "False": False, "None": None}[text]
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return text
+
+
+def execute(notebook, ipynb, parameters):
+    """Execute the report ``notebook`` with ``parameters`` (``{name: value}``) into ``ipynb``
+    with papermill's Python API, in this process (the kernel is papermill's, a child
+    process), as ``papermill NOTEBOOK IPYNB --kernel python3 --log-output`` would: the cells'
+    output logged, the executed notebook written once at the end (not after every cell)."""
+    import logging
+
+    import papermill
+
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
+    papermill.execute_notebook(str(notebook), str(ipynb), parameters=parameters,
+                               kernel_name="python3", progress_bar=False, log_output=True,
+                               request_save_on_cell_execute=False)
+
+
 def main(argv=None):
-    """``python -m vibroimpact.reports.notebook [--no-figures] REPORT.ipynb REPORT.html``."""
+    """``python -m vibroimpact.reports.notebook [--execute NOTEBOOK [-p NAME VALUE]...]
+    [--no-figures] [--summary SUMMARY.html] REPORT.ipynb REPORT.html``.
+
+    ``--execute`` first executes ``NOTEBOOK`` with the ``-p`` parameters into
+    ``REPORT.ipynb`` (:func:`execute`); ``--summary`` also writes the rendering without images
+    (Snakemake's report's copy). The report rules run all three in this one process: papermill,
+    nbformat and nbconvert start once a report.
+    """
     import argparse
 
     parser = argparse.ArgumentParser(prog="python -m vibroimpact.reports.notebook",
@@ -568,10 +603,24 @@ def main(argv=None):
                                                  "that reads offline.")
     parser.add_argument("ipynb")
     parser.add_argument("html")
+    parser.add_argument("--execute", metavar="NOTEBOOK",
+                        help="first execute this notebook (papermill) into REPORT.ipynb")
+    parser.add_argument("-p", "--parameter", nargs=2, action="append", default=[],
+                        metavar=("NAME", "VALUE"),
+                        help="a parameter of --execute, typed as papermill's -p types it")
     parser.add_argument("--no-figures", dest="figures", action="store_false",
                         help="leave the images out (Snakemake's report shows them once)")
+    parser.add_argument("--summary", metavar="SUMMARY.html",
+                        help="also write the rendering without images to this file")
     args = parser.parse_args(argv)
+    if args.parameter and not args.execute:
+        parser.error("-p/--parameter is a parameter of --execute NOTEBOOK")
+    if args.execute:
+        execute(args.execute, args.ipynb,
+                {name: parameter_value(value) for name, value in args.parameter})
     render_html(args.ipynb, args.html, figures=args.figures)
+    if args.summary:
+        render_html(args.ipynb, args.summary, figures=False)
 
 
 if __name__ == "__main__":

@@ -39,8 +39,19 @@ MAP_CAP_FRACTION = 0.34
 #: README numbers were measured with (its cells are 15-100 times longer).
 MAP_CELL_S = 0.010
 BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
-FIGURE_S = 1.5             # one figure, start-up included
-REPORT_S = 4.0             # one report notebook executed and rendered (papermill, nbconvert)
+#: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
+#: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
+#: (each drawn alone as its job does, 2 cores under load; h37a, issue 37).
+FIGURE_S = 1.0
+#: One report notebook executed (papermill, its kernel a process of its own) and rendered
+#: twice (nbconvert) in one job, besides its start-up: 1.9 to 2.4 CPU-s a job (best of 2,
+#: load ~7) for the reports that show no map (random_force, performance, stability).
+REPORT_S = 0.8
+#: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
+#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``): 6.6 to 7.5 CPU-s for the three
+#: default reports that show the map (the motion_map and harmonic studies' and the orbits
+#: entry's, each computing the same predictors) against 2.1 for one without.
+MAP_REPORT_S = 4.8
 #: The work-precision run and the stress sample together, wall time (the work-precision job
 #: holds every core while it times): 44 + 21 s on the default build.
 VALIDATION_S = 65.0

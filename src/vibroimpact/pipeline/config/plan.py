@@ -16,8 +16,8 @@ import shutil
 from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVERHEAD,
-                                               JOB_START_S, REPORT_BYTES, REPORT_S,
-                                               VALIDATION_S)
+                                               JOB_START_S, MAP_REPORT_S, REPORT_BYTES,
+                                               REPORT_S, VALIDATION_S)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
 from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
 
@@ -158,7 +158,8 @@ def built_entries(config, own=None):
     files it needs (`vibroimpact.pipeline.targets.needed_files`, the closure of ``rule
     all``'s targets through the rules' own input functions): ``{"noises": names, "studies":
     {name: kinds}, "orbits": {name: kinds}, "figures": {owner: count}, "sweeps": names,
-    "copies": count, "reports": count, "validation": files}``."""
+    "copies": count, "reports": count, "map_reports": count, "validation": files}``
+    (``map_reports``: the reports that read a map dataset, whose predictors they compute)."""
     sections = ("studies", "orbits", "paper_figures")
     drawn = {s: set(config.get(s, {})) if own is None else set(own[s]) for s in sections}
     for fig in drawn["paper_figures"]:
@@ -166,7 +167,7 @@ def built_entries(config, own=None):
         drawn[section].add(config["paper_figures"][fig])
     needed = targets.needed_files(config, drawn)
     build = {"noises": set(), "studies": {}, "orbits": {}, "figures": {}, "sweeps": set(),
-             "copies": 0, "reports": 0, "validation": set()}
+             "copies": 0, "reports": 0, "map_reports": 0, "validation": set()}
     for name in config.get("studies", {}):
         kinds = {k for k in _STUDY_KINDS if targets.DATASETS[k].format(name=name) in needed}
         if kinds:
@@ -197,6 +198,9 @@ def built_entries(config, own=None):
             build["validation"].add(path)
         elif parts[1] == "reports":
             build["reports"] += 1
+            if path.endswith(".html") and any(p.endswith("_map.nc") for p in
+                                              targets.rule_inputs(config, drawn, path)):
+                build["map_reports"] += 1
     return drawn, build
 
 
@@ -322,7 +326,8 @@ def make_plan(config, own=None, *, results="results", studies=None):
     if reports:
         plan.rows.append(Row("reports", f"{_n(reports, 'notebook')} executed, with HTML",
                              jobs=reports, bytes=reports * REPORT_BYTES,
-                             cpu_s=reports * (REPORT_S + JOB_START_S)))
+                             cpu_s=reports * (REPORT_S + JOB_START_S)
+                             + build["map_reports"] * MAP_REPORT_S))
     validation = build["validation"]
     if validation:
         runs = sum(f.endswith(".nc") for f in validation)
