@@ -177,6 +177,15 @@ def test_a_gap_plane_resolves_each_cells_two_wall_model(tmp_path):
         (2.0, 1.1, 1.0, 0.5)]
     assert study.fixed() == {"zeta": 0.05, "eps": 0.5, "amplitude": 1.0, "delta": 1.0,
                              "eps_lower": 0.5}
+    noise = tmp_path / "tiny.nc"
+    tasks.make_noise(config["noises"]["tiny"], noise)
+    entry = config["studies"]["joint"]
+    block = {k: entry[k] for k in JOB_KEYS["map"] if k in entry}
+    tasks.map_tile("joint", block, 0, noise, tmp_path / "t0.nc")
+    tile = io.load_dataset(tmp_path / "t0.nc")
+    assert tile.attrs["eps_lower"] == 0.5 and tile.attrs["n_walls"] == 2
+    assert "gap" not in tile.attrs and "inv_beta" not in tile.attrs    # the axes
+    assert tile["wall_n_collisions"].dims == ("cell", "wall")
 
 
 def test_the_plan_says_when_a_plane_runs_for_hours(tmp_path):

@@ -100,8 +100,7 @@ def _study_attrs(study, block, noise_attrs):
         attrs = dict(provenance(block, int(noise_attrs["seed"])), study=study.name,
                      noise=block["noise"], dt=float(noise_attrs["dt"]))
         attrs.update(noise)
-        fixed = study.fixed()
-        attrs.update({k: v for k, v in fixed.items() if k not in ("gap", "eps_lower")})
+        attrs.update(study.fixed())
         if study.gap is not None:   # the second wall's words (its values: fixed or axes)
             attrs.update({k: v for k, v in _wall_attrs(1.0, 1.0).items()
                           if k not in ("gap", "eps_lower")})
