@@ -12,7 +12,7 @@ import pytest
 
 from vibroimpact import periodic_motions, periodic_orbits, simulate
 from vibroimpact.model import Model
-from vibroimpact.orbits import shooting
+from vibroimpact.attractors import shooting
 
 ZETA, EPS = 0.05, 0.5           # config/config.yaml, orbits.harmonic (Fig. 16)
 TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))

@@ -24,7 +24,7 @@ _LAZY = {
     "periodic_orbits": "vibroimpact.orbits.api",
     "PeriodicOrbit": "vibroimpact.orbits.api",
     "orbit_map": "vibroimpact.orbits.api",
-    "periodic_motions": "vibroimpact.orbits.shooting",
+    "periodic_motions": "vibroimpact.attractors.shooting",
     "domain_boundaries": "vibroimpact.orbits.boundaries",
     "attractor_map": "vibroimpact.attractors.api",
 }

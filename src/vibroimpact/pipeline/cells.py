@@ -756,7 +756,7 @@ def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None
     """Stable periodic motions of a clearance over the (1/beta_f, delta) plane (the Fig. 16
     analogue), under ``sin(beta_f tau)`` alone, from the shooting solver.
 
-    In every cell :func:`vibroimpact.orbits.shooting.periodic_motions` runs from its default
+    In every cell :func:`vibroimpact.attractors.shooting.periodic_motions` runs from its default
     settled starts for the periods n of ``types``; each motion found is assigned to the type
     ``(m_upper, m_lower, n)`` of its impacts per period at each wall.
 
@@ -783,7 +783,7 @@ def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None
     Newton converges to an unstable one from a settled start nearby: unstable motions are
     found only by chance (``n_solutions`` counts what was found, not what exists).
     """
-    from vibroimpact.orbits.shooting import periodic_motions
+    from vibroimpact.attractors.shooting import periodic_motions
 
     inv_beta = np.asarray(inv_beta, dtype=float)
     delta = np.asarray(delta, dtype=float)
