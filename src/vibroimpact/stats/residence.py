@@ -326,8 +326,9 @@ def by_state(motion_map):
     Returns
     -------
     xarray.Dataset
-        Those of the four variables the map holds, over ``("state", "inv_beta", "delta")``,
-        states named as the map's motions ("1/1", ...) then "none".
+        Those of the four variables the map holds, over ``("state", *the map's plane)``
+        (``inv_beta, delta`` for the paper's; issue 36: any two parameters), states named
+        as the map's motions ("1/1", ...) then "none".
     """
     import xarray as xr
 
@@ -337,4 +338,4 @@ def by_state(motion_map):
         motions = motion_map[name].rename(motion="state")
         none = motion_map[f"{name}_none"].expand_dims(state=["none"])
         parts[name] = xr.concat([motions, none], dim="state")
-    return xr.Dataset(parts).transpose("state", "inv_beta", "delta")
+    return xr.Dataset(parts).transpose("state", ...)
