@@ -295,7 +295,10 @@ def _study_noise_entry(study):
 
 
 def simulate_mem_mb(wildcards):
-    return costs.simulate_mem_mb(int(_study_noise_entry(wildcards.study)["n_samples"]))
+    scaled = "rms" in STUDIES[wildcards.study].axis_names  # unit record and a cell's
+    return costs.simulate_mem_mb(
+        int(_study_noise_entry(wildcards.study)["n_samples"]), records=2 if scaled else 1
+    )
 
 
 def simulate_runtime(kind):

@@ -49,11 +49,13 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact._kernel_cache import kernel_decorator
+from vibroimpact._law import LAW_MODULES, rebound_velocity
 from vibroimpact.model import Model
 
 __all__ = ["PeriodicMotion", "SkippedSeed", "MotionSet", "periodic_motions"]
 
-kernel = kernel_decorator(njit, __file__, ("shooting.py",), error_model="numpy")
+kernel = kernel_decorator(njit, __file__, ("shooting.py",) + tuple(f"../{m}" for m in LAW_MODULES),
+                          error_model="numpy")
 
 # --- thresholds, each with its reason ---------------------------------------------------------
 #: Critical-point search: initial bracket in radians of the fastest of beta and wd (x' has
@@ -355,7 +357,8 @@ def advance(t0, t1, x, v, P, M, ev_t, ev_w, ev_u, stack, out):
         t = t + s
         f = amp * math.sin(beta * t)
         a_minus = f - 2.0 * zeta * u - pos
-        a_plus = f + 2.0 * zeta * eps * u - pos
+        v_plus = rebound_velocity(eps, u)       # the impact law (vibroimpact.model)
+        a_plus = f - 2.0 * zeta * v_plus - pos
         c21 = (a_plus + eps * a_minus) / u
         m11, m12 = M[0, 0], M[0, 1]
         M[1, 0] = c21 * m11 - eps * M[1, 0]
@@ -367,7 +370,7 @@ def advance(t0, t1, x, v, P, M, ev_t, ev_w, ev_u, stack, out):
         ev_u[n_ev] = u
         n_ev += 1
         x = pos
-        v = -eps * u
+        v = v_plus
     out[0] = x
     out[1] = v
     out[2] = margin

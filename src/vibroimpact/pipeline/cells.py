@@ -61,10 +61,18 @@ WALLS = ("upper", "lower")
 def study_model(study, cell):
     """The resolved :class:`vibroimpact.model.Model` of one cell of ``study``
     (`pipeline.study.Study`): its oscillator and walls at the cell's play, forced by
-    ``amplitude sin(tau / inv_beta)``. Here, beside the simulator, not on `Study`: reading a
-    config or drawing a figure loads no kernel (the import contracts, pyproject.toml)."""
-    return Model.paper(study.zeta, study.eps, cell.delta, study.amplitude,
-                       1.0 / cell.inv_beta, **study.walls())
+    ``amplitude sin(tau / inv_beta)``; a cell of a study's ``plane`` with the plane's two
+    parameters at the cell's values (`Study.parameters`; the rms is the record's, not the
+    model's: `pipeline.tasks.map_tile` scales the record). Here, beside the simulator, not
+    on `Study`: reading a config or drawing a figure loads no kernel (the import contracts,
+    pyproject.toml)."""
+    if study.plane is None:
+        return Model.paper(study.zeta, study.eps, cell.delta, study.amplitude,
+                           1.0 / cell.inv_beta, **study.walls())
+    p = study.parameters(cell)      # a plane's cell: the fixed values with its axes in
+    walls = {} if study.gap is None else dict(gap=p["gap"], eps_lower=p["eps_lower"])
+    return Model.paper(p["zeta"], p["eps"], p["delta"], p["amplitude"], 1.0 / p["inv_beta"],
+                       **walls)
 
 
 def _walls(gap, eps_lower, eps=None):

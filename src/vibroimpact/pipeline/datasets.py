@@ -10,6 +10,20 @@ import xarray as xr
 from vibroimpact import stats
 from vibroimpact.stats.motions import motion_key
 
+#: long_name and units of the other axes a map's plane may have
+#: (`pipeline.study.PLANE_PARAMETERS`); given to a plane's map only (an escape dataset's
+#: ``rms`` keeps its own words).
+PLANE_META = {
+    "inv_beta": ("inverse forcing frequency ratio 1/beta_f", "1"),
+    "delta": ("play delta", "1"),
+    "zeta": ("damping ratio zeta", "1"),
+    "eps": ("restitution coefficient eps (of the wall at delta)", "1"),
+    "eps_lower": ("restitution coefficient eps_lower of the wall at delta - gap", "1"),
+    "gap": ("clearance gap between the walls (the lower wall at x = delta - gap)", "1"),
+    "amplitude": ("amplitude of the harmonic force", "1"),
+    "rms": ("rms of the random force r(tau)", "1"),
+}
+
 #: long_name and units of every variable the datasets hold.
 META = {
     "inv_beta": ("inverse forcing frequency ratio 1/beta_f", "1"),
@@ -222,9 +236,22 @@ def bin_edges(bins_config):
 
 
 def _cell_coords(cells):
-    """Coordinates of a tile: the cell indices and each cell's parameter values."""
-    return dict(cell=[c.index for c in cells], inv_beta_cell=("cell", [c.inv_beta for c in cells]),
-                delta_cell=("cell", [c.delta for c in cells]))
+    """Coordinates of a tile: the cell indices and each cell's values of its plane's two
+    parameters, ``<x>_cell`` and ``<y>_cell`` (the default plane's ``inv_beta_cell``,
+    ``delta_cell``)."""
+    names = list(cells[0].values) if cells else ["inv_beta", "delta"]
+    return dict(cell=[c.index for c in cells],
+                **{f"{k}_cell": ("cell", [c.values[k] for c in cells]) for k in names})
+
+
+def plane_axes(ds):
+    """``(x, y)``: the names of a map dataset's (or tile's) two grid parameters: its
+    ``axes`` attribute, the default ``("inv_beta", "delta")`` without one."""
+    axes = ds.attrs.get("axes")
+    if axes is None:
+        return ("inv_beta", "delta")
+    axes = [axes] if isinstance(axes, str) else list(axes)
+    return tuple(str(a) for a in axes)
 
 
 def _motion_names(motions):
@@ -333,10 +360,15 @@ def map_tile(cells, results, motions, attrs):
 def aggregate_map(tiles, study, attrs, n_cells=None):
     """Probability-map dataset of a study (``docs/datasets.md``) from its tiles (the axes
     the study's, or with ``study=None`` the tiles' own, `tile_axes`)."""
-    ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells)).transpose(
-        "motion", "from_motion", "to_motion", "inv_beta", "delta", ..., missing_dims="ignore")
+    names = plane_axes(tiles[0])
+    ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells), names=names).transpose(
+        "motion", "from_motion", "to_motion", *names, ..., missing_dims="ignore")
     ds.attrs = dict(attrs)
-    return _annotate(ds)
+    ds = _annotate(ds)
+    if "axes" in attrs:             # a plane's map: its axes named in words
+        for name in names:
+            ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
+    return ds
 
 
 def spectra_tile(cells, results, attrs):
@@ -369,15 +401,16 @@ def tile_axes(tiles, n_cells=None):
     n = cell.size if n_cells is None else int(n_cells)
     if not np.array_equal(cell[order], np.arange(n)):
         raise ValueError(f"tiles cover cells {cell[order].tolist()}, expected 0..{n - 1}")
-    ib = np.concatenate([np.asarray(t["inv_beta_cell"], dtype=float) for t in tiles])[order]
-    d = np.concatenate([np.asarray(t["delta_cell"], dtype=float) for t in tiles])[order]
+    x, y = plane_axes(tiles[0])
+    ib = np.concatenate([np.asarray(t[f"{x}_cell"], dtype=float) for t in tiles])[order]
+    d = np.concatenate([np.asarray(t[f"{y}_cell"], dtype=float) for t in tiles])[order]
     other = np.flatnonzero(ib != ib[0])
     n_delta = int(other[0]) if other.size else ib.size
     inv_beta, delta = ib[::n_delta], d[:n_delta]
     if (ib.size % n_delta or not np.array_equal(ib, np.repeat(inv_beta, n_delta))
             or not np.array_equal(d, np.tile(delta, inv_beta.size))):
-        raise ValueError("the tiles' cells do not form an inv_beta x delta grid "
-                         "(cell = i * n_delta + j)")
+        raise ValueError(f"the tiles' cells do not form an {x} x {y} grid "
+                         f"(cell = i * n_{y} + j)")
     return inv_beta, delta
 
 
@@ -385,19 +418,23 @@ def _axes(tiles, study, kind="events", n_cells=None):
     """The grid's axes: the study's when given, else the tiles' (`tile_axes`)."""
     if study is None:
         return tile_axes(tiles, n_cells)
+    if study.plane is not None:
+        return tuple(study.axes[k] for k in study.plane)
     return study.inv_beta, study.spectra_delta if kind == "spectra" else study.delta
 
 
-def _to_grid(tiles, inv_beta, delta):
-    """Concatenate tiles along ``cell`` and reshape to ``(inv_beta, delta, ...)``."""
+def _to_grid(tiles, inv_beta, delta, names=("inv_beta", "delta")):
+    """Concatenate tiles along ``cell`` and reshape to ``(x, y, ...)``: the plane's two
+    parameters ``names`` (default (inv_beta, delta)) with values ``inv_beta``, ``delta``."""
+    x, y = names
     ds = xr.concat(tiles, dim="cell").sortby("cell")
     n = len(inv_beta) * len(delta)
     if ds.sizes["cell"] != n or not np.array_equal(ds["cell"].values, np.arange(n)):
         raise ValueError(f"tiles cover cells {ds['cell'].values.tolist()}, expected 0..{n - 1}")
     index = xr.Coordinates.from_pandas_multiindex(
-        pd.MultiIndex.from_product([inv_beta, delta], names=["inv_beta", "delta"]), "cell")
-    ds = ds.drop_vars(["cell", "inv_beta_cell", "delta_cell"]).assign_coords(index).unstack("cell")
-    return ds.transpose("inv_beta", "delta", ...)
+        pd.MultiIndex.from_product([inv_beta, delta], names=[x, y]), "cell")
+    ds = ds.drop_vars(["cell", f"{x}_cell", f"{y}_cell"]).assign_coords(index).unstack("cell")
+    return ds.transpose(x, y, ...)
 
 
 def aggregate_events(tiles, study, attrs, n_cells=None):

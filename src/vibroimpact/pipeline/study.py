@@ -1,4 +1,8 @@
-"""A study: the physical parameters and the (1/beta, delta) grid of cells, from its config entry.
+"""A study: the physical parameters and its plane's grid of cells, from its config entry.
+
+A study's plane is (1/beta, delta) unless its ``plane`` names two other parameters of
+`PLANE_PARAMETERS` (a map over, e.g., (eps, delta)): the two named are grids, every other
+parameter is fixed.
 
 Pure functions of the config mapping (validated by ``config/schema.yaml``): the workflow
 uses them to enumerate cells and tiles, the cell jobs to find their parameters. Cells are
@@ -38,7 +42,9 @@ _PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_
 JOB_KEYS = {
     "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins",
                           "rebound_floor"),
-    "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map"),
+    # a plane's axes (``plane``) and, with the rms an axis, its grid (``rms``): a study without
+    # a plane has neither key, so its map jobs' params are those they always were
+    "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map", "plane", "rms"),
     "spectra": _PHYSICS + ("spectra",),
     "trace": _PHYSICS + ("trace",),
     # its own records (no noise file, no grid): the noise entry's spectrum and seed reach the
@@ -96,15 +102,47 @@ def grid_values(spec):
     return values
 
 
+#: The parameters a study's map may run over (``plane: [x, y]``): the model's (damping,
+#: the two walls' restitutions, the play, the clearance, the forcing's amplitude and period
+#: ratio) and the noise's rms.
+PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta", "rms")
+#: The plane of a study that names none: Fig. 15's (1/beta_f, delta).
+DEFAULT_PLANE = ("inv_beta", "delta")
+#: Of `PLANE_PARAMETERS`, those of the noise (no harmonic-force problem has them: no Fig. 16).
+NOISE_PARAMETERS = ("rms",)
+
+
+def study_plane(entry):
+    """The two axes ``(x, y)`` a study entry names in ``plane``, or None (the default plane,
+    (inv_beta, delta), as every study had before planes)."""
+    plane = entry.get("plane")
+    return None if plane is None else tuple(str(p) for p in plane)
+
+
 @dataclass(frozen=True)
 class Cell:
-    """One parameter cell: its index in the study and its parameter values."""
+    """One parameter cell: its index in the study and its parameter values.
+
+    ``i_inv_beta, i_delta`` are the cell's indices along the plane's x and y axes (the
+    default plane's (1/beta_f, delta)); ``inv_beta, delta`` its values of those two
+    parameters, whether axes or fixed. ``axes``: for a study with a ``plane``, the plane's
+    ``((x, value), (y, value))``; empty for the default plane.
+    """
 
     index: int
     i_inv_beta: int
     i_delta: int
     inv_beta: float
     delta: float
+    axes: tuple = ()
+
+    @property
+    def values(self):
+        """``{x: value, y: value}`` of the plane's axes (the default plane's ``inv_beta``,
+        ``delta``)."""
+        if self.axes:
+            return dict(self.axes)
+        return {"inv_beta": self.inv_beta, "delta": self.delta}
 
 
 @dataclass(frozen=True)
@@ -124,6 +162,11 @@ class Study:
     #: restitution (None: eps)
     gap: float | None = None
     eps_lower: float | None = None
+    #: a plane named by the entry: its axes ``(x, y)`` (None: the default (inv_beta,
+    #: delta)); the axes' values in ``axes``, the other parameters in ``fixed``. A scalar
+    #: field above that is an axis holds NaN (its values are the cells').
+    plane: tuple | None = None
+    axes: dict | None = None
 
     @classmethod
     def from_config(cls, name, entry, grids=None):
@@ -135,6 +178,8 @@ class Study:
         "spectra_delta"}``, as `pipeline.config.checks.check` returns them), used as they
         are instead of expanding them again."""
         grids = grids or {}
+        if study_plane(entry) is not None:
+            return cls._from_plane(name, entry, grids)
         amplitude = float(entry["amplitude"])
         inv_beta = (np.array([1.0]) if amplitude == 0.0 else grids["inv_beta"]
                     if grids.get("inv_beta") is not None else grid_values(entry["inv_beta"]))
@@ -155,10 +200,74 @@ class Study:
                    motions=tuple(tuple(int(k) for k in m) for m in entry.get("motions", ())),
                    gap=gap, eps_lower=eps_lower)
 
+    @classmethod
+    def _from_plane(cls, name, entry, grids):
+        """A study over the plane ``entry["plane"]`` (`from_config`)."""
+        plane = study_plane(entry)
+        axes = {}
+        for key in plane:
+            spec = entry[key]
+            if not isinstance(spec, (list, dict)):
+                raise ValueError(f"studies.{name}.{key} = {spec!r}: an axis of the plane "
+                                 f"{list(plane)} needs a grid (a list or {{start, stop, step}})")
+            axes[key] = grids[key] if grids.get(key) is not None else grid_values(spec)
+        nan = math.nan
+
+        def fixed(key, default=None):
+            if key in axes:
+                return nan
+            value = entry.get(key, default)
+            if isinstance(value, (list, dict)):
+                raise ValueError(f"studies.{name}.{key} = {value!r}: fixed in the plane "
+                                 f"{list(plane)}, so a number (only the plane's axes are grids)")
+            return None if value is None else float(value)
+
+        gap = fixed("gap")
+        eps_lower = fixed("eps_lower") if (gap is not None or "eps_lower" in axes) else None
+        if gap is not None and eps_lower is None:
+            eps_lower = fixed("eps")        # the upper wall's (NaN: eps is an axis)
+        inv_beta = axes.get("inv_beta", np.array([fixed("inv_beta")]))
+        delta = axes.get("delta", np.array([fixed("delta")]))
+        return cls(name=name, zeta=fixed("zeta"), eps=fixed("eps"),
+                   amplitude=fixed("amplitude", 0.0), inv_beta=inv_beta, delta=delta,
+                   spectra_delta=np.empty(0), tile_size=int(entry["tile_size"]),
+                   motions=tuple(tuple(int(k) for k in m) for m in entry.get("motions", ())),
+                   gap=gap, eps_lower=eps_lower, plane=plane, axes=axes)
+
     @property
     def n_walls(self):
-        """1, or 2 with a ``gap``."""
+        """1, or 2 with a ``gap`` (fixed or an axis)."""
         return 1 if self.gap is None else 2
+
+    @property
+    def axis_names(self):
+        """``(x, y)``: the plane's axes, the default ``("inv_beta", "delta")`` without one."""
+        return self.plane or DEFAULT_PLANE
+
+    def fixed(self):
+        """``{parameter: value}`` of the model's parameters that are not axes of the
+        study's plane (the dataset's ``fixed`` attribute); the second wall's only with one.
+        The noise's rms is the noise entry's, not the study's: not among them."""
+        values = dict(zeta=self.zeta, eps=self.eps, amplitude=self.amplitude,
+                      inv_beta=float(self.inv_beta[0]), delta=float(self.delta[0]))
+        if self.gap is not None:
+            values.update(gap=self.gap, eps_lower=self.eps_lower)
+        # an eps_lower that follows an eps axis is no fixed value
+        return {k: float(v) for k, v in values.items()
+                if k not in self.axis_names and not math.isnan(v)}
+
+    def parameters(self, cell):
+        """``{zeta, eps, delta, amplitude, inv_beta[, gap, eps_lower][, rms]}`` of one cell:
+        the fixed values with the cell's axes in (``rms`` only when it is an axis; an
+        ``eps_lower`` not given is the cell's ``eps``)."""
+        values = dict(zeta=self.zeta, eps=self.eps, amplitude=self.amplitude,
+                      inv_beta=cell.inv_beta, delta=cell.delta)
+        if self.gap is not None:
+            values.update(gap=self.gap, eps_lower=self.eps_lower)
+        values.update(cell.values)
+        if self.gap is not None and self.plane is not None and math.isnan(values["eps_lower"]):
+            values["eps_lower"] = values["eps"]
+        return values
 
     def walls(self):
         """``{"gap": ..., "eps_lower": ...}`` for a two-wall study (the keywords of
@@ -171,7 +280,20 @@ class Study:
 
     def cells(self, kind="events"):
         """All cells of the events grid (``inv_beta x delta``; also the map's) or of the
-        spectra grid (``kind="spectra"``)."""
+        spectra grid (``kind="spectra"``); of a study with a ``plane``, the plane's cells
+        (``x x y``, x-major: ``index = i * n_y + j``)."""
+        if self.plane is not None:
+            x, y = self.plane
+            xs, ys = self.axes[x], self.axes[y]
+            out = []
+            for i, xv in enumerate(xs):
+                for j, yv in enumerate(ys):
+                    values = {x: float(xv), y: float(yv)}
+                    out.append(Cell(i * len(ys) + j, i, j,
+                                    values.get("inv_beta", float(self.inv_beta[0])),
+                                    values.get("delta", float(self.delta[0])),
+                                    axes=((x, float(xv)), (y, float(yv)))))
+            return out
         deltas = self.spectra_delta if kind == "spectra" else self.delta
         return [Cell(i * len(deltas) + j, i, j, float(ib), float(d))
                 for i, ib in enumerate(self.inv_beta) for j, d in enumerate(deltas)]

@@ -164,11 +164,15 @@ def validation_report_inputs(vreport):
 
 
 def sweep_inputs(config, sweep):
-    """The events datasets of the studies of sweep ``sweep``, in its order."""
+    """The events datasets of the studies of sweep ``sweep``, in its order; of a sweep over
+    a plane's third parameter (its studies have a ``plane``), their map datasets (a stack
+    of maps, drawn side by side)."""
     if sweep not in config.get("sweeps", {}):
         raise ValueError(f"{sweep} is not a sweep; sweeps: "
                          f"{sorted(config.get('sweeps', {})) or 'none'}")
-    return [DATASETS["events"].format(name=study) for study in config["sweeps"][sweep]["studies"]]
+    studies = config["sweeps"][sweep]["studies"]
+    kind = "map" if config["studies"][studies[0]].get("plane") is not None else "events"
+    return [DATASETS[kind].format(name=study) for study in studies]
 
 
 def sweep_targets(config, drawn):

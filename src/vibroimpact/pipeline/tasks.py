@@ -7,8 +7,11 @@ calls, inside `logged`, and the tests call them directly. ``block`` is the part 
 entry the task reads (the workflow passes nothing else, so nothing else can rerun it).
 """
 import contextlib
+import json
 import logging
 import sys
+
+import numpy as np
 
 from vibroimpact import stats
 from vibroimpact.pipeline import datasets, io
@@ -93,11 +96,37 @@ def make_noise(entry, out):
 
 def _study_attrs(study, block, noise_attrs):
     noise = {k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}
+    if study.plane is not None:     # the fixed parameters only (the axes are coordinates)
+        attrs = dict(provenance(block, int(noise_attrs["seed"])), study=study.name,
+                     noise=block["noise"], dt=float(noise_attrs["dt"]))
+        attrs.update(noise)
+        attrs.update(study.fixed())
+        if study.gap is not None:   # the second wall's words (its values: fixed or axes)
+            attrs.update({k: v for k, v in _wall_attrs(1.0, 1.0).items()
+                          if k not in ("gap", "eps_lower")})
+        return attrs
     attrs = dict(provenance(block, int(noise_attrs["seed"])), study=study.name,
                  zeta=study.zeta, eps=study.eps, amplitude=study.amplitude,
                  noise=block["noise"], dt=float(noise_attrs["dt"]))
     attrs.update(noise)
     attrs.update(_wall_attrs(study.gap, study.eps_lower))
+    return attrs
+
+
+def _plane_attrs(study, noise_attrs):
+    """A plane study's map attributes: ``axes`` (its two parameters, x first) and ``fixed``
+    (JSON text of ``{parameter: value}`` of the others: the model's and, unless it is an
+    axis, the noise's ``rms``); none for the default plane (its datasets are those they
+    always were)."""
+    if study.plane is None:
+        return {}
+    fixed = study.fixed()
+    if "rms" not in study.plane and noise_attrs.get("noise_rms") is not None:
+        fixed["rms"] = float(noise_attrs["noise_rms"])
+    attrs = dict(axes=list(study.plane), fixed=json.dumps(fixed, sort_keys=True))
+    if "rms" in study.plane:
+        attrs["rms_axis"] = ("the noise record is generated at unit rms (noise_rms) and "
+                             "scaled by each cell's rms: every cell on the same random numbers")
     return attrs
 
 
@@ -182,6 +211,10 @@ def map_tile(name, block, tile, noise_path, out):
 
     Every cell runs from rest over the same noise record (common random numbers), so the
     differences between neighbouring cells are not sampling noise of different records.
+    A study with a ``plane`` runs each cell at its two axes' values (`Study.parameters`);
+    with the rms an axis, the record is the unit-rms one (the sweep expansion gives such a
+    study a unit-rms noise entry) scaled by each cell's rms: the same random numbers in
+    every cell (docs/datasets.md, "Maps over any two parameters").
     """
     import time
 
@@ -194,10 +227,16 @@ def map_tile(name, block, tile, noise_path, out):
     map_cap_steps(len(samples), dt, float(block["transient"]), int(spec["max_periods"]),
                   1.0 / study.inv_beta.max(), where=f"studies.{name}.map.max_periods")
 
+    unit = None
+    if "rms" in study.axis_names:       # the record at unit rms, scaled per cell
+        unit = np.asarray(samples[:], dtype=float)
+
     def run_cell(cell):
         start = time.process_time()
+        physics = _physics(study, cell)
+        record = samples if unit is None else study.parameters(cell)["rms"] * unit
         result = cells.motion_map_cell(
-            samples, dt, **_physics(study, cell), transient=float(block["transient"]),
+            record, dt, **physics, transient=float(block["transient"]),
             motions=study.motions, window=float(block["motion_window"]),
             n_batches=int(block["n_batches"]), target_stderr=float(spec["target_stderr"]),
             min_time=float(spec["min_time"]), max_periods=int(spec["max_periods"]),
@@ -209,7 +248,7 @@ def map_tile(name, block, tile, noise_path, out):
         return result
 
     def to_dataset(tile_cells, results):
-        attrs = dict(_study_attrs(study, block, noise_attrs),
+        attrs = dict(_study_attrs(study, block, noise_attrs), **_plane_attrs(study, noise_attrs),
                      motion_window=float(block["motion_window"]),
                      n_batches=int(block["n_batches"]),
                      **{k: spec[k] for k in ("target_stderr", "min_time", "max_periods",
@@ -323,10 +362,13 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
     """Rules ``aggregate_events`` / ``aggregate_spectra`` / ``aggregate_map``: a study's
     dataset. The grid's axes are the tiles' own (`datasets.tile_axes`: the values their
     cells ran with), not the config's grid expanded once more."""
-    zeta = float(block["zeta"])
     # the grid's size (counted, not expanded): a missing tile is an error
-    rows = grid_size(block["inv_beta"]) if float(block["amplitude"]) != 0.0 else 1
-    n_cells = rows * grid_size((block["spectra"] if kind == "spectra" else block)["delta"])
+    if block.get("plane") is not None:      # a plane's map: its two axes' grids
+        x, y = block["plane"]
+        n_cells = grid_size(block[x]) * grid_size(block[y])
+    else:
+        rows = grid_size(block["inv_beta"]) if float(block["amplitude"]) != 0.0 else 1
+        n_cells = rows * grid_size((block["spectra"] if kind == "spectra" else block)["delta"])
     parts = [io.load_dataset(p) for p in tiles]
     attrs = dict(parts[0].attrs)
     attrs.update(provenance(block, attrs.get("seed")))
@@ -334,7 +376,7 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
         if float(attrs.get("amplitude", 0.0)) == 0.0:
             # the wall-free response's std's: fig09 draws Rice's large-play asymptotes
             sigma_x, sigma_v = stats.linear_response_std(
-                io.noise_spec(attrs).psd_piecewise_linear, zeta)
+                io.noise_spec(attrs).psd_piecewise_linear, float(block["zeta"]))
             attrs.update(linear_sigma_x=sigma_x, linear_sigma_v=sigma_v)
         ds = datasets.aggregate_events(parts, None, attrs, n_cells=n_cells)
     elif kind == "map":
@@ -343,7 +385,7 @@ def aggregate(name, block, kind, tiles, out, noise_path=None):
         spec = io.noise_spec(io.read_noise_attrs(noise_path))
         ds = datasets.aggregate_spectra(parts, None, spec, attrs,
                                         input_correlation=io.read_input_correlation(noise_path),
-                                        zeta=zeta, n_cells=n_cells)
+                                        zeta=float(block["zeta"]), n_cells=n_cells)
     io.write_dataset(ds, out)
 
 

@@ -10,6 +10,7 @@ reading offline: the maths turned into MathML at build time, no script or styles
 from the network (nbconvert's template would load require.js, MathJax and mermaid from a CDN).
 """
 from pathlib import Path
+import json
 import re
 import warnings
 
@@ -155,12 +156,21 @@ def study_settings(ds, name=""):
     skipped = () if float(ds.attrs.get("amplitude", 1.0)) != 0.0 else _HARMONIC_ONLY
     values = {"entry": name} if name else {}
     values.update({k: ds.attrs[k] for k in _SYSTEM if k in ds.attrs})
-    values.update({f"{d} grid": _grid_text(ds[d].values) for d in ("inv_beta", "delta")
-                   if d in ds.dims and d not in skipped})
+    if "axes" in ds.attrs:      # a map over any two parameters: its plane and what is fixed
+        axes = _plane(ds)
+        values.update({"plane": " x ".join(axes)})
+        values.update({f"{d} grid": _grid_text(ds[d].values) for d in axes})
+        fixed = json.loads(ds.attrs["fixed"])
+        values.update({"fixed": ", ".join(fixed)})
+        values.update({k: v for k, v in fixed.items() if k not in values})
+        skipped = tuple(skipped) + axes + ("noise_rms",) * ("rms" in axes)
+    else:
+        values.update({f"{d} grid": _grid_text(ds[d].values) for d in ("inv_beta", "delta")
+                       if d in ds.dims and d not in skipped})
     values.update({label: ds.attrs[k] for k, label in _TRACE
                    if k in ds.attrs and k not in ds.dims and k not in skipped})
     values.update({"noise" if label == "noise" else f"noise {label}": ds.attrs[k]
-                   for k, label in _NOISE if k in ds.attrs})
+                   for k, label in _NOISE if k in ds.attrs and k not in skipped})
     values.update({k: ds.attrs[k] for k in _RECORD if k in ds.attrs and k not in skipped})
     values.update({k: ds.attrs[k] for k in sorted(ds.attrs) if k.startswith("sweep")})
     return pd.Series({k: _text(v) for k, v in values.items()}, name="value").to_frame()
@@ -174,6 +184,13 @@ def map_agreement(motion_map, orbits):
     from vibroimpact.plotting.maps import map_agreement as agreement
 
     return agreement(motion_map, orbits)
+
+
+def _plane(motion_map):
+    """The map's two grid dims (`vibroimpact.reports.switching`: its ``axes``)."""
+    from vibroimpact.reports.switching import _plane as plane
+
+    return plane(motion_map)
 
 
 def map_summary(motion_map):
@@ -194,7 +211,8 @@ def map_summary(motion_map):
             rows[label.format(m=m)] = {"cells with P >= 50 %": int((p >= 0.5).sum()),
                                        "largest P": f"{float(p.max()):.2f}"}
     table = pd.DataFrame.from_dict(rows, orient="index")
-    cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
+    x, y = _plane(motion_map)
+    cells = motion_map.sizes[x] * motion_map.sizes[y]
     table.attrs["note"] = (f"{cells} cells; {100 * float(motion_map.reached.mean()):.1f} % "
                            f"reached the target standard error, "
                            f"{int(motion_map.few_switches.sum())} hatched (too few switches)")
@@ -792,6 +810,29 @@ def is_map_study(events="", spectra="", map=""):
     return bool(map) and not events and not spectra
 
 
+#: The paper's symbols of the parameters a map's plane may have (the report's words).
+_SYMBOLS = {"inv_beta": "1/\\beta_f", "delta": "\\delta", "zeta": "\\zeta", "eps": "\\epsilon",
+            "eps_lower": "\\epsilon_l", "gap": "g", "amplitude": "A", "rms": "\\sigma_r"}
+
+
+def _plane_words(map_path):
+    """``$(1/\\beta_f, \\delta)$``, or the plane the map at ``map_path`` names in its
+    ``axes`` attribute (a map over any two parameters)."""
+    axes = None
+    if map_path:
+        try:
+            import xarray as xr
+
+            with xr.open_dataset(map_path) as ds:
+                axes = ds.attrs.get("axes")
+        except (OSError, ValueError):
+            axes = None
+    if axes is None:
+        return "$(1/\\beta_f, \\delta)$"
+    axes = [axes] if isinstance(axes, str) else list(axes)
+    return "$(" + ", ".join(_SYMBOLS.get(str(a), str(a)) for a in axes) + ")$"
+
+
 def harmonic_heading(study, events="", spectra="", map="", figures=""):
     """The title and opening of a harmonic-plus-random report, from what the study has.
 
@@ -807,7 +848,7 @@ def harmonic_heading(study, events="", spectra="", map="", figures=""):
         return Markdown(
             f"# Harmonic plus random force: the probability map of study `{study}` "
             f"(paper section 5, {shown or 'Fig. 15'}{against})\n\n"
-            "A map study runs one record per cell of the $(1/\\beta_f, \\delta)$ plane under "
+            f"A map study runs one record per cell of the {_plane_words(map)} plane under "
             "$A \\sin(\\beta_f \\tau) + r(\\tau)$ and keeps, per cell, the fraction of time "
             "the mass spends in each periodic $(m/n)$ motion (its probability $P$, extended "
             "until its standard error reaches the target), how often it switches between "
@@ -848,7 +889,8 @@ def map_audit(motion_map):
     worst = float(motion_map.probability_stderr.where(reached).max()) if bool(
         reached.any()) else np.nan
     flagged = reached & (motion_map.probability_stderr > target).any("motion")
-    cells = motion_map.sizes["inv_beta"] * motion_map.sizes["delta"]
+    x, y = _plane(motion_map)
+    cells = motion_map.sizes[x] * motion_map.sizes[y]
     failed = int(outside.sum()) + int(flagged.sum())
     verdict = "**Self-audit passed:**" if failed == 0 else "**Self-audit FAILED:**"
     text = (f"{verdict} a map study keeps no impact record, so the two exact identities of "
@@ -861,8 +903,8 @@ def map_audit(motion_map):
             + (f", {int(flagged.sum())} above the target" if int(flagged.sum()) else "")
             + ".")
     if failed:
-        bad = (outside | flagged).stack(cell=("inv_beta", "delta"))
-        where = [f"(1/beta_f = {ib:.4g}, delta = {d:.4g})"
+        bad = (outside | flagged).transpose(x, y).stack(cell=(x, y))
+        where = [f"({x.replace('inv_beta', '1/beta_f')} = {ib:.4g}, {y} = {d:.4g})"
                  for ib, d in bad.cell.values[bad.values][:AUDIT_WORST]]
         text += " Failing cells: " + ", ".join(where) + "."
     return Markdown(text)

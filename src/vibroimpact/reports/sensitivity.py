@@ -94,9 +94,20 @@ def rule_sensitivity(events=None, motion_map=None, deltas=None, map_cells=((2.0,
                             rows.append(_row(vals, f"P({motion}){suffix}", **where))
     if _has_rules(motion_map):
         rules = [str(r) for r in motion_map.rule.values]
-        for inv_beta, delta in map_cells:
-            cell = motion_map.sel(inv_beta=inv_beta, delta=delta, method="nearest")
-            where = dict(dataset="map", inv_beta=float(cell.inv_beta), delta=float(cell.delta))
+        axes = motion_map.attrs.get("axes")
+        if axes is not None:    # a map over another plane: its middle cell, named by its axes
+            x, y = (str(a) for a in axes)
+            middle = {x: motion_map.sizes[x] // 2, y: motion_map.sizes[y] // 2}
+            picked = [motion_map.isel(middle)]
+        else:
+            picked = [motion_map.sel(inv_beta=inv_beta, delta=delta, method="nearest")
+                      for inv_beta, delta in map_cells]
+        for cell in picked:
+            where = dict(dataset="map", inv_beta=float(cell.inv_beta),
+                         delta=float(cell.delta))
+            if axes is not None:        # the plane's values (a fixed one is an attribute)
+                where.update(inv_beta=math.nan, delta=math.nan)
+                where.update({str(a): float(cell[str(a)]) for a in axes})
             for motion in cell.motion.values:
                 for var, suffix in (("rule_probability", ""), ("rule_stick_probability",
                                                                " stick")):

@@ -22,6 +22,15 @@ __all__ = ["stationary_check", "markov_cells", "markov_summary"]
 _PLANE = ("inv_beta", "delta")
 
 
+def _plane(motion_map):
+    """The map's two grid dims, x first: its ``axes`` attribute (a map over any two
+    parameters, docs/datasets.md), the default (inv_beta, delta) without one."""
+    axes = motion_map.attrs.get("axes")
+    if axes is None:
+        return _PLANE
+    return tuple(str(a) for a in ([axes] if isinstance(axes, str) else axes))
+
+
 def stationary_check(motion_map):
     """The rate matrix's stationary distribution against the stored fractions of time.
 
@@ -40,18 +49,19 @@ def stationary_check(motion_map):
     """
     from vibroimpact import stats
 
-    rate = motion_map["switch_rate"].transpose(*_PLANE, "from_motion", "to_motion").values
+    plane = _plane(motion_map)
+    rate = motion_map["switch_rate"].transpose(*plane, "from_motion", "to_motion").values
     p = (motion_map["probability"] + motion_map["stick_probability"]).transpose(
-        *_PLANE, "motion").values
+        *_plane(motion_map), "motion").values
     err = np.hypot(motion_map["probability_stderr"], motion_map["stick_probability_stderr"])
-    err = err.transpose(*_PLANE, "motion").values
+    err = err.transpose(*_plane(motion_map), "motion").values
     fraction = np.concatenate([p, 1.0 - p.sum(axis=-1, keepdims=True)], axis=-1)
     stderr = np.concatenate([err, np.sqrt((err ** 2).sum(axis=-1, keepdims=True))], axis=-1)
     pi = np.stack([[stats.stationary_distribution(r) for r in row] for row in rate])
     switches = motion_map["switch_count"].sum(("from_motion", "to_motion"))
     return dict(pi=pi, fraction=fraction, stderr=stderr,
                 within=np.abs(pi - fraction) <= stderr,
-                n_switches=switches.transpose(*_PLANE).values)
+                n_switches=switches.transpose(*_plane(motion_map)).values)
 
 
 def _unit(state):
@@ -75,7 +85,7 @@ def markov_cells(motion_map):
     stay = stats.by_state(motion_map)
     out = {}
     for state in (str(s) for s in stay["state"].values):
-        r = stay.sel(state=state).transpose(*_PLANE, ...)
+        r = stay.sel(state=state).transpose(*_plane(motion_map), ...)
         out[state] = stats.markov_residence_check(
             r["residence_time"].values, r["residence_time_stderr"].values,
             r["n_stretches"].values, unit=_unit(state))
@@ -85,7 +95,8 @@ def markov_cells(motion_map):
 def _where(motion_map, mask, limit=6):
     """The cells of ``mask`` as text, ``(1/beta_f, delta)`` pairs, at most ``limit`` of them."""
     i, j = np.nonzero(mask)
-    x, y = motion_map["inv_beta"].values[i], motion_map["delta"].values[j]
+    xn, yn = _plane(motion_map)
+    x, y = motion_map[xn].values[i], motion_map[yn].values[j]
     cells = [f"({a:.3g}, {b:.3g})" for a, b in zip(x, y)]
     more = f" and {len(cells) - limit} more" if len(cells) > limit else ""
     return ", ".join(cells[:limit]) + more
@@ -110,7 +121,7 @@ def markov_summary(motion_map):
     stretches = by_state(motion_map)["n_stretches"]
     rows = {}
     for state, check in markov_cells(motion_map).items():
-        n = stretches.sel(state=state).transpose(*_PLANE).values
+        n = stretches.sel(state=state).transpose(*_plane(motion_map)).values
         enough = (n >= MARKOV_MIN_STRETCHES) & np.isfinite(check.cv)
         judged = np.isfinite(check.markov)
         regular = judged & (check.markov == 0.0) & (check.z < 0)
@@ -124,7 +135,8 @@ def markov_summary(motion_map):
             "median CV": f"{np.median(check.cv[enough]):.2f}" if enough.any() else "",
             "median Markov CV": (f"{np.median(check.cv_markov[judged]):.2f}"
                                  if judged.any() else "not judged" if not verdict else ""),
-            "not Markov at (1/beta_f, delta)": _where(motion_map, regular | irregular),
+            f"not Markov at ({', '.join(_plane(motion_map))})".replace(
+                "inv_beta", "1/beta_f"): _where(motion_map, regular | irregular),
         }
     table = pd.DataFrame.from_dict(rows, orient="index")
     table.attrs["note"] = _bookkeeping_text(motion_map)

@@ -17,8 +17,9 @@ import numpy as np
 from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time, cutoff
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
-from vibroimpact.pipeline.study import (escape_samples, grid_decimals, grid_size, grid_values,
-                                        map_cap_steps, noise_record)
+from vibroimpact.pipeline.study import (NOISE_PARAMETERS, PLANE_PARAMETERS, escape_samples,
+                                        grid_decimals, grid_size, grid_values, map_cap_steps,
+                                        noise_record)
 
 __all__ = ["GRID_RTOL", "check"]
 
@@ -273,8 +274,51 @@ def _check_walls(where, entry, problems):
     return True
 
 
+def _check_motions(where, entry, two_walls, problems):
+    """The motions a study classifies: walls, repeats, ratios that cannot be told apart."""
+    motions = [tuple(m) for m in entry["motions"]]
+    walled = [list(m) for m in motions if len(m) == 3]
+    if walled and not two_walls:
+        problems.add(f"{where}.motions", walled, "two-wall motions [m_upper, m_lower, n], "
+                     "and this study has one wall (no gap)", "[m, n] pairs, or give "
+                     f"{where}.gap > 0")
+    for m in walled:
+        if m[0] + m[1] < 1:
+            problems.add(f"{where}.motions", m, "a motion without a collision",
+                         "[m_upper, m_lower, n] with m_upper + m_lower >= 1")
+    if len(set(motions)) != len(motions):
+        problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
+                     "distinct [m, n] pairs")
+    else:
+        ratios = {}
+        for m, n_ in (m for m in motions if len(m) == 2):
+            first = ratios.setdefault(Fraction(n_, m), (m, n_))
+            if first != (m, n_):
+                problems.add(f"{where}.motions", entry["motions"],
+                             f"({m}/{n_}) has z_j/z = {_num(n_ / m)} like ({first[0]}/"
+                             f"{first[1]}): the classification on z_j/z cannot tell them apart",
+                             "[m, n] pairs of distinct n/m")
+
+
 def _check_study(config, name, entry, problems, limits, unforced):
     where = f"studies.{name}"
+    if entry.get("plane") is not None:
+        return _check_plane_study(config, name, entry, problems, limits, unforced)
+    shapes_ok = True
+    for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
+        if key in ("inv_beta", "delta"):
+            if not isinstance(entry.get(key, []), (list, dict)):
+                shapes_ok = False
+                problems.add(f"{where}.{key}", entry[key], "a number, and this study has no "
+                             "plane that fixes it", f"a grid (a list or {{start, stop, step}}), "
+                             f"or a `plane` that does not name {key}")
+        elif isinstance(entry.get(key), (list, dict)):
+            shapes_ok = False
+            problems.add(f"{where}.{key}", entry[key], "a grid, and this study has no plane "
+                         "naming it", f"a number, or `plane: [{key}, delta]` (say) to map over "
+                         f"it")
+    if not shapes_ok:
+        return None
     two_walls = _check_walls(where, entry, problems)
     siblings = {name}           # itself, or every study of its sweep
     if "sweep" in entry:
@@ -379,28 +423,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
             if not _on_grid(v, grids["delta"]):
                 problems.add(f"{where}.density_delta[{j}]", v, "not on the delta grid",
                              _grid_text(grids["delta"]))
-    motions = [tuple(m) for m in entry["motions"]]
-    walled = [list(m) for m in motions if len(m) == 3]
-    if walled and not two_walls:
-        problems.add(f"{where}.motions", walled, "two-wall motions [m_upper, m_lower, n], "
-                     "and this study has one wall (no gap)", "[m, n] pairs, or give "
-                     f"{where}.gap > 0")
-    for m in walled:
-        if m[0] + m[1] < 1:
-            problems.add(f"{where}.motions", m, "a motion without a collision",
-                         "[m_upper, m_lower, n] with m_upper + m_lower >= 1")
-    if len(set(motions)) != len(motions):
-        problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
-                     "distinct [m, n] pairs")
-    else:
-        ratios = {}
-        for m, n_ in (m for m in motions if len(m) == 2):
-            first = ratios.setdefault(Fraction(n_, m), (m, n_))
-            if first != (m, n_):
-                problems.add(f"{where}.motions", entry["motions"],
-                             f"({m}/{n_}) has z_j/z = {_num(n_ / m)} like ({first[0]}/"
-                             f"{first[1]}): the classification on z_j/z cannot tell them apart",
-                             "[m, n] pairs of distinct n/m")
+    _check_motions(where, entry, two_walls, problems)
     if "map" in uses and harmonic and grids["inv_beta"] is not None:
         spec = entry["map"]
         try:        # the cap of the longest forcing period (the job's own check, at parse time)
@@ -420,6 +443,141 @@ def _check_study(config, name, entry, problems, limits, unforced):
         _check_figures(config, "studies", name, entry, problems, grids)
     resolved.update(grids)
     return resolved
+
+#: The bounds of each parameter a plane may run over, as (test, allowed) (the schema's for a
+#: number: an axis's values are checked here, after its grid is expanded).
+_AXIS_BOUNDS = {
+    "zeta": (lambda v: 0.0 < v <= 0.9999, "0 < zeta <= 0.9999"),
+    "eps": (lambda v: 0.0 <= v <= 1.0, "0 <= eps <= 1"),
+    "eps_lower": (lambda v: 0.0 <= v <= 1.0, "0 <= eps_lower <= 1"),
+    "gap": (lambda v: v > 0.0, "gap > 0"),
+    "amplitude": (lambda v: v != 0.0, "amplitude != 0 (a map needs the harmonic force)"),
+    "inv_beta": (lambda v: v > 0.0, "1/beta_f > 0"),
+    "rms": (lambda v: v >= 0.0, "rms >= 0"),
+    "delta": (lambda v: True, "any play"),
+}
+#: The figures a study with a plane draws: its map's (fig15_vs_fig16 needs an orbits entry
+#: over the same plane, which the workflow does not make yet).
+PLANE_FIGURES = ("fig15", "residence")
+
+
+def _check_plane_study(config, name, entry, problems, limits, unforced):
+    """The checks of a study with a ``plane``: its two axes are grids of values in their
+    bounds, every other parameter a number, only map figures (Fig. 16 not over a noise
+    parameter), the record long enough for the map's cap. Returns its grids (the axes', and
+    the fixed ``inv_beta``, ``delta`` as one-value arrays) or None."""
+    where = f"studies.{name}"
+    plane = list(entry["plane"])
+    grids, ok = {}, True
+    for key in plane:
+        spec = entry.get(key)
+        if key == "inv_beta" and spec == unforced:
+            spec = None         # the schema's default: left out (a one-value axis anyway)
+        if spec is None:
+            problems.add(f"{where}.{key}", None, f"missing: an axis of the plane {plane}",
+                         f"a grid under {key}: a list or {{start, stop, step}}")
+            ok = False
+            continue
+        if not isinstance(spec, (list, dict)):
+            problems.add(f"{where}.{key}", spec, f"a number, and {key} is an axis of the "
+                         f"plane {plane}", f"a grid (a list or {{start, stop, step}}), or a "
+                         f"plane that does not name {key}")
+            ok = False
+            continue
+        values = _grid(problems, f"{where}.{key}", spec, limits["max_cells"])
+        if values is None:
+            ok = False
+            continue
+        test, allowed_ = _AXIS_BOUNDS[key]
+        bad = [float(v) for v in values if not test(float(v))]
+        if bad:
+            problems.add(f"{where}.{key}", spec, f"holds {_num(bad[0])}", allowed_)
+            ok = False
+            continue
+        grids[key] = values
+    for key in PLANE_PARAMETERS:
+        if key in plane or key not in entry:
+            continue
+        value = entry[key]
+        if key == "inv_beta" and value == unforced:
+            problems.add(f"{where}.inv_beta", None, f"missing: the plane {plane} fixes "
+                         f"1/beta_f", "a number > 0 under inv_beta (a map needs the "
+                         "forcing period)")
+            ok = False
+        elif isinstance(value, (list, dict)):
+            problems.add(f"{where}.{key}", value, f"a grid, and {key} is fixed in the plane "
+                         f"{plane} (only the plane's axes are grids)",
+                         f"a number, or name {key} in the plane (a sweep of maps: a list "
+                         f"under zeta, eps, amplitude, rms or seed that the plane does not "
+                         f"name, one study each)")
+            ok = False
+    if "amplitude" not in plane and not float(entry["amplitude"]):
+        problems.add(f"{where}.amplitude", entry["amplitude"], "a study with a plane draws "
+                     "its map, which needs the harmonic force", "amplitude != 0")
+        ok = False
+    if "gap" not in plane:
+        _check_walls(where, entry, problems)
+    two_walls = entry.get("gap") is not None
+    if entry["noise"] not in config["noises"]:
+        problems.add(f"{where}.noise", entry["noise"], "no such noise record",
+                     ", ".join(sorted(config["noises"])))
+        return None
+    for block in ("spectra", "trace", "escape"):
+        if entry.get(block):
+            problems.add(f"{where}.{block}", None, f"a study with a plane ({plane}) draws its "
+                         "map only", f"leave {block} out, or put it in a study without a plane")
+    for i, item in enumerate(entry["figures"]):
+        fig = item if isinstance(item, str) else item["name"]
+        if fig == "fig15_vs_fig16" and set(plane) & set(NOISE_PARAMETERS):
+            noise_axis = sorted(set(plane) & set(NOISE_PARAMETERS))[0]
+            problems.add(f"{where}.figures[{i}]", fig, f"Fig. 16 is the harmonic-force "
+                         f"problem's, which has no {noise_axis} (a parameter of the noise): "
+                         f"the plane {plane} has no Fig. 16", ", ".join(PLANE_FIGURES))
+            ok = False
+        elif fig == "fig15_vs_fig16":
+            problems.add(f"{where}.figures[{i}]", fig, f"needs Fig. 16 over the plane "
+                         f"{plane}, and an orbits entry maps (1/beta_f, delta) only (over "
+                         f"another plane: vibroimpact.orbits.plane.orbit_plane, not yet a "
+                         f"workflow job)", ", ".join(PLANE_FIGURES))
+            ok = False
+        elif fig not in PLANE_FIGURES:
+            problems.add(f"{where}.figures[{i}]", fig, f"a study with a plane ({plane}) "
+                         "draws its map only", ", ".join(PLANE_FIGURES))
+            ok = False
+    _check_motions(where, entry, two_walls, problems)
+    n, dt, tau = noise_record(config["noises"][entry["noise"]])
+    transient = float(entry["transient"])
+    if transient >= tau:
+        problems.add(f"{where}.transient", transient, "leaves no record for the statistics "
+                     f"(the record of noises.{entry['noise']} ends at tau = {tau:.6g})",
+                     f"0 <= transient < {tau:.6g}")
+        return None
+    if not ok:
+        return None
+    for key in ("inv_beta", "delta"):
+        if key not in grids:
+            grids[key] = np.array([float(entry[key])])
+    if float(grids["inv_beta"].min()) < dt / (2 * math.pi):
+        problems.add(f"{where}.inv_beta", float(grids["inv_beta"].min()), "a forcing period "
+                     f"2 pi/beta_f shorter than the sample step dt = {_num(dt)}",
+                     f"1/beta_f >= dt/(2 pi) = {dt / (2 * math.pi):.6g}")
+        return None
+    spec = entry["map"]
+    try:
+        map_cap_steps(n, dt, transient, int(spec["max_periods"]),
+                      1.0 / float(grids["inv_beta"].max()), where=f"{where}.map.max_periods")
+    except ValueError as err:
+        problems.append(f"{err} in noises.{entry['noise']}")
+    if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
+        problems.add(f"{where}.map.min_time", spec["min_time"], "transient + min_time is "
+                     f"beyond the record (tau <= {tau:.6g})",
+                     f"0 < min_time <= {tau - transient:.6g}")
+    for key in plane:
+        if grids[key].size < 2:
+            problems.add(f"{where}.{key}", entry[key], f"fig15 draws contours over the "
+                         f"plane {plane}", "at least 2 values")
+    _check_figures(config, "studies", name, entry, problems, grids)
+    return dict(grids, spectra_delta=None)
 
 
 #: Shortest batch of the batch-means standard errors: a natural period 2 pi (time units),

@@ -7,8 +7,9 @@ measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job c
 """
 from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps
 
-__all__ = ["record_steps", "map_steps", "study_steps", "simulate_cpu_s", "simulate_runtime_min",
-           "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
+__all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
+           "simulate_cpu_s",
+           "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
@@ -30,6 +31,13 @@ US_PER_START = 70.0
 #: map (its `record_end` summed: 1.42e9 steps against 4.18e9 at the caps). A map whose cells
 #: all run to the cap costs up to 1 / 0.34 = 2.9 times the plan's figure.
 MAP_CAP_FRACTION = 0.34
+#: A map cell's CPU besides its sample steps (its precision checks regroup the collisions
+#: and classify the intervals in Python): measured on config/examples/planes.yaml, fresh
+#: builds on a shared 2-core node, 1.8-2.0 s of cell CPU over 153-204 cells of 1e4-7e4 steps
+#: (~10 ms a cell; the steps at NS_PER_STEP give 0.1-0.2 s). Costed for the cells of a plane
+#: (`plane_map_cpu_s`), whose short caps it dominates; the paper's map keeps the model its
+#: README numbers were measured with (its cells are 15-100 times longer).
+MAP_CELL_S = 0.010
 BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
 #: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
@@ -97,6 +105,27 @@ def study_steps(kind, entry, noise, inv_beta=None):
     return record_steps(n, dt, block.get("t_end"))
 
 
+def plane_cap_steps(study, entry, noise):
+    """Sample steps of every map cell of a study with a ``plane``, each run to its cap at
+    its own forcing period (`map_steps`; the rms, the walls and the restitution do not move
+    the cap, only how soon a cell reaches its precision)."""
+    n, dt = int(noise["n_samples"]), float(noise["dt"])
+    transient, max_periods = float(entry["transient"]), int(entry["map"]["max_periods"])
+    per_period = {}
+    for cell in study.cells():
+        if cell.inv_beta not in per_period:
+            per_period[cell.inv_beta] = map_steps(n, dt, transient, max_periods, cell.inv_beta)
+    return float(sum(per_period[cell.inv_beta] for cell in study.cells()))
+
+
+def plane_map_cpu_s(study, entry, noise):
+    """CPU seconds of the map cells of a study with a ``plane``: every cell's cap
+    (`plane_cap_steps`) at `MAP_CAP_FRACTION`, plus `MAP_CELL_S` a cell."""
+    cells = len(study.cells())
+    return (simulate_cpu_s(1, plane_cap_steps(study, entry, noise) * MAP_CAP_FRACTION)
+            + cells * MAP_CELL_S)
+
+
 def simulate_cpu_s(cells, steps, audit=False):
     """CPU seconds of ``cells`` cells of ``steps`` sample steps each (``audit``: events cells,
     which also integrate the power balance and the virial over every step)."""
@@ -108,9 +137,11 @@ def simulate_runtime_min(cells, steps, audit=False):
     return RUNTIME_FLOOR_MIN + int(simulate_cpu_s(cells, steps, audit) * RUNTIME_MARGIN / 60)
 
 
-def simulate_mem_mb(n_samples):
-    """Memory (MB) of a simulate job over a noise record of ``n_samples`` samples."""
-    return BASE_MEM_MB + SIMULATE_BUFFERS_MB + -(-8 * n_samples // 2**20)
+def simulate_mem_mb(n_samples, records=1):
+    """Memory (MB) of a simulate job over a noise record of ``n_samples`` samples
+    (``records``: copies of it held at once; 2 for a map over the rms, which scales the
+    unit-rms record into a cell's)."""
+    return BASE_MEM_MB + SIMULATE_BUFFERS_MB + records * -(-8 * n_samples // 2**20)
 
 
 def noise_cpu_s(n_samples):

@@ -239,12 +239,23 @@ def make_plan(config, own=None, *, results="results", studies=None):
             parts.append(f"events {_n(cells, 'cell')}")
         if "map" in needs:
             cells = len(study.cells("events"))
-            cap = sum(len(study.delta) * costs.study_steps("map", entry, noise, float(ib))
-                      for ib in study.inv_beta)
-            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200,
-                 costs.simulate_cpu_s(1, cap * costs.MAP_CAP_FRACTION))
-            parts.append(f"map {_n(cells, 'cell')} (CPU at {costs.MAP_CAP_FRACTION:g} of the "
-                         f"caps, the paper map's mean; <= x{1 / costs.MAP_CAP_FRACTION:.1f})")
+            if study.plane is None:
+                cap = sum(len(study.delta) * costs.study_steps("map", entry, noise, float(ib))
+                          for ib in study.inv_beta)
+                cpu = costs.simulate_cpu_s(1, cap * costs.MAP_CAP_FRACTION)
+            else:       # any plane: each cell's cap at its own forcing period
+                cpu = costs.plane_map_cpu_s(study, entry, noise)
+            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200, cpu)
+            if study.plane is None:
+                parts.append(f"map {_n(cells, 'cell')} (CPU at {costs.MAP_CAP_FRACTION:g} of "
+                             f"the caps, the paper map's mean; <= "
+                             f"x{1 / costs.MAP_CAP_FRACTION:.1f})"
+                             + _hours(cpu, study.n_tiles("events")))
+            else:
+                parts.append(f"map over ({', '.join(study.plane)}) {_n(cells, 'cell')}, "
+                             f"~{_time(cpu)} of cell CPU (at {costs.MAP_CAP_FRACTION:g} of the "
+                             f"caps and {costs.MAP_CELL_S * 1e3:g} ms a cell)"
+                             + _hours(cpu, study.n_tiles("events")))
         if "spectra" in needs:
             cells = len(study.cells("spectra"))
             spec = entry["spectra"]
@@ -340,6 +351,16 @@ def make_plan(config, own=None, *, results="results", studies=None):
     except OSError:
         plan.free_bytes = None
     return plan
+
+
+def _hours(cpu_s, jobs):
+    """``"; runs for hours: ..."`` for a map of more than an hour of CPU (its tiles in
+    parallel on every core, at best), else ``""``."""
+    if cpu_s < 3600:
+        return ""
+    return (f"; RUNS FOR HOURS: ~{_time(cpu_s)} of CPU, at best ~{_time(cpu_s / jobs)} "
+            f"with its {_n(jobs, 'tile')} on as many cores (a smaller grid, a lower "
+            f"map.max_periods or a larger map.target_stderr shortens it)")
 
 
 def _add(row, cells, jobs, nbytes, cpu_s):

@@ -15,7 +15,7 @@ import re
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems, _short
 
 __all__ = ["SWEEP_KEYS", "NOISE_KEYS", "Sweeps", "expand_sweeps", "sweep_label", "sweep_labels",
-           "drawn_sweeps", "sweep_figures"]
+           "drawn_sweeps", "sweep_figures", "Member", "sweep_members"]
 
 #: Study keys a list of values sweeps, in the order of the product: the first key varies
 #: slowest, the last fastest (nested loops), so ``eps: [a, b]`` with ``rms: [c, d]`` gives
@@ -23,6 +23,9 @@ __all__ = ["SWEEP_KEYS", "NOISE_KEYS", "Sweeps", "expand_sweeps", "sweep_label",
 SWEEP_KEYS = ("zeta", "eps", "amplitude", "rms", "seed")
 #: Of these, the keys that override the study's `noises` entry (a derived entry per value).
 NOISE_KEYS = ("rms", "seed")
+#: The rms of the record a study whose plane has the rms as an axis runs on: each cell scales
+#: it by its rms (`pipeline.tasks.map_tile`), so every cell reads the same random numbers.
+UNIT_RMS = 1.0
 #: Combinations an error message lists before "...".
 _LISTED = 6
 
@@ -96,9 +99,19 @@ class Sweeps:
         return ConfigError(lines, details=err.details)
 
 
+def _plane(entry):
+    """The parameters a study's ``plane`` names (its axes: grids, not sweeps), or ()."""
+    plane = entry.get("plane")
+    if not isinstance(plane, list):
+        return ()
+    return tuple(p for p in plane if isinstance(p, str))
+
+
 def _swept(entry):
-    """Whether a study entry is expanded: it lists a value of SWEEP_KEYS or overrides its noise."""
-    return any(isinstance(entry.get(k), list) for k in SWEEP_KEYS) or any(
+    """Whether a study entry is expanded: it lists a value of SWEEP_KEYS that is no axis of
+    its plane, or overrides its noise (an rms axis too: its record is the unit-rms one)."""
+    plane = _plane(entry)
+    return any(isinstance(entry.get(k), list) for k in SWEEP_KEYS if k not in plane) or any(
         k in entry for k in NOISE_KEYS)
 
 
@@ -106,8 +119,9 @@ def _axes(name, entry, problems, max_studies):
     """``{key: values}`` of the keys a study lists, or None after recording why not."""
     axes, ok = {}, True
     allowed_ = "a number, or a non-empty list of numbers (a sweep: one study per value)"
+    plane = _plane(entry)
     for key in SWEEP_KEYS:
-        if key not in entry:
+        if key not in entry or key in plane:     # an axis of the plane: a grid, no sweep
             continue
         value = entry[key]
         items = value if isinstance(value, list) else [value]
@@ -159,6 +173,9 @@ def expand_sweeps(config, own=None, *, max_studies=None):
     first use), shared by the combinations that use it; the pair equal to the entry uses the
     entry itself (a list of rms alone keeps the entry's seed: the records differ only in
     scale, common random numbers). A study that only overrides rms or seed keeps its name.
+    A parameter the study's ``plane`` names is an axis, not a sweep: its list (or
+    ``{start, stop, step}``) stays in the study as the axis's grid; the rms as an axis gives
+    the study its noise entry at unit rms (`UNIT_RMS`, a copy unless the entry has it).
     A study without lists or overrides is left as it is (the same dict).
 
     Parameters
@@ -241,9 +258,13 @@ def _expand(name, entry, axes, copies, taken, problems, sweeps):
                          f"rename the sweep or studies.{study_name}")
             continue
         taken.add(study_name)
-        study = {key: copy.deepcopy(v) for key, v in entry.items() if key not in NOISE_KEYS}
+        plane = _plane(entry)
+        # the rms as an axis stays in the study (its grid); its record is the unit-rms one
+        study = {key: copy.deepcopy(v) for key, v in entry.items()
+                 if key not in NOISE_KEYS or key in plane}
         study.update({key: v for key, v in values.items() if key not in NOISE_KEYS})
-        override = {key: values.get(key, entry[key]) for key in NOISE_KEYS if key in entry}
+        override = {key: UNIT_RMS if key in plane else values.get(key, entry[key])
+                    for key in NOISE_KEYS if key in entry}
         noise = copies.noise(override, k)
         if noise is not None:
             study["noise"] = noise
@@ -294,6 +315,33 @@ class _NoiseCopies:
         """``{"noises.<name>": label}``: each copy in the words of the user's file."""
         return {f"noises.{name}": _noise_label(self.study, self.overrides[name], indices, swept)
                 for name, indices in self.users.items()}
+
+
+@dataclass(frozen=True)
+class Member:
+    """One study of a sweep: its name and its values of the swept keys (`sweep_members`)."""
+
+    study: str
+    values: dict
+
+
+def sweep_members(config, name):
+    """The studies of sweep ``name`` in the sweep's order, each with its values of the swept
+    keys: a sweep over a plane's third parameter (``plane: [eps, delta]`` with ``zeta: [a,
+    b]``) is the stack of maps ``[Member("<name>_0", {"zeta": a}), ...]`` that a figure
+    sets side by side.
+
+    Raises
+    ------
+    KeyError
+        For a name that is no sweep of ``config`` (naming the sweeps there are).
+    """
+    sweeps = config.get("sweeps", {})
+    if name not in sweeps:
+        raise KeyError(f"no sweep {name!r}; the sweeps: {', '.join(sorted(sweeps)) or 'none'}")
+    sweep = sweeps[name]
+    return [Member(study, dict(zip(sweep["keys"], row)))
+            for study, row in zip(sweep["studies"], sweep["values"])]
 
 
 def drawn_sweeps(config, drawn):
