@@ -4,13 +4,13 @@ stationary record, carried by every events dataset as a self-audit.
 Each holds on every record up to a boundary term ([E]/T, [x v + zeta x^2]/T), so the
 residual of an exact record is well inside its batch-means standard error; a wrong impact
 record (velocities scaled by 1.1) leaves a bias that shows as many standard errors."""
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
 from vibroimpact import noise, simulate, stats
 from vibroimpact.pipeline import cells, datasets
+from vibroimpact.pipeline.study import Cell
 
 # the random study of config/test.yaml: its noise, zeta, transient and batches
 NOISE = noise.NoiseSpec(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0)
@@ -102,7 +102,7 @@ def test_chunks_do_not_change_the_residuals(record):
 def test_the_events_tile_carries_the_audit(record):
     out = cells.event_statistics(record, NOISE.dt, zeta=ZETA, eps=0.5, delta=0.0,
                                  transient=TRANSIENT, t_end=5000.0, bins=BINS)
-    cell = SimpleNamespace(index=0, inv_beta=1.0, delta=0.0)
+    cell = Cell(index=0, i_inv_beta=0, i_delta=0, inv_beta=1.0, delta=0.0)
     ds = datasets.events_tile([cell], [out], BINS, {})
     for name in ("power_residual", "power_residual_stderr", "power_input", "virial_residual",
                  "virial_residual_stderr", "virial_scale"):
