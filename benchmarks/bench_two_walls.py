@@ -5,7 +5,7 @@ samples, dt = 0.1, zeta = 0.05, eps = 0.5):
 
 - ``free``: no wall reachable (one wall at delta = 1e6; two walls at 1e6 and -1e6): the
   cost of a sample step, where the second wall adds one bound to the exclusion test;
-- ``impacts``: a wall at delta = 1 (one wall) against stops at +-1 (two walls, gap = 2):
+- ``impacts``: a wall at delta = 0.3 (one wall) against stops at +-0.3 (two walls, gap 0.6):
   the cost per impact, ``(t - n_steps t_free) / n_impacts`` with the matching ``free`` cost
   per step taken out.
 
@@ -31,8 +31,8 @@ from vibroimpact import simulate
 CASES = {
     ("free", 1): dict(delta=1e6),
     ("free", 2): dict(delta=1e6, gap=2e6),
-    ("impacts", 1): dict(delta=1.0),
-    ("impacts", 2): dict(delta=1.0, gap=2.0),
+    ("impacts", 1): dict(delta=0.3),
+    ("impacts", 2): dict(delta=0.3, gap=0.6),
 }
 
 
