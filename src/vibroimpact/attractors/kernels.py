@@ -615,8 +615,14 @@ def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_
     while k < k_cap:
         k1 = min(k + n_chunk, k_cap)
         while k < k1:
-            status, k = run_steps(zeros, k, k1, state, P, imp_step, imp_off, imp_u, stk_step,
-                                  stk_off, stk_kind, cnt, ftot, grid, grid, 0, grid_n)
+            if P.shape[0] > N_PARAMS:       # the second wall's tests compiled in
+                status, k = run_steps(zeros, k, k1, state, P, imp_step, imp_off, imp_u,
+                                      stk_step, stk_off, stk_kind, cnt, ftot, grid, grid, 0,
+                                      grid_n, -P[N_PARAMS + P_DELTA])
+            else:
+                status, k = run_steps(zeros, k, k1, state, P, imp_step, imp_off, imp_u,
+                                      stk_step, stk_off, stk_kind, cnt, ftot, grid, grid, 0,
+                                      grid_n)
             if status != OK and status != BUFFER_FULL:
                 outi[I_STATUS] = status
                 outf[F_LYAP1] = np.nan

@@ -347,6 +347,7 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
     """:func:`simulate_chunks` once its arguments are checked and resolved into ``model``."""
     delta, beta = model.delta, model.beta
     P = model_parameters(model, dt)
+    lower = (model.lower,) if model.n_walls == 2 else ()     # run_steps' second wall, if any
     params = dict(zeta=model.zeta, eps=model.eps, delta=delta, dt=dt,
                   amplitude=model.amplitude, beta=beta, x0=x0, v0=v0,
                   rebound_floor=rebound_floor)
@@ -380,7 +381,7 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
             status, k = kernels.run_steps(r[k - k0 :], k, k1, state, P, buf.imp_step, buf.imp_off,
                                           buf.imp_u, buf.stk_step, buf.stk_off, buf.stk_kind,
                                           buf.cnt, buf.ftot, buf.grid, buf.grid_v, stride,
-                                          buf.grid_n)
+                                          buf.grid_n, *lower)
             if status == kernels.BUFFER_FULL:
                 buf.drain(parts)
             else:

@@ -219,7 +219,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
 
 @kernel
 def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n):
+              stk_kind, cnt, ftot, grid, grid_v, stride, grid_n, lower=None):
     """Advance the oscillator over the force samples ``r`` from sample ``k_begin`` to ``k_end``.
 
     Steps ``k_begin .. k_end - 1`` are taken unless an output buffer runs short, in which case
@@ -257,6 +257,11 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
         Record every ``stride`` samples (0: none).
     grid_n : ndarray of int64, shape (1,)
         In and out: the number of grid values written.
+    lower : float or None
+        The position of the second wall (``P`` then holds both walls' halves), or None for
+        one wall: numba compiles the two cases apart, so the one-wall loop carries none of
+        the second wall's tests (measured: +4 % per impact-free step when it tested at run
+        time whether there was one).
 
     Returns
     -------
@@ -278,9 +283,16 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
     has_h = Aq != 0.0
     # a second wall below the mass (P holds its mirrored half): the exclusion test of a free
     # step also bounds x from below, and a step resting on it has its own stay test
-    two = P.shape[0] > N_PARAMS
-    lower = -P[N_PARAMS + P_DELTA] if two else -math.inf
-    abs_A_lower = abs(A) + abs(lower) + TINY if two else 0.0
+    if lower is None:
+        # one wall: numba compiles this call without the lower wall's tests (the argument's
+        # type is None), so the loop is the one-wall loop, instruction for instruction
+        two = False
+        low = -math.inf
+        abs_A_lower = 0.0
+    else:
+        two = True
+        low = lower
+        abs_A_lower = abs(A) + abs(low) + TINY
     w = state[S_W]
     wv = state[S_WV]
     mode = int(state[S_MODE])
@@ -297,7 +309,7 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
         if stride > 0 and k % stride == 0:
             if mode != FREE:
                 # on the wall; STUCK keeps w' = -p_h' exactly, so x' = 0 there
-                grid[grid_n[0]] = 0.0 if (mode == STUCK or mode == WALL) else delta - lower
+                grid[grid_n[0]] = 0.0 if (mode == STUCK or mode == WALL) else delta - low
                 grid_v[grid_n[0]] = wv + Aq * beta * cp
             elif has_h:
                 psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
@@ -333,11 +345,11 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             if clear and two:
                 # the same two tiers, mirrored, against the wall below
                 xmin = min(w + Aq * sp, w1 + Aq * sp1)
-                clear = xmin - (M0 + R) * h2_8 - margin > lower
-                if not clear and xmin - margin > lower:
+                clear = xmin - (M0 + R) * h2_8 - margin > low
+                if not clear and xmin - margin > low:
                     acc = max(abs(r0 - 2.0 * zeta * wv - w), abs(r1 - 2.0 * zeta * wv1 - w1))
                     clear = (xmin - (M0 + acc + 0.5 * h * R) * BOUND_SAFETY * h2_8 - margin
-                             > lower)
+                             > low)
             if clear:
                 w = w1
                 wv = wv1
@@ -365,18 +377,18 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                     sp = sp1
                     cp = cp1
                     continue
-            elif mode == STUCK_LO:
+            elif two and mode == STUCK_LO:
                 # resting on the wall below: the same test on the push into it, lower - f
-                F0 = lower - (r0 + A * (sp * cos_phi + cp * sin_phi))
-                F1 = lower - (r1 + A * (sp1 * cos_phi + cp1 * sin_phi))
+                F0 = low - (r0 + A * (sp * cos_phi + cp * sin_phi))
+                F1 = low - (r1 + A * (sp1 * cos_phi + cp1 * sin_phi))
                 if min(F0, F1) - MF_h2_8 > STICK_MARGIN * (abs(r0) + abs(r1) + abs_A_lower):
                     ftot[FT_CONTACT_TIME] += h
-                    w = lower - Aq * sp1
+                    w = low - Aq * sp1
                     wv = -Aq * beta * cp1
                     sp = sp1
                     cp = cp1
                     continue
-            x = delta if (mode == STUCK or mode == WALL) else lower
+            x = delta if (mode == STUCK or mode == WALL) else low
             v = wv          # w': slow_step adds p_h' in mode WALL, ignores it when STUCK
         # a non-finite sample always fails the exclusion test, so it is caught here at no cost
         if not (math.isfinite(r0) and math.isfinite(r1)):
