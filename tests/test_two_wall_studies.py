@@ -334,3 +334,11 @@ def test_the_two_wall_orbit_map_sees_the_mirror_of_its_cells():
         if out["reason"][k, 0, 0] == 0:
             assert abs(out["S"][k, 0, 0] - out["S"][k_m, 0, 2]) < 1e-6, types[k]
     assert out["reason"][1, 0, 0] == 0 and out["reason"][2, 0, 2] == 0
+
+
+def test_dataset_motion_names_are_the_classifications_names():
+    from vibroimpact.pipeline import datasets
+    from vibroimpact.stats.motions import motion_key
+
+    motions = [(1, 1), (2, 1), (1, 2), (1, 1, 1), (1, 0, 1), (0, 1, 2), (2, 3, 4)]
+    assert datasets._motion_names(motions) == [motion_key(m) for m in motions]
