@@ -206,7 +206,7 @@ def test_the_plan_says_when_a_plane_runs_for_hours(tmp_path):
 
 @pytest.mark.parametrize("change, key, fragment", [
     (("plane: [eps, delta]", "plane: [eps, seed]"), "studies.plane.plane", ""),
-    (("plane: [eps, delta]", "plane: [eps, eps]"), "studies.plane.plane", ""),
+    (("plane: [eps, delta]", "plane: [eps, eps]"), "studies.plane.plane", "all different"),
     (("    eps: [0.3, 0.5]\n", "    eps: 0.5\n"), "studies.plane.eps",
      "eps is an axis of the plane"),
     (("    inv_beta: 1.1\n", "    inv_beta: [1.1, 1.2]\n"), "studies.plane.inv_beta",

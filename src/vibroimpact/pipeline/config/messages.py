@@ -176,8 +176,15 @@ class _Words:
             text = "true or false"
         elif kind == "array":
             text = "a list"
-            if "minItems" in schema:
-                text += f" of at least {schema['minItems']} item(s)"
+            lo, hi = schema.get("minItems"), schema.get("maxItems")
+            if lo is not None and lo == hi:
+                text += f" of exactly {lo} item(s)"
+            elif lo is not None:
+                text += f" of at least {lo} item(s)"
+            elif hi is not None:
+                text += f" of at most {hi} item(s)"
+            if schema.get("uniqueItems"):
+                text += ", all different"
         elif kind == "object":
             props = list(schema.get("properties", {}))
             text = "a mapping" + (f" with keys {', '.join(props)}" if props
