@@ -158,7 +158,7 @@ def _escape(cfg):
     (lambda c: _escape(c).update(cells=[[-1.0, 1.0]]),
      "studies.motion_map.escape.cells[0]", "inv_beta > 0"),
     (lambda c: _escape(c).update(cells=[[1.0]]), "studies.motion_map.escape.cells[0]",
-     "at least 2"),
+     "exactly 2"),
     (lambda c: _escape(c).update(record_length=0.0),
      "studies.motion_map.escape.record_length", "> 0"),
     (lambda c: _escape(c).update(record_length=9e6),
