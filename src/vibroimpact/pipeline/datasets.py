@@ -3,6 +3,8 @@
 The layouts are documented in ``docs/datasets.md``; every variable carries ``long_name``
 and ``units`` (plots take their labels from them).
 """
+import json
+
 import numpy as np
 import pandas as pd
 import xarray as xr
@@ -624,10 +626,10 @@ def attractor_tile_dataset(result, attrs):
     ``(inv_beta, delta)``: what the basins and Lyapunov datasets are cut from."""
     motions = list(result["motions"])
     types = motions[:-1]
-    coords = dict(motion=motions, type=types, inv_beta=result["inv_beta"],
-                  delta=result["delta"], start=np.arange(result["lyapunov_start"].shape[0]),
+    plane = tuple(result.get("axes", ("inv_beta", "delta")))
+    coords = dict(motion=motions, type=types, **{k: result[k] for k in plane},
+                  start=np.arange(result["lyapunov_start"].shape[0]),
                   **{"class": list(ATTRACTOR_CLASSES)})
-    plane = ("inv_beta", "delta")
     data = {name: (("motion", *plane), result[name])
             for name in ("fraction", "fraction_lo", "fraction_hi", "count")}
     data["n_stable"] = (("type", *plane), result["n_stable"])
@@ -640,13 +642,21 @@ def attractor_tile_dataset(result, attrs):
     for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
         data[name] = (("start", *plane), result[name])
     data["class_start"] = (("start", *plane), result["class_start"].astype(np.int8))
-    return xr.Dataset(data, coords=coords, attrs=dict(attrs))
+    ds = xr.Dataset(data, coords=coords, attrs=dict(attrs))
+    if "axes" in result:        # a named plane (attractors.plane.attractor_plane)
+        ds.attrs.update(axes=list(plane), fixed=json.dumps(result["fixed"], sort_keys=True),
+                        **{k: float(v) for k, v in result["fixed"].items()})
+        for name in plane:
+            ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
+    return ds
 
 
 def concat_attractor_tiles(tiles):
-    """Join attractor-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
-    return xr.concat(tiles, dim="inv_beta", data_vars="minimal", coords="minimal",
-                     compat="override").sortby("inv_beta")
+    """Join attractor-map tiles (disjoint sets of rows of the plane's first axis,
+    ``inv_beta`` on the paper's plane) into one sorted dataset."""
+    dim = tiles[0]["lyapunov"].dims[0]
+    return xr.concat(tiles, dim=dim, data_vars="minimal", coords="minimal",
+                     compat="override").sortby(dim)
 
 
 def _described(ds):
