@@ -51,6 +51,10 @@ JOB_KEYS = {
     # job as a param of their own (common.smk, ``escape_noise``)
     "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
                "motions", "escape") + _WALLS,
+    # a plane study's basins and Lyapunov exponents: the harmonic force alone (no noise, no
+    # record), over the study's plane
+    "attractors": ("zeta", "eps", "amplitude", "inv_beta", "delta", "tile_size", "plane",
+                   "attractors") + _WALLS,
 }
 
 #: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns
@@ -371,6 +375,14 @@ def attractor_rows(entry):
     block = entry["attractors"]
     rows = grid_values(block["inv_beta"])
     return rows, -(-rows.size // int(block["tile_rows"]))
+
+
+def plane_attractor_rows(entry):
+    """The x values of a plane study's attractor map (its plane's first axis) and its number
+    of tiles (``attractors.tile_rows`` x values a tile, strided over the tiles)."""
+    x = study_plane(entry)[0]
+    rows = grid_values(entry[x])
+    return rows, -(-rows.size // int(entry["attractors"]["tile_rows"]))
 
 
 def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_periods"):

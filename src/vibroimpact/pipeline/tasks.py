@@ -18,7 +18,7 @@ from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
                                         grid_size, grid_values, map_cap_steps, orbit_rows,
-                                        walls)
+                                        plane_attractor_rows, walls)
 
 log = logging.getLogger("vibroimpact")
 
@@ -535,3 +535,36 @@ def aggregate_attractors(entry, tiles, out_basins, out_lyapunov):
     joined.attrs.update(provenance(entry))
     io.write_dataset(datasets.basins_dataset(joined), out_basins)
     io.write_dataset(datasets.lyapunov_dataset(joined), out_lyapunov)
+
+
+def plane_attractor_tile(name, entry, tile, out, threads=None):
+    """Rule ``solve_plane_attractor_tile``: basins and Lyapunov exponents under the harmonic
+    force alone on some values of the first axis of study ``name``'s plane (strided over the
+    tiles), every value of its second (`vibroimpact.attractors.plane.attractor_plane`)."""
+    import numba
+
+    from vibroimpact.attractors.plane import attractor_plane
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    study = Study.from_config(name, entry)
+    x, y = study.plane
+    rows, n_tiles = plane_attractor_rows(entry)
+    block = entry["attractors"]
+    gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
+    attrs = dict(study=name, n_starts=int(block["n_starts"]),
+                 max_time=float(block["max_time"]), seed=int(block["seed"]), gap=list(gap),
+                 velocity=list(vel),
+                 box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
+                     f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
+    result = attractor_plane(x, rows[tile::n_tiles], y, study.axes[y], study.fixed(),
+                             types=[tuple(int(k) for k in t) for t in block["types"]],
+                             n_starts=attrs["n_starts"], gap=gap, velocity=vel,
+                             max_time=attrs["max_time"], seed=attrs["seed"])
+    io.write_dataset(datasets.attractor_tile_dataset(result, dict(provenance(entry), **attrs)),
+                     out)
+
+
+def aggregate_plane_attractors(entry, tiles, out_basins, out_lyapunov):
+    """Rule ``aggregate_plane_attractors``: a plane study's basins and Lyapunov datasets."""
+    aggregate_attractors(entry, tiles, out_basins, out_lyapunov)

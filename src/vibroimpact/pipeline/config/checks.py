@@ -179,7 +179,7 @@ def _check_figures(config, section, name, entry, problems, grids):
     seen = set()
     for i, item in enumerate(entry["figures"]):
         fig = item if isinstance(item, str) else item["name"]
-        spec = figures.FIGURES[fig]
+        spec = figures.figure_spec(fig, kind) or figures.FIGURES[fig]
         at = f"{where}[{i}]"
         if spec["owner"] != kind:
             allowed_ = sorted(f for f, s in figures.FIGURES.items() if s["owner"] == kind)
@@ -191,7 +191,7 @@ def _check_figures(config, section, name, entry, problems, grids):
             problems.add(at, fig, "listed twice", "each figure once (a list of values under "
                          "its `inv_beta` draws it several times)")
         seen.add(fig)
-        if kind != "study":
+        if kind != "study" or spec.get("needs"):
             block = spec.get("needs")
             if block and not entry.get(block):
                 problems.add(f"{section}.{name}.{block}", None, f"missing, and {fig} draws it",
@@ -304,6 +304,11 @@ def _check_study(config, name, entry, problems, limits, unforced):
     where = f"studies.{name}"
     if entry.get("plane") is not None:
         return _check_plane_study(config, name, entry, problems, limits, unforced)
+    if entry.get("attractors"):
+        problems.add(f"{where}.attractors", "...", "basins and Lyapunov exponents of a study "
+                     "run over its plane, and this study has none", "a `plane: [x, y]` in the "
+                     "study, or the attractors block of an orbits entry (the paper's (1/beta_f, "
+                     "delta) plane)")
     shapes_ok = True
     for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
         if key in ("inv_beta", "delta"):
@@ -458,7 +463,7 @@ _AXIS_BOUNDS = {
 }
 #: The figures a study with a plane draws: its map's (fig15_vs_fig16 needs an orbits entry
 #: over the same plane, which the workflow does not make yet).
-PLANE_FIGURES = ("fig15", "residence")
+PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov")
 
 
 def _check_plane_study(config, name, entry, problems, limits, unforced):
@@ -545,6 +550,8 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
                          "draws its map only", ", ".join(PLANE_FIGURES))
             ok = False
     _check_motions(where, entry, two_walls, problems)
+    if entry.get("attractors"):
+        ok &= _check_plane_attractors(where, entry, plane, grids, problems)
     n, dt, tau = noise_record(config["noises"][entry["noise"]])
     transient = float(entry["transient"])
     if transient >= tau:
@@ -578,6 +585,64 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
                          f"plane {plane}", "at least 2 values")
     _check_figures(config, "studies", name, entry, problems, grids)
     return dict(grids, spectra_delta=None)
+
+
+def _check_plane_attractors(where, entry, plane, grids, problems):
+    """A plane study's attractors block: a plane of the harmonic problem (no noise axis), a
+    force (amplitude > 0 everywhere), the starts' box on the free side of the wall and within
+    the smallest clearance, one-wall closed-form types, a cap long enough to settle at the
+    smallest zeta. True when it holds."""
+    at = f"{where}.attractors"
+    block = entry["attractors"]
+    before = len(problems)
+    noise_axes = sorted(set(plane) & set(NOISE_PARAMETERS))
+    if noise_axes:
+        problems.add(at, "...", f"basins and Lyapunov exponents are those of the harmonic force "
+                     f"alone, which has no {noise_axes[0]} (a parameter of the noise): the plane "
+                     f"{plane} has none", "leave attractors out, or a plane over zeta, eps, "
+                     "eps_lower, delta, gap, amplitude or inv_beta")
+        return False
+
+    def values(key):
+        if key in plane:
+            return grids.get(key)
+        return None if entry.get(key) is None else np.array([float(entry[key])])
+
+    amp = values("amplitude")
+    if amp is not None and float(amp.min()) <= 0.0:
+        problems.add(f"{where}.amplitude", entry["amplitude"], "the attractors of "
+                     "A sin(beta_f tau) are those of sin(beta_f tau) at delta / A for A > 0 "
+                     "(A < 0 is a half-period shift, A = 0 has no force)", "amplitude > 0")
+    low, high = (float(v) for v in block["gap"])
+    if low < 0.0:
+        problems.add(f"{at}.gap", block["gap"], f"a distance from the wall of {_num(low)} "
+                     "puts starts beyond the wall (x0 = delta - g > delta)",
+                     "[low, high] with 0 <= low < high")
+    elif not low < high:
+        problems.add(f"{at}.gap", block["gap"], "an empty range", "[low, high], low < high")
+    clearance = values("gap")
+    if clearance is not None and high > float(clearance.min()):
+        problems.add(f"{at}.gap", block["gap"], f"starts below the lower wall: the smallest "
+                     f"clearance of the plane is gap = {_num(float(clearance.min()))}",
+                     f"[low, high] with high <= {_num(float(clearance.min()))}")
+    vlow, vhigh = (float(v) for v in block["velocity"])
+    if not vlow < vhigh:
+        problems.add(f"{at}.velocity", block["velocity"], "an empty range",
+                     "[low, high], low < high")
+    for j, t in enumerate(block["types"]):
+        if len(t) != 2 or not 1 <= int(t[0]) <= MAX_M:
+            problems.add(f"{at}.types[{j}]", t, "the attractors match the closed-form "
+                         f"solver's (m/n) orbits, m <= {MAX_M} (with a second wall, those that "
+                         "stay above it)", f"[m, n] pairs with 1 <= m <= {MAX_M}")
+    zeta = values("zeta")
+    if zeta is not None:
+        shortest = attractor_min_time(float(zeta.min()))
+        if float(block["max_time"]) < shortest:
+            problems.add(f"{at}.max_time", block["max_time"], f"too short for a start to "
+                         f"settle: the damping alone needs ln(1/{ATTRACTOR_MATCH_TOL:g})/zeta "
+                         f"= {shortest:.4g} at the plane's smallest zeta",
+                         f">= {shortest:.4g}")
+    return len(problems) == before
 
 
 #: Shortest batch of the batch-means standard errors: a natural period 2 pi (time units),

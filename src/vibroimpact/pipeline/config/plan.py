@@ -19,7 +19,8 @@ from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVER
                                                JOB_START_S, MAP_REPORT_S, REPORT_BYTES,
                                                REPORT_S, VALIDATION_S)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
-from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
+from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_rows,
+                                        plane_attractor_rows)
 
 __all__ = ["Plan", "Row", "make_plan", "built_entries"]
 
@@ -148,7 +149,7 @@ def _time(s):
     return f"{s:.2g} s"
 
 
-_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace")
+_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace", "plane_basins")
 _ORBIT_KINDS = ("orbits", "boundaries", "basins", "lyapunov")
 
 
@@ -172,7 +173,7 @@ def built_entries(config, own=None):
         kinds = {k for k in _STUDY_KINDS if targets.DATASETS[k].format(name=name) in needed}
         if kinds:
             build["studies"][name] = kinds
-            if kinds - {"escape"}:                  # escape: records of its own
+            if kinds - {"escape", "plane_basins"}:  # escape, attractors: no record file
                 build["noises"].add(config["studies"][name]["noise"])
     for name in config.get("orbits", {}):
         kinds = {k for k in _ORBIT_KINDS if targets.DATASETS[k].format(name=name) in needed}
@@ -274,6 +275,14 @@ def make_plan(config, own=None, *, results="results", studies=None):
             cpu += (levels + 1) * JOB_START_S + FIGURE_S     # its jobs' start-up, its figure
             parts.append(f"escape {_n(cells, 'cell')} x {_n(levels, 'noise level')} "
                          f"(~{cpu:.0f} CPU-s with its figure)")
+        if "plane_basins" in needs:        # its attractors block, over the plane
+            a_rows, a_tiles = plane_attractor_rows(entry)
+            a_cells = len(a_rows) * len(study.axes[study.plane[1]])
+            n_starts = int(entry["attractors"]["n_starts"])
+            _add(row, a_cells, a_tiles + 1, a_cells * (8 * 5 * n_starts + 400)
+                 + 2 * FILE_OVERHEAD, costs.attractor_cpu_s(a_cells, n_starts))
+            parts.append(f"attractors over ({', '.join(study.plane)}) {_n(a_cells, 'cell')} x "
+                         f"{_n(n_starts, 'start')}")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
             _add(row, 0, 1, 40 * steps, 0.0)
