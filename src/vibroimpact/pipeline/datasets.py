@@ -735,10 +735,11 @@ _ESCAPE_STATES = ("residence_time", "residence_time_stderr", "n_stretches", "n_c
                   "probability")
 
 
-def escape_part(index, rms, cells, results, motions, attrs):
+def escape_part(index, rms, cells, results, motions, attrs, axes=("inv_beta", "delta")):
     """Dataset of one escape job (one noise level, every cell) along ``rms`` (length 1).
 
-    ``cells`` are ``(inv_beta, delta)`` pairs, ``results`` their
+    ``cells`` are ``(inv_beta, delta)`` pairs (a plane study's: pairs of its ``axes``, each a
+    coordinate along ``cell`` named after its parameter), ``results`` their
     :func:`vibroimpact.pipeline.cells.escape_cell` dicts.
     """
     data = {name: (("rms", "cell", "state"), np.stack([r[name] for r in results])[None])
@@ -747,9 +748,16 @@ def escape_part(index, rms, cells, results, motions, attrs):
         data[name] = (("rms", "cell"), np.array([[r[name] for r in results]]))
     data["spawn_key"] = ("rms", np.array([int(index)]))
     pairs = np.asarray(cells, dtype=float).reshape(-1, 2)
-    coords = dict(rms=[float(rms)], cell=np.arange(len(results)), state=_motion_names(motions)
-                  + ["none"], inv_beta=("cell", pairs[:, 0]), delta=("cell", pairs[:, 1]))
-    return _escape_described(_annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
+    x, y = axes
+    coords = {"rms": [float(rms)], "cell": np.arange(len(results)),
+              "state": _motion_names(motions) + ["none"], x: ("cell", pairs[:, 0]),
+              y: ("cell", pairs[:, 1])}
+    ds = _escape_described(_annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
+    if tuple(axes) != ("inv_beta", "delta"):      # a plane's cells: named in its words
+        for name in axes:
+            ds[name].attrs.update(long_name=f"{PLANE_META[name][0]} of the cell",
+                                  units=PLANE_META[name][1])
+    return ds
 
 
 def aggregate_escape(parts, attrs, min_stretches, fit_max_rms=None):

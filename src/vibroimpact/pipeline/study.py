@@ -51,6 +51,9 @@ JOB_KEYS = {
     # job as a param of their own (common.smk, ``escape_noise``)
     "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
                "motions", "escape") + _WALLS,
+    # a plane study's escape cells are [x, y] in its plane: the fixed values of the others
+    "plane_escape": ("noise", "zeta", "eps", "amplitude", "inv_beta", "delta", "plane",
+                     "transient", "sweep", "motion_window", "motions", "escape") + _WALLS,
     # a plane study's basins and Lyapunov exponents: the harmonic force alone (no noise, no
     # record), over the study's plane
     "attractors": ("zeta", "eps", "amplitude", "inv_beta", "delta", "tile_size", "plane",

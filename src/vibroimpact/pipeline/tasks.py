@@ -303,6 +303,16 @@ def _escape_attrs(name, block, noise):
     spec = {f"noise_{k}": noise[k] for k in _NOISE_FIELDS
             if k != "rms" and noise.get(k) is not None}
     escape = block["escape"]
+    if block.get("plane") is not None:      # a plane's cells: [x, y], the rest fixed
+        fixed = _plane_fixed(block)
+        return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])),
+                    study=name, noise=block["noise"], dt=float(noise["dt"]), **spec,
+                    **fixed, axes=list(block["plane"]),
+                    fixed=json.dumps(fixed, sort_keys=True),
+                    transient=float(block["transient"]),
+                    record_length=float(escape["record_length"]),
+                    motion_window=float(block["motion_window"]),
+                    seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
     return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])), study=name,
                 zeta=float(block["zeta"]), eps=float(block["eps"]),
                 amplitude=float(block["amplitude"]), noise=block["noise"],
@@ -311,6 +321,40 @@ def _escape_attrs(name, block, noise):
                 record_length=float(escape["record_length"]),
                 motion_window=float(block["motion_window"]),
                 seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
+
+
+#: The model's parameters a plane study's escape cell is run with (its two axes from the
+#: cell, the others fixed).
+_ESCAPE_PARAMETERS = ("zeta", "eps", "amplitude", "inv_beta", "delta", "gap", "eps_lower")
+
+
+def _plane_fixed(block):
+    """``{parameter: value}`` of a plane study's fixed model parameters (not its axes; the
+    second wall's only with one; an eps_lower not given is not fixed: it follows eps)."""
+    plane = block["plane"]
+    return {k: float(block[k]) for k in _ESCAPE_PARAMETERS
+            if k not in plane and block.get(k) is not None}
+
+
+def escape_cells(block):
+    """``[{zeta, eps, amplitude, beta_f, delta[, gap, eps_lower]}]``: the model of each
+    escape cell of a study: ``[inv_beta, delta]``, or in a plane study ``[x, y]`` in the
+    plane's coordinates with every other parameter fixed."""
+    plane = block.get("plane") or ("inv_beta", "delta")
+    fixed = _plane_fixed(block) if block.get("plane") is not None else {
+        k: float(block[k]) for k in ("zeta", "eps", "amplitude")}
+    if block.get("plane") is None:
+        gap, eps_lower = walls(block, f"studies.{block.get('name', '')}".rstrip("."))
+        if gap is not None:
+            fixed.update(gap=gap, eps_lower=eps_lower)
+    out = []
+    for cell in block["escape"]["cells"]:
+        p = dict(fixed, **{k: float(v) for k, v in zip(plane, cell)})
+        if "gap" in p and p.get("eps_lower") is None:
+            p["eps_lower"] = p["eps"]
+        p["beta_f"] = 1.0 / p.pop("inv_beta")
+        out.append(p)
+    return out
 
 
 def escape_level(name, block, noise, index, out):
@@ -332,19 +376,17 @@ def escape_level(name, block, noise, index, out):
     log.info("level %d: rms %g, %d samples of %s", index, rms, n, spec)
     samples = generate_array(spec, n, escape_seed(noise["seed"], index))
     motions = [tuple(int(k) for k in m) for m in block["motions"]]
-    gap, eps_lower = walls(block, f"studies.{name}")
-    second = {} if gap is None else dict(gap=gap, eps_lower=eps_lower)
     progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]))
     results = []
-    for inv_beta, delta in escape["cells"]:
+    for p in escape_cells(block):
         results.append(cells.escape_cell(
-            samples, spec.dt, zeta=float(block["zeta"]), eps=float(block["eps"]),
-            delta=float(delta), beta_f=1.0 / float(inv_beta),
-            amplitude=float(block["amplitude"]), transient=transient, record_length=length,
-            motions=motions, window=float(block["motion_window"]), **second))
+            samples, spec.dt, **p, transient=transient, record_length=length,
+            motions=motions, window=float(block["motion_window"])))
         progress.cell_done(results[-1])
     io.write_dataset(datasets.escape_part(index, rms, escape["cells"], results, motions,
-                                          _escape_attrs(name, block, noise)), out)
+                                          _escape_attrs(name, block, noise),
+                                          axes=block.get("plane") or ("inv_beta", "delta")),
+                     out)
 
 
 def aggregate_escape(name, block, noise, parts, out):

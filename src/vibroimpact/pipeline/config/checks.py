@@ -463,7 +463,7 @@ _AXIS_BOUNDS = {
 }
 #: The figures a study with a plane draws: its map's (fig15_vs_fig16 needs an orbits entry
 #: over the same plane, which the workflow does not make yet).
-PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov")
+PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov", "escape_vs_noise")
 
 
 def _check_plane_study(config, name, entry, problems, limits, unforced):
@@ -527,10 +527,16 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
         return None
-    for block in ("spectra", "trace", "escape"):
+    for block in ("spectra", "trace"):
         if entry.get(block):
             problems.add(f"{where}.{block}", None, f"a study with a plane ({plane}) draws its "
-                         "map only", f"leave {block} out, or put it in a study without a plane")
+                         "map, its basins and its escape only", f"leave {block} out, or put "
+                         "it in a study without a plane")
+    if entry.get("escape") and set(plane) & set(NOISE_PARAMETERS):
+        problems.add(f"{where}.escape", "...", f"the escape runs its own noise levels "
+                     f"(escape.rms), and the plane {plane} has the rms as an axis",
+                     "leave escape out, or a plane without rms")
+        ok = False
     for i, item in enumerate(entry["figures"]):
         fig = item if isinstance(item, str) else item["name"]
         if fig == "fig15_vs_fig16" and set(plane) & set(NOISE_PARAMETERS):
@@ -583,6 +589,10 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         if grids[key].size < 2:
             problems.add(f"{where}.{key}", entry[key], f"fig15 draws contours over the "
                          f"plane {plane}", "at least 2 values")
+    if entry.get("escape") and not set(plane) & set(NOISE_PARAMETERS):
+        amp = grids.get("amplitude")
+        harmonic = bool(float(entry["amplitude"])) if amp is None else bool(np.all(amp != 0))
+        _check_escape(where, entry, grids, harmonic, dt, problems, axes=plane)
     _check_figures(config, "studies", name, entry, problems, grids)
     return dict(grids, spectra_delta=None)
 
@@ -673,11 +683,15 @@ def _check_batches(where, entry, length, dt, problems):
 ESCAPE_MAX_SAMPLES = 50_000_000
 
 
-def _check_escape(where, entry, grids, harmonic, dt, problems):
-    """The escape block: cells inside the study's (1/beta_f, delta) plane, distinct levels,
-    a record its job can hold, a fit with two levels at least."""
+def _check_escape(where, entry, grids, harmonic, dt, problems, axes=("inv_beta", "delta")):
+    """The escape block: cells inside the study's plane (``axes``: the paper's (1/beta_f,
+    delta), or the plane a study names, each cell ``[x, y]`` in its coordinates), distinct
+    levels, a record its job can hold, a fit with two levels at least."""
     where = f"{where}.escape"
     block = entry["escape"]
+    pair = f"[{axes[0]}, {axes[1]}]"
+    plane_words = ("(1/beta_f, delta)" if tuple(axes) == ("inv_beta", "delta")
+                   else f"({axes[0]}, {axes[1]})")
     if not harmonic:
         problems.add(where, None, "the escape cells lie in the (1/beta_f, delta) plane of the "
                      "harmonic force, and this study has none (amplitude = 0)",
@@ -685,23 +699,28 @@ def _check_escape(where, entry, grids, harmonic, dt, problems):
         return
     box = {k: (float(g.min()), float(g.max())) for k, g in grids.items() if g is not None}
     for i, cell in enumerate(block["cells"]):
-        inv_beta, delta = (float(v) for v in cell)
-        if inv_beta <= 0.0:
-            problems.add(f"{where}.cells[{i}]", cell, f"1/beta_f = {_num(inv_beta)} is not a "
-                         "forcing period ratio", "[inv_beta, delta] with inv_beta > 0")
+        values = [float(v) for v in cell]
+        bad = [(k, v) for k, v in zip(axes, values) if not _AXIS_BOUNDS[k][0](v)]
+        if bad:
+            k, v = bad[0]
+            if k == "inv_beta":
+                problems.add(f"{where}.cells[{i}]", cell, f"1/beta_f = {_num(v)} is not a "
+                             "forcing period ratio", f"{pair} with inv_beta > 0")
+            else:
+                problems.add(f"{where}.cells[{i}]", cell, f"{k} = {_num(v)} is out of its "
+                             "range", f"{pair} with {_AXIS_BOUNDS[k][1]}")
             continue
-        outside = [f"{k} in [{_num(lo)}, {_num(hi)}]" for k, v in (("inv_beta", inv_beta),
-                                                                  ("delta", delta))
+        outside = [f"{k} in [{_num(lo)}, {_num(hi)}]" for k, v in zip(axes, values)
                    if k in box for lo, hi in [box[k]]
                    if not lo - GRID_RTOL * max(1.0, abs(lo)) <= v
                    <= hi + GRID_RTOL * max(1.0, abs(hi))]
         if outside:
-            problems.add(f"{where}.cells[{i}]", cell, "outside the study's (1/beta_f, delta) "
+            problems.add(f"{where}.cells[{i}]", cell, f"outside the study's {plane_words} "
                          "plane", "a cell with " + " and ".join(outside))
     pairs = [tuple(float(v) for v in c) for c in block["cells"]]
     if len(set(pairs)) != len(pairs):
         problems.add(f"{where}.cells", block["cells"], "a cell is listed twice",
-                     "distinct [inv_beta, delta] pairs")
+                     f"distinct {pair} pairs")
     _distinct(problems, f"{where}.rms", block["rms"])
     n = escape_samples(entry["transient"], block["record_length"], dt)
     if n > ESCAPE_MAX_SAMPLES:
