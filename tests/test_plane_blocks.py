@@ -16,7 +16,7 @@ from vibroimpact.pipeline.config import ConfigError
 from vibroimpact.pipeline.study import JOB_KEYS, ORBIT_JOB_KEYS, plane_attractor_rows
 
 sys.path.insert(0, str(ROOT / "benchmarks"))
-from same_build import _data  # noqa: E402  (what same_build compares: no attrs, no timings)
+from same_build import _data  # what same_build compares: no attrs, no timings
 
 NOISE = """paper: false
 noises:
@@ -35,7 +35,7 @@ MAP = """    zeta: 0.05
     map: {target_stderr: 0.1, min_time: 300.0, max_periods: 200, min_switches: 10}
 """
 ATTRACTORS = "{n_starts: 6, max_time: 300.0, seed: 3, tile_rows: 1}"
-ORBITS = NOISE + f"""studies: {{}}
+ORBITS = NOISE + """studies: {}
 orbits:
   paper:
     zeta: 0.05
@@ -235,6 +235,86 @@ def test_a_plane_block_is_refused_naming_its_key(tmp_path, change, key, fragment
         text = text.replace(f"    attractors: {ATTRACTORS}\n", f"    {change}\n")
     else:
         text = text.replace("    figures:", f"    {change}\n    figures:")
+    with pytest.raises(ConfigError) as err:
+        _load(tmp_path, text)
+    lines = [p for p in err.value.problems if f"studies.restitution.{key}" in p]
+    assert lines and fragment in lines[0], err.value.problems
+
+
+def _trace(tmp_path, text, name):
+    config, _ = _load(tmp_path, text)
+    entry = config["studies"][name]
+    kind = "plane_trace" if entry.get("plane") else "trace"
+    block = {k: entry[k] for k in JOB_KEYS[kind] if k in entry}
+    noise = tmp_path / f"{entry['noise']}.nc"
+    if not noise.exists():
+        tasks.make_noise(config["noises"][entry["noise"]], noise)
+    tasks.trace(name, block, noise, tmp_path / f"{name}_trace.nc")
+    return xr.load_dataset(tmp_path / f"{name}_trace.nc")
+
+
+TRACE_PLANE = EPS_DELTA.replace(
+    "    figures: [fig15, basins, lyapunov, escape_vs_noise]",
+    "    trace: {cell: [0.5, 1.0], t_end: 60.0}\n"
+    "    figures: [fig15, basins, lyapunov, escape_vs_noise, fig10]")
+TRACE_PAPER = PAPER_ESCAPE.replace(
+    "    figures: [fig15, escape_vs_noise]",
+    "    trace: {delta: 1.0, inv_beta: 1.1, t_end: 60.0}\n    figures: [fig15, fig10]")
+TRACE_RMS = NOISE.replace("rms: 0.29", "rms: 1.0") + f"""studies:
+  noisy:
+    noise: tiny
+    plane: [rms, delta]
+    eps: 0.5
+    rms: [0.1, 0.29]
+    inv_beta: 1.1
+    delta: [0.25, 1.0]
+{MAP}    trace: {{cell: [0.29, 1.0], t_end: 60.0}}
+    figures: [fig15, fig10]
+"""
+TRACE_RMS_PAPER = NOISE + f"""studies:
+  flat:
+    noise: tiny
+    eps: 0.5
+    inv_beta: [1.0, 1.1]
+    delta: [0.25, 1.0]
+{MAP}    trace: {{delta: 1.0, inv_beta: 1.1, t_end: 60.0}}
+    figures: [fig15, fig10]
+"""
+
+
+def test_a_plane_trace_at_its_cell(tmp_path):
+    """The (eps, delta) study's trace at cell [0.5, 1.0] (1/beta_f = 1.1 fixed) is the
+    paper-plane study's trace at delta = 1, 1/beta_f = 1.1 on the same record, bit for bit;
+    on an (rms, delta) plane the unit record times the cell's rms is the record at that rms
+    (to round-off: the generator scales its unit draws), so the two traces agree to 1e-12."""
+    plane = _trace(tmp_path, TRACE_PLANE, "restitution")
+    paper = _trace(tmp_path, TRACE_PAPER, "flat")
+    assert list(plane.attrs["cell"]) == [0.5, 1.0] and list(plane.attrs["axes"]) == ["eps",
+                                                                                     "delta"]
+    assert plane.attrs["eps"] == 0.5 and plane.attrs["delta"] == 1.0
+    xr.testing.assert_identical(_data_of(plane), _data_of(paper))
+    assert plane.sizes["impact"] > 0
+    (tmp_path / "unit").mkdir()
+    (tmp_path / "at").mkdir()
+    rms = _trace(tmp_path / "unit", TRACE_RMS, "noisy")      # the record at rms 1, times 0.29
+    ref = _trace(tmp_path / "at", TRACE_RMS_PAPER, "flat")   # the record at rms 0.29
+    np.testing.assert_allclose(rms["x"].values, ref["x"].values, rtol=0, atol=1e-12)
+    assert rms.sizes["impact"] == ref.sizes["impact"]
+    from vibroimpact import plotting
+    from vibroimpact.plotting.harmonic import fig10
+
+    with plotting.style():
+        title = fig10(plane)._suptitle.get_text()
+    assert r"at the point $\varepsilon$ = 0.5, $\delta$ = 1 of the study's" in title
+
+
+@pytest.mark.parametrize("trace, key, fragment", [
+    ("{delta: 1.0, t_end: 60.0}", "trace.delta", "gives its trace's point as cell"),
+    ("{t_end: 60.0}", "trace.cell", "missing: the trace's point"),
+    ("{cell: [0.5, 7.0], t_end: 60.0}", "trace.cell", "outside the study's (eps, delta)"),
+])
+def test_a_bad_plane_trace_is_refused(tmp_path, trace, key, fragment):
+    text = TRACE_PLANE.replace("trace: {cell: [0.5, 1.0], t_end: 60.0}", f"trace: {trace}")
     with pytest.raises(ConfigError) as err:
         _load(tmp_path, text)
     lines = [p for p in err.value.problems if f"studies.restitution.{key}" in p]

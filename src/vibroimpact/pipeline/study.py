@@ -51,6 +51,8 @@ JOB_KEYS = {
     # job as a param of their own (common.smk, ``escape_noise``)
     "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
                "motions", "escape") + _WALLS,
+    # a plane study's trace is at its cell [x, y] (and the rms axis's value scales the record)
+    "plane_trace": _PHYSICS + ("trace", "plane", "delta", "rms"),
     # a plane study's escape cells are [x, y] in its plane: the fixed values of the others
     "plane_escape": ("noise", "zeta", "eps", "amplitude", "inv_beta", "delta", "plane",
                      "transient", "sweep", "motion_window", "motions", "escape") + _WALLS,

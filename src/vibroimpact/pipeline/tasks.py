@@ -285,6 +285,8 @@ def trace(name, block, noise_path, out):
     """Rule ``simulate_trace``: a short sampled record from rest (Figs. 3, 10)."""
     from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
+    if block.get("plane") is not None:
+        return _plane_trace(name, block, noise_path, out, cells)
     study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = block["trace"]
@@ -294,6 +296,32 @@ def trace(name, block, noise_path, out):
                      **study.walls())
     attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
                  beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
+    io.write_dataset(datasets.trace_dataset(tr, attrs), out)
+
+
+def _plane_trace(name, block, noise_path, out, cells):
+    """A plane study's trace: at ``trace.cell`` [x, y] of its plane, every other parameter
+    fixed; with the rms an axis, the unit-rms record times the cell's rms (as its map)."""
+    samples, dt, noise_attrs = io.read_noise(noise_path)
+    spec = block["trace"]
+    plane = list(block["plane"])
+    p = dict(_plane_fixed(block), **{k: float(v) for k, v in zip(plane, spec["cell"])})
+    if "rms" in p:
+        samples = samples * p.pop("rms")
+    if "gap" in p and p.get("eps_lower") is None:
+        p["eps_lower"] = p["eps"]
+    beta_f = 1.0 / p.pop("inv_beta")
+    tr = cells.trace(samples, dt, **p, beta_f=beta_f, t_end=float(spec["t_end"]))
+    fixed = _plane_fixed(block)
+    if "rms" not in plane and noise_attrs.get("noise_rms") is not None:
+        fixed["rms"] = float(noise_attrs["noise_rms"])
+    noise = {k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}
+    attrs = dict(provenance(block, int(noise_attrs["seed"])), study=name, noise=block["noise"],
+                 dt=float(noise_attrs["dt"]), **noise, **p, beta_f=beta_f,
+                 t_end=float(spec["t_end"]), axes=plane, cell=[float(v) for v in spec["cell"]],
+                 fixed=json.dumps(fixed, sort_keys=True))
+    if "gap" in p:
+        attrs.update({k: v for k, v in _wall_attrs(p["gap"], p["eps_lower"]).items()})
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
 
 

@@ -415,13 +415,13 @@ def _check_study(config, name, entry, problems, limits, unforced):
                         "not on the study's delta grid (a spectrum's cell has its impact "
                         "statistics too)", _grid_text(grids["delta"]))
     trace = entry.get("trace")
-    if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
-        problems.add(f"{where}.trace.t_end", trace["t_end"],
-                     f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
-    elif trace and float(trace["t_end"]) < dt * (1 - 1e-9):
-        problems.add(f"{where}.trace.t_end", trace["t_end"], f"shorter than one sample step "
-                     f"(dt = {_num(dt)} of noises.{entry['noise']}): a trace of one point",
-                     f"{_num(dt)} <= t_end <= {tau:.6g}")
+    if trace and trace.get("cell") is not None:
+        problems.add(f"{where}.trace.cell", trace["cell"], "a point [x, y] of a plane, and "
+                     "this study has none", "delta (and inv_beta) of the trace, or a `plane`")
+    if trace and trace.get("delta") is None:
+        problems.add(f"{where}.trace.delta", None, "missing: the play of the trace",
+                     "a number under trace.delta")
+    _check_trace_t_end(where, entry, dt, tau, record, problems)
     _distinct(problems, f"{where}.density_delta", entry["density_delta"])
     if grids["delta"] is not None:
         for j, v in enumerate(entry["density_delta"]):
@@ -449,6 +449,49 @@ def _check_study(config, name, entry, problems, limits, unforced):
     resolved.update(grids)
     return resolved
 
+def _check_trace_t_end(where, entry, dt, tau, record, problems):
+    """A trace (``trace.t_end``) within the noise record and at least one sample step."""
+    trace = entry.get("trace")
+    if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"],
+                     f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
+    elif trace and float(trace["t_end"]) < dt * (1 - 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"], f"shorter than one sample step "
+                     f"(dt = {_num(dt)} of noises.{entry['noise']}): a trace of one point",
+                     f"{_num(dt)} <= t_end <= {tau:.6g}")
+
+
+def _check_plane_trace(where, entry, plane, grids, dt, tau, problems):
+    """A plane study's trace: at its ``cell`` [x, y] inside the plane (no delta, inv_beta of
+    its own: the plane fixes them or runs over them)."""
+    at = f"{where}.trace"
+    trace = entry["trace"]
+    for key in ("delta", "inv_beta"):
+        if trace.get(key) is not None:
+            problems.add(f"{at}.{key}", trace[key], f"a study with a plane ({plane}) gives its "
+                         "trace's point as cell: [x, y]", f"trace.cell: [{plane[0]}, "
+                         f"{plane[1]}], the others the study's fixed values")
+    cell = trace.get("cell")
+    if cell is None:
+        problems.add(f"{at}.cell", None, f"missing: the trace's point in the plane {plane}",
+                     f"[{plane[0]}, {plane[1]}]")
+    else:
+        for k, v in zip(plane, (float(c) for c in cell)):
+            test, allowed_ = _AXIS_BOUNDS[k]
+            box = grids.get(k)
+            if not test(v):
+                problems.add(f"{at}.cell", cell, f"{k} = {_num(v)} is out of its range",
+                             f"[{plane[0]}, {plane[1]}] with {allowed_}")
+            elif box is not None and not (
+                    float(box.min()) - GRID_RTOL * max(1.0, abs(float(box.min()))) <= v
+                    <= float(box.max()) + GRID_RTOL * max(1.0, abs(float(box.max())))):
+                problems.add(f"{at}.cell", cell, f"outside the study's ({plane[0]}, "
+                             f"{plane[1]}) plane", f"{k} in [{_num(float(box.min()))}, "
+                             f"{_num(float(box.max()))}]")
+    record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
+    _check_trace_t_end(where, entry, dt, tau, record, problems)
+
+
 #: The bounds of each parameter a plane may run over, as (test, allowed) (the schema's for a
 #: number: an axis's values are checked here, after its grid is expanded).
 _AXIS_BOUNDS = {
@@ -463,7 +506,7 @@ _AXIS_BOUNDS = {
 }
 #: The figures a study with a plane draws: its map's (fig15_vs_fig16 needs an orbits entry
 #: over the same plane, which the workflow does not make yet).
-PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov", "escape_vs_noise")
+PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov", "escape_vs_noise", "fig10")
 
 
 def _check_plane_study(config, name, entry, problems, limits, unforced):
@@ -527,11 +570,11 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
         return None
-    for block in ("spectra", "trace"):
-        if entry.get(block):
-            problems.add(f"{where}.{block}", None, f"a study with a plane ({plane}) draws its "
-                         "map, its basins and its escape only", f"leave {block} out, or put "
-                         "it in a study without a plane")
+    if entry.get("spectra"):
+        problems.add(f"{where}.spectra", None, f"a study with a plane ({plane}) has no "
+                     "spectra: they run at plays of the (1/beta_f, delta) grid (Figs. 6, "
+                     "11, 12: a curve per play)", "leave spectra out, or put them in a study "
+                     "without a plane at the plane's fixed values")
     if entry.get("escape") and set(plane) & set(NOISE_PARAMETERS):
         problems.add(f"{where}.escape", "...", f"the escape runs its own noise levels "
                      f"(escape.rms), and the plane {plane} has the rms as an axis",
@@ -589,6 +632,8 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         if grids[key].size < 2:
             problems.add(f"{where}.{key}", entry[key], f"fig15 draws contours over the "
                          f"plane {plane}", "at least 2 values")
+    if entry.get("trace"):
+        _check_plane_trace(where, entry, plane, grids, dt, tau, problems)
     if entry.get("escape") and not set(plane) & set(NOISE_PARAMETERS):
         amp = grids.get("amplitude")
         harmonic = bool(float(entry["amplitude"])) if amp is None else bool(np.all(amp != 0))
