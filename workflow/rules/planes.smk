@@ -18,9 +18,7 @@ def plane_attractor_runtime_min(wildcards):
     time each, with the simulate jobs' margin and floor."""
     entry = config["studies"][wildcards.study]
     rows, n_tiles = plane_attractor_rows(entry)
-    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(
-        grid_values(entry[entry["plane"][1]])
-    )
+    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(grid_values(entry[entry["plane"][1]]))
     cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
     return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)
 
