@@ -173,13 +173,13 @@ def escape_vs_noise(escape):
                              **{k: v for k, v in OUTSIDE_FIT_STYLE.items() if k == "color"}))
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=7)
     noise = ", ".join(_spectrum_parts(escape.attrs))
-    system, force = ((f"{_system_text(escape)};  ", r"$\sin(\beta_f\tau)$")
+    system, force = ((f"{_system_text(escape)};  ", r"$\sin(\beta_f\tau) + r(\tau)$")
                      if _cell_axes(escape) == ("inv_beta", "delta") else
                      (f"fixed: {fixed_caption(_decoded(escape.attrs['fixed'], 'fixed'))};  ",
-                      r"$A\sin(\beta_f\tau)$"))
+                      r"$A\sin(\beta_f\tau) + r(\tau)$"))
     _header(fig, "Escape from the impact motions against the noise level",
             f"{system}"
-            rf"$f(\tau)$ = {force} + $r(\tau)$ ({noise});  "
+            rf"$f(\tau)$ = {force} ({noise});  "
             f"each cell from rest on one record per rms, "
             f"{float(_attr(escape, 'record_length')):,.0f} time units after the transient "
             f"{_num(_attr(escape, 'transient'))} "
