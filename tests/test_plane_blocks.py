@@ -222,7 +222,7 @@ def test_the_targets_and_the_plan(tmp_path):
      "outside the study's (eps, delta) plane"),
     ("escape: {cells: [[1.5, 1.0]], rms: [0.2, 0.3]}", "escape.cells[0]",
      "eps = 1.5 is out of its range"),
-    ("spectra: {delta: [1.0]}", "spectra", "draws its map, its basins and its escape only"),
+    ("spectra: {delta: [1.0]}", "spectra", "has no spectra: they run at plays"),
 ])
 def test_a_plane_block_is_refused_naming_its_key(tmp_path, change, key, fragment):
     text = EPS_DELTA.replace("    escape: {cells: [[0.5, 1.0], [0.3, 0.25]], rms: [0.2, 0.29], "
