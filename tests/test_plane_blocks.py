@@ -319,3 +319,11 @@ def test_a_bad_plane_trace_is_refused(tmp_path, trace, key, fragment):
         _load(tmp_path, text)
     lines = [p for p in err.value.problems if f"studies.restitution.{key}" in p]
     assert lines and fragment in lines[0], err.value.problems
+
+
+def test_basins_in_a_study_without_a_plane_is_refused(tmp_path):
+    text = PAPER_ESCAPE.replace("figures: [fig15, escape_vs_noise]", "figures: [fig15, basins]")
+    with pytest.raises(ConfigError) as err:
+        _load(tmp_path, text)
+    lines = [p for p in err.value.problems if "studies.flat.figures[1]" in p]
+    assert lines and "draws basins over its plane, and this study has none" in lines[0]

@@ -191,6 +191,11 @@ def _check_figures(config, section, name, entry, problems, grids):
             problems.add(at, fig, "listed twice", "each figure once (a list of values under "
                          "its `inv_beta` draws it several times)")
         seen.add(fig)
+        if kind == "study" and spec.get("needs") and not entry.get("plane"):
+            problems.add(at, fig, f"a study draws {fig} over its plane, and this study has "
+                         "none", f"a `plane: [x, y]` with an `{spec['needs']}:` block, or "
+                         f"{fig} in an orbits entry's figures (the paper's (1/beta_f, delta))")
+            continue
         if kind != "study" or spec.get("needs"):
             block = spec.get("needs")
             if block and not entry.get(block):
