@@ -515,9 +515,10 @@ def orbit_map_dataset(result, attrs):
     return ds
 
 
-def concat_orbit_tiles(tiles):
-    """Join orbit-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
-    return xr.concat(tiles, dim="inv_beta").sortby("inv_beta")
+def concat_orbit_tiles(tiles, dim="inv_beta"):
+    """Join orbit-map tiles (disjoint sets of ``dim`` rows: ``inv_beta``, or the tiled axis
+    of a plane) into one dataset sorted along ``dim``."""
+    return xr.concat(tiles, dim=dim).sortby(dim)
 
 
 def orbit_map_result(ds):
