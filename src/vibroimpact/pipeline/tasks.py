@@ -540,12 +540,40 @@ def boundaries(entry, orbits_path, out, threads=None):
 
 
 def plane_boundaries(entry, orbits_path, out, threads=None):
-    """`boundaries` of an ``orbits`` entry with a plane."""
+    """`boundaries` of an ``orbits`` entry with a plane: `plane_boundaries` of every type over
+    the map's box, seeded from the map; a two-wall entry, or one whose eps reaches 0, is
+    written untraced (``traced = 0``, ``not_traced`` says why), as over (1/beta, delta)."""
     fixed = orbit_plane_fixed(entry)
-    attrs = dict(provenance(entry), **fixed, axes=list(entry["plane"]),
-                 fixed=json.dumps(fixed, sort_keys=True), traced=0,
-                 not_traced="not yet traced over a plane other than (inv_beta, delta)")
-    io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
+    axes = tuple(entry["plane"])
+    attrs = dict(provenance(entry), **fixed, axes=list(axes),
+                 fixed=json.dumps(fixed, sort_keys=True), traced=1)
+    seeds = io.load_dataset(orbits_path)
+    box = {k: (float(seeds[k].min()), float(seeds[k].max())) for k in axes}
+    why = None
+    if entry.get("gap") is not None or "gap" in axes:
+        why = "two walls: the edges are the map's cell edges"
+    elif fixed.get("eps", 1.0) == 0.0 or ("eps" in axes and box["eps"][0] <= 0.0):
+        why = "eps = 0 in the plane: the edges are the map's cell edges"
+    if why is not None:
+        attrs.update(traced=0, not_traced=why)
+        io.write_dataset(datasets.boundaries_dataset({}, attrs, axes), out)
+        return
+    import numba
+
+    from vibroimpact.orbits.boundaries import plane_boundaries as trace
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    curves = {}
+    for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
+        curves[(m, n)] = trace(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
+                               seed_map=seeds, tol=BOUNDARY_TOL)
+        log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
+        lost = sum(c.ends.count("lost") for c in curves[(m, n)])
+        if lost:
+            log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
+                        "there (the dataset's `ends` says which curves)", m, n, lost)
+    io.write_dataset(datasets.boundaries_dataset(curves, attrs, axes), out)
 
 
 def _attractor_attrs(entry):

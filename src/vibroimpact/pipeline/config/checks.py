@@ -284,10 +284,10 @@ def _check_orbits_item_plane(name, entry, at, orbits, other, problems):
         if (a is None) != (b is None) or (a is not None and (
                 isinstance(a, (list, dict)) or isinstance(b, (list, dict))
                 or float(a) != float(b))):
-            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = "
-                         f"{_num(b) if isinstance(b, (int, float)) else b if b is not None else 'none'}"
-                         f", the study {key} = "
-                         f"{_num(a) if isinstance(a, (int, float)) else a if a is not None else 'none'}",
+            def text(v):
+                return _num(v) if isinstance(v, (int, float)) else "none" if v is None else v
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = {text(b)}, the "
+                         f"study {key} = {text(a)}",
                          f"an `orbits` entry over {plane} with the study's fixed values")
 
 
