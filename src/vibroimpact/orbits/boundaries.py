@@ -860,14 +860,13 @@ def plane_boundaries(m, n, x_name, x_range, y_name, y_range, fixed, *, resolutio
     n = _checks.integer("n", n, low=1)
     if m > MAX_M:
         raise ValueError(f"m must be at most {MAX_M}, got {m}")
-    x_range = _plane_range(x_name, x_range) if x_name in HARMONIC_PARAMETERS else x_range
-    y_range = _plane_range(y_name, y_range) if y_name in HARMONIC_PARAMETERS else y_range
-    xs, ys, fixed, parsed, two_walls = check_plane(x_name, list(x_range), y_name,
-                                                   list(y_range), fixed, [(m, n)])
-    if two_walls:
+    if "gap" in (x_name, y_name) or (isinstance(fixed, dict) and "gap" in fixed):
         raise ValueError("the boundaries continue the one-wall closed-form (m/n) solutions: "
                          "a plane with a second wall (gap) has none; its edges are the map's "
                          "cell edges")
+    x_range = _plane_range(x_name, x_range) if x_name in HARMONIC_PARAMETERS else x_range
+    y_range = _plane_range(y_name, y_range) if y_name in HARMONIC_PARAMETERS else y_range
+    fixed = check_plane(x_name, list(x_range), y_name, list(y_range), fixed, [(m, n)])[2]
     if "eps" in fixed and not fixed["eps"] > 0.0:
         raise ValueError(f"eps must be > 0 for the boundaries, got {fixed['eps']} (with eps = 0 "
                          f"every flight starts at rest on the wall; not supported)")
