@@ -161,7 +161,8 @@ def test_fig16_over_a_plane_from_orbit_plane(tmp_path):
     assert panels[0].get_xlabel() in ("", r"restitution $\varepsilon$")
     assert any(ax.get_xlabel() == r"restitution $\varepsilon$" for ax in fig.axes)
     assert r"fixed: $\zeta$ = 0.05, $A$ = 1, $1/\beta_f$ = 1.1" in fig.get_suptitle()
-    with pytest.raises(ValueError, match=r"traced over the \(inv_beta, delta\) plane only"):
+    with pytest.raises(ValueError, match=r"traced over \['inv_beta', 'delta'\] but the orbit "
+                                         r"map runs over \['eps', 'delta'\]"):
         plotting.fig16(orbits, boundaries=xr.Dataset())
 
 
