@@ -1,4 +1,6 @@
-"""Exact boundaries of the stable (m/n) domains of Fig. 16 over the ``(1/beta, delta)`` plane.
+"""Exact boundaries of the stable (m/n) domains of Fig. 16 over the ``(1/beta, delta)`` plane
+(``domain_boundaries``) or any plane of the harmonic-force problem (``plane_boundaries``: the
+two parameter unknowns below are then the plane's, e.g. ``(eps, delta)``).
 
 ``domain_boundaries`` replaces the pixel edges of ``orbit_map`` by curves traced by
 pseudo-arclength continuation on the augmented system: the 2m orbit equations (paper eqs.

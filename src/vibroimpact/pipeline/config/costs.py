@@ -41,9 +41,11 @@ MAP_CAP_FRACTION = 0.34
 MAP_CELL_S = 0.010
 BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 #: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
-#: no branch to follow), and one cell of a two-wall plane (the shooting solver, seeded by
-#: the simulator: ~135 ms measured by h35a, issue 35).
-ORBIT_CELL_S = 0.004
+#: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
+#: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
+#: one cell of a two-wall plane (the shooting solver, seeded by the simulator: ~135 ms
+#: measured by h35a, issue 35).
+ORBIT_CELL_S = 1.0e-4
 SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
 #: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
