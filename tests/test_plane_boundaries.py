@@ -144,3 +144,24 @@ def test_plane_boundaries_refuse_what_they_cannot_trace():
         plane_boundaries(1, 1, "eps", (0.0, 0.7), "delta", DELTA, fixed)
     with pytest.raises(ValueError, match="amplitude"):
         plane_boundaries(1, 1, "amplitude", (-1.0, 1.0), "delta", DELTA, dict(fixed, eps=EPS))
+
+
+@pytest.mark.parametrize("mn", [(1, 1), (2, 1)])
+def test_a_plane_without_delta_meets_a_plane_with_it(mn):
+    """Over (zeta, eps) at delta = 0.2 (no delta axis: every seed solved per cell) the edge
+    crosses zeta = 0.05 at the eps where the (delta, eps) edge at zeta = 0.05 crosses delta =
+    0.2: one point of the (zeta, eps, delta) space reached along two planes (measured to
+    5e-15)."""
+    fixed = {"inv_beta": IB}
+    across = plane_boundaries(*mn, "zeta", (0.02, 0.2), "eps", (0.2, 0.9),
+                              dict(fixed, delta=0.2), resolution=(19, 36))
+    tracer = _tracer(*mn, [0.0, 0.0, IB, 0.2, 1.0], [bk.PRM_ZETA, bk.PRM_EPS],
+                     (0.02, 0.2, 0.2, 0.9))
+    a = crossings(across, tracer, ZETA, lambda c: (c.x, c.y))
+    along = plane_boundaries(*mn, "delta", (-0.5, 1.0), "eps", (0.2, 0.9),
+                             dict(fixed, zeta=ZETA), resolution=(31, 36))
+    tracer = _tracer(*mn, [ZETA, 0.0, IB, 0.0, 1.0], [bk.PRM_DELTA, bk.PRM_EPS],
+                     (-0.5, 1.0, 0.2, 0.9))
+    b = crossings(along, tracer, 0.2, lambda c: (c.x, c.y))
+    assert [k for k, _ in a] == [k for k, _ in b] == ["grazing"]
+    assert abs(a[0][1] - b[0][1]) <= SAME_LINE_TOL
