@@ -165,3 +165,18 @@ def test_a_plane_without_delta_meets_a_plane_with_it(mn):
     b = crossings(along, tracer, 0.2, lambda c: (c.x, c.y))
     assert [k for k, _ in a] == [k for k, _ in b] == ["grazing"]
     assert abs(a[0][1] - b[0][1]) <= SAME_LINE_TOL
+
+
+def test_over_the_papers_plane_it_is_domain_boundaries_bit_for_bit():
+    """plane_boundaries over (inv_beta, delta) at A = 1 is the (1/beta, delta) tracer: the
+    kernels read the same numbers (1 / x, delta / 1) in the same order."""
+    box = dict(inv_beta=(0.9, 1.3), delta=(-0.5, 2.5))
+    old = domain_boundaries(1, 1, ZETA, EPS, **box, resolution=(9, 31))
+    new = plane_boundaries(1, 1, "inv_beta", box["inv_beta"], "delta", box["delta"],
+                           {"zeta": ZETA, "eps": EPS}, resolution=(9, 31))
+    assert len(old) == len(new) > 0
+    for a, b in zip(old, new):
+        assert a.kind == b.kind and a.ends == b.ends
+        for u, v in ((a.inv_beta, b.x), (a.delta, b.y), (a.orbits, b.orbits),
+                     (a.error, b.error)):
+            np.testing.assert_array_equal(u, v)
