@@ -403,3 +403,16 @@ def test_an_orbits_plane_built_by_its_tasks_is_orbit_plane_bit_for_bit(tmp_path)
     column = built["n_stable"].sel(type="1/1", eps=0.5).values > 0
     first = built["delta"].values[np.argmax(column)]
     assert abs(e[k] - 0.5) < 0.02 and first - 0.05 < d[k] <= first
+
+
+def test_the_planes_example_draws_fig16_over_its_restitution_plane():
+    """config/examples/planes.yaml: the (eps, delta) study draws fig15_vs_fig16 over the
+    orbits entry of its plane; the plan costs the entry's tiles, join, edges and figure."""
+    config, plan = configuration.load(root=ROOT,
+                                      user_files=[ROOT / "config/examples/planes.yaml"])
+    entry = config["orbits"]["restitution"]
+    assert entry["plane"] == config["studies"]["restitution"]["plane"] == ["eps", "delta"]
+    assert {"name": "fig15_vs_fig16", "orbits": "restitution"} in (
+        config["studies"]["restitution"]["figures"])
+    row = next(r for r in plan.rows if r.key == "orbits.restitution")
+    assert row.orbit_cells == 41 * 201 and row.jobs == 2 + 1 + 1 + 1
