@@ -403,7 +403,8 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
             b = (r_last[1] - r_last[0]) / dt
             if mode in (kernels.WALL, kernels.WALL_LO):
                 mode = kernels.FREE     # x on the wall, v is x' itself
-            x, v, mode, status = kernels.slow_step(
+            step = kernels.slow_step if lower else kernels.slow_step_one   # as run_steps
+            x, v, mode, status = step(
                 n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
                 buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
             _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[kernels.FT_DIAGNOSTICS],
