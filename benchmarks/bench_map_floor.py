@@ -43,9 +43,10 @@ inflated by the neighbours, walls meaningless), the default build's map (/work/c
   19 s wall on 2 cores): the <= 10 s target needs the statistics cut by ~4x as well.
 - What a closed-form chatter tail could still save (every 16th cell simulated alone to its
   record_end, fresh compilations with the tolerances of impact.tolerances scaled, best of
-  two alternations): RESOLVED_REBOUND x 1e4 alone changes 1.6-4.3 % of the impacts (it does
-  not bind: the tail is summed once chatter_tail's first-order bracket is within
-  CHATTER_TIME_TOL = 1e-7, i.e. T_hi - T_lo ~ 500 w^2 at F ~ 0.5, w ~ 1e-5); with
+  two alternations): RESOLVED_REBOUND x 1e4 alone removes 1.6-4.3 % of the impacts (four
+  harmonic cells, 4e5 steps each: it does not bind; the tail is summed once chatter_tail's
+  first-order bracket is within CHATTER_TIME_TOL = 1e-7, and by estimate T_hi - T_lo ~
+  500 w^2 at F ~ 0.5, so w ~ 1e-5); with
   CHATTER_TIME_TOL x 1e4 too, 5.01e6 -> 3.04e6 impacts (-39 %) saved 2.51 -> 2.11 CPU-s of
   the kernel (-13..-16 %, about 180 ns per rebound not resolved): resolving only the first
   rebound of each of the 3.0e5 chatter sequences (the sample's ~1e6 collisions keeping ~1.3e6
@@ -55,11 +56,11 @@ inflated by the neighbours, walls meaningless), the default build's map (/work/c
   remainder), not the first-order one.
 - Where the 2030 ns per collision go (the same 325 cells through a throw-away copy of the
   kernel with counters added to slow_step_one, not kept: counters in the loop cost time):
-  per 1e6 collisions (5.0e6 impacts, 3.0e5 chatter tails, 8.96e7 steps) 3.68e6 calls of
-  slow_step (4.1 % of the steps), of which 1.10e6 are flights near the wall that meet
-  nothing (mostly the step after a rebound or a release: the exclusion bound cannot clear
-  it) and 3.0e5 start on the wall (releases; only 3 170 stay stuck through the step: the
-  cheap stay test of run_steps takes the rest), 9.29e6 events walked (segment + search
+  for its ~0.99e6 collisions (5.0e6 impacts, 3.0e5 chatter tails, 8.96e7 steps) 3.68e6
+  calls of slow_step (4.1 % of the steps), of which 1.10e6 are flights that meet nothing
+  (steps within the exclusion bound's reach of the wall) and 3.0e5 start on the wall
+  (releases; only 3 170 stay stuck through the step: the cheap stay test of run_steps takes
+  the rest), 9.29e6 events walked (segment + search
   each), 4.64e6 chatter_tail calls. A sharper exclusion test would skip some near misses,
   but a step taken by the recurrence instead of segment rounds differently: not bit for bit.
 - the map, ``--stride 4 --no-main --peer a13f0b3`` (1297 cells, 2 processes): this tree
