@@ -60,9 +60,9 @@ inflated by the neighbours, walls meaningless), the default build's map (/work/c
   calls of slow_step (4.1 % of the steps), of which 1.10e6 are flights that meet nothing
   (steps within the exclusion bound's reach of the wall) and 3.0e5 start on the wall
   (releases; only 3 170 stay stuck through the step: the cheap stay test of run_steps takes
-  the rest), 9.29e6 events walked (segment + search
-  each), 4.64e6 chatter_tail calls. A sharper exclusion test would skip some near misses,
-  but a step taken by the recurrence instead of segment rounds differently: not bit for bit.
+  the rest), 9.29e6 events walked (segment + search each), 4.64e6 chatter_tail calls. A
+  sharper exclusion test would skip some near misses, but a step taken by the recurrence
+  instead of segment rounds differently: not bit for bit.
 - the map, ``--stride 4 --no-main --peer a13f0b3`` (1297 cells, 2 processes): this tree
   22.16 cell CPU-s, main a13f0b3 22.70 (0.98 x; slow_step_one), max |dP| 0 (bit for bit).
 - ``--only-step`` part of the same run: simulator 4.41 ns, prototype 4.45 ns per step (0.99 x).
