@@ -66,6 +66,10 @@ inflated by the neighbours, walls meaningless), the default build's map (/work/c
 - the map, ``--stride 4 --no-main --peer a13f0b3`` (1297 cells, 2 processes): this tree
   22.16 cell CPU-s, main a13f0b3 22.70 (0.98 x; slow_step_one), max |dP| 0 (bit for bit).
 - ``--only-step`` part of the same run: simulator 4.41 ns, prototype 4.45 ns per step (0.99 x).
+- the same command again at 05:59-06:03 UTC (load 23-31), the sticking intervals now kept as
+  arrays in the driver: this tree 22.91 cell CPU-s, main a13f0b3 23.44 (0.98 x), max |dP| 0;
+  the step without impact 4.38 against 5.22 ns (0.84 x: at this load the ratio moves by
+  +-0.15 between runs).
 
 Usage::
 
