@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from vibroimpact import stats
+from vibroimpact import stats, tally
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
@@ -387,14 +387,14 @@ class _EventRecord:
         pressed = self.pressed() if rule == "physical" else None
         if not self.walls:
             start, end = self.sticking()
-            return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
+            return tally.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
                                           end, dt=self.dt, eps=eps, floor=floor,
-                                          pressed=pressed, rule=rule).after(transient)
+                                          pressed=pressed, rule=rule, after=transient)
         start, end, wall = self.sticking()
-        return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
+        return tally.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
                                       rule=rule, wall=self.wall[0], stick_wall=wall,
-                                      eps_lower=self.walls["eps_lower"]).after(transient)
+                                      eps_lower=self.walls["eps_lower"], after=transient)
 
 
 class _IdentityRecord:
@@ -632,7 +632,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             k += chunk.n_steps
             n_checks += 1
             col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-            res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
+            res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
                                           window=window, motions=motions, n_batches=n_batches,
                                           stuck=col.stuck, **wall_of(col))
             worst = float(max(res.stderr.max(), res.stick_stderr.max()))
@@ -651,7 +651,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     by_rule = [res] + [
-        stats.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
+        tally.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
                                 motions=motions, n_batches=n_batches, stuck=c.stuck,
                                 **wall_of(c))
         for c in (events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient, rule=rule)
@@ -739,7 +739,7 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         events.add(chunk)
         k += chunk.n_steps
     col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-    res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
+    res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
                                   window=window, motions=motions, stuck=col.stuck,
                                   **({} if not walls else
                                      dict(walls=events.collision_walls(col))))

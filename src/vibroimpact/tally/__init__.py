@@ -1,0 +1,101 @@
+"""A streamed cell's statistics compiled: the collision grouping and the motion statistics.
+
+:func:`group_collisions` and :func:`motion_statistics` take the arguments of, and return to
+the bit, ``stats.group_collisions(...).after(t0)`` and ``stats.motion_statistics``: their
+loops over the impacts and the intervals run in numba (`kernels`) instead of the reference's
+some thirty numpy passes each, and the sums numpy takes pairwise stay numpy's. The numpy
+functions of `vibroimpact.stats` remain the statement of each rule (tests/test_tally.py holds
+these to them on random and simulated records); these are what the simulation cells run
+(`pipeline.cells`), where the map's adaptive cell regroups and relabels its whole record at
+every check.
+
+Why compiled and not vectorized further: the grouping is a merge of the impacts with the
+sticking phases and two backward scans, the labelling a greedy scan in time order with
+overlapping candidates; in numpy each is a dozen passes and temporaries over the record,
+cut into many small calls per cell (~40 ns an impact in all, 10 times the simulator's
+step), in numba one pass each.
+
+``stats`` loads no numba (the drawing and aggregation jobs stay light): this room sits on
+the simulator's floor, beside `impact`.
+"""
+import numpy as np
+
+from vibroimpact import _checks
+from vibroimpact.stats import collisions as _collisions
+from vibroimpact.stats import motions as _motions
+
+__all__ = ["group_collisions", "motion_statistics"]
+
+_RULE_CODES = {rule: code for code, rule in enumerate(_collisions.RULES)}
+
+
+def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *,
+                     dt, eps, floor=_collisions.DEFAULT_REBOUND_FLOOR, pressed=None,
+                     rule="physical", wall=None, stick_wall=None, eps_lower=None, after=None):
+    """``stats.group_collisions(...)``, then ``.after(after)`` unless ``after`` is None: the
+    same arguments, checks and result, bit for bit."""
+    from vibroimpact.tally import kernels
+
+    step, offset, u, start, end, dt, eps, floor, pressed, wall = _collisions._checked(
+        impact_step, impact_offset, impact_velocity, stick_start, stick_end, dt=dt, eps=eps,
+        floor=floor, pressed=pressed, rule=rule, wall=wall, stick_wall=stick_wall,
+        eps_lower=eps_lower)
+    n = step.size
+    eps = np.ascontiguousarray(np.broadcast_to(np.asarray(eps, dtype=float), (n,)))
+    if rule == "rebounds" and n and not np.any(eps * u >= floor):
+        n = 0
+    if n == 0:
+        return _collisions._no_collisions(floor, dt)
+    t0 = -np.inf if after is None else float(after)
+    pressed = (np.ascontiguousarray(pressed, dtype=np.bool_) if rule == "physical"
+               else np.zeros(0, np.bool_))
+    step = np.ascontiguousarray(step)
+    offset = np.ascontiguousarray(offset)
+    first, impact_collision, rebounds, stuck, stick_time, duration = kernels.group(
+        step, offset, np.ascontiguousarray(u), np.ascontiguousarray(start),
+        np.ascontiguousarray(end), dt, eps, floor, pressed, _RULE_CODES[rule],
+        np.ascontiguousarray(wall), t0)
+    t_first = step[first] * dt + offset[first]
+    return _collisions.Collisions(first, impact_collision, step[first], offset[first], t_first,
+                                  u[first], rebounds, stuck, stick_time, duration, floor, dt,
+                                  wall[first])
+
+
+def motion_statistics(impact_time, intervals, beta, t_start, t_stop, *,
+                      window=_motions.DEFAULT_MOTION_WINDOW, motions=_motions.DEFAULT_MOTIONS,
+                      n_batches=20, stuck=None, walls=None):
+    """``stats.motion_statistics``: the same arguments, checks and result, bit for bit."""
+    return _motions._motion_statistics(impact_time, intervals, beta, t_start, t_stop, window,
+                                       motions, n_batches, stuck, walls, _labelled, _cover_at)
+
+
+def _labelled(ratio, window, motions, walls, stuck):
+    """``stats.motions._labelled`` compiled."""
+    from vibroimpact.tally import kernels
+
+    ratio = np.ascontiguousarray(ratio, dtype=float)
+    window = _checks.real("window", window, low=0.0, high=0.5, low_open=True)
+    walls = _motions._walls(walls, ratio.size)
+    motions = _motions._check_motions(motions, walls=walls is not None)
+    if stuck is not None:
+        stuck = np.asarray(stuck, dtype=bool)
+        if stuck.shape != ratio.shape:
+            raise ValueError(f"stuck must hold one flag per interval ({ratio.size}), got "
+                             f"shape {stuck.shape}")
+    lengths = np.array([_motions._length(m) for m in motions], dtype=np.int64)
+    periods = np.array([m[-1] for m in motions], dtype=np.int64)
+    lowers = np.array([m[1] if len(m) == 3 else -1 for m in motions], dtype=np.int64)
+    return kernels.label(
+        ratio, window, lengths, periods, lowers,
+        np.zeros(0, np.int8) if walls is None else np.ascontiguousarray(walls),
+        np.zeros(0, np.bool_) if stuck is None else np.ascontiguousarray(stuck),
+        len(motions))
+
+
+def _cover_at(z, classes, n_classes, j):
+    """``stats.motions._cover_at`` compiled."""
+    from vibroimpact.tally import kernels
+
+    return kernels.cover_at(np.ascontiguousarray(z, dtype=float),
+                            np.ascontiguousarray(classes, dtype=np.int64), int(n_classes),
+                            np.ascontiguousarray(j, dtype=np.int64))
