@@ -20,8 +20,9 @@ rounds, per build.
 
 Measured 2026-11-27 (see the README of benchmarks, or the report of m37): run it as
 
-    python benchmarks/bench_map_stats.py --dataset /work/check35c/results/datasets/motion_map_map.nc \\
-        --noise /work/check35c/results/noise/harmonic_input.nc --stride 8 --rounds 3
+    python benchmarks/bench_map_stats.py --stride 8 --rounds 3 \\
+        --dataset /work/check35c/results/datasets/motion_map_map.nc \\
+        --noise /work/check35c/results/noise/harmonic_input.nc
 """
 import os
 
@@ -165,8 +166,9 @@ def main(argv=None):
               f"{b['kernel'].sum():13.3f} {b['total'].sum():11.3f} "
               f"{b['stats'].sum() / b['total'].sum():12.1%} {wall:10.2f} / {cpu:.2f}")
     other = [label for label in best if label != "this tree"][0]
-    print(f"statistics CPU, this tree / peer: {ref['stats'].sum() / best[other]['stats'].sum():.3f}"
-          f"; whole cell: {ref['total'].sum() / best[other]['total'].sum():.3f}")
+    ratio = ref["stats"].sum() / best[other]["stats"].sum()
+    whole = ref["total"].sum() / best[other]["total"].sum()
+    print(f"statistics CPU, this tree / peer: {ratio:.3f}; whole cell: {whole:.3f}")
     same = sum(a == b for a, b in zip(ref["digest"], best[other]["digest"]))
     print(f"results identical to the bit (every field of every cell): {same} of {n} cells")
 

@@ -143,3 +143,36 @@ def test_the_compiled_labels_on_overlapping_candidates():
             t_stop = t[-1] + 5.0
             _same(tally.motion_statistics(t if n else t[:0], z, beta, 300.0, t_stop, **a),
                   stats.motion_statistics(t if n else t[:0], z, beta, 300.0, t_stop, **a))
+
+
+def _batch_stderr_as_built(t, z, classes, n_classes, t_start, duration, n_batches):
+    """`stats.motions._batch_stderr` as the stored maps were built (15acb54), verbatim: the
+    layout of its arrays sets the order of the sums in its standard deviation."""
+    onehot = classes[None, :] == np.arange(n_classes)[:, None]
+    cover = np.concatenate([np.zeros((n_classes, 1)), np.cumsum(z * onehot, axis=1)], axis=1)
+    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
+    j = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 1)
+    inside = (edges > t[0]) & (j < z.size)
+    jj = np.minimum(j, z.size - 1)
+    extra = np.where(inside[None, :] & onehot[:, jj], np.minimum(edges - t[j], z[jj])[None, :],
+                     0.0)
+    at_edges = np.where(edges[None, :] > t[0], cover[:, j] + extra, 0.0)
+    batches = np.diff(at_edges, axis=1) * (n_batches / duration)
+    return batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
+
+
+def test_the_batch_errors_are_those_the_maps_were_built_with():
+    """Both paths' standard errors (the numpy cover and the compiled one) equal, to the bit,
+    the formula the stored maps were built with, whose sums run in the order of its arrays'
+    (Fortran) layout; a C-ordered intermediate changes the last bits."""
+    from vibroimpact.stats import motions
+
+    rng = np.random.default_rng(5)
+    for n, n_classes, n_batches in ((1, 3, 2), (50, 6, 20), (4000, 6, 20), (900, 4, 33)):
+        z = rng.uniform(0.1, 3.0, n)
+        t = 10.0 + np.concatenate([[0.0], np.cumsum(z)])
+        classes = rng.integers(-1, n_classes, n)
+        args = (t, z, classes, n_classes, 9.0, t[-1] + 2.0 - 9.0, n_batches)
+        ref = _batch_stderr_as_built(*args)
+        assert motions._batch_stderr(*args).tobytes() == ref.tobytes()
+        assert motions._batch_stderr(*args, cover_at=tally._cover_at).tobytes() == ref.tobytes()

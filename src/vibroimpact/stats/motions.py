@@ -439,6 +439,9 @@ def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches, cover_
     onehot = classes[jj][None, :] == np.arange(n_classes)[:, None]        # (n_classes, B + 1)
     extra = np.where(inside[None, :] & onehot, np.minimum(edges - t[j], z[jj])[None, :], 0.0)
     at_edges = np.where(edges[None, :] > t[0], cover_at(z, classes, n_classes, j) + extra, 0.0)
+    # in Fortran order, as the fancy-indexed ``cover[:, j]`` made it: the standard deviation
+    # below then sums each class's batches in the order the stored maps were built with
+    at_edges = np.asfortranarray(at_edges)
     batches = np.diff(at_edges, axis=1) * (n_batches / duration)           # (n_classes, B)
     return batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
 
