@@ -162,9 +162,9 @@ def _batch_stderr_as_built(t, z, classes, n_classes, t_start, duration, n_batche
 
 
 def test_the_batch_errors_are_those_the_maps_were_built_with():
-    """Both paths' standard errors (the numpy cover and the compiled one) equal, to the bit,
-    the formula the stored maps were built with, whose sums run in the order of its arrays'
-    (Fortran) layout; a C-ordered intermediate changes the last bits."""
+    """Both paths' standard errors (the numpy covered times and the compiled ones) equal, to
+    the bit, the formula the stored maps were built with, whose sums run in the order of its
+    arrays' (Fortran) layout; a C-ordered intermediate changes the last bits."""
     from vibroimpact.stats import motions
 
     rng = np.random.default_rng(5)
@@ -175,4 +175,27 @@ def test_the_batch_errors_are_those_the_maps_were_built_with():
         args = (t, z, classes, n_classes, 9.0, t[-1] + 2.0 - 9.0, n_batches)
         ref = _batch_stderr_as_built(*args)
         assert motions._batch_stderr(*args).tobytes() == ref.tobytes()
-        assert motions._batch_stderr(*args, cover_at=tally._cover_at).tobytes() == ref.tobytes()
+        assert motions._batch_stderr(*args, at_edges=tally._at_edges).tobytes() == ref.tobytes()
+
+
+def test_the_compiled_grouping_at_two_walls_by_hand():
+    """Impacts alternating between the walls, every rebound below the floor ('rebounds': no
+    event at all, although the walls change) and random walls and restitutions."""
+    rng = np.random.default_rng(11)
+    cases = [(np.array([1.0, 2.0, 3.0]), np.array([0.001, 0.001, 0.001]),
+              np.array([0, 1, 0], np.int8))]
+    for _ in range(30):
+        n = int(rng.integers(2, 200))
+        cases.append((np.sort(rng.uniform(0.0, 50.0, n)), rng.uniform(0.001, 1.0, n),
+                      rng.integers(0, 2, n).astype(np.int8)))
+    for t, u, wall in cases:
+        step = np.floor(t / DT).astype(np.int64)
+        pressed = rng.random(t.size - 1) < 0.6
+        for rule in stats.RULES:
+            kw = dict(dt=DT, eps=0.6, floor=0.01, pressed=pressed, rule=rule, wall=wall,
+                      eps_lower=0.3)
+            args = (step, t - step * DT, u, [], [])
+            for t0 in (None, 10.0):
+                ref = stats.group_collisions(*args, **kw)
+                _same(tally.group_collisions(*args, **kw, after=t0),
+                      ref if t0 is None else ref.after(t0))

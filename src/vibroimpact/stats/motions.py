@@ -372,15 +372,15 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     that, and its error is then too small (the workflow marks such cells).
     """
     return _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, motions,
-                              n_batches, stuck, walls, _labelled, _cover_at)
+                              n_batches, stuck, walls, _labelled, _at_edges)
 
 
 def _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, motions,
-                       n_batches, stuck, walls, labelled, cover_at):
+                       n_batches, stuck, walls, labelled, at_edges):
     """`motion_statistics` with its two passes over the intervals given: ``labelled(ratio,
     window, motions, walls, stuck) -> (labels, classes, n_switches)`` (`_labelled`) and
-    ``cover_at(z, classes, n_classes, j) -> (n_classes, j.size)`` (`_cover_at`); the compiled
-    twins (`vibroimpact.tally`) return the same values to the bit."""
+    ``at_edges(t, z, classes, n_classes, edges) -> (n_classes, B + 1)`` (`_at_edges`); the
+    compiled twins (`vibroimpact.tally`) return the same values to the bit."""
     t = np.asarray(impact_time, dtype=float)
     z = np.asarray(intervals, dtype=float)
     if walls is not None:
@@ -403,7 +403,7 @@ def _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, mo
     stderr = np.zeros(n_classes)
     if z.size:
         stderr = _batch_stderr(t, z, classes, n_classes, float(t_start), duration, n_batches,
-                               cover_at)
+                               at_edges)
     nan = np.full(n_motions, np.nan)
     stick, stick_err = ((probability[n_motions:], stderr[n_motions:]) if stuck is not None
                         else (nan, nan.copy()))
@@ -421,28 +421,27 @@ def _labelled(ratio, window, motions, walls, stuck):
     return labels, classes, count_motion_switches(labels)
 
 
-def _cover_at(z, classes, n_classes, j):
-    """``cover[c, k]``: the summed ``z`` of class ``c`` over the intervals before ``j[k]``."""
+def _at_edges(t, z, classes, n_classes, edges):
+    """``(n_classes, B + 1)``: the time each class covered from the first collision to each
+    stretch edge (linear within an interval of that class, flat elsewhere; 0 before the
+    first collision)."""
     onehot = classes[None, :] == np.arange(n_classes)[:, None]            # (n_classes, N)
     cover = np.concatenate([np.zeros((n_classes, 1)), np.cumsum(z * onehot, axis=1)], axis=1)
-    return cover[:, j]
-
-
-def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches, cover_at=_cover_at):
-    """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
-    # covered time of each class up to each collision, then at the stretch edges (linear
-    # within an interval of that class, flat elsewhere)
-    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
     j = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 1)   # collision before
     inside = (edges > t[0]) & (j < z.size)                                   # within interval j
     jj = np.minimum(j, z.size - 1)
-    onehot = classes[jj][None, :] == np.arange(n_classes)[:, None]        # (n_classes, B + 1)
-    extra = np.where(inside[None, :] & onehot, np.minimum(edges - t[j], z[jj])[None, :], 0.0)
-    at_edges = np.where(edges[None, :] > t[0], cover_at(z, classes, n_classes, j) + extra, 0.0)
-    # in Fortran order, as the fancy-indexed ``cover[:, j]`` made it: the standard deviation
-    # below then sums each class's batches in the order the stored maps were built with
-    at_edges = np.asfortranarray(at_edges)
-    batches = np.diff(at_edges, axis=1) * (n_batches / duration)           # (n_classes, B)
+    extra = np.where(inside[None, :] & onehot[:, jj], np.minimum(edges - t[j], z[jj])[None, :],
+                     0.0)
+    return np.where(edges[None, :] > t[0], cover[:, j] + extra, 0.0)
+
+
+def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches, at_edges=_at_edges):
+    """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
+    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
+    # in Fortran order, as the fancy-indexed ``cover[:, j]`` makes it: the standard deviation
+    # below sums each class's batches in the order the stored maps were built with
+    covered = np.asfortranarray(at_edges(t, z, classes, n_classes, edges))
+    batches = np.diff(covered, axis=1) * (n_batches / duration)           # (n_classes, B)
     return batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
 
 

@@ -41,24 +41,22 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         floor=floor, pressed=pressed, rule=rule, wall=wall, stick_wall=stick_wall,
         eps_lower=eps_lower)
     n = step.size
-    eps = np.ascontiguousarray(np.broadcast_to(np.asarray(eps, dtype=float), (n,)))
-    if rule == "rebounds" and n and not np.any(eps * u >= floor):
-        n = 0
     if n == 0:
         return _collisions._no_collisions(floor, dt)
+    eps = np.full(n, eps) if np.ndim(eps) == 0 else np.ascontiguousarray(eps, dtype=float)
     t0 = -np.inf if after is None else float(after)
     pressed = (np.ascontiguousarray(pressed, dtype=np.bool_) if rule == "physical"
                else np.zeros(0, np.bool_))
-    step = np.ascontiguousarray(step)
-    offset = np.ascontiguousarray(offset)
-    first, impact_collision, rebounds, stuck, stick_time, duration = kernels.group(
-        step, offset, np.ascontiguousarray(u), np.ascontiguousarray(start),
-        np.ascontiguousarray(end), dt, eps, floor, pressed, _RULE_CODES[rule],
-        np.ascontiguousarray(wall), t0)
-    t_first = step[first] * dt + offset[first]
-    return _collisions.Collisions(first, impact_collision, step[first], offset[first], t_first,
-                                  u[first], rebounds, stuck, stick_time, duration, floor, dt,
-                                  wall[first])
+    n_counted, *fields = kernels.group(
+        np.ascontiguousarray(step), np.ascontiguousarray(offset), np.ascontiguousarray(u),
+        np.ascontiguousarray(start), np.ascontiguousarray(end), dt, eps, floor, pressed,
+        _RULE_CODES[rule], np.ascontiguousarray(wall), t0)
+    if rule == "rebounds" and n_counted == 0:     # no rebound reaches the floor: no event
+        return _collisions._no_collisions(floor, dt)
+    first, impact_collision, step, offset, time, u, rebounds, stuck, stick_time, duration, \
+        wall = fields
+    return _collisions.Collisions(first, impact_collision, step, offset, time, u, rebounds,
+                                  stuck, stick_time, duration, floor, dt, wall)
 
 
 def motion_statistics(impact_time, intervals, beta, t_start, t_stop, *,
@@ -66,7 +64,7 @@ def motion_statistics(impact_time, intervals, beta, t_start, t_stop, *,
                       n_batches=20, stuck=None, walls=None):
     """``stats.motion_statistics``: the same arguments, checks and result, bit for bit."""
     return _motions._motion_statistics(impact_time, intervals, beta, t_start, t_stop, window,
-                                       motions, n_batches, stuck, walls, _labelled, _cover_at)
+                                       motions, n_batches, stuck, walls, _labelled, _at_edges)
 
 
 def _labelled(ratio, window, motions, walls, stuck):
@@ -92,10 +90,11 @@ def _labelled(ratio, window, motions, walls, stuck):
         len(motions))
 
 
-def _cover_at(z, classes, n_classes, j):
-    """``stats.motions._cover_at`` compiled."""
+def _at_edges(t, z, classes, n_classes, edges):
+    """``stats.motions._at_edges`` compiled."""
     from vibroimpact.tally import kernels
 
-    return kernels.cover_at(np.ascontiguousarray(z, dtype=float),
+    return kernels.at_edges(np.ascontiguousarray(t, dtype=float),
+                            np.ascontiguousarray(z, dtype=float),
                             np.ascontiguousarray(classes, dtype=np.int64), int(n_classes),
-                            np.ascontiguousarray(j, dtype=np.int64))
+                            np.ascontiguousarray(edges, dtype=float))

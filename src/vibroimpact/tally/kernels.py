@@ -63,9 +63,12 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
     """The collisions of a record at or after ``t0`` (``group_collisions(...).after(t0)``).
 
     ``eps`` holds the restitution of each impact's wall; ``pressed`` the hops (physical rule
-    only, else unread); ``wall`` the wall of each impact (int8). Returns ``(first,
-    impact_collision, rebounds, stuck, stick_time, duration)`` of the kept collisions (the
-    caller takes ``step, offset, time, velocity, wall`` at ``first``)."""
+    only, else unread); ``wall`` the wall of each impact (int8). Returns the fields of the
+    kept collisions, ``first, impact_collision, rebounds, stuck, stick_time, duration`` and
+    ``step, offset, time, velocity, wall`` at ``first``), after the number of rebounds that
+    reach ``floor`` (rule "rebounds": none, no collision): ``(n_counted, first,
+    impact_collision, step, offset, time, velocity, rebounds, stuck, stick_time, duration,
+    wall)``."""
     n = step.size
     t = np.empty(n)
     for i in range(n):
@@ -156,7 +159,21 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
         lo = hi
     for i in range(n):
         impact_collision[i] = max(impact_collision[i] - n_before, -1)
-    return out_first, impact_collision, rebounds, stuck, stick_time, duration
+    step_first = np.empty(k, np.int64)
+    offset_first = np.empty(k)
+    time_first = np.empty(k)
+    u_first = np.empty(k)
+    wall_first = np.empty(k, np.int8)
+    for o in range(k):
+        a = out_first[o]
+        step_first[o], offset_first[o], time_first[o] = step[a], offset[a], t[a]
+        u_first[o], wall_first[o] = u[a], wall[a]
+    n_counted = 0
+    for i in range(n):
+        if counted[i]:
+            n_counted += 1
+    return (n_counted, out_first, impact_collision, step_first, offset_first, time_first, u_first,
+            rebounds, stuck, stick_time, duration, wall_first)
 
 
 @kernel
@@ -222,18 +239,30 @@ def label(ratio, window, lengths, periods, lowers, walls, stuck, n_motions):
 
 
 @kernel
-def cover_at(z, classes, n_classes, at):
-    """``cover[c, k]``: the summed ``z`` of the intervals of class ``c`` before interval
-    ``at[k]`` (sequential sums, as ``numpy.cumsum`` of ``z * onehot``); ``at`` ascending."""
-    out = np.zeros((n_classes, at.size))
+def at_edges(t, z, classes, n_classes, edges):
+    """``stats.motions._at_edges``: the time each class covered from the first collision to
+    each edge (``edges`` ascending), the cumulative sums taken sequentially as ``numpy.cumsum``
+    of ``z * onehot`` takes them, the part of the interval an edge cuts added to its class."""
+    n = z.size
+    out = np.zeros((n_classes, edges.size))
     s = np.zeros(n_classes)
-    q = 0
-    for k in range(at.size):
-        while q < at[k]:
+    q = 0           # the intervals summed so far: those before j
+    count = 0       # collisions at or before the edge
+    for k in range(edges.size):
+        e = edges[k]
+        while count < t.size and t[count] <= e:
+            count += 1
+        j = min(max(count - 1, 0), t.size - 1)
+        while q < j:
             c = classes[q]
             if c >= 0:
                 s[c] = s[c] + z[q]
             q += 1
+        if not e > t[0]:
+            continue            # before the first collision: 0
+        jj = min(j, n - 1)
+        cut = min(e - t[j], z[jj])
         for c in range(n_classes):
-            out[c, k] = s[c]
+            extra = cut if (j < n and classes[jj] == c) else 0.0
+            out[c, k] = s[c] + extra
     return out
