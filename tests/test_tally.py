@@ -199,3 +199,11 @@ def test_the_compiled_grouping_at_two_walls_by_hand():
                 ref = stats.group_collisions(*args, **kw)
                 _same(tally.group_collisions(*args, **kw, after=t0),
                       ref if t0 is None else ref.after(t0))
+
+
+def test_the_defaults_are_the_references():
+    """The compiled functions' defaults (written out: importing `tally` loads no statistics
+    module) are those of the references."""
+    assert tally.DEFAULT_REBOUND_FLOOR == stats.DEFAULT_REBOUND_FLOOR
+    assert tally.DEFAULT_MOTION_WINDOW == stats.DEFAULT_MOTION_WINDOW
+    assert tally.DEFAULT_MOTIONS == tuple(stats.DEFAULT_MOTIONS)

@@ -17,23 +17,30 @@ step), in numba one pass each.
 
 ``stats`` loads no numba (the drawing and aggregation jobs stay light): this room sits on
 the simulator's floor, beside `impact`.
+
+Nothing at the top of this module imports a statistics module or numba: a job that imports
+the cells but groups no collision (a trace, a spectrum) reaches neither, and its code digest
+(`pipeline.provenance`) does not change with them.
 """
 import numpy as np
 
 from vibroimpact import _checks
-from vibroimpact.stats import collisions as _collisions
-from vibroimpact.stats import motions as _motions
 
 __all__ = ["group_collisions", "motion_statistics"]
 
-_RULE_CODES = {rule: code for code, rule in enumerate(_collisions.RULES)}
+#: ``stats.collisions.DEFAULT_REBOUND_FLOOR`` and ``stats.motions.DEFAULT_MOTION_WINDOW``,
+#: ``DEFAULT_MOTIONS`` (tests/test_tally.py holds them equal)
+DEFAULT_REBOUND_FLOOR = 0.01
+DEFAULT_MOTION_WINDOW = 0.1
+DEFAULT_MOTIONS = ((1, 1), (2, 1), (1, 2))
 
 
 def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *,
-                     dt, eps, floor=_collisions.DEFAULT_REBOUND_FLOOR, pressed=None,
-                     rule="physical", wall=None, stick_wall=None, eps_lower=None, after=None):
+                     dt, eps, floor=DEFAULT_REBOUND_FLOOR, pressed=None, rule="physical",
+                     wall=None, stick_wall=None, eps_lower=None, after=None):
     """``stats.group_collisions(...)``, then ``.after(after)`` unless ``after`` is None: the
     same arguments, checks and result, bit for bit."""
+    from vibroimpact.stats import collisions as _collisions
     from vibroimpact.tally import kernels
 
     step, offset, u, start, end, dt, eps, floor, pressed, wall = _collisions._checked(
@@ -50,7 +57,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     n_counted, *fields = kernels.group(
         np.ascontiguousarray(step), np.ascontiguousarray(offset), np.ascontiguousarray(u),
         np.ascontiguousarray(start), np.ascontiguousarray(end), dt, eps, floor, pressed,
-        _RULE_CODES[rule], np.ascontiguousarray(wall), t0)
+        _collisions.RULES.index(rule), np.ascontiguousarray(wall), t0)
     if rule == "rebounds" and n_counted == 0:     # no rebound reaches the floor: no event
         return _collisions._no_collisions(floor, dt)
     first, impact_collision, step, offset, time, u, rebounds, stuck, stick_time, duration, \
@@ -60,15 +67,18 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
 
 
 def motion_statistics(impact_time, intervals, beta, t_start, t_stop, *,
-                      window=_motions.DEFAULT_MOTION_WINDOW, motions=_motions.DEFAULT_MOTIONS,
-                      n_batches=20, stuck=None, walls=None):
+                      window=DEFAULT_MOTION_WINDOW, motions=DEFAULT_MOTIONS, n_batches=20,
+                      stuck=None, walls=None):
     """``stats.motion_statistics``: the same arguments, checks and result, bit for bit."""
+    from vibroimpact.stats import motions as _motions
+
     return _motions._motion_statistics(impact_time, intervals, beta, t_start, t_stop, window,
                                        motions, n_batches, stuck, walls, _labelled, _at_edges)
 
 
 def _labelled(ratio, window, motions, walls, stuck):
     """``stats.motions._labelled`` compiled."""
+    from vibroimpact.stats import motions as _motions
     from vibroimpact.tally import kernels
 
     ratio = np.ascontiguousarray(ratio, dtype=float)
