@@ -18,7 +18,17 @@ Also the job's start-up: a fresh interpreter importing what the map job imports 
 first cell (``vibroimpact.pipeline.tasks``, then ``vibroimpact.pipeline.cells``), best of the
 rounds, per build.
 
-Measured 2026-11-27 (see the README of benchmarks, or the report of m37): run it as
+Measured 2026-11-27 05:47-05:53 UTC (load average 22-24 on 2 cores: a shared machine), 325
+cells (every 16th of the default map), best of 3 interleaved rounds, peer = main a13f0b3:
+
+    build             stats CPU s  per cell ms  kernel CPU s  cell CPU s  stats share
+    this tree               1.387        4.267         2.805       4.192        33.1%
+    peer a13f0b3            2.927        9.007         2.803       5.731        51.1%
+    statistics CPU, this tree / peer: 0.474; whole cell: 0.731
+    results identical to the bit (every field of every cell): 325 of 325 cells
+
+Start-up (import of tasks and cells, CPU) 0.80 s against 0.79 s. Of the 1.39 s left, the hop
+check (``impact.hops``, compiled already) is about a third. Run it as
 
     python benchmarks/bench_map_stats.py --stride 8 --rounds 3 \\
         --dataset /work/check35c/results/datasets/motion_map_map.nc \\
