@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from vibroimpact import stats, tally
+from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
@@ -384,6 +384,8 @@ class _EventRecord:
     def collisions(self, eps, floor, transient, rule="physical"):
         """Collisions of the record so far that begin at or after ``transient``, grouped by
         ``rule`` (:data:`vibroimpact.stats.RULES`)."""
+        from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
         pressed = self.pressed() if rule == "physical" else None
         if not self.walls:
             start, end = self.sticking()
@@ -614,6 +616,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     ValueError
         If the record is shorter than ``transient`` plus the cap.
     """
+    from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
     walls = _walls(gap, eps_lower, eps)
@@ -726,6 +730,8 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
     (``target_stderr = 0.5``, ``min_switches = 1``) stops at the same sample and returns the
     same residence times, bit for bit (``tests/test_escape.py``).
     """
+    from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
     n_end = escape_samples(transient, record_length, dt) - 1
     if n_end > len(noise) - 1:
         raise ValueError(f"record_length = {record_length!r} after the transient "
