@@ -28,7 +28,14 @@ cells (every 16th of the default map), best of 3 interleaved rounds, peer = main
     results identical to the bit (every field of every cell): 325 of 325 cells
 
 Start-up (import of tasks and cells, CPU) 0.80 s against 0.79 s. Of the 1.39 s left, the hop
-check (``impact.hops``, compiled already) is about a third. Run it as
+check (``impact.hops``, compiled already) is about a third. Again after merging main 9347978
+(its simulator changes in both builds), 06:07-06:14 UTC, load average 13-18:
+
+    this tree               1.143        3.518         2.314       3.458        33.1%
+    peer 9347978            2.488        7.655         2.357       4.845        51.4%
+    statistics CPU, this tree / peer: 0.460; whole cell: 0.714; 325 of 325 cells identical
+
+Run it as
 
     python benchmarks/bench_map_stats.py --stride 8 --rounds 3 \\
         --dataset /work/check35c/results/datasets/motion_map_map.nc \\
