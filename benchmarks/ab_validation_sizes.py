@@ -111,10 +111,10 @@ def wp_conclusions(old, news):
                   "same impacts compared: every error bit-identical to the old sizes'")
         sim = int(np.flatnonzero(first.method.values == "simulate")[0])
         for name, ds in (("old", o), ("new", n)):
-            peers = np.delete(ds.error.values, sim)
-            check(bool(np.all(ds.error.values[sim] < peers)),
-                  f"{name}: simulator's error {float(ds.error[sim]):.2g} below every peer's "
-                  f"(smallest {np.nanmin(peers):.2g}, x{np.nanmin(peers) / float(ds.error[sim]):.3g})")
+            peers, own = np.delete(ds.error.values, sim), float(ds.error[sim])
+            check(bool(np.all(own < peers)),
+                  f"{name}: simulator's error {own:.2g} below every peer's "
+                  f"(smallest {np.nanmin(peers):.2g}, x{np.nanmin(peers) / own:.3g})")
         top = [str(ds.method.values[np.nanargmin(np.where(ds.method.values == "simulate",
                                                           np.inf, ds.error.values))])
                for ds in (o, n)]
