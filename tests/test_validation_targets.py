@@ -399,3 +399,20 @@ def test_the_validation_targets_are_built(built):
         assert any(ds[v].attrs.get("run_measurement") == 1 for v in ds.variables)
     for rule in ("measure_work_precision", "sample_stress_families"):
         assert (results / "benchmarks" / f"{rule}.tsv").is_file()
+
+
+def test_the_plan_costs_the_validation_runs_from_their_sizes():
+    """The plan's cost of the two runs follows the config: more repeats, a longer timed or
+    compared stretch, more plays cost more; the quick stress sample more than the sample."""
+    from vibroimpact.pipeline.config import costs
+
+    block = dict(delta=[1.0, 0.0, -0.5], impacts=20, stretch=5.0, max_stretch=60.0,
+                 long_samples=20_000, rtol=[1e-3, 1e-6, 1e-9, 1e-12],
+                 solvers=["RK45", "DOP853", "LSODA"], rk4_steps=[1, 2, 4, 8, 16, 32, 64],
+                 repeats=3)
+    base = costs.work_precision_cpu_s(block)
+    for change in (dict(repeats=6), dict(stretch=20.0), dict(max_stretch=200.0, impacts=60),
+                   dict(delta=[1.0, 0.0, -0.5, 2.0]), dict(long_samples=100_000)):
+        assert costs.work_precision_cpu_s(dict(block, **change)) > base, change
+    assert costs.work_precision_cpu_s(dict(block, impacts=1)) < base
+    assert costs.stress_cpu_s({"size": "quick"}) > costs.stress_cpu_s({"size": "sample"})
