@@ -54,8 +54,12 @@ REPORT_S = 0.8
 #: entry's, each computing the same predictors) against 2.1 for one without.
 MAP_REPORT_S = 4.8
 #: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
-#: mpmath, the numba cache loads and the simulator's own runs.
-WP_FIXED_S = 1.5
+#: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
+#: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured
+#: (benchmarks/ab_validation_sizes.py, 3 runs, load ~22; the job's own CPU: 1.8 s timing
+#: solve_ivp, 3.5 its runs over the compared stretches, 1.0 the references, 0.6 RK4); the
+#: sizes before issue 37 give 43.7 against 45.3 (the default build's benchmark file).
+WP_FIXED_S = 1.0
 #: One restarted solve_ivp run per unit of simulated time (CPU s): 1-6 ms over the default
 #: methods, tolerances and plays (restart overhead: one restart per force sample).
 SOLVE_IVP_S_PER_UNIT = 2.6e-3
@@ -70,8 +74,9 @@ UNITS_PER_IMPACT = 2.1
 RK4_NS_PER_STEP = 30.0
 #: The stress job, besides its start-up, per size (`stress_cpu_s`): every family's cases, the
 #: streamed record written, streamed by three processes (~0.8 CPU-s each to start) and
-#: replayed. Measured with benchmarks/ab_validation_sizes.py (issue 37).
-STRESS_S = {"sample": 6.0, "quick": 20.0}
+#: replayed. Measured with benchmarks/ab_validation_sizes.py (issue 37; load ~22, the job's
+#: process and its children): 6.7-7.1 CPU-s at ``sample`` (3 runs), 22.6 at ``quick``.
+STRESS_S = {"sample": 5.6, "quick": 21.0}
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
 FILE_OVERHEAD = 20_000
