@@ -33,7 +33,7 @@ from vibroimpact.validation.streaming import DEFAULT_CHUNK_SIZES, run_streamed_r
 
 log = logging.getLogger(__name__)
 
-#: Cases per simulator family in a quick sample (seconds).
+#: Cases per simulator family in a quick sample (5 % of the full campaign, at least 5).
 QUICK_CASES = {name: max(5, n // 20) for name, n in FULL_CASES.items()}
 #: Cases per simulator family in the default build's sample: CPU-s per case of the quick sample
 #: (shared 2-core machine, warm numba cache) release 0.05, release_touch 0.004, start_pulled
@@ -64,8 +64,8 @@ def run_campaign(seed, quick=False, workdir=None, size=None):
     seed : int
         Seed of every family's case draws.
     quick : bool
-        A seeded quick sample (about a minute) instead of the full campaign (when ``size``
-        is None).
+        A seeded quick sample (~20 CPU-s) instead of the full campaign (when ``size`` is
+        None).
     workdir : path-like, optional
         Where the streamed record is written (default: a temporary directory).
     size : {"full", "quick", "sample"}, optional
