@@ -10,6 +10,7 @@ from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_step
 __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
            "simulate_cpu_s",
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
+           "orbit_plane_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
            "work_precision_cpu_s", "stress_cpu_s"]
 
@@ -40,6 +41,13 @@ MAP_CAP_FRACTION = 0.34
 #: README numbers were measured with (its cells are 15-100 times longer).
 MAP_CELL_S = 0.010
 BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
+#: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
+#: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
+#: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
+#: one cell of a two-wall plane (the shooting solver, seeded by the simulator: ~135 ms
+#: measured by h35a, issue 35).
+ORBIT_CELL_S = 1.0e-4
+SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
 #: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
 #: (each drawn alone as its job does, 2 cores under load; h37a, issue 37).
@@ -174,6 +182,19 @@ def noise_cpu_s(n_samples):
 def orbit_cpu_s(cells, types):
     """CPU seconds of the orbit solves of ``cells`` (1/beta, delta) cells of ``types`` types."""
     return cells * types * US_PER_ORBIT * 1e-6
+
+
+def orbit_plane_cpu_s(entry, cells):
+    """CPU seconds of an ``orbits`` entry's map over its ``plane`` of ``cells`` cells: along
+    delta the map's branch following (`orbit_cpu_s`); a plane without delta solves each cell
+    alone (`ORBIT_CELL_S` a type: the global scan, the finer m = 3 one included); two walls
+    the shooting solver (`SHOOTING_CELL_S` a cell)."""
+    types = len(entry["types"])
+    if entry.get("gap") is not None or "gap" in entry["plane"]:
+        return cells * SHOOTING_CELL_S
+    if "delta" in entry["plane"]:
+        return orbit_cpu_s(cells, types)
+    return cells * types * ORBIT_CELL_S
 
 
 def attractor_cpu_s(cells, n_starts):

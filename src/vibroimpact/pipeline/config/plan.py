@@ -19,7 +19,8 @@ from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVER
                                                JOB_START_S, MAP_REPORT_S, REPORT_BYTES,
                                                REPORT_S)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
-from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
+from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_plane_cells,
+                                        orbit_rows)
 
 __all__ = ["Plan", "Row", "make_plan", "built_entries"]
 
@@ -294,11 +295,12 @@ def make_plan(config, own=None, *, results="results", studies=None):
         parts = []
         if "orbits" in needs:
             rows, n_tiles = orbit_rows(entry)
-            cells = len(rows) * grid_size(entry["delta"])
+            cells = orbit_plane_cells(entry)
             row.orbit_cells += cells
             row.jobs += n_tiles + 1
             row.bytes += 2 * cells * len(entry["types"]) * 34
-            row.cpu_s += costs.orbit_cpu_s(cells, len(entry["types"]))
+            row.cpu_s += (costs.orbit_plane_cpu_s(entry, cells) if entry.get("plane")
+                          else costs.orbit_cpu_s(cells, len(entry["types"])))
             parts.append(f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}")
         if "boundaries" in needs:
             row.jobs += 1                       # the boundary curves Fig. 16 draws
