@@ -11,7 +11,8 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
            "simulate_cpu_s",
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "orbit_plane_cpu_s",
-           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
+           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
+           "work_precision_cpu_s", "stress_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
@@ -60,9 +61,30 @@ REPORT_S = 0.8
 #: default reports that show the map (the motion_map and harmonic studies' and the orbits
 #: entry's, each computing the same predictors) against 2.1 for one without.
 MAP_REPORT_S = 4.8
-#: The work-precision run and the stress sample together, wall time (the work-precision job
-#: holds every core while it times): 44 + 21 s on the default build.
-VALIDATION_S = 65.0
+#: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
+#: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
+#: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured
+#: (benchmarks/ab_validation_sizes.py, 3 runs, load ~22; the job's own CPU: 1.8 s timing
+#: solve_ivp, 3.5 its runs over the compared stretches, 1.0 the references, 0.6 RK4); the
+#: sizes before issue 37 give 43.7 against 45.3 (the default build's benchmark file).
+WP_FIXED_S = 1.0
+#: One restarted solve_ivp run per unit of simulated time (CPU s): 1-6 ms over the default
+#: methods, tolerances and plays (restart overhead: one restart per force sample).
+SOLVE_IVP_S_PER_UNIT = 2.6e-3
+#: The 34-digit reference and its 53-bit twin per unit of compared stretch, per play (CPU s):
+#: 2-3 ms without chatter, ~20 ms in the chatter of delta = -0.5; a mean.
+REFERENCE_S_PER_UNIT = 6e-3
+#: A compared stretch is as long as ``impacts`` need at this many time units each (a mean over
+#: the default plays: one impact every ~14 time units at delta = 1, ~3 at 0, ~0.2 at -0.5),
+#: between ``stretch`` and ``max_stretch``.
+UNITS_PER_IMPACT = 2.1
+#: One RK4 step of the event-locating peer (CPU ns).
+RK4_NS_PER_STEP = 30.0
+#: The stress job, besides its start-up, per size (`stress_cpu_s`): every family's cases, the
+#: streamed record written, streamed by three processes (~0.8 CPU-s each to start) and
+#: replayed. Measured with benchmarks/ab_validation_sizes.py (issue 37; load ~22, the job's
+#: process and its children): 6.7-7.1 CPU-s at ``sample`` (3 runs), 22.6 at ``quick``.
+STRESS_S = {"sample": 5.6, "quick": 21.0}
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
 FILE_OVERHEAD = 20_000
@@ -198,3 +220,25 @@ def escape_cpu_s(entry, dt, levels=None):
     levels = len(entry["escape"]["rms"]) if levels is None else int(levels)
     cells = len(entry["escape"]["cells"])
     return levels * (n * NS_PER_SAMPLE * 1e-9 + simulate_cpu_s(cells, n - 1))
+
+
+def work_precision_cpu_s(block):
+    """CPU seconds of the work-precision job at the config block ``validation.work_precision``
+    (start-up excluded): solve_ivp timed ``repeats`` times on ``stretch`` and run once over the
+    compared stretch, at every play and setting; the reference over the compared stretch; RK4
+    with event location ``repeats`` times over ``long_samples`` at every step count."""
+    n_delta = len(block["delta"])
+    stretch, max_stretch = float(block["stretch"]), float(block.get("max_stretch", 1e300))
+    compared = min(max_stretch, max(stretch, UNITS_PER_IMPACT * int(block["impacts"])))
+    ivp_runs = len(block["solvers"]) * len(block["rtol"])
+    repeats = int(block["repeats"])
+    ivp = SOLVE_IVP_S_PER_UNIT * ivp_runs * (repeats * stretch + compared)
+    reference = REFERENCE_S_PER_UNIT * compared
+    rk4 = RK4_NS_PER_STEP * 1e-9 * int(block["long_samples"]) * sum(block["rk4_steps"]) * repeats
+    return WP_FIXED_S + n_delta * (ivp + reference + rk4)
+
+
+def stress_cpu_s(block):
+    """CPU seconds of the stress job at the config block ``validation.stress`` (start-up
+    excluded)."""
+    return STRESS_S[block.get("size", "sample")]

@@ -17,7 +17,7 @@ from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVERHEAD,
                                                JOB_START_S, MAP_REPORT_S, REPORT_BYTES,
-                                               REPORT_S, VALIDATION_S)
+                                               REPORT_S)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
 from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_plane_cells,
                                         orbit_rows, plane_attractor_rows)
@@ -347,7 +347,8 @@ def make_plan(config, own=None, *, results="results", studies=None):
         plan.rows.append(Row("validation", f"work-precision and stress-sample runs ({runs}), "
                              f"{_n(figs, 'figure')}, {_n(notebooks, 'report')}", jobs=jobs,
                              bytes=figs * FIGURE_BYTES + notebooks * REPORT_BYTES,
-                             cpu_s=VALIDATION_S * runs / 2 + figs * FIGURE_S
+                             cpu_s=_validation_runs_cpu_s(config["validation"], validation)
+                             + figs * FIGURE_S
                              + notebooks * REPORT_S + jobs * JOB_START_S))
     copies = build["copies"]
     if copies:
@@ -361,6 +362,16 @@ def make_plan(config, own=None, *, results="results", studies=None):
     except OSError:
         plan.free_bytes = None
     return plan
+
+
+def _validation_runs_cpu_s(block, files):
+    """CPU seconds of the validation runs among ``files`` (start-up excluded)."""
+    cpu_s = 0.0
+    if "results/validation/work_precision.nc" in files:
+        cpu_s += costs.work_precision_cpu_s(block["work_precision"])
+    if "results/validation/stress_sample.nc" in files:
+        cpu_s += costs.stress_cpu_s(block["stress"])
+    return cpu_s
 
 
 def _hours(cpu_s, jobs):
