@@ -38,11 +38,13 @@ MAP_CAP_FRACTION = 0.34
 #: (`plane_map_cpu_s`), whose short caps it dominates; the paper's map keeps the model its
 #: README numbers were measured with (its cells are 15-100 times longer).
 MAP_CELL_S = 0.010
-BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
+#: The boundary curves of one (m/n) type: 6.2 CPU-s for the default entry's 5 types, start-up
+#: included (its benchmark file at 15acb54, a fresh clone's `make`).
+BOUNDARIES_S = 1.0
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
-#: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
-#: (each drawn alone as its job does, 2 cores under load; h37a, issue 37).
-FIGURE_S = 1.0
+#: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
+#: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
+FIGURE_S = 0.6
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
 #: twice (nbconvert) in one job, besides its start-up: 1.9 to 2.4 CPU-s a job (best of 2,
 #: load ~7) for the reports that show no map (random_force, performance, stability).
@@ -55,6 +57,27 @@ MAP_REPORT_S = 4.8
 #: The work-precision run and the stress sample together, wall time (the work-precision job
 #: holds every core while it times): 44 + 21 s on the default build.
 VALIDATION_S = 65.0
+#: Each validation run alone (wall s: the rules hold every core), by rule.
+#: Measured at 15acb54 (a fresh clone's `make`, benchmark files' ``s``): 45.6 and 39.3 s.
+VALIDATION_RUN_S = {"measure_work_precision": 45.6, "sample_stress_families": 39.3}
+#: The rule writing each validation dataset (``results/validation/<name>.nc``).
+VALIDATION_RULES = {"work_precision": "measure_work_precision",
+                    "stress_sample": "sample_stress_families"}
+#: One validation figure drawn, besides its job's start-up.
+VALIDATION_FIGURE_S = FIGURE_S
+#: One aggregation job (tiles joined into a dataset), start-up included, by kind (default
+#: ``"*"``): 0.44-0.48 CPU-s each at 15acb54 (benchmark files of a fresh clone's `make`), the
+#: events joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
+AGGREGATE_S = {"*": 0.5, "aggregate_events": 0.7, "aggregate_spectra": 1.0}
+#: Numba compilation on an empty cache (a fresh clone's first build: `make` after
+#: installation compiles), CPU-s, charged to the kind of job that compiled in the default
+#: build at 15acb54: one tile of each paid it (solve_orbit_tile 9.6 CPU-s against 2.4 for
+#: the others; simulate_escape 8.0 against 2.0; the random trace 4.9 against 1.0).
+COMPILE_S = {"solve_orbit_tile": 7.0, "simulate_escape": 6.0, "simulate_trace": 4.0}
+#: A map cell's sample step (the map's own work: the hop check and the collision grouping of
+#: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
+#: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns.
+NS_PER_MAP_STEP = 38.0
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
 FILE_OVERHEAD = 20_000
@@ -116,6 +139,16 @@ def plane_cap_steps(study, entry, noise):
         if cell.inv_beta not in per_period:
             per_period[cell.inv_beta] = map_steps(n, dt, transient, max_periods, cell.inv_beta)
     return float(sum(per_period[cell.inv_beta] for cell in study.cells()))
+
+
+def map_cpu_s(steps):
+    """CPU seconds of a paper map's cells running ``steps`` sample steps in all."""
+    return steps * NS_PER_MAP_STEP * 1e-9
+
+
+def aggregate_s(rule):
+    """CPU seconds of one aggregation job of kind ``rule`` (`AGGREGATE_S`)."""
+    return AGGREGATE_S.get(rule, AGGREGATE_S["*"])
 
 
 def plane_map_cpu_s(study, entry, noise):
