@@ -143,9 +143,10 @@ class _Bootstrap:
     the resampled cells (one ``default_rng(seed)`` draw per number of cells: every call of
     :func:`rank_correlation` with the same ``n`` draws the same indices) and the centred
     resampled ranks of the last few variables (P of one motion over one set of cells is
-    correlated with each of the four predictors). A few (N_RESAMPLES, n) arrays at most."""
+    correlated with each of the four predictors; the Lyapunov exponent, one per cell, with
+    every motion's P). At most `_KEEP` + 1 (N_RESAMPLES, n) arrays of ranks and one of cells."""
 
-    _KEEP = 4
+    _KEEP = 6
 
     def __init__(self, seed, n_resamples):
         self.seed, self.n_resamples = seed, n_resamples
@@ -163,10 +164,12 @@ class _Bootstrap:
     def centred_ranks(self, values):
         """Per chunk of :meth:`indices`, ``_centred`` of the resampled ranks of ``values``."""
         key = (values.size, values.tobytes())
-        if key not in self._ranks:
-            coded = _codes(values)
+        if key in self._ranks:                          # the most recently used last
+            self._ranks[key] = self._ranks.pop(key)
+        else:
             if len(self._ranks) >= self._KEEP:
                 self._ranks.pop(next(iter(self._ranks)))
+            coded = _codes(values)
             self._ranks[key] = [_centred(_resample_ranks(coded, idx))
                                 for idx in self.indices(values.size)]
         return self._ranks[key]
