@@ -46,14 +46,18 @@ BOUNDARIES_S = 1.0
 #: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
 FIGURE_S = 0.6
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
-#: twice (nbconvert) in one job, besides its start-up: 1.9 to 2.4 CPU-s a job (best of 2,
-#: load ~7) for the reports that show no map (random_force, performance, stability).
-REPORT_S = 0.8
+#: twice (nbconvert) in one job, besides its start-up: the reports that show no map
+#: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
+#: files' cpu_time, a fresh clone's `make`), `JOB_START_S` alone within its spread.
+REPORT_S = 0.0
 #: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
-#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``): 6.6 to 7.5 CPU-s for the three
+#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``; ``nb.map_agreement``): the three
 #: default reports that show the map (the motion_map and harmonic studies' and the orbits
-#: entry's, each computing the same predictors) against 2.1 for one without.
-MAP_REPORT_S = 4.8
+#: entry's, each computing the same predictors) took 5.56, 5.37 and 4.55 CPU-s at 15acb54;
+#: the predictors' shared bootstrap (issue 37) takes 0.68-0.71 of that (the jobs' process
+#: trees' CPU, this tree against a13f0b3, best of 3, `benchmarks/job_costs.py --jobs --only
+#: report`): ~3.6 CPU-s a job, 2.3 of it the map's.
+MAP_REPORT_S = 2.3
 #: The work-precision run and the stress sample together, wall time (the work-precision job
 #: holds every core while it times): 44 + 21 s on the default build.
 VALIDATION_S = 65.0
