@@ -96,8 +96,11 @@ def map_floor(side_results, peer):
 def make_test(workdir):
     env = dict(os.environ, PYTHONPATH=str(workdir / "src"))
     start = time.perf_counter()
-    out = subprocess.run(["make", "test", f"VENV={ROOT / '.venv'}"], cwd=workdir, env=env,
-                         capture_output=True, text=True)
+    venv = ROOT / ".venv"
+    # this .venv, never reinstalled (-o: its stamp taken as up to date; a peer's newer
+    # pyproject.toml would otherwise reinstall the package from the peer into it)
+    out = subprocess.run(["make", "-o", str(venv / ".installed"), "test", f"VENV={venv}"],
+                         cwd=workdir, env=env, capture_output=True, text=True)
     wall = time.perf_counter() - start
     tail = out.stdout.strip().splitlines()[-1:] or [""]
     print(f"  make test in {workdir.name}: exit {out.returncode}, {wall:.0f} s; {tail[0]}",
