@@ -1,5 +1,6 @@
-# `make` installs into .venv and builds every figure and report of the default config, then
-# Snakemake's own report of that build (results/report.html);
+# `make` installs into .venv (and compiles the numba kernels into their cache: python -m
+# vibroimpact.warm, so that no job of a build compiles one) and builds every figure and report
+# of the default config, then Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
 # of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, the
 # slow (stress/convergence) suite on two workers, the end-to-end workflow and SLURM suites
@@ -47,6 +48,7 @@ $(STAMP): environment.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check -r environment.txt
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps -e .
+	$(BIN)/python -m vibroimpact.warm --jobs 2
 	touch $(STAMP)
 
 # the seconds-long checks first: a lint failure stops the build before the half-hour suites
