@@ -28,7 +28,10 @@ benchmark files (issue 37: within 25 %).
    ``s`` for the validation rules, which hold every core), their ratio, and whether it is
    within ``--tolerance`` (25 %). Exit status 1 when a rule is outside::
 
-       python benchmarks/job_costs.py --plan --results /work/check35c/results
+       python benchmarks/job_costs.py --plan --results /work/check35c/results --cold-cache
+
+   ``--cold-cache``: the build's jobs compiled numba's kernels (15acb54's did; since 15572b0
+   `make` compiles them when it installs), and the plan adds `costs.COMPILE_S`.
 """
 import argparse
 import csv
@@ -209,9 +212,10 @@ def jobs_mode(args):
 
 # --- mode 3: the plan against benchmark files ------------------------------------------------
 
-def plan_comparison(results, configfile="config/config.yaml"):
+def plan_comparison(results, configfile="config/config.yaml", cold_cache=False):
     """``[(rule, planned jobs, measured jobs, planned CPU-s, measured CPU-s)]`` per rule of the
-    plan of ``configfile`` against the benchmark files under ``results``."""
+    plan of ``configfile`` against the benchmark files under ``results`` (``cold_cache``: a
+    build whose jobs compiled numba's kernels, `Plan.rule_costs`)."""
     from vibroimpact.pipeline import config
     from vibroimpact.pipeline.config.plan import WHOLE_MACHINE_RULES
 
@@ -225,14 +229,14 @@ def plan_comparison(results, configfile="config/config.yaml"):
         # then its wall time; wall time too for the rules that hold every core
         whole = rule in WHOLE_MACHINE_RULES or not cpu > 0.1
         measured[rule][1] += s if whole else cpu
-    planned = plan.rule_costs()
+    planned = plan.rule_costs(cold_cache=cold_cache)
     return [(rule, planned.get(rule, (0, 0.0))[0], measured[rule][0],
              planned.get(rule, (0, 0.0))[1], measured[rule][1])
             for rule in sorted(set(planned) | set(measured))]
 
 
 def plan_mode(args):
-    rows = plan_comparison(args.results, args.configfile)
+    rows = plan_comparison(args.results, args.configfile, args.cold_cache)
     print(f"plan ({args.configfile}) against the benchmark files of {args.results}: CPU "
           f"seconds per rule (cpu_time summed; wall s for the rules holding every core and "
           f"for a job whose cpu_time reads 0)")
@@ -272,6 +276,9 @@ def main():
     parser.add_argument("--only", help="--jobs: comma-separated rules (default: "
                         + ",".join(SHORT_RULES) + ")")
     parser.add_argument("--limit", type=float, default=5.0, help="--jobs: flag jobs above")
+    parser.add_argument("--cold-cache", action="store_true", help="--plan: the build's jobs "
+                        "compiled numba's kernels (before 15572b0, or a cache emptied "
+                        "after installation)")
     parser.add_argument("--tolerance", type=float, default=0.25, help="--plan: allowed "
                         "relative error")
     args = parser.parse_args()

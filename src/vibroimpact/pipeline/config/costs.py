@@ -13,7 +13,10 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
-JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
+#: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
+#: the 15acb54 build took 0.97-1.0 CPU-s (the harmonic trace, noise and the escape levels
+#: that compiled nothing; benchmark files' cpu_time).
+JOB_START_S = 1.0
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
 #: The self-audit of an events cell (`impact.audit.audit_moments`: exact integrals over every
 #: step), per step on top of NS_PER_STEP. CPU ns measured by benchmarks/bench_audit.py (1e6
@@ -44,12 +47,12 @@ BOUNDARIES_S = 1.0
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
 #: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
 #: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
-FIGURE_S = 0.6
+FIGURE_S = 0.9
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
 #: twice (nbconvert) in one job, besides its start-up: the reports that show no map
 #: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
-#: files' cpu_time, a fresh clone's `make`), `JOB_START_S` alone within its spread.
-REPORT_S = 0.0
+#: files' cpu_time, a fresh clone's `make`).
+REPORT_S = 0.3
 #: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
 #: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``; ``nb.map_agreement``): the three
 #: default reports that show the map (the motion_map and harmonic studies' and the orbits
@@ -73,11 +76,17 @@ VALIDATION_FIGURE_S = FIGURE_S
 #: ``"*"``): 0.44-0.48 CPU-s each at 15acb54 (benchmark files of a fresh clone's `make`), the
 #: events joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
 AGGREGATE_S = {"*": 0.5, "aggregate_events": 0.7, "aggregate_spectra": 1.0}
-#: Numba compilation on an empty cache (a fresh clone's first build: `make` after
-#: installation compiles), CPU-s, charged to the kind of job that compiled in the default
-#: build at 15acb54: one tile of each paid it (solve_orbit_tile 9.6 CPU-s against 2.4 for
-#: the others; simulate_escape 8.0 against 2.0; the random trace 4.9 against 1.0).
+#: Numba compilation on an empty cache, CPU-s, by the kind of job that compiled in the
+#: default build at 15acb54, a fresh clone whose jobs compiled (solve_orbit_tile 9.6 CPU-s
+#: against 2.4 for the other tiles; simulate_escape 8.0 against 2.0; the random trace 4.9
+#: against 1.0). Since 15572b0 `make` compiles the kernels when it installs
+#: (`vibroimpact.warm`), so the plan of a build charges none of it; `Plan.rule_costs(
+#: cold_cache=True)` adds it, to compare with a build whose jobs compiled.
 COMPILE_S = {"solve_orbit_tile": 7.0, "simulate_escape": 6.0, "simulate_trace": 4.0}
+#: A spectra cell's analysis besides its sample steps (the Welch estimate of its record):
+#: the default build's 4 spectra tiles (10 + 8 cells) took 6.9 CPU-s at 15acb54, 2.2 more
+#: than their start-up and steps at `NS_PER_STEP`.
+SPECTRA_CELL_S = 0.12
 #: A map cell's sample step (the map's own work: the hop check and the collision grouping of
 #: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
 #: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns.

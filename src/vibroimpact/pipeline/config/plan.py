@@ -78,16 +78,21 @@ class Plan:
     def cpu_s(self):
         return sum(r.cpu_s for r in self.rows)
 
-    def rule_costs(self):
+    def rule_costs(self, cold_cache=False):
         """``{kind of job: (jobs, CPU seconds)}`` over every entry, the kind named as its
         benchmark files' folder (``results/benchmarks/<kind>/``): what
         ``benchmarks/job_costs.py --plan`` compares with a build's benchmark files. The jobs
-        and seconds sum to the plan's."""
+        and seconds sum to the plan's. ``cold_cache``: plus numba's compilation in the
+        jobs (`costs.COMPILE_S`), as in a build whose installation compiled nothing."""
         out = {}
         for row in self.rows:
             for rule, (jobs, cpu) in row.rules.items():
                 n, c = out.get(rule, (0, 0.0))
                 out[rule] = (n + jobs, c + cpu)
+        if cold_cache:
+            for rule, cpu in COMPILE_S.items():
+                if rule in out:
+                    out[rule] = (out[rule][0], out[rule][1] + cpu)
         return out
 
     def summary(self, cores=2):
@@ -292,7 +297,8 @@ def make_plan(config, own=None, *, results="results", studies=None):
             _add(row, cells, 0, 2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1)
                  + (tiles + 1) * FILE_OVERHEAD, 0.0)
             _charge(row, "simulate_spectra", tiles,
-                    costs.simulate_cpu_s(cells, steps) + tiles * JOB_START_S)
+                    costs.simulate_cpu_s(cells, steps) + cells * costs.SPECTRA_CELL_S
+                    + tiles * JOB_START_S)
             _charge(row, "aggregate_spectra", 1, costs.aggregate_s("aggregate_spectra"))
             parts.append(f"spectra {_n(cells, 'cell')}")
         if "escape" in needs:
@@ -385,7 +391,6 @@ def make_plan(config, own=None, *, results="results", studies=None):
         row = Row("paper_figures", _n(copies, "copy"), bytes=copies * FIGURE_BYTES)
         _charge(row, "copy_paper_figure", copies, 0.0)      # a local copy: no benchmark file
         plan.rows.append(row)
-    _compile(plan)
     try:
         probe = Path(results)
         while not probe.exists():
@@ -406,19 +411,10 @@ def _hours(cpu_s, jobs):
             f"map.max_periods or a larger map.target_stderr shortens it)")
 
 
-def _compile(plan):
-    """Numba's compilation on an empty cache (`COMPILE_S`), once a build, on the first row
-    that runs a job of each kind that compiles."""
-    for rule, cpu_s in COMPILE_S.items():
-        row = next((r for r in plan.rows if rule in r.rules), None)
-        if row is not None:
-            _charge(row, rule, 0, cpu_s)
-
-
 def _charge(row, rule, jobs, cpu_s):
     """``jobs`` jobs of kind ``rule`` (its benchmark files' folder) costing ``cpu_s`` in all,
     on ``row`` and its per-rule account (:meth:`Plan.rule_costs`)."""
-    if not jobs and not cpu_s:
+    if not jobs:
         return
     row.jobs += jobs
     row.cpu_s += cpu_s
