@@ -26,6 +26,10 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 NS_PER_AUDIT_STEP = 25.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
+#: One cell of a two-wall orbits entry: the shooting solver's seeds settled and its motions
+#: solved, every type at once (`attractors.shooting`; ~135 ms a cell measured by h35a,
+#: issue 35's closing note).
+CLEARANCE_CELL_S = 0.135
 #: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
 #: map's 5,187 cells x 64 starts (68 us a start; its four tiles' benchmark files, 2 cores).
 US_PER_START = 70.0

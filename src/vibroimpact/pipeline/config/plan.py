@@ -336,8 +336,12 @@ def make_plan(config, own=None, *, results="results", studies=None):
             cells = len(rows) * grid_size(entry["delta"])
             row.orbit_cells += cells
             row.bytes += 2 * cells * len(entry["types"]) * 34
-            _charge(row, "solve_orbit_tile", n_tiles,
-                    costs.orbit_cpu_s(cells, len(entry["types"])) + n_tiles * JOB_START_S)
+            # a clearance between two walls: the shooting solver's rule (common.smk)
+            tile_rule = ("solve_clearance_orbit_tile" if entry.get("gap") is not None
+                         else "solve_orbit_tile")
+            work = (costs.CLEARANCE_CELL_S * cells if tile_rule != "solve_orbit_tile"
+                    else costs.orbit_cpu_s(cells, len(entry["types"])))
+            _charge(row, tile_rule, n_tiles, work + n_tiles * JOB_START_S)
             _charge(row, "aggregate_orbits", 1, costs.aggregate_s("aggregate_orbits"))
             parts.append(f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}")
         if "boundaries" in needs:
