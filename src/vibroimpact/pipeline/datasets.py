@@ -515,9 +515,10 @@ def orbit_map_dataset(result, attrs):
     return ds
 
 
-def concat_orbit_tiles(tiles):
-    """Join orbit-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
-    return xr.concat(tiles, dim="inv_beta").sortby("inv_beta")
+def concat_orbit_tiles(tiles, dim="inv_beta"):
+    """Join orbit-map tiles (disjoint sets of ``dim`` rows: ``inv_beta``, or the tiled axis
+    of a plane) into one dataset sorted along ``dim``."""
+    return xr.concat(tiles, dim=dim).sortby(dim)
 
 
 def orbit_map_result(ds):
@@ -548,25 +549,31 @@ BOUNDARY_META = {
 }
 
 
-def boundaries_dataset(curves_by_type, attrs):
+def boundaries_dataset(curves_by_type, attrs, axes=("inv_beta", "delta")):
     """Dataset of the boundary curves of :func:`vibroimpact.orbits.domain_boundaries`, one
-    call per type: ``curves_by_type`` is ``{(m, n): result}``.
+    call per type: ``curves_by_type`` is ``{(m, n): result}``; or of
+    :func:`vibroimpact.orbits.boundaries.plane_boundaries` over the plane ``axes`` (its
+    curves' ``x``, ``y``).
 
-    Dimensions ``point`` (every curve's points, curve after curve), ``curve`` and ``codim2``.
+    Dimensions ``point`` (every curve's points, curve after curve), ``curve`` and ``codim2``;
+    the points' coordinates are named after the axes (``inv_beta``, ``delta``; over a plane
+    ``eps``, ``delta`` ..., and ``codim2_<axis>``).
     """
-    inv_beta, delta, index, kinds, types, ends = [], [], [], [], [], []
-    c_ib, c_d, c_type, c_kinds = [], [], [], []
+    x_name, y_name = axes
+    default = tuple(axes) == ("inv_beta", "delta")
+    xs, ys, index, kinds, types, ends = [], [], [], [], [], []
+    c_x, c_y, c_type, c_kinds = [], [], [], []
     for (m, n), result in curves_by_type.items():
         for curve in result:
-            inv_beta.append(np.asarray(curve.inv_beta, dtype=float))
-            delta.append(np.asarray(curve.delta, dtype=float))
-            index.append(np.full(inv_beta[-1].size, len(kinds), dtype=np.int32))
+            xs.append(np.asarray(curve.inv_beta if default else curve.x, dtype=float))
+            ys.append(np.asarray(curve.delta if default else curve.y, dtype=float))
+            index.append(np.full(xs[-1].size, len(kinds), dtype=np.int32))
             kinds.append(str(curve.kind))
             types.append(f"{m}/{n}")
             ends.append("+".join(str(e) for e in getattr(curve, "ends", ())))
         for point in result.codimension_two:
-            c_ib.append(float(point.inv_beta))
-            c_d.append(float(point.delta))
+            c_x.append(float(point.inv_beta if default else point.x))
+            c_y.append(float(point.delta if default else point.y))
             c_type.append(f"{m}/{n}")
             c_kinds.append("+".join(sorted(point.kinds)))
 
@@ -574,17 +581,25 @@ def boundaries_dataset(curves_by_type, attrs):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype)
 
     ds = xr.Dataset(
-        {"inv_beta": ("point", cat(inv_beta, float)), "delta": ("point", cat(delta, float)),
+        {x_name: ("point", cat(xs, float)), y_name: ("point", cat(ys, float)),
          "curve": ("point", cat(index, np.int32)),
          "kind": ("curve", np.array(kinds, dtype=str)),
          "type": ("curve", np.array(types, dtype=str)),
          "ends": ("curve", np.array(ends, dtype=str)),
-         "codim2_inv_beta": ("codim2", np.array(c_ib, dtype=float)),
-         "codim2_delta": ("codim2", np.array(c_d, dtype=float)),
+         f"codim2_{x_name}": ("codim2", np.array(c_x, dtype=float)),
+         f"codim2_{y_name}": ("codim2", np.array(c_y, dtype=float)),
          "codim2_type": ("codim2", np.array(c_type, dtype=str)),
          "codim2_kinds": ("codim2", np.array(c_kinds, dtype=str))},
         attrs=dict(attrs))
-    for name, (long_name, units) in BOUNDARY_META.items():
+    meta = dict(BOUNDARY_META)
+    if not default:
+        for name in ("inv_beta", "delta", "codim2_inv_beta", "codim2_delta"):
+            del meta[name]
+        for name in axes:
+            meta[name] = (f"{name} of a point on a boundary curve", "1")
+            meta[f"codim2_{name}"] = (f"{name} of a codimension-two point (two kinds meet)",
+                                      "1")
+    for name, (long_name, units) in meta.items():
         ds[name].attrs.update(long_name=long_name, units=units)
     return ds
 

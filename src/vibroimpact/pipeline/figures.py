@@ -271,6 +271,11 @@ def caption(kind, name, entry, target):
     fig, _ = figure_variant(target)
     number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
     what = FIGURES[fig]["shows"]
+    plane = entry.get("plane")
+    if plane:
+        what = what.replace("the (1/beta_f, delta) plane", f"the ({plane[0]}, {plane[1]}) "
+                            f"plane").replace("over the (1/beta_f, delta) plane of Fig. 15",
+                                              f"over the ({plane[0]}, {plane[1]}) plane")
     title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
              "lyapunov": "Lyapunov exponents",
              "residence": "Residence times",
@@ -284,6 +289,13 @@ def caption(kind, name, entry, target):
         if options:
             parts.append("drawn with " + ", ".join(f"{key} = {_values_text(value)}"
                                                    for key, value in options.items()))
+    elif plane:
+        parts = [f"{key} = {_values_text(entry[key])}"
+                 for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta",
+                             "delta") if entry.get(key) is not None]
+        if "amplitude" not in entry:
+            parts.append("amplitude = 1")
+        parts.append("types " + ", ".join(_type_text(t) for t in entry.get("types", [])))
     else:
         parts += [f"1/beta_f = {_values_text(entry['inv_beta'])}",
                   f"delta = {_values_text(entry['delta'])}",

@@ -56,8 +56,11 @@ JOB_KEYS = {
 #: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns
 #: only figures): the map's tiles, the boundary curves seeded from the map, the attractors.
 ORBIT_JOB_KEYS = {
-    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows") + _WALLS,
-    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types") + _WALLS,
+    # ``plane`` and ``amplitude``: absent from an entry over (inv_beta, delta), so its jobs'
+    # params are those they always were
+    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows", "plane",
+               "amplitude") + _WALLS,
+    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types", "plane", "amplitude") + _WALLS,
     "attractors": ("zeta", "eps", "types", "attractors") + _WALLS,
 }
 
@@ -359,10 +362,27 @@ def noise_record(entry):
     return n, dt, (n - 1) * dt
 
 
+def orbit_tiled_axis(entry):
+    """The axis an ``orbits`` entry's tiles split: ``inv_beta`` without a plane; with one,
+    its axis other than ``delta`` (the cells along delta are one branch followed, which a
+    tile must not cut: `vibroimpact.orbits.plane.orbit_plane`), else its x axis."""
+    plane = entry.get("plane")
+    if not plane:
+        return "inv_beta"
+    return plane[1] if plane[0] == "delta" else plane[0]
+
+
 def orbit_rows(entry):
-    """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
-    rows = grid_values(entry["inv_beta"])
+    """The values of an ``orbits`` entry's tiled axis (`orbit_tiled_axis`: ``inv_beta``
+    without a plane) and its number of tiles (row groups)."""
+    rows = grid_values(entry[orbit_tiled_axis(entry)])
     return rows, -(-rows.size // int(entry["tile_rows"]))
+
+
+def orbit_plane_cells(entry):
+    """Cells of an ``orbits`` entry's map (the product of its two axes' sizes)."""
+    plane = entry.get("plane") or ("inv_beta", "delta")
+    return grid_size(entry[plane[0]]) * grid_size(entry[plane[1]])
 
 
 def attractor_rows(entry):

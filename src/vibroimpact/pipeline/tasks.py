@@ -18,6 +18,7 @@ from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
                                         grid_size, grid_values, map_cap_steps, orbit_rows,
+                                        orbit_tiled_axis,
                                         walls)
 
 log = logging.getLogger("vibroimpact")
@@ -418,6 +419,11 @@ def orbit_tile(entry, tile, out, threads=None):
 
     if threads is not None:
         numba.set_num_threads(int(threads))
+    if entry.get("plane"):
+        from vibroimpact.orbits.plane import orbit_plane
+
+        io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
+        return
     rows, n_tiles = orbit_rows(entry)
     result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
                        types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
@@ -432,6 +438,11 @@ def clearance_orbit_tile(entry, tile, out):
     ``orbits`` entry on some 1/beta rows (`pipeline.cells.two_wall_orbit_map`: the shooting
     solver, seeded by the simulator; a rule of its own, so that the one-wall orbit tiles'
     code reaches no simulator)."""
+    if entry.get("plane"):
+        from vibroimpact.attractors.plane import orbit_plane
+
+        io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
+        return
     from vibroimpact.pipeline.cells import two_wall_orbit_map
 
     rows, n_tiles = orbit_rows(entry)
@@ -444,9 +455,38 @@ def clearance_orbit_tile(entry, tile, out):
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
 
+#: The parameters of an ``orbits`` entry with a plane that its map holds fixed when given.
+ORBIT_PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta")
+
+
+def orbit_plane_fixed(entry):
+    """``{parameter: value}`` an ``orbits`` entry with a plane holds fixed (its amplitude 1
+    when not given)."""
+    fixed = {k: float(entry[k]) for k in ORBIT_PLANE_PARAMETERS
+             if k not in entry["plane"] and entry.get(k) is not None}
+    if "amplitude" not in entry["plane"]:
+        fixed.setdefault("amplitude", 1.0)
+    return fixed
+
+
+def _plane_tile(entry, tile, orbit_plane):
+    """One tile of an ``orbits`` entry with a plane: `orbit_plane` over its share of the
+    tiled axis (`orbit_tiled_axis`, values strided over tiles) by the whole other axis."""
+    x_name, y_name = entry["plane"]
+    rows, n_tiles = orbit_rows(entry)
+    values = {k: grid_values(entry[k]) for k in (x_name, y_name)}
+    values[orbit_tiled_axis(entry)] = rows[tile::n_tiles]
+    ds = orbit_plane(x_name, values[x_name], y_name, values[y_name], orbit_plane_fixed(entry),
+                     types=[tuple(int(k) for k in t) for t in entry["types"]])
+    ds.attrs.update(provenance(entry), reason_codes="0 stable, 1 no solution, 2 inadmissible, "
+                                                    "3 unstable")
+    return ds
+
+
 def aggregate_orbits(entry, tiles, out):
     """Rule ``aggregate_orbits``: the orbit map of one entry from its tiles."""
-    ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles])
+    ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles],
+                                     dim=orbit_tiled_axis(entry))
     ds.attrs.update(provenance(entry))
     io.write_dataset(ds, out)
 
@@ -460,6 +500,8 @@ BOUNDARY_TOL = 1e-9
 def boundaries(entry, orbits_path, out, threads=None):
     """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
     the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
+    if entry.get("plane"):
+        return plane_boundaries(entry, orbits_path, out, threads)
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                  traced=1)
     if entry.get("gap") is not None:
@@ -495,6 +537,43 @@ def boundaries(entry, orbits_path, out, threads=None):
             log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
                         "there (the dataset's `ends` says which curves)", m, n, lost)
     io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
+
+
+def plane_boundaries(entry, orbits_path, out, threads=None):
+    """`boundaries` of an ``orbits`` entry with a plane: `plane_boundaries` of every type over
+    the map's box, seeded from the map; a two-wall entry, or one whose eps reaches 0, is
+    written untraced (``traced = 0``, ``not_traced`` says why), as over (1/beta, delta)."""
+    fixed = orbit_plane_fixed(entry)
+    axes = tuple(entry["plane"])
+    attrs = dict(provenance(entry), **fixed, axes=list(axes),
+                 fixed=json.dumps(fixed, sort_keys=True), traced=1)
+    seeds = io.load_dataset(orbits_path)
+    box = {k: (float(seeds[k].min()), float(seeds[k].max())) for k in axes}
+    why = None
+    if entry.get("gap") is not None or "gap" in axes:
+        why = "two walls: the edges are the map's cell edges"
+    elif fixed.get("eps", 1.0) == 0.0 or ("eps" in axes and box["eps"][0] <= 0.0):
+        why = "eps = 0 in the plane: the edges are the map's cell edges"
+    if why is not None:
+        attrs.update(traced=0, not_traced=why)
+        io.write_dataset(datasets.boundaries_dataset({}, attrs, axes), out)
+        return
+    import numba
+
+    from vibroimpact.orbits.boundaries import plane_boundaries as trace
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    curves = {}
+    for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
+        curves[(m, n)] = trace(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
+                               seed_map=seeds, tol=BOUNDARY_TOL)
+        log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
+        lost = sum(c.ends.count("lost") for c in curves[(m, n)])
+        if lost:
+            log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
+                        "there (the dataset's `ends` says which curves)", m, n, lost)
+    io.write_dataset(datasets.boundaries_dataset(curves, attrs, axes), out)
 
 
 def _attractor_attrs(entry):

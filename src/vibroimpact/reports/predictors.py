@@ -34,6 +34,7 @@ resamples without spread in either variable are dropped. Neighbouring cells are 
 pieces of evidence than their number and the interval is narrower than it should be: read
 it as a lower bound on the uncertainty.
 """
+import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -226,14 +227,28 @@ def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95, *, _s
     return rho, float(min(low, rho)), float(max(high, rho)), n
 
 
+def _map_axes(motion_map):
+    """The map's plane ``(x, y)``: ``attrs["axes"]`` (a map over another plane), else the
+    paper's ``(inv_beta, delta)``."""
+    axes = motion_map.attrs.get("axes")
+    if axes is None:
+        return ("inv_beta", "delta")
+    if isinstance(axes, (bytes, str)):
+        text = axes.decode() if isinstance(axes, bytes) else axes
+        axes = json.loads(text) if text.lstrip().startswith("[") else text.split()
+    return tuple(str(a) for a in np.atleast_1d(axes))
+
+
 def _stable_domain(motion_map, orbits, basins, motion):
     """(stable, S) on the map's grid: Fig. 16's nearest cell, or the basins' n_stable."""
     if orbits is not None and motion in orbits["type"].values:
+        x_name, y_name = _map_axes(motion_map)
         o = orbits.sel(type=motion)
-        near = o.sel(inv_beta=motion_map.inv_beta, delta=motion_map.delta, method="nearest")
+        near = o.sel({x_name: motion_map[x_name], y_name: motion_map[y_name]},
+                     method="nearest").transpose(x_name, y_name)
         # map cells beyond the orbit map's plane (more than half a step out) are unknown
-        inside = np.ones((motion_map.sizes["inv_beta"], motion_map.sizes["delta"]), bool)
-        for axis, d in enumerate(("inv_beta", "delta")):
+        inside = np.ones((motion_map.sizes[x_name], motion_map.sizes[y_name]), bool)
+        for axis, d in enumerate((x_name, y_name)):
             grid = o[d].values
             half = 0.5 * (np.diff(grid).max() if grid.size > 1 else 0.0) + 1e-9
             out = np.abs(near[d].values - motion_map[d].values) > half
@@ -293,6 +308,7 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
     list of Correlation
         Per predictor (the order of `PREDICTORS`), per motion of the map, domain then plane.
     """
+    motion_map = motion_map.transpose(..., *_map_axes(motion_map))   # every field (x, y)
     errors = {}
     aligned = {}
     for name, ds in (("basin", basins), ("lyapunov", lyapunov)):

@@ -246,6 +246,52 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                      "an `orbits` entry (none defined)")
         return
     other = config["orbits"][orbits]
+    if entry.get("plane") or other.get("plane"):
+        _check_orbits_item_plane(name, entry, at, orbits, other, problems)
+    else:
+        _check_orbits_item_system(entry, at, orbits, other, problems)
+    types = {tuple(t) for t in other["types"]}
+    missing = [m for m in entry["motions"] if tuple(m) not in types]
+    if missing:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
+                     f"which studies.{name}.motions lists", "an `orbits` entry whose types "
+                     "include every motion of the study")
+
+
+#: The parameters a map over a plane and its orbits entry must share (each fixed, or an
+#: axis of both): the harmonic-force problem's.
+SHARED_PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta")
+
+
+def _check_orbits_item_plane(name, entry, at, orbits, other, problems):
+    """fig15_vs_fig16 of a study and an orbits entry, one of them with a plane: the same
+    plane, and the same value of every parameter both hold fixed (a missing amplitude of
+    the orbits entry is 1)."""
+    plane = list(entry.get("plane") or ("inv_beta", "delta"))
+    oplane = list(other.get("plane") or ("inv_beta", "delta"))
+    if plane != oplane:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps the plane {oplane}, the "
+                     f"study the plane {plane}", f"an `orbits` entry with plane: {plane}")
+        return
+    for key in SHARED_PLANE_PARAMETERS:
+        if key in plane:
+            continue
+        a = entry.get(key)
+        b = other.get(key, 1.0 if key == "amplitude" else None)
+        if key == "eps_lower" and entry.get("gap") is not None:
+            a = entry["eps"] if a is None else a        # absent with a gap: the study's eps
+            b = other["eps"] if b is None else b
+        if (a is None) != (b is None) or (a is not None and (
+                isinstance(a, (list, dict)) or isinstance(b, (list, dict))
+                or float(a) != float(b))):
+            def text(v):
+                return _num(v) if isinstance(v, (int, float)) else "none" if v is None else v
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = {text(b)}, the "
+                         f"study {key} = {text(a)}",
+                         f"an `orbits` entry over {plane} with the study's fixed values")
+
+
+def _check_orbits_item_system(entry, at, orbits, other, problems):
     for key in ("zeta", "eps", "gap", "eps_lower"):
         if other.get(key) != entry.get(key) and (
                 other.get(key) is None or entry.get(key) is None
@@ -255,12 +301,6 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                          f"study {key} = "
                          f"{_num(entry[key]) if entry.get(key) is not None else 'none'}",
                          "an `orbits` entry of the same zeta and eps (and walls)")
-    types = {tuple(t) for t in other["types"]}
-    missing = [m for m in entry["motions"] if tuple(m) not in types]
-    if missing:
-        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
-                     f"which studies.{name}.motions lists", "an `orbits` entry whose types "
-                     "include every motion of the study")
 
 
 def _check_walls(where, entry, problems):
@@ -456,8 +496,8 @@ _AXIS_BOUNDS = {
     "rms": (lambda v: v >= 0.0, "rms >= 0"),
     "delta": (lambda v: True, "any play"),
 }
-#: The figures a study with a plane draws: its map's (fig15_vs_fig16 needs an orbits entry
-#: over the same plane, which the workflow does not make yet).
+#: The figures a study with a plane draws: its map's; and fig15_vs_fig16 over an orbits entry
+#: of the same plane (`_check_orbits_item`), unless the plane names a noise parameter.
 PLANE_FIGURES = ("fig15", "residence")
 
 
@@ -534,15 +574,9 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
                          f"problem's, which has no {noise_axis} (a parameter of the noise): "
                          f"the plane {plane} has no Fig. 16", ", ".join(PLANE_FIGURES))
             ok = False
-        elif fig == "fig15_vs_fig16":
-            problems.add(f"{where}.figures[{i}]", fig, f"needs Fig. 16 over the plane "
-                         f"{plane}, and an orbits entry maps (1/beta_f, delta) only (over "
-                         f"another plane: vibroimpact.orbits.plane.orbit_plane, not yet a "
-                         f"workflow job)", ", ".join(PLANE_FIGURES))
-            ok = False
-        elif fig not in PLANE_FIGURES:
+        elif fig not in PLANE_FIGURES + ("fig15_vs_fig16",):
             problems.add(f"{where}.figures[{i}]", fig, f"a study with a plane ({plane}) "
-                         "draws its map only", ", ".join(PLANE_FIGURES))
+                         "draws its map only", ", ".join(PLANE_FIGURES + ("fig15_vs_fig16",)))
             ok = False
     _check_motions(where, entry, two_walls, problems)
     n, dt, tau = noise_record(config["noises"][entry["noise"]])
@@ -668,15 +702,37 @@ def _check_orbits(config, name, entry, problems, limits):
         problems.add(where, name, "ends like a dataset an orbits entry derives "
                      "(results/orbits/<name>_basins.nc ...)",
                      f"a name not ending in {', '.join(DERIVED_SUFFIXES)}")
-    two_walls = _check_walls(where, entry, problems)
-    if two_walls:
-        _check_two_wall_orbits(where, entry, problems)
-    grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
-                               limits["max_orbit_cells"], positive=True),
-             "delta": _grid(problems, f"{where}.delta", entry["delta"],
-                            limits["max_orbit_cells"])}
-    if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
-        _plane(problems, where, grids, "fig16")
+    if entry.get("plane"):
+        if not _check_orbits_plane(where, entry, problems, limits):
+            return
+        two_walls = entry.get("gap") is not None
+        if two_walls:
+            _check_two_wall_orbits(where, entry, problems)
+    else:
+        for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta", "delta"):
+            fixed_only = key not in ("inv_beta", "delta")
+            if isinstance(entry.get(key), (list, dict)) == fixed_only:
+                problems.add(f"{where}.{key}", entry[key], "a grid, and this entry has no "
+                             "plane naming it" if fixed_only else "a number, and this "
+                             "entry has no plane that fixes it", f"a number, or `plane: "
+                             f"[{key}, delta]` (say) to map over it" if fixed_only else
+                             f"a grid (a list or {{start, stop, step}}), or a `plane` that "
+                             f"does not name {key}")
+                return
+        if entry.get("amplitude") is not None:
+            problems.add(f"{where}.amplitude", entry["amplitude"], "the amplitude of an entry "
+                         "over the paper's (1/beta_f, delta) plane, whose map is Fig. 16's "
+                         "(A = 1)", "leave it out, or give the entry a `plane` (A is then "
+                         "fixed or an axis)")
+        two_walls = _check_walls(where, entry, problems)
+        if two_walls:
+            _check_two_wall_orbits(where, entry, problems)
+        grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
+                                   limits["max_orbit_cells"], positive=True),
+                 "delta": _grid(problems, f"{where}.delta", entry["delta"],
+                                limits["max_orbit_cells"])}
+        if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
+            _plane(problems, where, grids, "fig16")
     for j, t in enumerate(entry["types"]):
         if len(t) == 3:
             if not two_walls:
@@ -701,6 +757,76 @@ def _check_orbits(config, name, entry, problems, limits):
     if entry.get("attractors"):
         _check_attractors(where, entry, problems, limits)
     _check_figures(config, "orbits", name, entry, problems, None)
+
+
+#: Bounds of an orbits plane's axes (the harmonic-force problem: the amplitude is > 0, the
+#: motions at -A being those at A shifted by half a period).
+_ORBIT_AXIS_BOUNDS = dict(_AXIS_BOUNDS, amplitude=(lambda v: v > 0.0, "amplitude > 0"))
+
+
+def _check_orbits_plane(where, entry, problems, limits):
+    """An orbits entry with a ``plane``: no noise parameter on it, its axes grids in their
+    bounds (at least 2 values), every other parameter a number, no attractors block. False
+    when the entry cannot be checked further."""
+    plane = list(entry["plane"])
+    noise = sorted(set(plane) & set(NOISE_PARAMETERS))
+    if noise:
+        problems.add(f"{where}.plane", plane, f"names {noise[0]}, a parameter of the random "
+                     f"force: the periodic motions of Fig. 16 are those of the harmonic force "
+                     f"alone, so a plane over the noise has no Fig. 16",
+                     "two of zeta, eps, delta, amplitude, inv_beta (and gap, eps_lower with "
+                     "a second wall)")
+        return False
+    ok = True
+    two_walls = "gap" in plane or entry.get("gap") is not None
+    if "eps_lower" in plane and not two_walls:
+        problems.add(f"{where}.plane", plane, "names eps_lower, the restitution of a second "
+                     "wall, and this entry has one wall (no gap)", f"give {where}.gap > 0, or "
+                     "a plane without eps_lower")
+        ok = False
+    for key in plane:
+        spec = entry.get(key)
+        if not isinstance(spec, (list, dict)):
+            problems.add(f"{where}.{key}", spec, f"{'missing' if spec is None else 'a number'}"
+                         f", and {key} is an axis of the plane {plane}",
+                         "a grid (a list or {start, stop, step})")
+            ok = False
+            continue
+        values = _grid(problems, f"{where}.{key}", spec, limits["max_orbit_cells"])
+        if values is None:
+            ok = False
+            continue
+        test, allowed_ = _ORBIT_AXIS_BOUNDS[key]
+        bad = [float(v) for v in values if not test(float(v))]
+        if bad:
+            problems.add(f"{where}.{key}", spec, f"holds {_num(bad[0])}", allowed_)
+            ok = False
+        elif values.size < 2:
+            problems.add(f"{where}.{key}", spec, f"fig16 draws contours over the plane "
+                         f"{plane}", "at least 2 values")
+            ok = False
+    for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta", "delta"):
+        if key in plane or entry.get(key) is None:
+            continue
+        if isinstance(entry[key], (list, dict)):
+            problems.add(f"{where}.{key}", entry[key], f"a grid, and {key} is fixed in the "
+                         f"plane {plane} (only the plane's axes are grids)",
+                         f"a number, or name {key} in the plane")
+            ok = False
+        else:
+            test, allowed_ = _ORBIT_AXIS_BOUNDS[key]
+            if not test(float(entry[key])):
+                problems.add(f"{where}.{key}", entry[key], "out of range", allowed_)
+                ok = False
+    if "gap" not in plane:
+        _check_walls(where, entry, problems)
+    if entry.get("attractors"):
+        problems.add(f"{where}.attractors", "...", f"basins and Lyapunov exponents over the "
+                     f"plane {plane} are not a job of an orbits entry", "leave the attractors "
+                     "block out of an entry with a plane (an entry over (inv_beta, delta) "
+                     "has them)")
+        ok = False
+    return ok
 
 
 #: Periods n the two-wall orbit map solves for (the shooting solver's cost grows with n).

@@ -10,7 +10,9 @@ from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_step
 __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
            "simulate_cpu_s",
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
-           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
+           "orbit_plane_cpu_s",
+           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
+           "work_precision_cpu_s", "stress_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 #: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
@@ -26,10 +28,6 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 NS_PER_AUDIT_STEP = 25.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
-#: One cell of a two-wall orbits entry: the shooting solver's seeds settled and its motions
-#: solved, every type at once (`attractors.shooting`; ~135 ms a cell measured by h35a,
-#: issue 35's closing note).
-CLEARANCE_CELL_S = 0.135
 #: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
 #: map's 5,187 cells x 64 starts (68 us a start; its four tiles' benchmark files, 2 cores).
 US_PER_START = 70.0
@@ -48,6 +46,13 @@ MAP_CELL_S = 0.010
 #: The boundary curves of one (m/n) type: 6.2 CPU-s for the default entry's 5 types, start-up
 #: included (its benchmark file at 15acb54, a fresh clone's `make`).
 BOUNDARIES_S = 1.0
+#: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
+#: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
+#: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
+#: one cell of a two-wall plane (the shooting solver, seeded by the simulator: ~135 ms
+#: measured by h35a, issue 35).
+ORBIT_CELL_S = 1.0e-4
+SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
 #: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
 #: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
@@ -65,12 +70,6 @@ REPORT_S = 0.3
 #: trees' CPU, this tree against a13f0b3, best of 3, `benchmarks/job_costs.py --jobs --only
 #: report`): ~3.6 CPU-s a job, 2.3 of it the map's.
 MAP_REPORT_S = 2.3
-#: The work-precision run and the stress sample together, wall time (the work-precision job
-#: holds every core while it times): 44 + 21 s on the default build.
-VALIDATION_S = 65.0
-#: Each validation run alone (wall s: the rules hold every core), by rule.
-#: Measured at 15acb54 (a fresh clone's `make`, benchmark files' ``s``): 45.6 and 39.3 s.
-VALIDATION_RUN_S = {"measure_work_precision": 45.6, "sample_stress_families": 39.3}
 #: The rule writing each validation dataset (``results/validation/<name>.nc``).
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
@@ -95,6 +94,30 @@ SPECTRA_CELL_S = 0.12
 #: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
 #: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns.
 NS_PER_MAP_STEP = 38.0
+#: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
+#: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
+#: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured
+#: (benchmarks/ab_validation_sizes.py, 3 runs, load ~22; the job's own CPU: 1.8 s timing
+#: solve_ivp, 3.5 its runs over the compared stretches, 1.0 the references, 0.6 RK4); the
+#: sizes before issue 37 give 43.7 against 45.3 (the default build's benchmark file).
+WP_FIXED_S = 1.0
+#: One restarted solve_ivp run per unit of simulated time (CPU s): 1-6 ms over the default
+#: methods, tolerances and plays (restart overhead: one restart per force sample).
+SOLVE_IVP_S_PER_UNIT = 2.6e-3
+#: The 34-digit reference and its 53-bit twin per unit of compared stretch, per play (CPU s):
+#: 2-3 ms without chatter, ~20 ms in the chatter of delta = -0.5; a mean.
+REFERENCE_S_PER_UNIT = 6e-3
+#: A compared stretch is as long as ``impacts`` need at this many time units each (a mean over
+#: the default plays: one impact every ~14 time units at delta = 1, ~3 at 0, ~0.2 at -0.5),
+#: between ``stretch`` and ``max_stretch``.
+UNITS_PER_IMPACT = 2.1
+#: One RK4 step of the event-locating peer (CPU ns).
+RK4_NS_PER_STEP = 30.0
+#: The stress job, besides its start-up, per size (`stress_cpu_s`): every family's cases, the
+#: streamed record written, streamed by three processes (~0.8 CPU-s each to start) and
+#: replayed. Measured with benchmarks/ab_validation_sizes.py (issue 37; load ~22, the job's
+#: process and its children): 6.7-7.1 CPU-s at ``sample`` (3 runs), 22.6 at ``quick``.
+STRESS_S = {"sample": 5.6, "quick": 21.0}
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
 FILE_OVERHEAD = 20_000
@@ -204,6 +227,19 @@ def orbit_cpu_s(cells, types):
     return cells * types * US_PER_ORBIT * 1e-6
 
 
+def orbit_plane_cpu_s(entry, cells):
+    """CPU seconds of an ``orbits`` entry's map over its ``plane`` of ``cells`` cells: along
+    delta the map's branch following (`orbit_cpu_s`); a plane without delta solves each cell
+    alone (`ORBIT_CELL_S` a type: the global scan, the finer m = 3 one included); two walls
+    the shooting solver (`SHOOTING_CELL_S` a cell)."""
+    types = len(entry["types"])
+    if entry.get("gap") is not None or "gap" in entry["plane"]:
+        return cells * SHOOTING_CELL_S
+    if "delta" in entry["plane"]:
+        return orbit_cpu_s(cells, types)
+    return cells * types * ORBIT_CELL_S
+
+
 def attractor_cpu_s(cells, n_starts):
     """CPU seconds of the attractor map's ``n_starts`` starts in each of ``cells`` cells."""
     return cells * n_starts * US_PER_START * 1e-6
@@ -227,3 +263,25 @@ def escape_cpu_s(entry, dt, levels=None):
     levels = len(entry["escape"]["rms"]) if levels is None else int(levels)
     cells = len(entry["escape"]["cells"])
     return levels * (n * NS_PER_SAMPLE * 1e-9 + simulate_cpu_s(cells, n - 1))
+
+
+def work_precision_cpu_s(block):
+    """CPU seconds of the work-precision job at the config block ``validation.work_precision``
+    (start-up excluded): solve_ivp timed ``repeats`` times on ``stretch`` and run once over the
+    compared stretch, at every play and setting; the reference over the compared stretch; RK4
+    with event location ``repeats`` times over ``long_samples`` at every step count."""
+    n_delta = len(block["delta"])
+    stretch, max_stretch = float(block["stretch"]), float(block.get("max_stretch", 1e300))
+    compared = min(max_stretch, max(stretch, UNITS_PER_IMPACT * int(block["impacts"])))
+    ivp_runs = len(block["solvers"]) * len(block["rtol"])
+    repeats = int(block["repeats"])
+    ivp = SOLVE_IVP_S_PER_UNIT * ivp_runs * (repeats * stretch + compared)
+    reference = REFERENCE_S_PER_UNIT * compared
+    rk4 = RK4_NS_PER_STEP * 1e-9 * int(block["long_samples"]) * sum(block["rk4_steps"]) * repeats
+    return WP_FIXED_S + n_delta * (ivp + reference + rk4)
+
+
+def stress_cpu_s(block):
+    """CPU seconds of the stress job at the config block ``validation.stress`` (start-up
+    excluded)."""
+    return STRESS_S[block.get("size", "sample")]

@@ -18,10 +18,10 @@ from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.config.costs import (COMPILE_S, FIGURE_BYTES, FIGURE_S,
                                                FILE_OVERHEAD, JOB_START_S, MAP_REPORT_S,
                                                REPORT_BYTES, REPORT_S, VALIDATION_FIGURE_S,
-                                               VALIDATION_RULES, VALIDATION_RUN_S,
-                                               VALIDATION_S)
+                                               VALIDATION_RULES)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
-from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
+from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_plane_cells,
+                                        orbit_rows)
 
 __all__ = ["Plan", "Row", "make_plan", "built_entries", "WHOLE_MACHINE_RULES"]
 
@@ -333,14 +333,18 @@ def make_plan(config, own=None, *, results="results", studies=None):
         parts = []
         if "orbits" in needs:
             rows, n_tiles = orbit_rows(entry)
-            cells = len(rows) * grid_size(entry["delta"])
+            cells = orbit_plane_cells(entry)
             row.orbit_cells += cells
             row.bytes += 2 * cells * len(entry["types"]) * 34
             # a clearance between two walls: the shooting solver's rule (common.smk)
             tile_rule = ("solve_clearance_orbit_tile" if entry.get("gap") is not None
                          else "solve_orbit_tile")
-            work = (costs.CLEARANCE_CELL_S * cells if tile_rule != "solve_orbit_tile"
-                    else costs.orbit_cpu_s(cells, len(entry["types"])))
+            if entry.get("plane"):
+                work = costs.orbit_plane_cpu_s(entry, cells)
+            elif tile_rule == "solve_clearance_orbit_tile":
+                work = costs.SHOOTING_CELL_S * cells
+            else:
+                work = costs.orbit_cpu_s(cells, len(entry["types"]))
             _charge(row, tile_rule, n_tiles, work + n_tiles * JOB_START_S)
             _charge(row, "aggregate_orbits", 1, costs.aggregate_s("aggregate_orbits"))
             parts.append(f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}")
@@ -385,8 +389,9 @@ def make_plan(config, own=None, *, results="results", studies=None):
                   bytes=figs * FIGURE_BYTES + notebooks * REPORT_BYTES)
         for path in sorted(validation):
             if path.endswith(".nc"):        # the rule writing it: its file's name
-                rule = VALIDATION_RULES.get(Path(path).stem, "measure_work_precision")
-                _charge(row, rule, 1, VALIDATION_RUN_S.get(rule, VALIDATION_S / 2))
+                rule = VALIDATION_RULES[Path(path).stem]
+                _charge(row, rule, 1,
+                        _validation_runs_cpu_s(config["validation"], [path]) + JOB_START_S)
         _charge(row, "draw_validation_figure", figs, figs * (VALIDATION_FIGURE_S + JOB_START_S))
         _charge(row, "report", notebooks, notebooks * (REPORT_S + JOB_START_S))
         plan.rows.append(row)
@@ -403,6 +408,16 @@ def make_plan(config, own=None, *, results="results", studies=None):
     except OSError:
         plan.free_bytes = None
     return plan
+
+
+def _validation_runs_cpu_s(block, files):
+    """CPU seconds of the validation runs among ``files`` (start-up excluded)."""
+    cpu_s = 0.0
+    if "results/validation/work_precision.nc" in files:
+        cpu_s += costs.work_precision_cpu_s(block["work_precision"])
+    if "results/validation/stress_sample.nc" in files:
+        cpu_s += costs.stress_cpu_s(block["stress"])
+    return cpu_s
 
 
 def _hours(cpu_s, jobs):
