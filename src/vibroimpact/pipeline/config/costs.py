@@ -15,7 +15,10 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
            "work_precision_cpu_s", "stress_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
-JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
+#: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
+#: the 15acb54 build took 0.97-1.0 CPU-s (the harmonic trace, noise and the escape levels
+#: that compiled nothing; benchmark files' cpu_time).
+JOB_START_S = 1.0
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
 #: The self-audit of an events cell (`impact.audit.audit_moments`: exact integrals over every
 #: step), per step on top of NS_PER_STEP. CPU ns measured by benchmarks/bench_audit.py (1e6
@@ -40,7 +43,9 @@ MAP_CAP_FRACTION = 0.34
 #: (`plane_map_cpu_s`), whose short caps it dominates; the paper's map keeps the model its
 #: README numbers were measured with (its cells are 15-100 times longer).
 MAP_CELL_S = 0.010
-BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
+#: The boundary curves of one (m/n) type: 6.2 CPU-s for the default entry's 5 types, start-up
+#: included (its benchmark file at 15acb54, a fresh clone's `make`).
+BOUNDARIES_S = 1.0
 #: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
 #: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
 #: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
@@ -49,18 +54,46 @@ BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
 ORBIT_CELL_S = 1.0e-4
 SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
-#: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
-#: (each drawn alone as its job does, 2 cores under load; h37a, issue 37).
-FIGURE_S = 1.0
+#: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
+#: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
+FIGURE_S = 0.9
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
-#: twice (nbconvert) in one job, besides its start-up: 1.9 to 2.4 CPU-s a job (best of 2,
-#: load ~7) for the reports that show no map (random_force, performance, stability).
-REPORT_S = 0.8
+#: twice (nbconvert) in one job, besides its start-up: the reports that show no map
+#: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
+#: files' cpu_time, a fresh clone's `make`).
+REPORT_S = 0.3
 #: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
-#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``): 6.6 to 7.5 CPU-s for the three
+#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``; ``nb.map_agreement``): the three
 #: default reports that show the map (the motion_map and harmonic studies' and the orbits
-#: entry's, each computing the same predictors) against 2.1 for one without.
-MAP_REPORT_S = 4.8
+#: entry's, each computing the same predictors) took 5.56, 5.37 and 4.55 CPU-s at 15acb54;
+#: the predictors' shared bootstrap (issue 37) takes 0.68-0.71 of that (the jobs' process
+#: trees' CPU, this tree against a13f0b3, best of 3, `benchmarks/job_costs.py --jobs --only
+#: report`): ~3.6 CPU-s a job, 2.3 of it the map's.
+MAP_REPORT_S = 2.3
+#: The rule writing each validation dataset (``results/validation/<name>.nc``).
+VALIDATION_RULES = {"work_precision": "measure_work_precision",
+                    "stress_sample": "sample_stress_families"}
+#: One validation figure drawn, besides its job's start-up.
+VALIDATION_FIGURE_S = FIGURE_S
+#: One aggregation job (tiles joined into a dataset), start-up included, by kind (default
+#: ``"*"``): 0.44-0.48 CPU-s each at 15acb54 (benchmark files of a fresh clone's `make`), the
+#: events joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
+AGGREGATE_S = {"*": 0.5, "aggregate_events": 0.7, "aggregate_spectra": 1.0}
+#: Numba compilation on an empty cache, CPU-s, by the kind of job that compiled in the
+#: default build at 15acb54, a fresh clone whose jobs compiled (solve_orbit_tile 9.6 CPU-s
+#: against 2.4 for the other tiles; simulate_escape 8.0 against 2.0; the random trace 4.9
+#: against 1.0). Since 15572b0 `make` compiles the kernels when it installs
+#: (`vibroimpact.warm`), so the plan of a build charges none of it; `Plan.rule_costs(
+#: cold_cache=True)` adds it, to compare with a build whose jobs compiled.
+COMPILE_S = {"solve_orbit_tile": 7.0, "simulate_escape": 6.0, "simulate_trace": 4.0}
+#: A spectra cell's analysis besides its sample steps (the Welch estimate of its record):
+#: the default build's 4 spectra tiles (10 + 8 cells) took 6.9 CPU-s at 15acb54, 2.2 more
+#: than their start-up and steps at `NS_PER_STEP`.
+SPECTRA_CELL_S = 0.12
+#: A map cell's sample step (the map's own work: the hop check and the collision grouping of
+#: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
+#: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns.
+NS_PER_MAP_STEP = 38.0
 #: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
 #: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
 #: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured
@@ -146,6 +179,16 @@ def plane_cap_steps(study, entry, noise):
         if cell.inv_beta not in per_period:
             per_period[cell.inv_beta] = map_steps(n, dt, transient, max_periods, cell.inv_beta)
     return float(sum(per_period[cell.inv_beta] for cell in study.cells()))
+
+
+def map_cpu_s(steps):
+    """CPU seconds of a paper map's cells running ``steps`` sample steps in all."""
+    return steps * NS_PER_MAP_STEP * 1e-9
+
+
+def aggregate_s(rule):
+    """CPU seconds of one aggregation job of kind ``rule`` (`AGGREGATE_S`)."""
+    return AGGREGATE_S.get(rule, AGGREGATE_S["*"])
 
 
 def plane_map_cpu_s(study, entry, noise):
