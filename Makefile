@@ -1,5 +1,6 @@
-# `make` installs into .venv and builds every figure and report of the default config, then
-# Snakemake's own report of that build (results/report.html);
+# `make` installs into .venv (and compiles the numba kernels into their cache: python -m
+# vibroimpact.warm, so that no job of a build compiles one) and builds every figure and report
+# of the default config, then Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
 # of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, then
 # the slow (stress/convergence), end-to-end workflow and SLURM suites in one session on two
@@ -56,6 +57,7 @@ $(STAMP): environment.txt pyproject.toml
 	  && $(BIN)/uv pip install --quiet --python $(BIN)/python -r environment.txt \
 	  || $(BIN)/python -m pip install --quiet --disable-pip-version-check -r environment.txt
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps -e .
+	$(BIN)/python -m vibroimpact.warm --jobs 2
 	touch $(STAMP)
 
 # the seconds-long checks first: a lint failure stops the build before the half-hour suites
