@@ -13,8 +13,8 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 CORES  ?= all
-# the fast suite's tests on both cores (pytest-xdist; CPU-bound, mostly numba compilation on
-# a fresh clone, whose kernels every later build and suite loads from numba's cache)
+# the fast suite's tests on both cores (pytest-xdist; the kernels come compiled from the
+# installation, vibroimpact.warm, and every build and suite loads them from numba's cache)
 FAST_WORKERS ?= -n 2
 # the slow, workflow and SLURM suites in one session on both cores: every test of the built
 # test config on one worker (xdist group `built`, tests/conftest.py), the rebuild-scope
