@@ -26,11 +26,57 @@ max |dP| to the peer 0.037 (the physical collision rule of issue 33, expected). 
 impact: simulator 3.97 ns, prototype 4.33 ns (0.92 x; an earlier 2e6-step run gave 1.23 x:
 noisy at this load).
 
+0. (``--split STRIDE``) Where a tile's CPU time goes: every STRIDE-th cell in one process under
+   cProfile: the kernel, the simulator's driver, the pressed-flight kernel and the per-cell
+   statistics; the kernel's time per step without impact and per resolved impact.
+
+Measured 2026-11-27 05:41-05:51 UTC on branch k37 (load average 22-27 on 2 cores: CPU times
+inflated by the neighbours, walls meaningless), the default build's map (/work/check35c):
+
+- ``--split 8`` (649 cells, one process): cells 12.99 CPU-s, of which the kernel (run_steps
+  and slow_step) 4.65 s = 35.9 %, the rest of the simulator's driver 0.83 s = 6.4 %, the
+  pressed-flight kernel of the collision rule 0.82 s = 6.3 %, the per-cell Python/numpy
+  statistics 6.66 s = 51.4 %. Kernel: 1.76e8 steps, of which the impact-free part at the
+  measured 3.83 ns/step is 0.68 s; the other 3.98 s are the events: 9.88e6 resolved impacts
+  in 1.96e6 collisions (5.04 per collision), 403 ns per resolved impact, 2030 ns per
+  collision. So a kernel at no cost at all leaves 64 % of the map (about 38 of 60 CPU-s idle,
+  19 s wall on 2 cores): the <= 10 s target needs the statistics cut by ~4x as well.
+- What a closed-form chatter tail could still save (every 16th cell simulated alone to its
+  record_end, fresh compilations with the tolerances of impact.tolerances scaled, best of
+  two alternations): RESOLVED_REBOUND x 1e4 alone removes 1.6-4.3 % of the impacts (four
+  harmonic cells, 4e5 steps each: it does not bind; the tail is summed once chatter_tail's
+  first-order bracket is within CHATTER_TIME_TOL = 1e-7, and by estimate T_hi - T_lo ~
+  500 w^2 at F ~ 0.5, so w ~ 1e-5); with
+  CHATTER_TIME_TOL x 1e4 too, 5.01e6 -> 3.04e6 impacts (-39 %) saved 2.51 -> 2.11 CPU-s of
+  the kernel (-13..-16 %, about 180 ns per rebound not resolved): resolving only the first
+  rebound of each of the 3.0e5 chatter sequences (the sample's ~1e6 collisions keeping ~1.3e6
+  of its 5.0e6 impacts) would save ~3.7e6 x 180 ns, about 27 % of the kernel and 10 % of the
+  map (an estimate: the marginal cost measured on the slowest rebounds), and needs a bracket
+  on the onset of order w^5 (a perturbation series of the chatter in w with a proved
+  remainder), not the first-order one.
+- Where the 2030 ns per collision go (the same 325 cells through a throw-away copy of the
+  kernel with counters added to slow_step_one, not kept: counters in the loop cost time):
+  for its ~0.99e6 collisions (5.0e6 impacts, 3.0e5 chatter tails, 8.96e7 steps) 3.68e6
+  calls of slow_step (4.1 % of the steps), of which 1.10e6 are flights that meet nothing
+  (steps within the exclusion bound's reach of the wall) and 3.0e5 start on the wall
+  (releases; only 3 170 stay stuck through the step: the cheap stay test of run_steps takes
+  the rest), 9.29e6 events walked (segment + search each), 4.64e6 chatter_tail calls. A
+  sharper exclusion test would skip some near misses, but a step taken by the recurrence
+  instead of segment rounds differently: not bit for bit.
+- the map, ``--stride 4 --no-main --peer a13f0b3`` (1297 cells, 2 processes): this tree
+  22.16 cell CPU-s, main a13f0b3 22.70 (0.98 x; slow_step_one), max |dP| 0 (bit for bit).
+- ``--only-step`` part of the same run: simulator 4.41 ns, prototype 4.45 ns per step (0.99 x).
+- the same command again at 05:59-06:03 UTC (load 23-31), the sticking intervals now kept as
+  arrays in the driver: this tree 22.91 cell CPU-s, main a13f0b3 23.44 (0.98 x), max |dP| 0;
+  the step without impact 4.38 against 5.22 ns (0.84 x: at this load the ratio moves by
+  +-0.15 between runs).
+
 Usage::
 
     python benchmarks/bench_map_floor.py --noise results/noise/harmonic_input.nc
     python benchmarks/bench_map_floor.py --stride 4 --no-main     # a quarter of the cells
     python benchmarks/bench_map_floor.py --only-step
+    python benchmarks/bench_map_floor.py --split 8 --dataset ... --noise ...
 """
 import os
 
@@ -99,6 +145,66 @@ def merge_base(main):
                           capture_output=True, text=True).stdout.strip()
 
 
+# ---------------------------------------------------------------------------- 0. the split
+def split(dataset, noise_path, stride, n_free):
+    """Where a tile's CPU time goes: every ``stride``-th cell in this process under cProfile
+    (timer time.process_time), the time split between the kernel (``run_steps``, which calls
+    ``slow_step`` inside numba), the rest of the simulator's driver (``simulate_chunks`` less
+    the kernel), the pressed-flight kernel of the collision rule (``hops._pressed``) and the
+    per-cell statistics (everything else); the kernel's own time split between the steps
+    without impact (the steps taken, at the ns per step of ``simulate`` at delta = 100,
+    measured here) and the events (the rest), per resolved impact and per collision."""
+    import cProfile
+    import pstats
+    from vibroimpact import simulate
+    from vibroimpact.pipeline.cells import motion_map_cell
+    from vibroimpact.pipeline.io import read_noise
+    cells, kw = map_job(dataset, noise_path, stride)
+    noise, dt, _ = read_noise(noise_path)
+    noise = np.asarray(noise[:], dtype=float)
+    motion_map_cell(noise, dt, beta_f=1.0 / 2.5, delta=-1.0, **dict(kw, max_periods=50))
+    free = noise[: n_free + 1]
+    simulate(kw["zeta"], kw["eps"], 100.0, free[:1001], dt)
+    ns_free = np.inf
+    for _ in range(3):
+        c0 = time.process_time()
+        simulate(kw["zeta"], kw["eps"], 100.0, free, dt)
+        ns_free = min(ns_free, (time.process_time() - c0) / n_free * 1e9)
+    prof = cProfile.Profile(time.process_time)
+    steps = impacts = collisions = 0
+    c0 = time.process_time()
+    prof.enable()
+    for inv_beta, delta in cells:
+        cell = motion_map_cell(noise, dt, beta_f=1.0 / inv_beta, delta=delta, **kw)
+        steps += round(float(cell["simulated_time"]) / dt)
+        impacts += int(cell["n_impacts_resolved"])
+        collisions += int(cell["n_collisions"])
+    prof.disable()
+    total = time.process_time() - c0
+    st = pstats.Stats(prof).stats      # {(file, line, name): (cc, nc, tottime, cumtime, ...)}
+
+    def cum(name, file_end):
+        return sum(v[3] for k, v in st.items() if k[2] == name and k[0].endswith(file_end))
+    prof_total = cum("motion_map_cell", "cells.py")
+    kernel = cum("run_steps", "stepping.py")
+    driver = cum("simulate_chunks", "simulate.py") - kernel
+    pressed = cum("_pressed", "hops.py")
+    stats_ = prof_total - kernel - driver - pressed
+    print(f"\n== 0. Split of {len(cells)} cells (every {stride}th of {dataset}), one process, "
+          f"cProfile on CPU time ==")
+    print(f"cells CPU {total:.2f} s (under the profiler: {prof_total:.2f} s)")
+    for name, t in (("kernel run_steps/slow_step", kernel), ("driver (simulate_chunks)", driver),
+                    ("pressed flights (hops)", pressed), ("statistics (Python/numpy)", stats_)):
+        print(f"{name:<28} {t:7.2f} s  {t / prof_total:6.1%}")
+    free_s = steps * ns_free * 1e-9
+    print(f"steps {steps:.3e} (without impact at {ns_free:.2f} ns: {free_s:.2f} s), resolved "
+          f"impacts {impacts:.3e}, collisions {collisions:.3e} ({impacts / collisions:.2f} "
+          f"impacts per collision)")
+    ev = kernel - free_s
+    print(f"kernel less the free steps: {ev:.2f} s = {ev / impacts * 1e9:.0f} ns per resolved "
+          f"impact, {ev / collisions * 1e9:.0f} ns per collision")
+
+
 # ---------------------------------------------------------------------------- 2. the step
 def prototype_kernel():
     """A minimal numba loop: x_{k+1} = A x_k + g0 f_k + g1 f_{k+1}, nothing else."""
@@ -163,8 +269,13 @@ def main(argv=None):
     p.add_argument("--steps", type=float, default=2e7)
     p.add_argument("--rounds", type=int, default=5)
     p.add_argument("--only-step", action="store_true")
+    p.add_argument("--split", type=int, default=0, metavar="STRIDE",
+                   help="only the split of a tile's time, over every STRIDE-th cell")
     args = p.parse_args(argv)
     print(f"load average {os.getloadavg()} on {os.cpu_count()} CPUs")
+    if args.split:
+        split(args.dataset, args.noise, args.split, int(2e6))
+        return
     if not args.only_step:
         cells, kw = map_job(args.dataset, args.noise, args.stride)
         print(f"\n== 1. The map job: {len(cells)} cells of {args.dataset} on {args.procs} "

@@ -331,3 +331,23 @@ def test_a_stable_orbit_at_its_grazing_edge_has_a_tiny_basin_not_a_failed_match(
     on = outi[:, ak.I_MOTION] == t
     assert 0 < on.sum() < 0.02 * on.size
     assert np.all(outi[~on, ak.I_PERIOD_M] == 4)
+
+
+def test_a_cell_does_not_depend_on_the_rows_it_is_solved_with():
+    """The workflow splits the plane's rows into tiles of any size (`tile_rows`) and joins
+    them sorted (`datasets.concat_attractor_tiles`): a cell's result must be the same bit for
+    bit whichever rows share its job, so that a change of tiling leaves the datasets alone."""
+    rows, deltas = np.array([0.35, 1.0, 1.45]), np.array([0.0, 0.95])
+    kw = dict(n_starts=8, max_time=300.0, seed=3)
+    whole = attractor_map(rows, deltas, ZETA, EPS, **kw)
+    parts = [(sel, attractor_map(rows[sel], deltas, ZETA, EPS, **kw))
+             for sel in (slice(0, None, 2), slice(1, None, 2))]
+    compared = 0
+    for key, value in whole.items():
+        if not (isinstance(value, np.ndarray) and value.ndim >= 2
+                and value.shape[-2:] == (rows.size, deltas.size)):
+            continue
+        for sel, part in parts:
+            np.testing.assert_array_equal(part[key], value[..., sel, :], err_msg=key)
+        compared += 1
+    assert compared >= 10

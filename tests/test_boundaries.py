@@ -256,12 +256,14 @@ def _conditions(m, n, y, ib, d):
     bk.all_tests(y, m, n, 1.0 / ib, d, ZETA, EPS, stack, tmat, out)
     conds = [("fold", out[0]), ("period_doubling", out[1])]
     x = np.concatenate((y, [ib, d]))
+    prm = np.array([ZETA, EPS, 0.0, 0.0, 1.0])
+    ax = np.array([bk.PRM_INV_BETA, bk.PRM_DELTA])
     for j in range(m):
         conds.append(("grazing", y[m + j]))
-        top, place = bk.peak_of(bk.COND_MARGIN, j, -1.0, x, m, n, ZETA, EPS)
+        top, place = bk.peak_of(bk.COND_MARGIN, j, -1.0, x, m, n, prm, ax)
         conds.append(("grazing", top))
-        conds.append(("grazing", bk.peak_of(bk.COND_OTHER_PEAK, j, place, x, m, n, ZETA,
-                                            EPS)[0]))
+        conds.append(("grazing", bk.peak_of(bk.COND_OTHER_PEAK, j, place, x, m, n, prm,
+                                            ax)[0]))
         conds.append(("existence", out[2 + 2 * m + j]))
     return conds
 

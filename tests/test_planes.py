@@ -240,13 +240,84 @@ def test_a_grid_without_a_plane_is_refused(tmp_path):
     assert "no plane that fixes it" in "\n".join(info.value.problems)
 
 
-def test_fig15_vs_fig16_over_another_plane_is_refused_until_orbits_map_it(tmp_path):
-    text = EPS_DELTA.replace("figures: [fig15]",
-                             "figures: [fig15, {name: fig15_vs_fig16, orbits: harmonic}]")
+#: An orbits entry over the (eps, delta) plane of study ``plane`` (EPS_DELTA), its fixed values.
+EPS_DELTA_ORBITS = """orbits:
+  restitution:
+    plane: [eps, delta]
+    zeta: 0.05
+    eps: [0.3, 0.4, 0.5]
+    inv_beta: 1.1
+    delta: {start: 0.0, stop: 1.0, step: 0.05}
+    types: [[1, 1], [2, 1], [1, 2]]
+    tile_rows: 2
+    figures: [fig16]
+"""
+WITH_FIG16 = EPS_DELTA.replace(
+    "figures: [fig15]", "figures: [fig15, {name: fig15_vs_fig16, orbits: restitution}]")
+
+
+def test_fig15_vs_fig16_over_a_plane_reads_an_orbits_entry_of_that_plane(tmp_path):
+    config, plan = _load(tmp_path, WITH_FIG16 + EPS_DELTA_ORBITS)
+    entry = config["orbits"]["restitution"]
+    assert plan.drawn["orbits"] == {"restitution"}
+    row = next(r for r in plan.rows if r.key == "orbits.restitution")
+    assert row.orbit_cells == 3 * 21            # the plane's cells
+    assert row.jobs == 2 + 1 + 1 + 1            # 2 tiles (eps), joined, boundaries, fig16
+    assert tasks.orbit_plane_fixed(entry) == {"zeta": 0.05, "inv_beta": 1.1,
+                                              "amplitude": 1.0}
+
+
+@pytest.mark.parametrize("change, fragment", [
+    (("    plane: [eps, delta]\n    zeta: 0.05\n    eps: [0.3, 0.4, 0.5]\n",
+      "    zeta: 0.05\n    eps: 0.5\n    inv_beta: [1.0, 1.1]\n"),
+     "maps the plane ['inv_beta', 'delta'], the study the plane ['eps', 'delta']"),
+    (("    zeta: 0.05\n    eps: [0.3", "    zeta: 0.1\n    eps: [0.3"),
+     "orbits.restitution has zeta = 0.1, the study zeta = 0.05"),
+    (("    inv_beta: 1.1\n    delta: {", "    inv_beta: 1.2\n    delta: {"),
+     "orbits.restitution has inv_beta = 1.2, the study inv_beta = 1.1"),
+])
+def test_fig15_vs_fig16_over_a_plane_needs_the_same_plane_and_fixed_values(tmp_path, change,
+                                                                            fragment):
+    orbits = EPS_DELTA_ORBITS.replace(*change)
+    if "inv_beta: [1.0" in orbits:
+        orbits = orbits.replace("    inv_beta: 1.1\n", "")
     with pytest.raises(configuration.ConfigError) as info:
-        _load(tmp_path, text)
+        _load(tmp_path, WITH_FIG16 + orbits)
     text = "\n".join(info.value.problems)
-    assert "studies.plane.figures[1]" in text and "maps (1/beta_f, delta) only" in text, text
+    assert "studies.plane.figures[1].orbits" in text and fragment in text, text
+
+
+@pytest.mark.parametrize("change, key, fragment", [
+    (("plane: [eps, delta]", "plane: [rms, delta]"), "orbits.restitution.plane",
+     "a plane over the noise has no Fig. 16"),
+    (("    inv_beta: 1.1\n", "    inv_beta: [1.0, 1.1]\n"), "orbits.restitution.inv_beta",
+     "a grid, and inv_beta is fixed"),
+    (("    eps: [0.3, 0.4, 0.5]\n", "    eps: 0.5\n"), "orbits.restitution.eps",
+     "a number, and eps is an axis"),
+    (("    eps: [0.3, 0.4, 0.5]\n", "    eps: [0.3, 1.5]\n"), "orbits.restitution.eps[1]",
+     ">= 0 and <= 1"),
+    (("    eps: [0.3, 0.4, 0.5]\n", "    eps: {start: 0.5, stop: 1.5, step: 0.5}\n"),
+     "orbits.restitution.eps", "0 <= eps <= 1"),
+    (("    zeta: 0.05\n", "    zeta: 0.05\n    amplitude: -1.0\n"),
+     "orbits.restitution.amplitude", "amplitude A > 0"),
+    (("    figures: [fig16]\n", "    figures: [fig16]\n    attractors: {inv_beta: [1.0, 1.1], "
+      "delta: [0.0, 0.5]}\n"), "orbits.restitution.attractors", "not a job of an orbits "
+     "entry"),
+])
+def test_a_bad_orbits_plane_is_refused_naming_its_key(tmp_path, change, key, fragment):
+    with pytest.raises(configuration.ConfigError) as info:
+        _load(tmp_path, EPS_DELTA + EPS_DELTA_ORBITS.replace(*change))
+    text = "\n".join(info.value.problems)
+    assert key in text and fragment in text, text
+
+
+def test_an_orbits_entry_without_a_plane_takes_no_grid_of_eps(tmp_path):
+    orbits = EPS_DELTA_ORBITS.replace("    plane: [eps, delta]\n", "").replace(
+        "    inv_beta: 1.1\n", "    inv_beta: [1.0, 1.1]\n")
+    with pytest.raises(configuration.ConfigError) as info:
+        _load(tmp_path, EPS_DELTA + orbits)
+    text = "\n".join(info.value.problems)
+    assert "orbits.restitution.eps" in text and "no plane naming it" in text, text
 
 
 def test_an_rms_plane_has_no_fig16(tmp_path):
@@ -289,3 +360,59 @@ def test_a_tiny_rms_delta_map_builds(tmp_path):
     assert fixed["inv_beta"] == 1.1 and "rms" not in fixed
     assert ds["probability"].sizes == {"motion": 3, "rms": 2, "delta": 3}
     assert (work / "results/noise/noisy_noise0.nc").exists()
+
+
+def test_an_orbits_plane_built_by_its_tasks_is_orbit_plane_bit_for_bit(tmp_path):
+    """The orbits entry's tiles (eps columns strided over 2 jobs) joined by the aggregate are
+    `orbit_plane` over the whole plane, bit for bit; the boundaries job writes the plane's
+    curves with points named after its axes (one checked against the map's cells)."""
+    from vibroimpact.orbits.plane import orbit_plane
+    from vibroimpact.pipeline.study import ORBIT_JOB_KEYS, grid_values, orbit_rows
+
+    config, _ = _load(tmp_path, WITH_FIG16 + EPS_DELTA_ORBITS)
+    entry = config["orbits"]["restitution"]
+    block = {k: entry[k] for k in ORBIT_JOB_KEYS["orbits"] if k in entry}
+    _, n_tiles = orbit_rows(block)
+    assert n_tiles == 2
+    tiles = [tmp_path / f"tile{t}.nc" for t in range(n_tiles)]
+    for t, path in enumerate(tiles):
+        tasks.orbit_tile(block, t, path)
+    tasks.aggregate_orbits(block, tiles, tmp_path / "orbits.nc")
+    built = io.load_dataset(tmp_path / "orbits.nc")
+    whole = orbit_plane("eps", [0.3, 0.4, 0.5], "delta", grid_values(entry["delta"]),
+                        {"zeta": 0.05, "inv_beta": 1.1}, types=[(1, 1), (2, 1), (1, 2)])
+    assert built.attrs["axes"] == ["eps", "delta"] or list(built.attrs["axes"]) == ["eps",
+                                                                                    "delta"]
+    for name in ("exists", "n_solutions", "n_stable", "lam", "S", "reason"):
+        np.testing.assert_array_equal(built[name].values, whole[name].values)
+    np.testing.assert_array_equal(built["delta"].values, whole["delta"].values)
+    bblock = {k: entry[k] for k in ORBIT_JOB_KEYS["boundaries"] if k in entry}
+    tasks.boundaries(bblock, tmp_path / "orbits.nc", tmp_path / "boundaries.nc")
+    curves = io.load_dataset(tmp_path / "boundaries.nc")
+    assert int(curves.attrs["traced"]) == 1
+    assert {"eps", "delta", "codim2_eps", "codim2_delta"} <= set(curves.variables)
+    assert "inv_beta" not in curves.variables
+    # the (1/1) grazing edge at eps = 0.5 lies between the map's last unstable and first
+    # stable cell of that column
+    one = curves["type"].values == "1/1"
+    graz = [c for c in np.flatnonzero(one) if curves["kind"].values[c] == "grazing"]
+    assert graz
+    pts = curves["curve"].values == graz[0]
+    e, d = curves["eps"].values[pts], curves["delta"].values[pts]
+    k = np.argmin(np.abs(e - 0.5))
+    column = built["n_stable"].sel(type="1/1", eps=0.5).values > 0
+    first = built["delta"].values[np.argmax(column)]
+    assert abs(e[k] - 0.5) < 0.02 and first - 0.05 < d[k] <= first
+
+
+def test_the_planes_example_draws_fig16_over_its_restitution_plane():
+    """config/examples/planes.yaml: the (eps, delta) study draws fig15_vs_fig16 over the
+    orbits entry of its plane; the plan costs the entry's tiles, join, edges and figure."""
+    config, plan = configuration.load(root=ROOT,
+                                      user_files=[ROOT / "config/examples/planes.yaml"])
+    entry = config["orbits"]["restitution"]
+    assert entry["plane"] == config["studies"]["restitution"]["plane"] == ["eps", "delta"]
+    assert {"name": "fig15_vs_fig16", "orbits": "restitution"} in (
+        config["studies"]["restitution"]["figures"])
+    row = next(r for r in plan.rows if r.key == "orbits.restitution")
+    assert row.orbit_cells == 41 * 201 and row.jobs == 2 + 1 + 1 + 1

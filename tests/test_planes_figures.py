@@ -161,7 +161,8 @@ def test_fig16_over_a_plane_from_orbit_plane(tmp_path):
     assert panels[0].get_xlabel() in ("", r"restitution $\varepsilon$")
     assert any(ax.get_xlabel() == r"restitution $\varepsilon$" for ax in fig.axes)
     assert r"fixed: $\zeta$ = 0.05, $A$ = 1, $1/\beta_f$ = 1.1" in fig.get_suptitle()
-    with pytest.raises(ValueError, match=r"traced over the \(inv_beta, delta\) plane only"):
+    with pytest.raises(ValueError, match=r"traced over \['inv_beta', 'delta'\] but the orbit "
+                                         r"map runs over \['eps', 'delta'\]"):
         plotting.fig16(orbits, boundaries=xr.Dataset())
 
 
@@ -242,3 +243,19 @@ def test_residence_over_another_plane(tmp_path):
     drawn = mesh.get_array().reshape(ds.sizes["delta"], ds.sizes["eps"])
     assert np.allclose(drawn[0], np.linspace(1.0, 50.0, ds.sizes["eps"]))
     assert panels[0].get_xlabel() == r"restitution $\varepsilon$"
+
+
+def test_the_predictors_read_a_plane_by_its_axes(tmp_path):
+    """The report's predictors over an (eps, delta) map and its Fig. 16 (`orbit_plane`): S is
+    read at each map cell's nearest orbit cell by the axes' names (the map stored (y, x))."""
+    from vibroimpact.orbits.plane import orbit_plane
+    from vibroimpact.reports.predictors import _stable_domain, predictor_correlations
+
+    motion_map = _plane_map(tmp_path)
+    orbits = orbit_plane("eps", EPS, "delta", DELTA, {"zeta": 0.05, "inv_beta": 1.1},
+                         types=((1, 1), (2, 1)))
+    stable, S = _stable_domain(motion_map.transpose(..., "eps", "delta"), orbits, None, "1/1")
+    expected = orbits["n_stable"].sel(type="1/1").transpose("eps", "delta").values > 0
+    np.testing.assert_array_equal(stable, expected)
+    rows = predictor_correlations(motion_map, orbits, n_resamples=20)
+    assert any(r.predictor == "S" and np.isfinite(r.rho) for r in rows)

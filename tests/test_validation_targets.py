@@ -19,7 +19,9 @@ from matplotlib.text import Text
 from helpers import assert_figure, make_workdir, scheduled_jobs
 from vibroimpact import plotting
 from vibroimpact.validation import peers
-from vibroimpact.validation.campaign import COUNTS, campaign_dataset
+from vibroimpact.validation.campaign import (CASES, CHUNK_SIZES, COUNTS, ORBIT_CASES, REPLAYS,
+                                             STREAM_SAMPLES, campaign_dataset, run_campaign,
+                                             stress_sample)
 from vibroimpact.validation.families import run_family
 from vibroimpact.validation.orbit_families import run_orbit_family
 from vibroimpact.validation.report import FamilyReport
@@ -27,7 +29,7 @@ from vibroimpact.plotting.validation import place_setting_labels
 from vibroimpact.validation.work_precision import (DT, EPS, RK4_EVENT, RUN_MEASUREMENTS,
                                                    SIMULATOR, TIMING_STATISTIC, ZETA,
                                                    impact_errors, reference_run, split_time,
-                                                   work_precision)
+                                                   stretch_end, work_precision)
 
 TINY = dict(delta=(1.0, 0.0), impacts=6, stretch=20.0, long_samples=3000, seed=19740072,
             rtol=(1e-3, 1e-9), solvers=("RK45", "DOP853", "LSODA"), rk4_steps=(1, 4, 16),
@@ -139,6 +141,35 @@ def test_work_precision_rejects_bad_arguments():
         work_precision(**dict(TINY, long_samples=100))
     with pytest.raises(ValueError, match="solvers"):
         work_precision(**dict(TINY, solvers=("Euler",)))
+    with pytest.raises(ValueError, match="max_stretch"):
+        work_precision(**dict(TINY, max_stretch=10.0))
+
+
+def test_the_compared_stretch_lies_between_stretch_and_max_stretch():
+    """Just past the n-th fast impact, never before `stretch` nor after `max_stretch`."""
+    t = np.array([3.0, 10.0, 40.0, 90.0])
+    u = np.ones(4)
+    assert stretch_end(t, u, 2, 5.0, 10_001) == pytest.approx(1.05 * 10.0 + 2.0, abs=DT)
+    assert stretch_end(t, u, 1, 5.0, 10_001) == pytest.approx(5.2, abs=1e-9)  # 5.15, on the grid
+    assert stretch_end(t, u, 1, 8.0, 10_001) == pytest.approx(8.0, abs=1e-9)  # at least stretch
+    assert stretch_end(t, u, 4, 5.0, 10_001) == pytest.approx(96.5, abs=1e-9)
+    assert stretch_end(t, u, 4, 5.0, 10_001, 60.0) == pytest.approx(60.0, abs=1e-9)
+    assert stretch_end(t, u, 1, 5.0, 10_001, 5.0) == pytest.approx(5.0, abs=1e-9)
+    assert stretch_end(t, u, 4, 5.0, 301) == pytest.approx(30.0, abs=1e-9)  # the record's end
+
+
+def test_a_longest_stretch_compares_fewer_impacts_with_the_same_errors():
+    """Capping the stretch drops the last impacts; the errors over the impacts still compared
+    are those of the uncapped run's first impacts (runs restart at every sample)."""
+    small = dict(TINY, delta=(1.0,), impacts=3, stretch=5.0, long_samples=1000,
+                 rtol=(1e-6,), solvers=("DOP853",), rk4_steps=(2,), repeats=1)
+    full = work_precision(**small)
+    capped = work_precision(**dict(small, max_stretch=35.0))
+    assert float(capped["t_stretch"][0]) == pytest.approx(35.0)
+    assert float(full["t_stretch"][0]) > 35.0
+    assert 1 <= int(capped["n_compared"][0]) < int(full["n_compared"][0])
+    assert capped.attrs["stretch_max"] == 35.0
+    assert np.all(capped["error"].values <= full["error"].values)
 
 
 # --- the fixed-step peer with event location ----------------------------------------------------
@@ -196,6 +227,36 @@ def test_stress_dataset_layout(stress_ds):
     assert "noise=[2 values]" in str(stress_ds["worst_case"].values[2])
     assert "missed an impact" in str(stress_ds["first_failure"].values[2])
     assert stress_ds["first_failure"].values[0] == ""
+
+
+def test_the_campaign_sizes_nest():
+    """Every family at every size; the sample no larger than the quick sample, itself no larger
+    than the full campaign; the sample's record streamed in three chunk sizes (one not a power
+    of two), all but the last shorter than the record."""
+    for small, large in (("sample", "quick"), ("quick", "full")):
+        assert CASES[small].keys() == CASES[large].keys()
+        assert all(1 <= CASES[small][k] <= CASES[large][k] for k in CASES[small])
+        assert 1 <= ORBIT_CASES[small] <= ORBIT_CASES[large]
+        assert STREAM_SAMPLES[small] <= STREAM_SAMPLES[large]
+        assert 1 <= REPLAYS[small] <= REPLAYS[large]
+    chunks = CHUNK_SIZES["sample"]
+    assert len(chunks) >= 3 and any(c & (c - 1) for c in chunks)
+    assert all(c < STREAM_SAMPLES["sample"] for c in chunks[:-1])
+
+
+def test_the_sample_draws_the_first_cases_of_the_quick_sample():
+    """A smaller size runs the first cases of the same seeded sequence: its worst error cannot
+    exceed the larger size's over the same family."""
+    few, more = run_family("release_touch", 3, SEED), run_family("release_touch", 8, SEED)
+    assert few.compared <= more.compared
+    assert few.worst_error <= more.worst_error
+
+
+def test_campaign_sizes_are_checked():
+    with pytest.raises(ValueError, match="size"):
+        run_campaign(SEED, size="huge")
+    with pytest.raises(ValueError, match="size"):
+        stress_sample(SEED, size="full")
 
 
 def test_stress_dataset_survives_netcdf(stress_ds, tmp_path):
@@ -338,3 +399,20 @@ def test_the_validation_targets_are_built(built):
         assert any(ds[v].attrs.get("run_measurement") == 1 for v in ds.variables)
     for rule in ("measure_work_precision", "sample_stress_families"):
         assert (results / "benchmarks" / f"{rule}.tsv").is_file()
+
+
+def test_the_plan_costs_the_validation_runs_from_their_sizes():
+    """The plan's cost of the two runs follows the config: more repeats, a longer timed or
+    compared stretch, more plays cost more; the quick stress sample more than the sample."""
+    from vibroimpact.pipeline.config import costs
+
+    block = dict(delta=[1.0, 0.0, -0.5], impacts=20, stretch=5.0, max_stretch=60.0,
+                 long_samples=20_000, rtol=[1e-3, 1e-6, 1e-9, 1e-12],
+                 solvers=["RK45", "DOP853", "LSODA"], rk4_steps=[1, 2, 4, 8, 16, 32, 64],
+                 repeats=3)
+    base = costs.work_precision_cpu_s(block)
+    for change in (dict(repeats=6), dict(stretch=20.0), dict(max_stretch=200.0, impacts=60),
+                   dict(delta=[1.0, 0.0, -0.5, 2.0]), dict(long_samples=100_000)):
+        assert costs.work_precision_cpu_s(dict(block, **change)) > base, change
+    assert costs.work_precision_cpu_s(dict(block, impacts=1)) < base
+    assert costs.stress_cpu_s({"size": "quick"}) > costs.stress_cpu_s({"size": "sample"})

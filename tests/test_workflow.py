@@ -85,7 +85,9 @@ def _suite_configs():
             "report_with_the_papers_map": REPORT_WITH,
             "paper_true_with_mine": MINE.replace("paper: false", "paper: true"),
             "mine_with_the_papers_validation": MINE + "validation:\n  build: true\n",
-            "degenerate": yaml.safe_dump(DEGENERATE), "sweeps": SWEEPS}
+            "degenerate": yaml.safe_dump(DEGENERATE), "sweeps": SWEEPS,
+            # maps, basins, escape and a trace over planes (issue 36)
+            "planes": (ROOT / "config" / "examples" / "planes.yaml").read_text()}
 
 
 @pytest.mark.parametrize("name", sorted(_suite_configs()))

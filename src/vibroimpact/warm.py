@@ -56,12 +56,15 @@ def _simulator():
 
 def _orbits():
     """Fig. 16 (the closed-form solver over a grid) and its exact domain boundaries."""
-    from vibroimpact.orbits import domain_boundaries, orbit_map
+    from vibroimpact.orbits import domain_boundaries, orbit_map, plane_boundaries
 
     seeds = orbit_map(np.linspace(0.8, 1.4, 4), np.linspace(-0.5, 1.5, 5),
                       types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), zeta=ZETA, eps=EPS)
     domain_boundaries(1, 1, ZETA, EPS, inv_beta=(0.8, 1.4), delta=(-0.5, 1.5),
                       resolution=(4, 5), seed_map=seeds, tol=1e-8)
+    # over another plane: the same kernels, and the plane point read from Python
+    plane_boundaries(1, 1, "eps", (0.4, 0.6), "delta", (-0.5, 1.5),
+                     {"zeta": ZETA, "inv_beta": 1.1}, resolution=(3, 5), tol=1e-8)
 
 
 def _attractors():

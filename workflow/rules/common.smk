@@ -60,7 +60,11 @@ def study_block(kind):
 
     def block(wildcards):
         entry = config["studies"][wildcards.study]
-        return {key: entry[key] for key in JOB_KEYS[kind] if key in entry}
+        # a plane study's job may read more (its fixed values): JOB_KEYS["plane_<kind>"]
+        keys = (
+            JOB_KEYS.get(f"plane_{kind}", JOB_KEYS[kind]) if entry.get("plane") else JOB_KEYS[kind]
+        )
+        return {key: entry[key] for key in keys if key in entry}
 
     return block
 

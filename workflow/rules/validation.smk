@@ -1,5 +1,5 @@
 # The validation targets (docs/figures.md, "Beyond the paper"): the work-precision run of the
-# simulator against its peers, and a seeded quick sample of the stress families; drawing is
+# simulator against its peers, and a seeded sample of the stress families; drawing is
 # cheap and runs locally. The work-precision job compares wall times, so it holds every core
 # of the run (threads = --cores): no other job of the build runs beside it. On SLURM its
 # profile asks for a node to itself (workflow/profiles/slurm).
@@ -29,7 +29,7 @@ rule measure_work_precision:
 
 
 rule sample_stress_families:
-    """A seeded quick sample of the stress families."""
+    """A seeded sample of the stress families (config validation.stress.size)."""
     output:
         "results/validation/stress_sample.nc",
     conda:

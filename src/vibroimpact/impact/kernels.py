@@ -19,7 +19,8 @@ this module gathers what the driver and the tests use:
   double-double phase, ``sincos``, ``expm1`` it rests on);
 - :mod:`~vibroimpact.impact.events`: event location: first contact, release, chatter tails;
 - :mod:`~vibroimpact.impact.stepping`: the loop over force samples (``run_steps``) and one
-  step through its events (``slow_step``).
+  step through its events (``slow_step``; ``slow_step_one`` the one-wall step compiled
+  apart).
 
 Every kernel is compiled with ``njit(cache=True, error_model="numpy")``; the cache is
 stamped with all of those modules (:mod:`vibroimpact.impact._jit`), so an edit of any one of
@@ -32,6 +33,6 @@ from vibroimpact.impact.events import (  # noqa: F401
 from vibroimpact.impact.layout import *  # noqa: F403  (the named slots and codes)
 from vibroimpact.impact.motion import (  # noqa: F401
     expm1, phase, push_eval, seg_eval, segment, sincos, two_prod)
-from vibroimpact.impact.stepping import run_steps, slow_step  # noqa: F401
+from vibroimpact.impact.stepping import run_steps, slow_step, slow_step_one  # noqa: F401
 from vibroimpact.impact.tolerances import *  # noqa: F403  (every threshold)
 

@@ -403,7 +403,8 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
             b = (r_last[1] - r_last[0]) / dt
             if mode in (kernels.WALL, kernels.WALL_LO):
                 mode = kernels.FREE     # x on the wall, v is x' itself
-            x, v, mode, status = kernels.slow_step(
+            step = kernels.slow_step if lower else kernels.slow_step_one   # as run_steps
+            x, v, mode, status = step(
                 n_full, rem, x, v, mode, r_last[0], b, P, buf.imp_step, buf.imp_off, buf.imp_u,
                 buf.stk_step, buf.stk_off, buf.stk_kind, buf.cnt, buf.ftot)
             _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[kernels.FT_DIAGNOSTICS],
@@ -446,7 +447,8 @@ def _pair_sticking(time, kind, stick_open):
     """Sticking intervals and their walls from the kernel's onsets and releases in time
     order (kinds :data:`~vibroimpact.impact.layout.STICK_ON`/``STICK_OFF``, plus ``STICK_LO``
     at the lower wall); ``stick_open`` holds an onset whose release is still to come (its
-    time, or None, and its wall)."""
+    time, or None, and its wall). Returns arrays (float64, float64, int8): no Python float
+    per event (a list of them cost ~1 % of a map cell)."""
     wall = (kind >= kernels.STICK_LO).astype(np.int8)
     onset = (kind - kernels.STICK_LO * wall) == kernels.STICK_ON
     first_open = stick_open[0] is not None
@@ -457,7 +459,8 @@ def _pair_sticking(time, kind, stick_open):
         off = time[~onset]
         stick_open[0] = float(on[-1]) if on.size > off.size else None
         stick_open[1] = int(on_wall[-1]) if on.size > off.size else 0
-        return list(on[:off.size]), list(off), list(on_wall[:off.size])
+        return (on[:off.size].astype(np.float64), off,
+                on_wall[:off.size].astype(np.int8))
     starts, ends, walls = [], [], []
     for t, k, w in zip(time, onset, wall):
         if k:
@@ -467,7 +470,8 @@ def _pair_sticking(time, kind, stick_open):
             ends.append(t)
             walls.append(stick_open[1])
             stick_open[0] = None
-    return starts, ends, walls
+    return (np.asarray(starts, dtype=np.float64), np.asarray(ends, dtype=np.float64),
+            np.asarray(walls, dtype=np.int8))
 
 
 def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final,
@@ -488,9 +492,10 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
     stuck = mode in (kernels.STUCK, kernels.STUCK_LO)
     stuck_since = stick_open[0] if stick_open[0] is not None else math.nan
     if final and stick_open[0] is not None:
-        starts.append(stick_open[0])   # still resting on the wall at the record's end
-        ends.append(t_chunk)
-        walls.append(stick_open[1])
+        # still resting on the wall at the record's end
+        starts = np.append(starts, np.float64(stick_open[0]))
+        ends = np.append(ends, np.float64(t_chunk))
+        walls = np.append(walls, np.int8(stick_open[1]))
         stick_open[0] = None
     n = int(buf.grid_n[0])
     grid_time = ((np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt
@@ -500,8 +505,8 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         impact_velocity=imp_u,
         impact_step=imp_step,
         impact_offset=imp_off,
-        stick_start=np.asarray(starts, dtype=np.float64),
-        stick_end=np.asarray(ends, dtype=np.float64),
+        stick_start=starts,
+        stick_end=ends,
         grid_time=grid_time,
         a=buf.grid[:n].copy(),
         v=buf.grid_v[:n].copy(),
@@ -517,7 +522,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         params=params,
         force_record=noise,
         impact_wall=imp_wall,
-        stick_wall=np.asarray(walls, dtype=np.int8),
+        stick_wall=walls,
         model=model,
     )
 

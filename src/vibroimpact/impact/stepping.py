@@ -218,6 +218,125 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
 
 
 @kernel
+def slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+              stk_kind, cnt, ftot):
+    """:func:`slow_step` for one wall (``P`` of ``N_PARAMS`` slots), compiled apart.
+
+    The same arguments, results and events as :func:`slow_step` with one wall, with the
+    arithmetic of the one-wall simulator before the second wall (cb9f1ee) operation for
+    operation: no view of ``P`` per event, no sign multiplications, no test for a second
+    wall. :func:`run_steps` calls it when ``lower`` is None (measured by
+    benchmarks/ab_kernels.py: the generic step cost 7-13 % per run with impacts). An edit of
+    the one-wall logic in :func:`slow_step` is made here too; tests/test_two_walls.py holds
+    the two bit for bit (the far wall, the mirror) and tests/test_simulate*.py hold this one
+    to the stress families' references.
+    """
+    zeta, eps, delta = P[P_ZETA], P[P_EPS], P[P_DELTA]
+    theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
+    s = 0.0
+    n_events = 0
+    if mode == WALL:
+        # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
+        if P[P_A] != 0.0:
+            v += P[P_AQ] * P[P_BETA] * math.cos(theta_k - P[P_PHI])
+        mode = FREE
+    at_wall = x >= delta
+    if at_wall:
+        x = delta
+    just_hit = False
+    imp0, stk0 = cnt[CNT_IMPACTS], cnt[CNT_STICK_EVENTS]
+    while True:
+        if s >= H:
+            # nothing of the step is left: every path here has set x = delta
+            return delta, v, (STUCK if mode == STUCK else WALL), OK
+        n_events += 1
+        if n_events > STEP_HEADROOM - 2:
+            ftot[FT_OFFSET] = s
+            ftot[FT_GAP] = x - delta
+            ftot[FT_V] = v
+            ftot[FT_MODE] = mode
+            ftot[FT_IMPACTS] = cnt[CNT_IMPACTS] - imp0
+            ftot[FT_STICK_EVENTS] = cnt[CNT_STICK_EVENTS] - stk0
+            return x, v, mode, TOO_MANY_EVENTS
+        c = segment(x, v, s, r0, b, theta_k, P)
+        Hs = H - s
+        if just_hit and v < 0.0 and c[C_F0] > 0.0:
+            # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
+            # the tail is summed in closed form as soon as chatter_tail proves where it ends
+            wv, F, dF = -v, c[C_F0], c[C_DF0]
+            if eps < 1.0:
+                n = cnt[CNT_IMPACTS] - 1    # the impact just recorded, and the one before it
+                prev = ((imp_step[n] - imp_step[n - 1]) * P[P_DT]
+                        + (imp_off[n] - imp_off[n - 1]) if n >= 1 else 0.0)
+                tail = chatter_tail(wv, F, dF, prev, Hs, P)
+                ok = tail >= 0.0
+                F_end = 1.0
+                if not ok:
+                    # no bracket inside the step (a tail across a sample point, eps near 1):
+                    # the first-order estimate once its neglected terms are below round-off
+                    tail = 2.0 * wv / (F * (1.0 - eps))
+                    ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_ESTIMATE_TOL
+                    F_end = (F + dF * tail
+                             - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail)
+            else:
+                tail = 2.0 * wv / F
+                ok = tail <= ELASTIC_MICRO_FLIGHT
+                F_end = F + dF * tail - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail
+            micro = n_events >= MANY_EVENTS and (
+                wv * wv <= 2.0 * F * MICRO_HEIGHT * (1.0 + abs(delta))
+                or 2.0 * wv / F <= MICRO_FLIGHTS_PER_HEADROOM * H / STEP_HEADROOM)
+            if (ok and tail <= Hs and F_end > 0.0) or micro:
+                if not micro:
+                    s = s + tail
+                cnt[CNT_CHATTER] += 1
+                mode = STUCK
+                _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s, STICK_ON)
+                cnt[CNT_STICK_EVENTS] += 1
+                v = 0.0
+                just_hit = False
+                continue
+        just_hit = False
+        if mode == STUCK:
+            sig = release_time(c, P, Hs)
+            if sig < 0.0:
+                ftot[FT_CONTACT_TIME] += Hs
+                return delta, 0.0, STUCK, OK
+            ftot[FT_CONTACT_TIME] += sig
+            s = min(s + sig, H)
+            _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s, STICK_OFF)
+            cnt[CNT_STICK_EVENTS] += 1
+            mode = FREE
+            x = delta
+            v = 0.0
+            at_wall = True
+            continue
+        code, sig, u, gH = first_contact(c, P, Hs, at_wall)
+        if code == NO_ROOT:
+            return gH + delta, u, FREE, OK
+        if code == PRESSED:
+            mode = STUCK
+            s = min(s + sig, H)
+            _record_event(stk_step, stk_off, stk_kind, cnt[CNT_STICK_EVENTS], k, s, STICK_ON)
+            cnt[CNT_STICK_EVENTS] += 1
+            x = delta
+            v = 0.0
+            continue
+        s = min(s + sig, H)
+        x = delta
+        at_wall = True
+        if code == ROOT and u <= TOUCH_ULPS * EPS64 * (abs(b) + abs(P[P_AQ]) * P[P_BETA]
+                                                       + c[C_R] + abs(v)):
+            code = TOUCH          # arrives with zero velocity within round-off: grazing touch
+        if code == TOUCH:
+            v = min(u, 0.0)
+            continue
+        _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, u)
+        cnt[CNT_IMPACTS] += 1
+        v = rebound_velocity(eps, u)      # inlined: rounds as -eps * u
+        just_hit = True
+
+
+@kernel
 def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, stk_off,
               stk_kind, cnt, ftot, grid, grid_v, stride, grid_n, lower=None):
     """Advance the oscillator over the force samples ``r`` from sample ``k_begin`` to ``k_end``.
@@ -400,8 +519,13 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 grid_n[0] -= 1      # sample k is recorded again when the step is resumed
             status, k_stop = BUFFER_FULL, k
             break
-        x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u,
-                                       stk_step, stk_off, stk_kind, cnt, ftot)
+        if lower is None:
+            # one wall: its own step, compiled without any of the second wall's logic
+            x, v, mode, status = slow_step_one(k, h, x, v, mode, r0, b, P, imp_step, imp_off,
+                                               imp_u, stk_step, stk_off, stk_kind, cnt, ftot)
+        else:
+            x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off,
+                                           imp_u, stk_step, stk_off, stk_kind, cnt, ftot)
         if status != OK:
             return status, k
         if has_h:

@@ -10,7 +10,9 @@ stable domains (`boundaries`, kernels in `boundaries_kernels`); thresholds in `t
 """
 from vibroimpact.orbits.api import REASON_CODES, PeriodicOrbit, Reason, orbit_map, periodic_orbits
 from vibroimpact.orbits.boundaries import (BoundaryCurve, CodimTwoPoint, DomainBoundaries,
-                                           domain_boundaries)
+                                           PlaneCurve, PlanePoint, domain_boundaries,
+                                           plane_boundaries)
 
 __all__ = ["periodic_orbits", "PeriodicOrbit", "orbit_map", "Reason", "REASON_CODES",
-           "domain_boundaries", "BoundaryCurve", "CodimTwoPoint", "DomainBoundaries"]
+           "domain_boundaries", "BoundaryCurve", "CodimTwoPoint", "DomainBoundaries",
+           "plane_boundaries", "PlaneCurve", "PlanePoint"]

@@ -1,4 +1,6 @@
-"""Exact boundaries of the stable (m/n) domains of Fig. 16 over the ``(1/beta, delta)`` plane.
+"""Exact boundaries of the stable (m/n) domains of Fig. 16 over the ``(1/beta, delta)`` plane
+(``domain_boundaries``) or any plane of the harmonic-force problem (``plane_boundaries``: the
+two parameter unknowns below are then the plane's, e.g. ``(eps, delta)``).
 
 ``domain_boundaries`` replaces the pixel edges of ``orbit_map`` by curves traced by
 pseudo-arclength continuation on the augmented system: the 2m orbit equations (paper eqs.
@@ -61,7 +63,8 @@ from vibroimpact._limits import MAX_M
 from vibroimpact.orbits import boundaries_kernels as bk
 from vibroimpact.orbits.api import _raw_solutions, orbit_map
 
-__all__ = ["domain_boundaries", "BoundaryCurve", "CodimTwoPoint", "DomainBoundaries", "KINDS"]
+__all__ = ["domain_boundaries", "plane_boundaries", "BoundaryCurve", "CodimTwoPoint",
+           "DomainBoundaries", "PlaneCurve", "PlanePoint", "KINDS"]
 
 #: The kinds of boundary, in the order of the kernels' test-function codes.
 KINDS = ("fold", "period_doubling", "grazing", "existence")
@@ -182,12 +185,16 @@ def _test_code(i, m):
 
 
 class _Tracer:
-    """Seeds, continuation and filtering for one (m/n) type."""
+    """Seeds, continuation and filtering for one (m/n) type, over the plane whose parameters
+    ``prm`` and axis slots ``ax`` describe (`boundaries_kernels.plane_point`): the last two
+    unknowns of a point ``x`` are its plane coordinates (Fig. 16's: 1/beta, delta)."""
 
-    def __init__(self, m, n, zeta, eps, box):
-        self.m, self.n, self.zeta, self.eps = m, n, zeta, eps
+    def __init__(self, m, n, prm, ax, box):
+        self.m, self.n = m, n
+        self.prm = np.ascontiguousarray(prm, dtype=float)
+        self.ax = np.ascontiguousarray(ax, dtype=np.int64)
         self.nn = 2 * m
-        self.box = box                  # (ib_lo, ib_hi, d_lo, d_hi)
+        self.box = box                  # (x_lo, x_hi, y_lo, y_hi)
         diag = math.hypot(box[1] - box[0], box[3] - box[2])
         self.hmax = MAX_STEP_OF_DIAGONAL * diag
         self.hmin = MIN_STEP_OF_DIAGONAL * diag
@@ -200,15 +207,20 @@ class _Tracer:
         self.hint = -1.0        # grazing curves: time of the followed maximum in its flight
 
     # --- kernels' wrappers ---------------------------------------------------------------
+    def point(self, p):
+        """``(beta, delta, zeta, eps)`` of the unit-force problem at the plane point ``p``."""
+        return bk.plane_point(np.asarray(p, dtype=float), 0, self.prm, self.ax)
+
     def tests(self, x):
         out = np.empty(2 + 3 * self.m)
-        bk.all_tests(x[:self.nn], self.m, self.n, 1.0 / x[-2], x[-1], self.zeta, self.eps,
-                     self.stack, self.tmat, out)
+        beta, delta, zeta, eps = self.point(x[-2:])
+        bk.all_tests(x[:self.nn], self.m, self.n, beta, delta, zeta, eps, self.stack,
+                     self.tmat, out)
         return out
 
     def peak(self, code, j, x, hint=None):
         hint = self.hint if hint is None else hint
-        return bk.peak_of(code, j, hint, x, self.m, self.n, self.zeta, self.eps)
+        return bk.peak_of(code, j, hint, x, self.m, self.n, self.prm, self.ax)
 
     def side_tests(self, x, code, j, own):
         """Every test function; the own entry is the other maxima of the own flight (margin
@@ -226,13 +238,13 @@ class _Tracer:
     def newton(self, x, code, j, mode=0, code2=0, j2=0, tvec=None, xref=None, idx=0, val=0.0,
                hint2=-1.0):
         x = np.array(x, dtype=float)
-        it, _ = bk.newton_aug(x, self.m, self.n, self.zeta, self.eps, code, j, self.hint, mode,
+        it, _ = bk.newton_aug(x, self.m, self.n, self.prm, self.ax, code, j, self.hint, mode,
                               code2, j2, hint2, self.dummy if tvec is None else tvec,
                               self.dummy if xref is None else xref, idx, val)
         return (x, it) if it >= 0 else (None, it)
 
     def tangent(self, x, code, j):
-        bk.aug_system(x, self.m, self.n, self.zeta, self.eps, code, j, self.hint, self.fvec,
+        bk.aug_system(x, self.m, self.n, self.prm, self.ax, code, j, self.hint, self.fvec,
                       self.jac)
         t = np.linalg.svd(self.jac)[2][-1]
         return t / np.linalg.norm(t)
@@ -240,7 +252,7 @@ class _Tracer:
     def error_of(self, x, code, j, hint):
         """Distance of ``x`` to the exact curve in the (1/beta, delta) plane: the parameter
         part of the minimum-norm Newton correction ``J^+ F`` (the conditioning included)."""
-        bk.aug_system(x, self.m, self.n, self.zeta, self.eps, code, j, hint, self.fvec,
+        bk.aug_system(x, self.m, self.n, self.prm, self.ax, code, j, hint, self.fvec,
                       self.jac)
         dx = np.linalg.lstsq(self.jac, -self.fvec, rcond=None)[0]
         return float(np.hypot(dx[-2], dx[-1]))
@@ -255,7 +267,7 @@ class _Tracer:
         neighbour ``pu``: each stable orbit at ``ps`` is followed along the segment until a
         test function vanishes (or the branch ends at a fold), then solved for exactly."""
         found = []
-        rows = _raw_solutions(self.m, self.n, 1.0 / ps[0], ps[1], self.zeta, self.eps)
+        rows = _raw_solutions(self.m, self.n, *self.point(ps))
         fix = self.nn if ps[0] == pu[0] else self.nn + 1
         for y in rows:
             x = np.concatenate((y, ps))
@@ -268,7 +280,7 @@ class _Tracer:
 
     def _at(self, x, p):
         y = x[:self.nn].copy()
-        if not bk.follow_orbit(y, self.m, self.n, 1.0 / p[0], p[1], self.zeta, self.eps):
+        if not bk.follow_orbit(y, self.m, self.n, *self.point(p)):
             return None
         return np.concatenate((y, p))
 
@@ -459,9 +471,9 @@ class _Tracer:
     def other_stable(self, x):
         """A stable admissible (m/n) orbit other than ``x``'s at its point, or None."""
         m, nn = self.m, self.nn
-        beta = 1.0 / x[-2]
+        beta, delta, zeta, eps = self.point(x[-2:])
         tf = 2.0 * math.pi / beta
-        rows = _raw_solutions(m, self.n, beta, x[-1], self.zeta, self.eps)
+        rows = _raw_solutions(m, self.n, beta, delta, zeta, eps)
         ph0 = np.sort(np.mod(x[:m], tf))
         u0 = np.sort(x[m:nn])
         uscale = 1.0 + np.max(np.abs(u0))
@@ -642,8 +654,19 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
     stable, ib_grid, d_grid = _seed_stable(seed_map, m, n, inv_beta, delta, (nb, nd), zeta,
                                            eps)
     box = (inv_beta[0], inv_beta[1], delta[0], delta[1])
-    tr = _Tracer(m, n, zeta, eps, box)
-    segs = [(ps, pu) for ps, pu in _seed_segments(stable, ib_grid, d_grid)
+    prm = np.array([zeta, eps, 0.0, 0.0, 1.0])
+    ax = np.array([bk.PRM_INV_BETA, bk.PRM_DELTA])
+    return _trace(m, n, prm, ax, box, stable, ib_grid, d_grid, tol)
+
+
+def _trace(m, n, prm, ax, box, stable, x_grid, y_grid, tol):
+    """The boundary curves of the (m/n) stable domain over the plane (``prm``, ``ax``: see
+    `_Tracer`), seeded by the pixel edges of ``stable`` over ``(x_grid, y_grid)``, cut at
+    ``box``. Coordinates ``x`` and ``y`` are in the fields ``inv_beta`` and ``delta`` of the
+    `BoundaryCurve` and `CodimTwoPoint` objects (Fig. 16's plane; `plane_boundaries` renames
+    them)."""
+    tr = _Tracer(m, n, prm, ax, box)
+    segs = [(ps, pu) for ps, pu in _seed_segments(stable, x_grid, y_grid)
             if tr.inside(ps) and tr.inside(pu)]    # a seed map may be larger than the box
     seg_arr = np.array(segs).reshape(-1, 2, 2)
     covered = np.zeros(len(segs), dtype=bool)
@@ -734,3 +757,154 @@ def _dedupe(points):
                    for o in out):
             out.append(p)
     return out
+
+
+#: Slots of the plane's parameters in the kernels' parameter vector.
+_SLOTS = {"zeta": bk.PRM_ZETA, "eps": bk.PRM_EPS, "inv_beta": bk.PRM_INV_BETA,
+          "delta": bk.PRM_DELTA, "amplitude": bk.PRM_AMPLITUDE}
+
+
+@dataclass(frozen=True, eq=False)
+class PlaneCurve:
+    """One boundary curve of the stable (m/n) domain over a plane (`plane_boundaries`).
+
+    As `BoundaryCurve`, with the points' coordinates ``x``, ``y`` along the plane's
+    ``axes`` (x first). ``orbits`` are those of the unit-force problem: with an amplitude
+    A != 1 the velocities are over A (the orbit at A is A times the one at delta / A).
+    """
+
+    kind: str
+    m: int
+    n: int
+    x: np.ndarray
+    y: np.ndarray
+    orbits: np.ndarray = field(repr=False)
+    error: np.ndarray = field(repr=False)
+    ends: tuple = ("box", "box")
+    axes: tuple = ("inv_beta", "delta")
+
+    def __len__(self):
+        return int(self.x.size)
+
+
+@dataclass(frozen=True)
+class PlanePoint:
+    """A codimension-two point (`CodimTwoPoint`) over a plane: coordinates ``x``, ``y``."""
+
+    x: float
+    y: float
+    kinds: tuple
+    m: int
+    n: int
+    other_orbit: bool = False
+    axes: tuple = ("inv_beta", "delta")
+
+
+def _plane_range(name, value):
+    lo, hi = _range(name, value)
+    if name == "eps" and not lo > 0.0:
+        raise ValueError(f"the eps range must be > 0 for the boundaries, got {(lo, hi)} (with "
+                         f"eps = 0 every flight starts at rest on the wall, where its maximum "
+                         f"is degenerate; not supported)")
+    for v in (lo, hi):
+        _plane_check_value(name, v)
+    return lo, hi
+
+
+def _plane_check_value(name, value):
+    from vibroimpact.orbits.plane import _check_value
+
+    return _check_value(name, value)
+
+
+def plane_boundaries(m, n, x_name, x_range, y_name, y_range, fixed, *, resolution=(41, 201),
+                     seed_map=None, tol=1e-10):
+    """Exact boundary curves of the stable (m/n) domain over any plane of the harmonic-force
+    problem with one wall (Fig. 16 over that plane; `domain_boundaries` over (1/beta, delta)).
+
+    Parameters
+    ----------
+    m, n : int
+        Motion type (m <= 3).
+    x_name, y_name : str
+        The plane's axes, two of ``zeta``, ``eps``, ``delta``, ``inv_beta``, ``amplitude``
+        (`vibroimpact.orbits.plane.orbit_plane`'s; a second wall or the noise's rms raises).
+    x_range, y_range : (lo, hi)
+        The box; curves are cut at its edges. An eps range must be > 0 (as `domain_boundaries`
+        refuses eps = 0).
+    fixed : dict
+        Every other parameter, as `orbit_plane` takes it (``amplitude`` default 1).
+    resolution : (nx, ny)
+        Grid of the seed map when ``seed_map`` is not given (`orbit_plane` over the box).
+    seed_map : xarray.Dataset, optional
+        An `orbit_plane` result over this plane holding the (m/n) type; its pixel edges
+        (``n_stable > 0`` against ``== 0``) seed the curves.
+    tol : float
+        As `domain_boundaries`.
+
+    Returns
+    -------
+    DomainBoundaries
+        A list of `PlaneCurve` (``x``, ``y`` along ``axes``) with ``codimension_two``, a list
+        of `PlanePoint`.
+
+    Notes
+    -----
+    The continuation of `domain_boundaries` with its two parameter unknowns the plane's: the
+    kernels read the unit-force problem at each point (``beta``, ``delta / A``, ``zeta``,
+    ``eps``; the amplitude scales out, `vibroimpact.orbits.plane`). Over ``(inv_beta,
+    delta)`` with A = 1 the result is `domain_boundaries`' bit for bit. Step lengths and
+    tolerances are in the plane's own units (its box's diagonal), as there.
+    """
+    from vibroimpact.orbits.plane import HARMONIC_PARAMETERS, check_plane
+
+    m = _checks.integer("m", m, low=1)
+    n = _checks.integer("n", n, low=1)
+    if m > MAX_M:
+        raise ValueError(f"m must be at most {MAX_M}, got {m}")
+    if "gap" in (x_name, y_name) or (isinstance(fixed, dict) and "gap" in fixed):
+        raise ValueError("the boundaries continue the one-wall closed-form (m/n) solutions: "
+                         "a plane with a second wall (gap) has none; its edges are the map's "
+                         "cell edges")
+    x_range = _plane_range(x_name, x_range) if x_name in HARMONIC_PARAMETERS else x_range
+    y_range = _plane_range(y_name, y_range) if y_name in HARMONIC_PARAMETERS else y_range
+    fixed = check_plane(x_name, list(x_range), y_name, list(y_range), fixed, [(m, n)])[2]
+    if "eps" in fixed and not fixed["eps"] > 0.0:
+        raise ValueError(f"eps must be > 0 for the boundaries, got {fixed['eps']} (with eps = 0 "
+                         f"every flight starts at rest on the wall; not supported)")
+    try:
+        nx, ny = (int(r) for r in resolution)
+    except (TypeError, ValueError):
+        raise ValueError(f"resolution must be a pair of integers, got {resolution!r}") from None
+    if nx < 2 or ny < 2:
+        raise ValueError(f"resolution must be at least (2, 2), got {resolution!r}")
+    tol = _checks.real("tol", tol, low=0.0, low_open=True)
+    label = f"{m}/{n}"
+    if seed_map is None:
+        from vibroimpact.orbits.plane import orbit_plane
+
+        seed_map = orbit_plane(x_name, np.linspace(*x_range, nx), y_name,
+                               np.linspace(*y_range, ny), fixed, types=[(m, n)])
+    try:
+        types = [str(t) for t in seed_map["type"].values]
+        x_grid = np.asarray(seed_map[x_name].values, dtype=float)
+        y_grid = np.asarray(seed_map[y_name].values, dtype=float)
+    except (KeyError, TypeError, AttributeError) as exc:
+        raise ValueError(f"seed_map must be an orbit_plane dataset over ({x_name}, {y_name}) "
+                         f"({exc!r})") from None
+    if label not in types:
+        raise ValueError(f"seed_map has no ({label}) type (types {types})")
+    stable = (seed_map["n_stable"].sel(type=label).transpose(x_name, y_name).values > 0)
+    prm = np.zeros(5)
+    for name, slot in _SLOTS.items():
+        if name in fixed:
+            prm[slot] = fixed[name]
+    ax = np.array([_SLOTS[x_name], _SLOTS[y_name]])
+    box = (x_range[0], x_range[1], y_range[0], y_range[1])
+    found = _trace(m, n, prm, ax, box, stable, x_grid, y_grid, tol)
+    axes = (x_name, y_name)
+    curves = [PlaneCurve(kind=c.kind, m=c.m, n=c.n, x=c.inv_beta, y=c.delta, orbits=c.orbits,
+                         error=c.error, ends=c.ends, axes=axes) for c in found]
+    points = [PlanePoint(p.inv_beta, p.delta, p.kinds, p.m, p.n, p.other_orbit, axes)
+              for p in found.codimension_two]
+    return DomainBoundaries(curves, points)

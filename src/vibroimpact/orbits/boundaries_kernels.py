@@ -1,5 +1,12 @@
 """Kernels of the stable-domain boundaries (Fig. 16): the test functions of an orbit and Newton
-on the augmented system in ``X = (tau_0..tau_{m-1}, u_0..u_{m-1}, 1/beta, delta)``.
+on the augmented system in ``X = (tau_0..tau_{m-1}, u_0..u_{m-1}, p, q)``, ``(p, q)`` the
+plane's two parameters (Fig. 16's: ``(1/beta, delta)``).
+
+The plane: ``prm`` holds every parameter ``(zeta, eps, 1/beta, delta, A)`` (`PRM_*` slots) and
+``ax`` the slots of ``p`` and ``q``; `plane_point` reads ``(beta, delta / A, zeta, eps)`` of the
+unit-force problem at ``X`` (the amplitude scales out: docs in `vibroimpact.orbits.plane`).
+Over ``(1/beta, delta)`` with ``A = 1`` that is ``(1 / X[2m], X[2m+1], zeta, eps)``, the
+arithmetic the kernels did before they knew of planes, bit for bit.
 
 The stable admissible (m/n) orbits are those where every test function is positive:
 
@@ -38,6 +45,53 @@ from vibroimpact.orbits.tolerances import (BOUNDARY_FD_REL, BOUNDARY_NEWTON_MAXI
 #: Test-function codes (``cond_value``); the index ``j`` picks the impact / flight.
 #: COND_OTHER_PEAK (flight j): the highest maximum of the flight other than the one followed.
 COND_FOLD, COND_PD, COND_U, COND_MARGIN, COND_Z, COND_OTHER_PEAK = 0, 1, 2, 3, 4, 5
+#: Slots of the parameter vector ``prm`` (`plane_point`).
+PRM_ZETA, PRM_EPS, PRM_INV_BETA, PRM_DELTA, PRM_AMPLITUDE = 0, 1, 2, 3, 4
+
+
+@kernel
+def plane_point(x, nn, prm, ax):
+    """``(beta, delta, zeta, eps)`` of the unit-force problem at ``x``: ``prm`` with its slots
+    ``ax[0]``, ``ax[1]`` taken from ``x[nn]``, ``x[nn + 1]``; delta is the play over the
+    amplitude. ``beta`` is 0 and the rest NaN-free but meaningless when the point is not a
+    problem (`plane_valid`)."""
+    zeta = prm[PRM_ZETA]
+    eps = prm[PRM_EPS]
+    inv_beta = prm[PRM_INV_BETA]
+    delta = prm[PRM_DELTA]
+    amp = prm[PRM_AMPLITUDE]
+    for k in range(2):
+        v = x[nn + k]
+        slot = ax[k]
+        if slot == PRM_ZETA:
+            zeta = v
+        elif slot == PRM_EPS:
+            eps = v
+        elif slot == PRM_INV_BETA:
+            inv_beta = v
+        elif slot == PRM_DELTA:
+            delta = v
+        else:
+            amp = v
+    return 1.0 / inv_beta, delta / amp, zeta, eps
+
+
+@kernel
+def plane_valid(x, nn, prm, ax):
+    """Whether ``x``'s parameters are a problem: 1/beta > 0, A > 0, 0 < zeta < 1, eps >= 0."""
+    for k in range(2):
+        v = x[nn + k]
+        slot = ax[k]
+        if slot == PRM_ZETA:
+            if not (0.0 < v < 1.0):
+                return False
+        elif slot == PRM_EPS:
+            if not (v >= 0.0):
+                return False
+        elif slot == PRM_INV_BETA or slot == PRM_AMPLITUDE:
+            if not (v > 0.0):
+                return False
+    return True
 
 
 @kernel
@@ -187,12 +241,11 @@ def flight_peak(tau_a, u_a, s_end, beta, delta, zeta, eps, hint, skip):
 
 
 @kernel
-def peak_of(code, j, hint, x, m, n, zeta, eps):
+def peak_of(code, j, hint, x, m, n, prm, ax):
     """``(margin, place)`` of the maximum that test ``code`` (COND_MARGIN or COND_OTHER_PEAK)
-    picks on flight ``j`` with ``hint``, at ``x = (y, 1/beta, delta)``."""
+    picks on flight ``j`` with ``hint``, at ``x = (y, p, q)``."""
     nn = 2 * m
-    beta = 1.0 / x[nn]
-    delta = x[nn + 1]
+    beta, delta, zeta, eps = plane_point(x, nn, prm, ax)
     z = 2.0 * pi * n / beta
     b = (j + 1) % m
     tb = x[b] + (z if j == m - 1 else 0.0)
@@ -219,23 +272,23 @@ def all_tests(y, m, n, beta, delta, zeta, eps, stack, tmat, out):
 
 
 @kernel
-def _cond_x(code, j, hint, x, m, n, zeta, eps, stack, tmat):
+def _cond_x(code, j, hint, x, m, n, prm, ax, stack, tmat):
     nn = 2 * m
-    return cond_value(code, j, x[:nn], m, n, 1.0 / x[nn], x[nn + 1], zeta, eps, stack, tmat,
-                      True, hint)
+    beta, delta, zeta, eps = plane_point(x, nn, prm, ax)
+    return cond_value(code, j, x[:nn], m, n, beta, delta, zeta, eps, stack, tmat, True, hint)
 
 
 @kernel
-def _orbit_rows(x, m, n, zeta, eps, res, jy):
+def _orbit_rows(x, m, n, prm, ax, res, jy):
     nn = 2 * m
-    beta = 1.0 / x[nn]
+    beta, delta, zeta, eps = plane_point(x, nn, prm, ax)
     wd, q, phi = harmonic_constants(beta, zeta)
     z = 2.0 * pi * n / beta
-    _residual_jacobian(x[:nn], m, z, beta, x[nn + 1], zeta, eps, wd, q, phi, res, jy)
+    _residual_jacobian(x[:nn], m, z, beta, delta, zeta, eps, wd, q, phi, res, jy)
 
 
 @kernel
-def _cond_row(code, j, hint, x, m, n, zeta, eps, stack, tmat, xs, row):
+def _cond_row(code, j, hint, x, m, n, prm, ax, stack, tmat, xs, row):
     """Central-difference gradient of a test function in X into ``row``; returns its value."""
     na = 2 * m + 2
     for c in range(na):
@@ -243,16 +296,16 @@ def _cond_row(code, j, hint, x, m, n, zeta, eps, stack, tmat, xs, row):
     for c in range(na):
         h = BOUNDARY_FD_REL * (1.0 + abs(x[c]))
         xs[c] = x[c] + h
-        fp = _cond_x(code, j, hint, xs, m, n, zeta, eps, stack, tmat)
+        fp = _cond_x(code, j, hint, xs, m, n, prm, ax, stack, tmat)
         xs[c] = x[c] - h
-        fm = _cond_x(code, j, hint, xs, m, n, zeta, eps, stack, tmat)
+        fm = _cond_x(code, j, hint, xs, m, n, prm, ax, stack, tmat)
         xs[c] = x[c]
         row[c] = (fp - fm) / (2.0 * h)
-    return _cond_x(code, j, hint, x, m, n, zeta, eps, stack, tmat)
+    return _cond_x(code, j, hint, x, m, n, prm, ax, stack, tmat)
 
 
 @kernel
-def aug_system(x, m, n, zeta, eps, code, j, hint, fvec, jac):
+def aug_system(x, m, n, prm, ax, code, j, hint, fvec, jac):
     """The 2m orbit equations and test function ``code`` (rows of ``fvec``) at ``x``, with the
     (2m + 1) x (2m + 2) Jacobian ``jac`` (analytic in y, central differences elsewhere)."""
     nn = 2 * m
@@ -265,7 +318,7 @@ def aug_system(x, m, n, zeta, eps, code, j, hint, fvec, jac):
     xs = np.empty(na)
     stack = np.empty((64, 2))
     tmat = np.empty((2, 2))
-    _orbit_rows(x, m, n, zeta, eps, res, jy)
+    _orbit_rows(x, m, n, prm, ax, res, jy)
     for i in range(nn):
         fvec[i] = res[i]
         for c in range(nn):
@@ -275,16 +328,16 @@ def aug_system(x, m, n, zeta, eps, code, j, hint, fvec, jac):
             xs[k] = x[k]
         h = BOUNDARY_FD_REL * (1.0 + abs(x[c]))
         xs[c] = x[c] + h
-        _orbit_rows(xs, m, n, zeta, eps, res_p, jtmp)
+        _orbit_rows(xs, m, n, prm, ax, res_p, jtmp)
         xs[c] = x[c] - h
-        _orbit_rows(xs, m, n, zeta, eps, res_m, jtmp)
+        _orbit_rows(xs, m, n, prm, ax, res_m, jtmp)
         for i in range(nn):
             jac[i, c] = (res_p[i] - res_m[i]) / (2.0 * h)
-    fvec[nn] = _cond_row(code, j, hint, x, m, n, zeta, eps, stack, tmat, xs, jac[nn])
+    fvec[nn] = _cond_row(code, j, hint, x, m, n, prm, ax, stack, tmat, xs, jac[nn])
 
 
 @kernel
-def newton_aug(x, m, n, zeta, eps, code, j, hint, mode, code2, j2, hint2, tvec, xref, idx,
+def newton_aug(x, m, n, prm, ax, code, j, hint, mode, code2, j2, hint2, tvec, xref, idx,
                val):
     """Newton in place on ``x`` for the orbit equations, test ``code`` = 0, and a last equation:
 
@@ -309,9 +362,9 @@ def newton_aug(x, m, n, zeta, eps, code, j, hint, mode, code2, j2, hint2, tvec, 
     tmat = np.empty((2, 2))
     prev = np.inf
     for it in range(BOUNDARY_NEWTON_MAXIT):
-        if not (x[nn] > 0.0):
+        if not plane_valid(x, nn, prm, ax):
             return -1, np.inf
-        aug_system(x, m, n, zeta, eps, code, j, hint, fvec, jac)
+        aug_system(x, m, n, prm, ax, code, j, hint, fvec, jac)
         for i in range(nn + 1):
             for c in range(na):
                 a[i, c] = jac[i, c]
@@ -328,7 +381,7 @@ def newton_aug(x, m, n, zeta, eps, code, j, hint, mode, code2, j2, hint2, tvec, 
             a[nn + 1, idx] = 1.0
             rhs[nn + 1] = -(x[idx] - val)
         else:
-            g = _cond_row(code2, j2, hint2, x, m, n, zeta, eps, stack, tmat, xs, row2)
+            g = _cond_row(code2, j2, hint2, x, m, n, prm, ax, stack, tmat, xs, row2)
             for c in range(na):
                 a[nn + 1, c] = row2[c]
             rhs[nn + 1] = -g

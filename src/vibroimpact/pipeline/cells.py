@@ -384,17 +384,19 @@ class _EventRecord:
     def collisions(self, eps, floor, transient, rule="physical"):
         """Collisions of the record so far that begin at or after ``transient``, grouped by
         ``rule`` (:data:`vibroimpact.stats.RULES`)."""
+        from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
         pressed = self.pressed() if rule == "physical" else None
         if not self.walls:
             start, end = self.sticking()
-            return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
+            return tally.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
                                           end, dt=self.dt, eps=eps, floor=floor,
-                                          pressed=pressed, rule=rule).after(transient)
+                                          pressed=pressed, rule=rule, after=transient)
         start, end, wall = self.sticking()
-        return stats.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
+        return tally.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
                                       rule=rule, wall=self.wall[0], stick_wall=wall,
-                                      eps_lower=self.walls["eps_lower"]).after(transient)
+                                      eps_lower=self.walls["eps_lower"], after=transient)
 
 
 class _IdentityRecord:
@@ -614,6 +616,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     ValueError
         If the record is shorter than ``transient`` plus the cap.
     """
+    from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
     walls = _walls(gap, eps_lower, eps)
@@ -632,7 +636,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             k += chunk.n_steps
             n_checks += 1
             col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-            res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
+            res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
                                           window=window, motions=motions, n_batches=n_batches,
                                           stuck=col.stuck, **wall_of(col))
             worst = float(max(res.stderr.max(), res.stick_stderr.max()))
@@ -651,7 +655,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     by_rule = [res] + [
-        stats.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
+        tally.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
                                 motions=motions, n_batches=n_batches, stuck=c.stuck,
                                 **wall_of(c))
         for c in (events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient, rule=rule)
@@ -726,6 +730,8 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
     (``target_stderr = 0.5``, ``min_switches = 1``) stops at the same sample and returns the
     same residence times, bit for bit (``tests/test_escape.py``).
     """
+    from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
     n_end = escape_samples(transient, record_length, dt) - 1
     if n_end > len(noise) - 1:
         raise ValueError(f"record_length = {record_length!r} after the transient "
@@ -739,7 +745,7 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         events.add(chunk)
         k += chunk.n_steps
     col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-    res = stats.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
+    res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
                                   window=window, motions=motions, stuck=col.stuck,
                                   **({} if not walls else
                                      dict(walls=events.collision_walls(col))))

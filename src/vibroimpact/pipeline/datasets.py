@@ -3,6 +3,8 @@
 The layouts are documented in ``docs/datasets.md``; every variable carries ``long_name``
 and ``units`` (plots take their labels from them).
 """
+import json
+
 import numpy as np
 import pandas as pd
 import xarray as xr
@@ -515,9 +517,10 @@ def orbit_map_dataset(result, attrs):
     return ds
 
 
-def concat_orbit_tiles(tiles):
-    """Join orbit-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
-    return xr.concat(tiles, dim="inv_beta").sortby("inv_beta")
+def concat_orbit_tiles(tiles, dim="inv_beta"):
+    """Join orbit-map tiles (disjoint sets of ``dim`` rows: ``inv_beta``, or the tiled axis
+    of a plane) into one dataset sorted along ``dim``."""
+    return xr.concat(tiles, dim=dim).sortby(dim)
 
 
 def orbit_map_result(ds):
@@ -548,25 +551,31 @@ BOUNDARY_META = {
 }
 
 
-def boundaries_dataset(curves_by_type, attrs):
+def boundaries_dataset(curves_by_type, attrs, axes=("inv_beta", "delta")):
     """Dataset of the boundary curves of :func:`vibroimpact.orbits.domain_boundaries`, one
-    call per type: ``curves_by_type`` is ``{(m, n): result}``.
+    call per type: ``curves_by_type`` is ``{(m, n): result}``; or of
+    :func:`vibroimpact.orbits.boundaries.plane_boundaries` over the plane ``axes`` (its
+    curves' ``x``, ``y``).
 
-    Dimensions ``point`` (every curve's points, curve after curve), ``curve`` and ``codim2``.
+    Dimensions ``point`` (every curve's points, curve after curve), ``curve`` and ``codim2``;
+    the points' coordinates are named after the axes (``inv_beta``, ``delta``; over a plane
+    ``eps``, ``delta`` ..., and ``codim2_<axis>``).
     """
-    inv_beta, delta, index, kinds, types, ends = [], [], [], [], [], []
-    c_ib, c_d, c_type, c_kinds = [], [], [], []
+    x_name, y_name = axes
+    default = tuple(axes) == ("inv_beta", "delta")
+    xs, ys, index, kinds, types, ends = [], [], [], [], [], []
+    c_x, c_y, c_type, c_kinds = [], [], [], []
     for (m, n), result in curves_by_type.items():
         for curve in result:
-            inv_beta.append(np.asarray(curve.inv_beta, dtype=float))
-            delta.append(np.asarray(curve.delta, dtype=float))
-            index.append(np.full(inv_beta[-1].size, len(kinds), dtype=np.int32))
+            xs.append(np.asarray(curve.inv_beta if default else curve.x, dtype=float))
+            ys.append(np.asarray(curve.delta if default else curve.y, dtype=float))
+            index.append(np.full(xs[-1].size, len(kinds), dtype=np.int32))
             kinds.append(str(curve.kind))
             types.append(f"{m}/{n}")
             ends.append("+".join(str(e) for e in getattr(curve, "ends", ())))
         for point in result.codimension_two:
-            c_ib.append(float(point.inv_beta))
-            c_d.append(float(point.delta))
+            c_x.append(float(point.inv_beta if default else point.x))
+            c_y.append(float(point.delta if default else point.y))
             c_type.append(f"{m}/{n}")
             c_kinds.append("+".join(sorted(point.kinds)))
 
@@ -574,17 +583,25 @@ def boundaries_dataset(curves_by_type, attrs):
         return np.concatenate(parts).astype(dtype) if parts else np.zeros(0, dtype)
 
     ds = xr.Dataset(
-        {"inv_beta": ("point", cat(inv_beta, float)), "delta": ("point", cat(delta, float)),
+        {x_name: ("point", cat(xs, float)), y_name: ("point", cat(ys, float)),
          "curve": ("point", cat(index, np.int32)),
          "kind": ("curve", np.array(kinds, dtype=str)),
          "type": ("curve", np.array(types, dtype=str)),
          "ends": ("curve", np.array(ends, dtype=str)),
-         "codim2_inv_beta": ("codim2", np.array(c_ib, dtype=float)),
-         "codim2_delta": ("codim2", np.array(c_d, dtype=float)),
+         f"codim2_{x_name}": ("codim2", np.array(c_x, dtype=float)),
+         f"codim2_{y_name}": ("codim2", np.array(c_y, dtype=float)),
          "codim2_type": ("codim2", np.array(c_type, dtype=str)),
          "codim2_kinds": ("codim2", np.array(c_kinds, dtype=str))},
         attrs=dict(attrs))
-    for name, (long_name, units) in BOUNDARY_META.items():
+    meta = dict(BOUNDARY_META)
+    if not default:
+        for name in ("inv_beta", "delta", "codim2_inv_beta", "codim2_delta"):
+            del meta[name]
+        for name in axes:
+            meta[name] = (f"{name} of a point on a boundary curve", "1")
+            meta[f"codim2_{name}"] = (f"{name} of a codimension-two point (two kinds meet)",
+                                      "1")
+    for name, (long_name, units) in meta.items():
         ds[name].attrs.update(long_name=long_name, units=units)
     return ds
 
@@ -624,10 +641,10 @@ def attractor_tile_dataset(result, attrs):
     ``(inv_beta, delta)``: what the basins and Lyapunov datasets are cut from."""
     motions = list(result["motions"])
     types = motions[:-1]
-    coords = dict(motion=motions, type=types, inv_beta=result["inv_beta"],
-                  delta=result["delta"], start=np.arange(result["lyapunov_start"].shape[0]),
+    plane = tuple(result.get("axes", ("inv_beta", "delta")))
+    coords = dict(motion=motions, type=types, **{k: result[k] for k in plane},
+                  start=np.arange(result["lyapunov_start"].shape[0]),
                   **{"class": list(ATTRACTOR_CLASSES)})
-    plane = ("inv_beta", "delta")
     data = {name: (("motion", *plane), result[name])
             for name in ("fraction", "fraction_lo", "fraction_hi", "count")}
     data["n_stable"] = (("type", *plane), result["n_stable"])
@@ -640,13 +657,21 @@ def attractor_tile_dataset(result, attrs):
     for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
         data[name] = (("start", *plane), result[name])
     data["class_start"] = (("start", *plane), result["class_start"].astype(np.int8))
-    return xr.Dataset(data, coords=coords, attrs=dict(attrs))
+    ds = xr.Dataset(data, coords=coords, attrs=dict(attrs))
+    if "axes" in result:        # a named plane (attractors.plane.attractor_plane)
+        ds.attrs.update(axes=list(plane), fixed=json.dumps(result["fixed"], sort_keys=True),
+                        **{k: float(v) for k, v in result["fixed"].items()})
+        for name in plane:
+            ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
+    return ds
 
 
 def concat_attractor_tiles(tiles):
-    """Join attractor-map tiles (disjoint sets of ``inv_beta`` rows) into one sorted dataset."""
-    return xr.concat(tiles, dim="inv_beta", data_vars="minimal", coords="minimal",
-                     compat="override").sortby("inv_beta")
+    """Join attractor-map tiles (disjoint sets of rows of the plane's first axis,
+    ``inv_beta`` on the paper's plane) into one sorted dataset."""
+    dim = tiles[0]["lyapunov"].dims[0]
+    return xr.concat(tiles, dim=dim, data_vars="minimal", coords="minimal",
+                     compat="override").sortby(dim)
 
 
 def _described(ds):
@@ -725,10 +750,11 @@ _ESCAPE_STATES = ("residence_time", "residence_time_stderr", "n_stretches", "n_c
                   "probability")
 
 
-def escape_part(index, rms, cells, results, motions, attrs):
+def escape_part(index, rms, cells, results, motions, attrs, axes=("inv_beta", "delta")):
     """Dataset of one escape job (one noise level, every cell) along ``rms`` (length 1).
 
-    ``cells`` are ``(inv_beta, delta)`` pairs, ``results`` their
+    ``cells`` are ``(inv_beta, delta)`` pairs (a plane study's: pairs of its ``axes``, each a
+    coordinate along ``cell`` named after its parameter), ``results`` their
     :func:`vibroimpact.pipeline.cells.escape_cell` dicts.
     """
     data = {name: (("rms", "cell", "state"), np.stack([r[name] for r in results])[None])
@@ -737,9 +763,16 @@ def escape_part(index, rms, cells, results, motions, attrs):
         data[name] = (("rms", "cell"), np.array([[r[name] for r in results]]))
     data["spawn_key"] = ("rms", np.array([int(index)]))
     pairs = np.asarray(cells, dtype=float).reshape(-1, 2)
-    coords = dict(rms=[float(rms)], cell=np.arange(len(results)), state=_motion_names(motions)
-                  + ["none"], inv_beta=("cell", pairs[:, 0]), delta=("cell", pairs[:, 1]))
-    return _escape_described(_annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
+    x, y = axes
+    coords = {"rms": [float(rms)], "cell": np.arange(len(results)),
+              "state": _motion_names(motions) + ["none"], x: ("cell", pairs[:, 0]),
+              y: ("cell", pairs[:, 1])}
+    ds = _escape_described(_annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
+    if tuple(axes) != ("inv_beta", "delta"):      # a plane's cells: named in its words
+        for name in axes:
+            ds[name].attrs.update(long_name=f"{PLANE_META[name][0]} of the cell",
+                                  units=PLANE_META[name][1])
+    return ds
 
 
 def aggregate_escape(parts, attrs, min_stretches, fit_max_rms=None):

@@ -13,6 +13,9 @@ value of its entry's grid of that parameter (:func:`per_values`). ``harmonic`` f
 draws the map over the ``orbits`` entry given as ``{name: fig15_vs_fig16, orbits: harmonic}``).
 
 ``needs`` names the block of an ``orbits`` entry a figure draws from (``attractors``).
+``also`` gives a figure drawn from an entry of another kind too: ``{kind: {reads, needs,
+shows}}`` (the basins and Lyapunov maps of a study with a ``plane`` and an ``attractors``
+block); :func:`figure_spec` resolves a figure for an entry's kind.
 
 ``draw`` names the function that draws the figure, ``"module:function"`` with the module
 under `vibroimpact.plotting` (``"random:fig07"``), resolved by :func:`drawing_function` when
@@ -23,7 +26,7 @@ import re
 
 from vibroimpact.pipeline.study import grid_values
 
-__all__ = ["FIGURES", "VALIDATION_FIGURES", "drawing_function", "figure_targets",
+__all__ = ["FIGURES", "VALIDATION_FIGURES", "figure_spec", "drawing_function", "figure_targets",
            "figure_variant", "figure_options", "figure_item", "figure_sources", "paper_target",
            "caption", "rest_text", "per_values"]
 
@@ -101,11 +104,21 @@ FIGURES = {
                         "period-doubling and existence curves"),
     "basins": dict(draw="attractors:basins",
                    owner="orbits", reads=("basins", "orbits"), needs="attractors",
+                   also={"study": dict(
+                       reads=("plane_basins",), needs="attractors",
+                       shows="the share of starting states that settle on each stable (m/n) "
+                             "motion under A sin(beta_f tau) alone (its basin of attraction), "
+                             "over the study's plane, cell for cell with its map")},
                    shows="the share of starting states that settle on each stable (m/n) "
                          "motion under sin(beta_f tau) alone (its basin of attraction), over "
                          "the (1/beta_f, delta) plane of Fig. 15"),
     "lyapunov": dict(draw="attractors:lyapunov",
                      owner="orbits", reads=("lyapunov",), needs="attractors",
+                     also={"study": dict(
+                         reads=("plane_lyapunov",), needs="attractors",
+                         shows="the largest Lyapunov exponent under A sin(beta_f tau) alone "
+                               "and what each cell's starts settle on, over the study's "
+                               "plane")},
                      shows="the largest Lyapunov exponent under sin(beta_f tau) alone and what "
                            "each cell's starts settle on: a listed periodic motion, another "
                            "periodic motion, sticking, chaos"),
@@ -123,6 +136,17 @@ VALIDATION_FIGURES = {
     "work_precision": dict(draw="validation:work_precision"),
     "stress": dict(draw="validation:stress"),
 }
+
+
+def figure_spec(name, kind):
+    """The figure table's entry of figure ``name`` drawn from a ``kind`` entry (``"study"``
+    or ``"orbits"``): its own, or its ``also[kind]`` over it; None when that kind does not
+    draw it."""
+    spec = FIGURES[name]
+    if spec["owner"] == kind:
+        return spec
+    other = spec.get("also", {}).get(kind)
+    return None if other is None else dict(spec, owner=kind, **other)
 
 
 def drawing_function(name):
@@ -270,12 +294,20 @@ def caption(kind, name, entry, target):
     """
     fig, _ = figure_variant(target)
     number = fig[3:5].lstrip("0") if fig.startswith("fig") else fig
-    what = FIGURES[fig]["shows"]
+    what = (figure_spec(fig, kind) or FIGURES[fig])["shows"]
+    plane = entry.get("plane")
+    if plane:
+        what = what.replace("the (1/beta_f, delta) plane", f"the ({plane[0]}, {plane[1]}) "
+                            f"plane").replace("over the (1/beta_f, delta) plane of Fig. 15",
+                                              f"over the ({plane[0]}, {plane[1]}) plane")
     title = {"fig15_vs_fig16": "Fig. 15 against Fig. 16", "basins": "Basins of attraction",
              "lyapunov": "Lyapunov exponents",
              "residence": "Residence times",
              "escape_vs_noise": "Escape against noise level"}.get(fig, f"Fig. {number}")
     parts = [f"{key} = {_values_text(entry[key])}" for key in _PHYSICS_KEYS if key in entry]
+    if kind == "study" and entry.get("plane"):
+        parts.insert(0, f"over the plane ({entry['plane'][0]}, {entry['plane'][1]}), every "
+                        f"other parameter fixed")
     if kind == "study":
         if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:
             parts.append(f"1/beta_f = {_values_text(entry['inv_beta'])}")
@@ -284,6 +316,13 @@ def caption(kind, name, entry, target):
         if options:
             parts.append("drawn with " + ", ".join(f"{key} = {_values_text(value)}"
                                                    for key, value in options.items()))
+    elif plane:
+        parts = [f"{key} = {_values_text(entry[key])}"
+                 for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta",
+                             "delta") if entry.get(key) is not None]
+        if "amplitude" not in entry:
+            parts.append("amplitude = 1")
+        parts.append("types " + ", ".join(_type_text(t) for t in entry.get("types", [])))
     else:
         parts += [f"1/beta_f = {_values_text(entry['inv_beta'])}",
                   f"delta = {_values_text(entry['delta'])}",

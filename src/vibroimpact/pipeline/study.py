@@ -51,13 +51,25 @@ JOB_KEYS = {
     # job as a param of their own (common.smk, ``escape_noise``)
     "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
                "motions", "escape") + _WALLS,
+    # a plane study's trace is at its cell [x, y] (and the rms axis's value scales the record)
+    "plane_trace": _PHYSICS + ("trace", "plane", "delta", "rms"),
+    # a plane study's escape cells are [x, y] in its plane: the fixed values of the others
+    "plane_escape": ("noise", "zeta", "eps", "amplitude", "inv_beta", "delta", "plane",
+                     "transient", "sweep", "motion_window", "motions", "escape") + _WALLS,
+    # a plane study's basins and Lyapunov exponents: the harmonic force alone (no noise, no
+    # record), over the study's plane
+    "attractors": ("zeta", "eps", "amplitude", "inv_beta", "delta", "tile_size", "plane",
+                   "attractors") + _WALLS,
 }
 
 #: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns
 #: only figures): the map's tiles, the boundary curves seeded from the map, the attractors.
 ORBIT_JOB_KEYS = {
-    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows") + _WALLS,
-    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types") + _WALLS,
+    # ``plane`` and ``amplitude``: absent from an entry over (inv_beta, delta), so its jobs'
+    # params are those they always were
+    "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows", "plane",
+               "amplitude") + _WALLS,
+    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types", "plane", "amplitude") + _WALLS,
     "attractors": ("zeta", "eps", "types", "attractors") + _WALLS,
 }
 
@@ -359,10 +371,27 @@ def noise_record(entry):
     return n, dt, (n - 1) * dt
 
 
+def orbit_tiled_axis(entry):
+    """The axis an ``orbits`` entry's tiles split: ``inv_beta`` without a plane; with one,
+    its axis other than ``delta`` (the cells along delta are one branch followed, which a
+    tile must not cut: `vibroimpact.orbits.plane.orbit_plane`), else its x axis."""
+    plane = entry.get("plane")
+    if not plane:
+        return "inv_beta"
+    return plane[1] if plane[0] == "delta" else plane[0]
+
+
 def orbit_rows(entry):
-    """The ``inv_beta`` values of an ``orbits`` entry and its number of tiles (row groups)."""
-    rows = grid_values(entry["inv_beta"])
+    """The values of an ``orbits`` entry's tiled axis (`orbit_tiled_axis`: ``inv_beta``
+    without a plane) and its number of tiles (row groups)."""
+    rows = grid_values(entry[orbit_tiled_axis(entry)])
     return rows, -(-rows.size // int(entry["tile_rows"]))
+
+
+def orbit_plane_cells(entry):
+    """Cells of an ``orbits`` entry's map (the product of its two axes' sizes)."""
+    plane = entry.get("plane") or ("inv_beta", "delta")
+    return grid_size(entry[plane[0]]) * grid_size(entry[plane[1]])
 
 
 def attractor_rows(entry):
@@ -371,6 +400,14 @@ def attractor_rows(entry):
     block = entry["attractors"]
     rows = grid_values(block["inv_beta"])
     return rows, -(-rows.size // int(block["tile_rows"]))
+
+
+def plane_attractor_rows(entry):
+    """The x values of a plane study's attractor map (its plane's first axis) and its number
+    of tiles (``attractors.tile_rows`` x values a tile, strided over the tiles)."""
+    x = study_plane(entry)[0]
+    rows = grid_values(entry[x])
+    return rows, -(-rows.size // int(entry["attractors"]["tile_rows"]))
 
 
 def map_cap_steps(n_samples, dt, transient, max_periods, beta_f, where="max_periods"):

@@ -31,6 +31,9 @@ DATASETS = {
     "boundaries": "results/orbits/{name}_boundaries.nc",
     "basins": "results/orbits/{name}_basins.nc",
     "lyapunov": "results/orbits/{name}_lyapunov.nc",
+    # a plane study's (attractors block): the harmonic force alone over its plane
+    "plane_basins": "results/datasets/{name}_basins.nc",
+    "plane_lyapunov": "results/datasets/{name}_lyapunov.nc",
 }
 
 #: Each validation figure and the dataset it draws.
@@ -58,11 +61,12 @@ def figure_inputs(config, owner, fig):
     table `~vibroimpact.pipeline.figures.FIGURES`."""
     kind, name, entry = _owner(config, owner)
     base, _ = figures.figure_variant(fig)
-    if figures.FIGURES.get(base, {}).get("owner") != kind:
+    spec = figures.figure_spec(base, kind) if base in figures.FIGURES else None
+    if spec is None:
         raise ValueError(f"{owner}: no figure {base!r} for a {kind} entry")
     names = dict(figures.figure_sources(entry, base), name=name, noise=entry.get("noise"))
     return [DATASETS[d].format(name=names.get(d, name), noise=names["noise"])
-            for d in figures.FIGURES[base]["reads"]]
+            for d in spec["reads"]]
 
 
 def paper_figure_source(config, paper_fig):
@@ -83,7 +87,7 @@ def study_datasets(config, name):
     out = {}
     for fig in sorted(set(figure_names(entry))):
         names = dict(figures.figure_sources(entry, fig), name=name, noise=entry.get("noise"))
-        for kind in figures.FIGURES[fig]["reads"]:
+        for kind in figures.figure_spec(fig, "study")["reads"]:
             out.setdefault(kind, DATASETS[kind].format(name=names.get(kind, name),
                                                        noise=names["noise"]))
     return out

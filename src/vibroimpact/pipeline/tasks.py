@@ -18,6 +18,7 @@ from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
                                         grid_size, grid_values, map_cap_steps, orbit_rows,
+                                        orbit_tiled_axis, plane_attractor_rows,
                                         walls)
 
 log = logging.getLogger("vibroimpact")
@@ -285,6 +286,8 @@ def trace(name, block, noise_path, out):
     """Rule ``simulate_trace``: a short sampled record from rest (Figs. 3, 10)."""
     from vibroimpact.pipeline import cells    # the simulator: only the jobs that simulate load it
 
+    if block.get("plane") is not None:
+        return _plane_trace(name, block, noise_path, out, cells)
     study = Study.from_config(name, block)
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = block["trace"]
@@ -297,12 +300,48 @@ def trace(name, block, noise_path, out):
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
 
 
+def _plane_trace(name, block, noise_path, out, cells):
+    """A plane study's trace: at ``trace.cell`` [x, y] of its plane, every other parameter
+    fixed; with the rms an axis, the unit-rms record times the cell's rms (as its map)."""
+    samples, dt, noise_attrs = io.read_noise(noise_path)
+    spec = block["trace"]
+    plane = list(block["plane"])
+    p = dict(_plane_fixed(block), **{k: float(v) for k, v in zip(plane, spec["cell"])})
+    if "rms" in p:
+        samples = samples * p.pop("rms")
+    if "gap" in p and p.get("eps_lower") is None:
+        p["eps_lower"] = p["eps"]
+    beta_f = 1.0 / p.pop("inv_beta")
+    tr = cells.trace(samples, dt, **p, beta_f=beta_f, t_end=float(spec["t_end"]))
+    fixed = _plane_fixed(block)
+    if "rms" not in plane and noise_attrs.get("noise_rms") is not None:
+        fixed["rms"] = float(noise_attrs["noise_rms"])
+    noise = {k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}
+    attrs = dict(provenance(block, int(noise_attrs["seed"])), study=name, noise=block["noise"],
+                 dt=float(noise_attrs["dt"]), **noise, **p, beta_f=beta_f,
+                 t_end=float(spec["t_end"]), axes=plane, cell=[float(v) for v in spec["cell"]],
+                 fixed=json.dumps(fixed, sort_keys=True))
+    if "gap" in p:
+        attrs.update({k: v for k, v in _wall_attrs(p["gap"], p["eps_lower"]).items()})
+    io.write_dataset(datasets.trace_dataset(tr, attrs), out)
+
+
 def _escape_attrs(name, block, noise):
     """Global attributes of the escape datasets: the study's system, the noise entry's
     spectrum (its rms is the levels' coordinate) and seed, the record."""
     spec = {f"noise_{k}": noise[k] for k in _NOISE_FIELDS
             if k != "rms" and noise.get(k) is not None}
     escape = block["escape"]
+    if block.get("plane") is not None:      # a plane's cells: [x, y], the rest fixed
+        fixed = _plane_fixed(block)
+        return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])),
+                    study=name, noise=block["noise"], dt=float(noise["dt"]), **spec,
+                    **fixed, axes=list(block["plane"]),
+                    fixed=json.dumps(fixed, sort_keys=True),
+                    transient=float(block["transient"]),
+                    record_length=float(escape["record_length"]),
+                    motion_window=float(block["motion_window"]),
+                    seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
     return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])), study=name,
                 zeta=float(block["zeta"]), eps=float(block["eps"]),
                 amplitude=float(block["amplitude"]), noise=block["noise"],
@@ -311,6 +350,40 @@ def _escape_attrs(name, block, noise):
                 record_length=float(escape["record_length"]),
                 motion_window=float(block["motion_window"]),
                 seeds="record k: SeedSequence(seed, spawn_key=(k,)), k = spawn_key")
+
+
+#: The model's parameters a plane study's escape cell is run with (its two axes from the
+#: cell, the others fixed).
+_ESCAPE_PARAMETERS = ("zeta", "eps", "amplitude", "inv_beta", "delta", "gap", "eps_lower")
+
+
+def _plane_fixed(block):
+    """``{parameter: value}`` of a plane study's fixed model parameters (not its axes; the
+    second wall's only with one; an eps_lower not given is not fixed: it follows eps)."""
+    plane = block["plane"]
+    return {k: float(block[k]) for k in _ESCAPE_PARAMETERS
+            if k not in plane and block.get(k) is not None}
+
+
+def escape_cells(block):
+    """``[{zeta, eps, amplitude, beta_f, delta[, gap, eps_lower]}]``: the model of each
+    escape cell of a study: ``[inv_beta, delta]``, or in a plane study ``[x, y]`` in the
+    plane's coordinates with every other parameter fixed."""
+    plane = block.get("plane") or ("inv_beta", "delta")
+    fixed = _plane_fixed(block) if block.get("plane") is not None else {
+        k: float(block[k]) for k in ("zeta", "eps", "amplitude")}
+    if block.get("plane") is None:
+        gap, eps_lower = walls(block, f"studies.{block.get('name', '')}".rstrip("."))
+        if gap is not None:
+            fixed.update(gap=gap, eps_lower=eps_lower)
+    out = []
+    for cell in block["escape"]["cells"]:
+        p = dict(fixed, **{k: float(v) for k, v in zip(plane, cell)})
+        if "gap" in p and p.get("eps_lower") is None:
+            p["eps_lower"] = p["eps"]
+        p["beta_f"] = 1.0 / p.pop("inv_beta")
+        out.append(p)
+    return out
 
 
 def escape_level(name, block, noise, index, out):
@@ -332,19 +405,17 @@ def escape_level(name, block, noise, index, out):
     log.info("level %d: rms %g, %d samples of %s", index, rms, n, spec)
     samples = generate_array(spec, n, escape_seed(noise["seed"], index))
     motions = [tuple(int(k) for k in m) for m in block["motions"]]
-    gap, eps_lower = walls(block, f"studies.{name}")
-    second = {} if gap is None else dict(gap=gap, eps_lower=eps_lower)
     progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]))
     results = []
-    for inv_beta, delta in escape["cells"]:
+    for p in escape_cells(block):
         results.append(cells.escape_cell(
-            samples, spec.dt, zeta=float(block["zeta"]), eps=float(block["eps"]),
-            delta=float(delta), beta_f=1.0 / float(inv_beta),
-            amplitude=float(block["amplitude"]), transient=transient, record_length=length,
-            motions=motions, window=float(block["motion_window"]), **second))
+            samples, spec.dt, **p, transient=transient, record_length=length,
+            motions=motions, window=float(block["motion_window"])))
         progress.cell_done(results[-1])
     io.write_dataset(datasets.escape_part(index, rms, escape["cells"], results, motions,
-                                          _escape_attrs(name, block, noise)), out)
+                                          _escape_attrs(name, block, noise),
+                                          axes=block.get("plane") or ("inv_beta", "delta")),
+                     out)
 
 
 def aggregate_escape(name, block, noise, parts, out):
@@ -418,6 +489,11 @@ def orbit_tile(entry, tile, out, threads=None):
 
     if threads is not None:
         numba.set_num_threads(int(threads))
+    if entry.get("plane"):
+        from vibroimpact.orbits.plane import orbit_plane
+
+        io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
+        return
     rows, n_tiles = orbit_rows(entry)
     result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
                        types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
@@ -432,6 +508,11 @@ def clearance_orbit_tile(entry, tile, out):
     ``orbits`` entry on some 1/beta rows (`pipeline.cells.two_wall_orbit_map`: the shooting
     solver, seeded by the simulator; a rule of its own, so that the one-wall orbit tiles'
     code reaches no simulator)."""
+    if entry.get("plane"):
+        from vibroimpact.attractors.plane import orbit_plane
+
+        io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
+        return
     from vibroimpact.pipeline.cells import two_wall_orbit_map
 
     rows, n_tiles = orbit_rows(entry)
@@ -444,9 +525,38 @@ def clearance_orbit_tile(entry, tile, out):
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
 
+#: The parameters of an ``orbits`` entry with a plane that its map holds fixed when given.
+ORBIT_PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta")
+
+
+def orbit_plane_fixed(entry):
+    """``{parameter: value}`` an ``orbits`` entry with a plane holds fixed (its amplitude 1
+    when not given)."""
+    fixed = {k: float(entry[k]) for k in ORBIT_PLANE_PARAMETERS
+             if k not in entry["plane"] and entry.get(k) is not None}
+    if "amplitude" not in entry["plane"]:
+        fixed.setdefault("amplitude", 1.0)
+    return fixed
+
+
+def _plane_tile(entry, tile, orbit_plane):
+    """One tile of an ``orbits`` entry with a plane: `orbit_plane` over its share of the
+    tiled axis (`orbit_tiled_axis`, values strided over tiles) by the whole other axis."""
+    x_name, y_name = entry["plane"]
+    rows, n_tiles = orbit_rows(entry)
+    values = {k: grid_values(entry[k]) for k in (x_name, y_name)}
+    values[orbit_tiled_axis(entry)] = rows[tile::n_tiles]
+    ds = orbit_plane(x_name, values[x_name], y_name, values[y_name], orbit_plane_fixed(entry),
+                     types=[tuple(int(k) for k in t) for t in entry["types"]])
+    ds.attrs.update(provenance(entry), reason_codes="0 stable, 1 no solution, 2 inadmissible, "
+                                                    "3 unstable")
+    return ds
+
+
 def aggregate_orbits(entry, tiles, out):
     """Rule ``aggregate_orbits``: the orbit map of one entry from its tiles."""
-    ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles])
+    ds = datasets.concat_orbit_tiles([io.load_dataset(p) for p in tiles],
+                                     dim=orbit_tiled_axis(entry))
     ds.attrs.update(provenance(entry))
     io.write_dataset(ds, out)
 
@@ -460,6 +570,8 @@ BOUNDARY_TOL = 1e-9
 def boundaries(entry, orbits_path, out, threads=None):
     """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
     the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
+    if entry.get("plane"):
+        return plane_boundaries(entry, orbits_path, out, threads)
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                  traced=1)
     if entry.get("gap") is not None:
@@ -495,6 +607,43 @@ def boundaries(entry, orbits_path, out, threads=None):
             log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
                         "there (the dataset's `ends` says which curves)", m, n, lost)
     io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
+
+
+def plane_boundaries(entry, orbits_path, out, threads=None):
+    """`boundaries` of an ``orbits`` entry with a plane: `plane_boundaries` of every type over
+    the map's box, seeded from the map; a two-wall entry, or one whose eps reaches 0, is
+    written untraced (``traced = 0``, ``not_traced`` says why), as over (1/beta, delta)."""
+    fixed = orbit_plane_fixed(entry)
+    axes = tuple(entry["plane"])
+    attrs = dict(provenance(entry), **fixed, axes=list(axes),
+                 fixed=json.dumps(fixed, sort_keys=True), traced=1)
+    seeds = io.load_dataset(orbits_path)
+    box = {k: (float(seeds[k].min()), float(seeds[k].max())) for k in axes}
+    why = None
+    if entry.get("gap") is not None or "gap" in axes:
+        why = "two walls: the edges are the map's cell edges"
+    elif fixed.get("eps", 1.0) == 0.0 or ("eps" in axes and box["eps"][0] <= 0.0):
+        why = "eps = 0 in the plane: the edges are the map's cell edges"
+    if why is not None:
+        attrs.update(traced=0, not_traced=why)
+        io.write_dataset(datasets.boundaries_dataset({}, attrs, axes), out)
+        return
+    import numba
+
+    from vibroimpact.orbits.boundaries import plane_boundaries as trace
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    curves = {}
+    for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
+        curves[(m, n)] = trace(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
+                               seed_map=seeds, tol=BOUNDARY_TOL)
+        log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
+        lost = sum(c.ends.count("lost") for c in curves[(m, n)])
+        if lost:
+            log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
+                        "there (the dataset's `ends` says which curves)", m, n, lost)
+    io.write_dataset(datasets.boundaries_dataset(curves, attrs, axes), out)
 
 
 def _attractor_attrs(entry):
@@ -535,3 +684,36 @@ def aggregate_attractors(entry, tiles, out_basins, out_lyapunov):
     joined.attrs.update(provenance(entry))
     io.write_dataset(datasets.basins_dataset(joined), out_basins)
     io.write_dataset(datasets.lyapunov_dataset(joined), out_lyapunov)
+
+
+def plane_attractor_tile(name, entry, tile, out, threads=None):
+    """Rule ``solve_plane_attractor_tile``: basins and Lyapunov exponents under the harmonic
+    force alone on some values of the first axis of study ``name``'s plane (strided over the
+    tiles), every value of its second (`vibroimpact.attractors.plane.attractor_plane`)."""
+    import numba
+
+    from vibroimpact.attractors.plane import attractor_plane
+
+    if threads is not None:
+        numba.set_num_threads(int(threads))
+    study = Study.from_config(name, entry)
+    x, y = study.plane
+    rows, n_tiles = plane_attractor_rows(entry)
+    block = entry["attractors"]
+    gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
+    attrs = dict(study=name, n_starts=int(block["n_starts"]),
+                 max_time=float(block["max_time"]), seed=int(block["seed"]), gap=list(gap),
+                 velocity=list(vel),
+                 box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
+                     f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
+    result = attractor_plane(x, rows[tile::n_tiles], y, study.axes[y], study.fixed(),
+                             types=[tuple(int(k) for k in t) for t in block["types"]],
+                             n_starts=attrs["n_starts"], gap=gap, velocity=vel,
+                             max_time=attrs["max_time"], seed=attrs["seed"])
+    io.write_dataset(datasets.attractor_tile_dataset(result, dict(provenance(entry), **attrs)),
+                     out)
+
+
+def aggregate_plane_attractors(entry, tiles, out_basins, out_lyapunov):
+    """Rule ``aggregate_plane_attractors``: a plane study's basins and Lyapunov datasets."""
+    aggregate_attractors(entry, tiles, out_basins, out_lyapunov)

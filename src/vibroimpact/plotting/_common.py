@@ -18,7 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from vibroimpact._files import atomic_path
-from vibroimpact._symbols import PARAMETERS, fixed_caption
+from vibroimpact._symbols import PARAMETERS, fixed_caption, parameter_symbol
 from vibroimpact.stats.events import poisson_interval, t_quantile
 from vibroimpact.stats.spectra import line_power
 from vibroimpact.stats.theory import upcrossing_rate
@@ -533,6 +533,16 @@ def _trace_figure(trace, title, harmonic):
     beta_f = trace.attrs.get("beta_f")
     params = (f"{_system_text(trace)}, $\\delta$ = {_num(_attr(trace, 'delta'))};  "
               f"{_forcing_text(trace, beta_f=beta_f)}")
+    if "axes" in trace.attrs and "cell" in trace.attrs:     # a plane study's point
+        axes = trace.attrs["axes"]
+        if isinstance(axes, (bytes, str)):
+            text = axes.decode() if isinstance(axes, bytes) else axes
+            axes = _decoded(text, "axes") if text.lstrip().startswith("[") else text.split()
+        axes = [str(a) for a in np.atleast_1d(axes)]
+        point = ", ".join(f"{parameter_symbol(k)} = {_num(v)}"
+                          for k, v in zip(axes, np.atleast_1d(trace.attrs["cell"])))
+        params += (f"\nat the point {point} of the study's "
+                   f"({', '.join(parameter_symbol(k) for k in axes)}) plane")
     _header(fig, title, params)
     return fig
 

@@ -18,7 +18,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
 from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
-                                          axis_label)
+                                          axis_label, custom_plane, plane_axes, plane_caption)
 from vibroimpact.plotting.maps import cell_edges, cell_outline, cell_rectangles, label_contours
 
 #: The basin fraction (%) is filled in bands of `BASIN_BAND` and its labelled lines drawn
@@ -82,22 +82,34 @@ OWNER_MARKER = dict(marker="D", ms=2.2, mec="k", mew=0.3, ls="none")
 
 
 def _grid(ds):
-    return ds["inv_beta"].values, ds["delta"].values
+    """Cell centres along the map's two axes (`plane_axes`: the paper's (1/beta_f, delta),
+    or the plane a dataset names)."""
+    x, y = plane_axes(ds)
+    return ds[x].values, ds[y].values
+
+
+def _params_text(ds):
+    """The header's system and force: the paper's plane's words, or on a named plane what it
+    holds fixed (`plane_caption`) and the force ``A sin(beta_f tau)``."""
+    if not custom_plane(ds):
+        return f"{_system_text(ds)};  " + r"$f(\tau) = \sin(\beta_f\tau)$"
+    return f"{plane_caption(ds)};  " + r"$f(\tau) = A\sin(\beta_f\tau)$ alone"
 
 
 def _finish_axes(axes, ds, bottom):
     """Cell-edge limits, labels on the outer panels, x labels on the `bottom` panels."""
     x, y = _grid(ds)
+    x_name, y_name = plane_axes(ds)
     xe, ye = cell_edges(x), cell_edges(y)
     for ax in axes:
         ax.set_xlim(xe[0], xe[-1])
         ax.set_ylim(ye[0], ye[-1])
-        ax.set_xlabel(axis_label(ds["inv_beta"]))
-        ax.set_ylabel(axis_label(ds["delta"]))
+        ax.set_xlabel(axis_label(ds[x_name]))
+        ax.set_ylabel(axis_label(ds[y_name]))
         ax.label_outer()
     for ax in bottom:
         ax.xaxis.set_tick_params(labelbottom=True)
-        ax.set_xlabel(axis_label(ds["inv_beta"]))
+        ax.set_xlabel(axis_label(ds[x_name]))
 
 
 def _smoothed(p):
@@ -130,7 +142,7 @@ def _composition_text(ds):
     """What the starts that settle on none of the listed types do, over the whole map."""
     if "class_fraction" not in ds:
         return None
-    share = ds["class_fraction"].mean(("inv_beta", "delta"))
+    share = ds["class_fraction"].mean(plane_axes(ds))
     parts = [f"{CLASSES.get(str(c), (None, str(c)))[1]}: {_pct(float(share.sel({'class': c})))}"
              for c in ds["class"].values if str(c) != "listed"]
     return "other, of all starts over the map:  " + ";  ".join(parts)
@@ -265,8 +277,7 @@ def basins(basins, orbits=None):
     fig.legend(handles=handles, loc="outside lower center", ncols=2, fontsize=7,
                title=_composition_text(basins), title_fontsize=7)
     _header(fig, "Basins of attraction of the periodic impact motions",
-            f"{_system_text(basins)};  " + r"$f(\tau) = \sin(\beta_f\tau)$" + "\n"
-            + _starts_text(basins))
+            f"{_params_text(basins)}\n{_starts_text(basins)}")
     return fig
 
 
@@ -452,6 +463,6 @@ def lyapunov(lyapunov):
     n = lyapunov.attrs.get("n_starts")
     starts = "" if n is None else f";  {int(n)} starts per cell, the largest exponent of them"
     _header(fig, "Largest Lyapunov exponent and the motion the starts settle to",
-            f"{_system_text(lyapunov)};  " + r"$f(\tau) = \sin(\beta_f\tau)$" + starts)
+            f"{_params_text(lyapunov)}{starts}")
     return fig
 

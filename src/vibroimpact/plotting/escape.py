@@ -14,8 +14,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
-from vibroimpact.plotting._common import (CONFIDENCE, _attr, _header, _num, _spectrum_parts,
-                                          _styled, _system_text, motion_title,
+from vibroimpact._symbols import fixed_caption, parameter_symbol
+from vibroimpact.plotting._common import (CONFIDENCE, _attr, _decoded, _header, _num,
+                                          _spectrum_parts, _styled, _system_text, motion_title,
                                           note_on_axes)
 from vibroimpact.plotting.maps import TYPE_COLORS
 from vibroimpact.stats.events import t_quantile
@@ -151,8 +152,7 @@ def escape_vs_noise(escape):
             ax.legend(loc="upper left", fontsize=6.5, title_fontsize=6.5,
                       title=r"fit $\ln T = \ln C + \Delta/\mathrm{rms}_r^2$:  $\Delta$ "
                       f"[{int(100 * CONFIDENCE)} % interval]" + r", $\chi^2$ per d.o.f. $\nu$")
-        ax.set_title(rf"$1/\beta_f$ = {_num(cell['inv_beta'])}, $\delta$ = "
-                     rf"{_num(cell['delta'])}: {_state_label(states[home])} "
+        ax.set_title(f"{_cell_text(escape, cell)}: {_state_label(states[home])} "
                      rf"{100 * share[home]:.0f} % at rms {_num(escape['rms'].values[weakest])}")
         ax.set_xlim(x_line[0], x_line[-1])
         ax.set_xlabel(r"$1/\mathrm{rms}_r^2$")
@@ -173,9 +173,13 @@ def escape_vs_noise(escape):
                              **{k: v for k, v in OUTSIDE_FIT_STYLE.items() if k == "color"}))
     fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=7)
     noise = ", ".join(_spectrum_parts(escape.attrs))
+    system, force = ((f"{_system_text(escape)};  ", r"$\sin(\beta_f\tau) + r(\tau)$")
+                     if _cell_axes(escape) == ("inv_beta", "delta") else
+                     (f"fixed: {fixed_caption(_decoded(escape.attrs['fixed'], 'fixed'))};  ",
+                      r"$A\sin(\beta_f\tau) + r(\tau)$"))
     _header(fig, "Escape from the impact motions against the noise level",
-            f"{_system_text(escape)};  "
-            rf"$f(\tau)$ = $\sin(\beta_f\tau) + r(\tau)$ ({noise});  "
+            f"{system}"
+            rf"$f(\tau)$ = {force} ({noise});  "
             f"each cell from rest on one record per rms, "
             f"{float(_attr(escape, 'record_length')):,.0f} time units after the transient "
             f"{_num(_attr(escape, 'transient'))} "
@@ -184,6 +188,22 @@ def escape_vs_noise(escape):
             rf"impact-stick together), $w$ = {_num(_attr(escape, 'motion_window'))};  "
             r"$\Delta$: slope of $\ln T$ against $1/\mathrm{rms}_r^2$ (weighted)")
     return fig
+
+
+def _cell_axes(escape):
+    """The two parameters an escape cell is given by: ``attrs["axes"]`` of a plane study's
+    dataset, else the paper's ``("inv_beta", "delta")``."""
+    axes = escape.attrs.get("axes")
+    if axes is None:
+        return ("inv_beta", "delta")
+    if isinstance(axes, str):
+        axes = _decoded(axes, "axes") if axes.lstrip().startswith("[") else axes.split()
+    return tuple(str(a) for a in np.atleast_1d(axes))
+
+
+def _cell_text(escape, cell):
+    """``"$1/\\beta_f$ = 1.1, $\\delta$ = 1"``: a cell in its plane's symbols."""
+    return ", ".join(f"{parameter_symbol(k)} = {_num(cell[k])}" for k in _cell_axes(escape))
 
 
 def _rms_of(x):

@@ -1,6 +1,8 @@
 """Fig. 16: domains of stable periodic impact motions under the harmonic force alone."""
 from __future__ import annotations
 
+import json
+
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.collections import LineCollection
@@ -238,6 +240,28 @@ def _fits(allowed, bw, bh):
                                   cval=0) > 0
 
 
+def boundary_axes(boundaries):
+    """The plane ``(x, y)`` of a boundaries dataset: ``attrs["axes"]``, else ``(inv_beta,
+    delta)`` (its points are variables over ``point``, not dimensions)."""
+    axes = boundaries.attrs.get("axes")
+    if axes is None:
+        return ("inv_beta", "delta")
+    if isinstance(axes, (bytes, str)):
+        text = axes.decode() if isinstance(axes, bytes) else axes
+        axes = json.loads(text) if text.lstrip().startswith("[") else text.split()
+    axes = tuple(str(a) for a in np.atleast_1d(axes))
+    if len(axes) != 2 or axes[0] == axes[1]:
+        raise ValueError(f"attrs['axes'] must name two different parameters, got {axes!r}")
+    return axes
+
+
+def _fixed_of(boundaries):
+    """``{parameter: value}`` a boundaries dataset over a plane holds fixed
+    (``attrs["fixed"]``, JSON text)."""
+    fixed = boundaries.attrs.get("fixed", "{}")
+    return json.loads(fixed) if isinstance(fixed, (str, bytes)) else dict(fixed)
+
+
 def boundary_curves(boundaries):
     """The curves of a boundaries dataset: ``[(index, type, kind, vertices)]``.
 
@@ -260,8 +284,9 @@ def boundary_curves(boundaries):
     curve = np.asarray(boundaries["curve"].values, dtype=int)
     if curve.size == 0:
         return []
-    xy = np.column_stack([np.asarray(boundaries["inv_beta"].values, dtype=float),
-                          np.asarray(boundaries["delta"].values, dtype=float)])
+    x_name, y_name = boundary_axes(boundaries)
+    xy = np.column_stack([np.asarray(boundaries[x_name].values, dtype=float),
+                          np.asarray(boundaries[y_name].values, dtype=float)])
     starts = np.flatnonzero(np.r_[True, curve[1:] != curve[:-1]])
     return [(int(curve[a]), types[curve[a]], kinds[curve[a]], piece)
             for a, piece in zip(starts, np.split(xy, starts[1:]))]
@@ -305,8 +330,9 @@ def _draw_boundaries(overview, panels, boundaries):
                       **_overview_style(style, order[name]))
         drawn.add(kind)
     types = np.array([str(t) for t in boundaries["codim2_type"].values])
-    x = np.asarray(boundaries["codim2_inv_beta"].values, dtype=float)
-    y = np.asarray(boundaries["codim2_delta"].values, dtype=float)
+    x_name, y_name = boundary_axes(boundaries)
+    x = np.asarray(boundaries[f"codim2_{x_name}"].values, dtype=float)
+    y = np.asarray(boundaries[f"codim2_{y_name}"].values, dtype=float)
     marked = False
     for name, (ax, color) in panels.items():
         here = types == name
@@ -361,11 +387,17 @@ def fig16(orbits, boundaries=None):
 
     if boundaries is not None and not int(boundaries.attrs.get("traced", 1)):
         boundaries = None           # not traced (eps = 0): the cell edges, as without them
+    if boundaries is not None and boundary_axes(boundaries) != tuple(plane_axes(orbits)):
+        raise ValueError(f"the boundaries are traced over {list(boundary_axes(boundaries))} "
+                         f"but the orbit map runs over {list(plane_axes(orbits))}: not the "
+                         f"same plane")
     if boundaries is not None and custom_plane(orbits):
-        raise ValueError(f"the exact boundaries are traced over the (inv_beta, delta) plane "
-                         f"only; this orbit map runs over {list(plane_axes(orbits))}: draw it "
-                         f"without boundaries")
-    if boundaries is not None:
+        a, b = _fixed_of(boundaries), plane_fixed(orbits)
+        for key in sorted(set(a) | set(b)):
+            if key not in a or key not in b or float(a[key]) != float(b[key]):
+                raise ValueError(f"the boundaries hold {key} = {a.get(key, 'unset')} but the "
+                                 f"orbit map {b.get(key, 'unset')}: not the same system")
+    elif boundaries is not None:
         _same_system(boundaries, orbits, ("the boundaries", "the orbit map"))
     types = [str(t) for t in orbits["type"].values]
     ncols = 3

@@ -232,7 +232,7 @@ def orbit_domains(orbits):
     import pandas as pd
 
     rows = {}
-    total = orbits.sizes["inv_beta"] * orbits.sizes["delta"]
+    total = int(np.prod([orbits.sizes[d] for d in orbits.dims if d != "type"]))
     for name in orbits.type.values:
         o = orbits.sel(type=name)
         stable = o.n_stable.values > 0

@@ -34,6 +34,7 @@ resamples without spread in either variable are dropped. Neighbouring cells are 
 pieces of evidence than their number and the interval is narrower than it should be: read
 it as a lower bound on the uncertainty.
 """
+import json
 from dataclasses import dataclass
 
 import numpy as np
@@ -120,25 +121,73 @@ def _codes(a):
 def _resample_ranks(coded, idx):
     """``rankdata(a[idx], method="average", axis=-1)``, bit for bit, in O(n) a row: counting
     the dense codes of each resample (``coded`` from :func:`_codes`) instead of sorting it.
-    A value's average rank is ``(below + 1 + below + equal) / 2``, integers halved (exact)."""
+    A value's average rank is ``(below + 1 + below + equal) / 2``, integers halved (exact):
+    a table of K ranks a row, read at each drawn cell by one flat gather."""
     codes, k = coded
     rows = idx.shape[0]
-    sample = codes[idx]
-    counts = np.bincount((sample + k * np.arange(rows)[:, None]).ravel(),
-                         minlength=rows * k).reshape(rows, k)
+    flat = codes[idx] + k * np.arange(rows)[:, None]
+    counts = np.bincount(flat.ravel(), minlength=rows * k).reshape(rows, k)
     upto = np.cumsum(counts, axis=1)
     below = upto - counts
-    return np.take_along_axis(below + upto + 1, sample, axis=1) / 2.0
+    return ((below + upto + 1) / 2.0).ravel()[flat]
+
+
+def _centred(a):
+    """``(a - mean, sum of squares)`` a row: the halves of :func:`_pearson_rows`, computed
+    once for a variable every correlation of a call shares."""
+    a = a - a.mean(axis=-1, keepdims=True)
+    return a, (a * a).sum(axis=-1)
+
+
+class _Bootstrap:
+    """What the correlations of one :func:`predictor_correlations` call share, bit for bit:
+    the resampled cells (one ``default_rng(seed)`` draw per number of cells: every call of
+    :func:`rank_correlation` with the same ``n`` draws the same indices) and the centred
+    resampled ranks of the last few variables (P of one motion over one set of cells is
+    correlated with each of the four predictors; the Lyapunov exponent, one per cell, with
+    every motion's P). At most `_KEEP` + 1 (N_RESAMPLES, n) arrays of ranks and one of cells."""
+
+    _KEEP = 6
+
+    def __init__(self, seed, n_resamples):
+        self.seed, self.n_resamples = seed, n_resamples
+        self._idx = {}
+        self._ranks = {}
+
+    def indices(self, n):
+        """The resampled cells, a list of (rows, n) chunks of `_CHUNK` rows."""
+        if n not in self._idx:
+            rng = np.random.default_rng(self.seed)
+            self._idx = {n: [rng.integers(0, n, size=(min(_CHUNK, self.n_resamples - start), n))
+                             for start in range(0, self.n_resamples, _CHUNK)]}
+        return self._idx[n]
+
+    def centred_ranks(self, values):
+        """Per chunk of :meth:`indices`, ``_centred`` of the resampled ranks of ``values``."""
+        key = (values.size, values.tobytes())
+        if key in self._ranks:                          # the most recently used last
+            self._ranks[key] = self._ranks.pop(key)
+        else:
+            if len(self._ranks) >= self._KEEP:
+                self._ranks.pop(next(iter(self._ranks)))
+            coded = _codes(values)
+            self._ranks[key] = [_centred(_resample_ranks(coded, idx))
+                                for idx in self.indices(values.size)]
+        return self._ranks[key]
 
 
 def _pearson_rows(a, b):
-    a = a - a.mean(axis=-1, keepdims=True)
-    b = b - b.mean(axis=-1, keepdims=True)
+    return _pearson_centred(_centred(a), _centred(b))
+
+
+def _pearson_centred(a, b):
+    """Pearson's r a row of two :func:`_centred` variables."""
+    (a, aa), (b, bb) = a, b
     with np.errstate(invalid="ignore", divide="ignore"):
-        return (a * b).sum(axis=-1) / np.sqrt((a * a).sum(axis=-1) * (b * b).sum(axis=-1))
+        return (a * b).sum(axis=-1) / np.sqrt(aa * bb)
 
 
-def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95):
+def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95, *, _shared=None):
     """Spearman's rho of ``x`` and ``p`` with a bootstrap percentile interval.
 
     Parameters
@@ -165,13 +214,12 @@ def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95):
     if n < MIN_CELLS or np.unique(x).size < 2 or np.unique(p).size < 2:
         return np.nan, np.nan, np.nan, n
     rho = float(_pearson_rows(_ranks(x), _ranks(p)))
-    rng = np.random.default_rng(seed)
-    x_codes, p_codes = _codes(x), _codes(p)
-    boot = []
-    for start in range(0, n_resamples, _CHUNK):
-        idx = rng.integers(0, n, size=(min(_CHUNK, n_resamples - start), n))
-        boot.append(_pearson_rows(_resample_ranks(x_codes, idx), _resample_ranks(p_codes, idx)))
-    boot = np.concatenate(boot)
+    shared = _shared if _shared is not None else _Bootstrap(seed, n_resamples)
+    if (shared.seed, shared.n_resamples) != (seed, n_resamples):
+        raise ValueError(f"a bootstrap of seed {shared.seed} and {shared.n_resamples} "
+                         f"resamples shared by a call with seed {seed} and {n_resamples}")
+    boot = np.concatenate([_pearson_centred(a, b) for a, b in
+                           zip(shared.centred_ranks(x), shared.centred_ranks(p))])
     boot = boot[np.isfinite(boot)]
     tail = 50.0 * (1.0 - level)
     low, high = (np.percentile(boot, [tail, 100.0 - tail]) if boot.size
@@ -179,14 +227,28 @@ def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95):
     return rho, float(min(low, rho)), float(max(high, rho)), n
 
 
+def _map_axes(motion_map):
+    """The map's plane ``(x, y)``: ``attrs["axes"]`` (a map over another plane), else the
+    paper's ``(inv_beta, delta)``."""
+    axes = motion_map.attrs.get("axes")
+    if axes is None:
+        return ("inv_beta", "delta")
+    if isinstance(axes, (bytes, str)):
+        text = axes.decode() if isinstance(axes, bytes) else axes
+        axes = json.loads(text) if text.lstrip().startswith("[") else text.split()
+    return tuple(str(a) for a in np.atleast_1d(axes))
+
+
 def _stable_domain(motion_map, orbits, basins, motion):
     """(stable, S) on the map's grid: Fig. 16's nearest cell, or the basins' n_stable."""
     if orbits is not None and motion in orbits["type"].values:
+        x_name, y_name = _map_axes(motion_map)
         o = orbits.sel(type=motion)
-        near = o.sel(inv_beta=motion_map.inv_beta, delta=motion_map.delta, method="nearest")
+        near = o.sel({x_name: motion_map[x_name], y_name: motion_map[y_name]},
+                     method="nearest").transpose(x_name, y_name)
         # map cells beyond the orbit map's plane (more than half a step out) are unknown
-        inside = np.ones((motion_map.sizes["inv_beta"], motion_map.sizes["delta"]), bool)
-        for axis, d in enumerate(("inv_beta", "delta")):
+        inside = np.ones((motion_map.sizes[x_name], motion_map.sizes[y_name]), bool)
+        for axis, d in enumerate((x_name, y_name)):
             grid = o[d].values
             half = 0.5 * (np.diff(grid).max() if grid.size > 1 else 0.0) + 1e-9
             out = np.abs(near[d].values - motion_map[d].values) > half
@@ -246,6 +308,7 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
     list of Correlation
         Per predictor (the order of `PREDICTORS`), per motion of the map, domain then plane.
     """
+    motion_map = motion_map.transpose(..., *_map_axes(motion_map))   # every field (x, y)
     errors = {}
     aligned = {}
     for name, ds in (("basin", basins), ("lyapunov", lyapunov)):
@@ -253,29 +316,37 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
             aligned[name] = None if ds is None else on_map_grid(ds, motion_map, name)
         except ValueError as error:
             errors[name], aligned[name] = f"not used: {error}", None
-    out = []
     motions = [str(m) for m in motion_map["motion"].values]
     fields = {m: _fields(motion_map, m, orbits, aligned["basin"], aligned["lyapunov"], errors)
               for m in motions}
-    for predictor in PREDICTORS:
-        for m in motions:
-            stable, values = fields[m]
-            x = values[predictor]
-            p = motion_map["probability"].sel(motion=m).values
-            for where in ("domain", "plane"):
+    # computed motion by motion (P's resampled ranks shared by the four predictors), listed
+    # predictor by predictor
+    shared = _Bootstrap(seed, n_resamples)
+    found = {}
+    for m in motions:
+        stable, values = fields[m]
+        p = motion_map["probability"].sel(motion=m).values
+        for where in ("domain", "plane"):
+            for predictor in PREDICTORS:
+                x = values[predictor]
                 if isinstance(x, str):
-                    out.append(Correlation(predictor, m, where, np.nan, np.nan, np.nan, 0, x))
+                    found[predictor, m, where] = Correlation(predictor, m, where, np.nan,
+                                                             np.nan, np.nan, 0, x)
                     continue
                 if where == "domain" and stable is None:
-                    out.append(Correlation(predictor, m, where, np.nan, np.nan, np.nan, 0,
-                                           "no stable domain (no orbit map or basins)"))
+                    found[predictor, m, where] = Correlation(
+                        predictor, m, where, np.nan, np.nan, np.nan, 0,
+                        "no stable domain (no orbit map or basins)")
                     continue
                 cells = stable if where == "domain" else np.ones(p.shape, bool)
-                rho, low, high, n = rank_correlation(x[cells], p[cells], seed, n_resamples)
+                rho, low, high, n = rank_correlation(x[cells], p[cells], seed, n_resamples,
+                                                     _shared=shared)
                 note = ("" if np.isfinite(rho) else
                         f"fewer than {MIN_CELLS} cells" if n < MIN_CELLS else "no spread")
-                out.append(Correlation(predictor, m, where, rho, low, high, n, note))
-    return out
+                found[predictor, m, where] = Correlation(predictor, m, where, rho, low, high,
+                                                         n, note)
+    return [found[predictor, m, where] for predictor in PREDICTORS for m in motions
+            for where in ("domain", "plane")]
 
 
 def _rho_text(c):

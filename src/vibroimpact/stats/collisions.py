@@ -349,46 +349,16 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     Collisions
         ``wall`` holds each collision's wall (all 0 with one wall).
     """
-    step = np.asarray(impact_step, dtype=np.int64)
-    offset = np.asarray(impact_offset, dtype=float)
-    u = np.asarray(impact_velocity, dtype=float)
-    start = np.asarray(stick_start, dtype=float)
-    end = np.asarray(stick_end, dtype=float)
-    dt = _checks.real("dt", dt, low=0.0, low_open=True)
-    eps = _checks.eps(eps)
-    floor = _checks.real("rebound_floor", floor, low=MIN_REBOUND_FLOOR)
-    if rule not in RULES:
-        raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
-    if not (step.shape == offset.shape == u.shape) or step.ndim != 1:
-        raise ValueError(f"impact_step, impact_offset and impact_velocity must be 1-D of one "
-                         f"length, got {step.shape}, {offset.shape}, {u.shape}")
-    if start.shape != end.shape or start.ndim != 1:
-        raise ValueError(f"stick_start and stick_end must be 1-D of one length, got "
-                         f"{start.shape} and {end.shape}")
-    wall = _impact_walls(wall, step.size)
-    if stick_wall is not None:
-        _check_stick_walls(stick_wall, start, step * dt + offset, wall)
-    # the rebound speed's coefficient, per impact where a second wall has its own
-    if eps_lower is not None:
-        eps_lower = _checks.eps(eps_lower, "eps_lower")
-        eps = np.where(wall == 1, eps_lower, eps)
+    step, offset, u, start, end, dt, eps, floor, pressed, wall = _checked(
+        impact_step, impact_offset, impact_velocity, stick_start, stick_end, dt=dt, eps=eps,
+        floor=floor, pressed=pressed, rule=rule, wall=wall, stick_wall=stick_wall,
+        eps_lower=eps_lower)
     n = step.size
-    t = step * dt + offset
-    if rule == "physical":
-        if pressed is None:
-            raise ValueError("pressed (the flights pressed throughout, pressed_flights) is "
-                             "required by rule='physical'")
-        pressed = np.asarray(pressed, dtype=bool)
-        if pressed.shape != (max(n - 1, 0),):
-            raise ValueError(f"pressed must have one value per flight, shape "
-                             f"({max(n - 1, 0)},), got {pressed.shape}")
     if rule == "rebounds" and n and not np.any(eps * u >= floor):
         n = 0
     if n == 0:
-        e_i, e_f = np.empty(0, np.int64), np.empty(0)
-        return Collisions(e_i, e_i.copy(), e_i.copy(), e_f, e_f.copy(), e_f.copy(), e_i.copy(),
-                          np.empty(0, bool), e_f.copy(), e_f.copy(), floor, dt,
-                          np.empty(0, np.int8))
+        return _no_collisions(floor, dt)
+    t = step * dt + offset
     # the first sticking phase that begins at or after each impact, and whether it begins
     # before the next impact
     k = np.searchsorted(start, t, side="left")
@@ -423,6 +393,54 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     rebounds = np.add.reduceat((eps * u >= floor).astype(np.int64), first)
     return Collisions(first, impact_collision, step[first], offset[first], t[first], u[first],
                       rebounds, stuck, stick_time, duration, floor, dt, wall[first])
+
+
+def _checked(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *, dt, eps,
+             floor, pressed, rule, wall, stick_wall, eps_lower):
+    """`group_collisions`'s arguments as arrays, checked: ``(step, offset, u, start, end, dt,
+    eps, floor, pressed, wall)``, ``eps`` per impact where a second wall has its own
+    restitution (else the float), ``wall`` int8."""
+    step = np.asarray(impact_step, dtype=np.int64)
+    offset = np.asarray(impact_offset, dtype=float)
+    u = np.asarray(impact_velocity, dtype=float)
+    start = np.asarray(stick_start, dtype=float)
+    end = np.asarray(stick_end, dtype=float)
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    eps = _checks.eps(eps)
+    floor = _checks.real("rebound_floor", floor, low=MIN_REBOUND_FLOOR)
+    if rule not in RULES:
+        raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
+    if not (step.shape == offset.shape == u.shape) or step.ndim != 1:
+        raise ValueError(f"impact_step, impact_offset and impact_velocity must be 1-D of one "
+                         f"length, got {step.shape}, {offset.shape}, {u.shape}")
+    if start.shape != end.shape or start.ndim != 1:
+        raise ValueError(f"stick_start and stick_end must be 1-D of one length, got "
+                         f"{start.shape} and {end.shape}")
+    wall = _impact_walls(wall, step.size)
+    if stick_wall is not None:
+        _check_stick_walls(stick_wall, start, step * dt + offset, wall)
+    # the rebound speed's coefficient, per impact where a second wall has its own
+    if eps_lower is not None:
+        eps_lower = _checks.eps(eps_lower, "eps_lower")
+        eps = np.where(wall == 1, eps_lower, eps)
+    n = step.size
+    if rule == "physical":
+        if pressed is None:
+            raise ValueError("pressed (the flights pressed throughout, pressed_flights) is "
+                             "required by rule='physical'")
+        pressed = np.asarray(pressed, dtype=bool)
+        if pressed.shape != (max(n - 1, 0),):
+            raise ValueError(f"pressed must have one value per flight, shape "
+                             f"({max(n - 1, 0)},), got {pressed.shape}")
+    return step, offset, u, start, end, dt, eps, floor, pressed, wall
+
+
+def _no_collisions(floor, dt):
+    """The `Collisions` of a record without any."""
+    e_i, e_f = np.empty(0, np.int64), np.empty(0)
+    return Collisions(e_i, e_i.copy(), e_i.copy(), e_f, e_f.copy(), e_f.copy(), e_i.copy(),
+                      np.empty(0, bool), e_f.copy(), e_f.copy(), floor, dt,
+                      np.empty(0, np.int8))
 
 
 def _check_stick_walls(stick_wall, start, t, wall):

@@ -371,6 +371,16 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     to forget its type; a record with few switches between motions (`n_switches`) violates
     that, and its error is then too small (the workflow marks such cells).
     """
+    return _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, motions,
+                              n_batches, stuck, walls, _labelled, _at_edges)
+
+
+def _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, motions,
+                       n_batches, stuck, walls, labelled, at_edges):
+    """`motion_statistics` with its two passes over the intervals given: ``labelled(ratio,
+    window, motions, walls, stuck) -> (labels, classes, n_switches)`` (`_labelled`) and
+    ``at_edges(t, z, classes, n_classes, edges) -> (n_classes, B + 1)`` (`_at_edges`); the
+    compiled twins (`vibroimpact.tally`) return the same values to the bit."""
     t = np.asarray(impact_time, dtype=float)
     z = np.asarray(intervals, dtype=float)
     if walls is not None:
@@ -383,38 +393,55 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     if t.size != z.size + 1 and not (t.size == 0 and z.size == 0):
         raise ValueError(f"impact_time must hold one more value than intervals, got "
                          f"{t.size} and {z.size}")
-    labels, group = _classify(interval_ratio(z, beta), window, motions, walls)
-    n_motions = len(motions)
-    classes, n_classes = labels, n_motions
     if stuck is not None:
         stuck = np.asarray(stuck, dtype=bool)[: z.size]
-        classes = _refine(labels, _with_sticking(labels, group, stuck), n_motions)
-        n_classes = 2 * n_motions
+    labels, classes, n_switches = labelled(interval_ratio(z, beta), window, motions, walls,
+                                           stuck)
+    n_motions = len(motions)
+    n_classes = n_motions if stuck is None else 2 * n_motions
     probability = np.array(_fractions(z, classes, n_classes, duration))
     stderr = np.zeros(n_classes)
     if z.size:
-        stderr = _batch_stderr(t, z, classes, n_classes, float(t_start), duration, n_batches)
+        stderr = _batch_stderr(t, z, classes, n_classes, float(t_start), duration, n_batches,
+                               at_edges)
     nan = np.full(n_motions, np.nan)
     stick, stick_err = ((probability[n_motions:], stderr[n_motions:]) if stuck is not None
                         else (nan, nan.copy()))
-    return MotionStatistics(probability[:n_motions], stderr[:n_motions],
-                            count_motion_switches(labels), labels, stick, stick_err)
+    return MotionStatistics(probability[:n_motions], stderr[:n_motions], n_switches, labels,
+                            stick, stick_err)
 
 
-def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches):
-    """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
-    # covered time of each class up to each collision, then at the stretch edges (linear
-    # within an interval of that class, flat elsewhere)
+def _labelled(ratio, window, motions, walls, stuck):
+    """Labels (`classify_impact_intervals`), classes (the labels, or with ``stuck`` the
+    motions and their impact-stick variants, `_refine`) and switches of the intervals."""
+    labels, group = _classify(ratio, window, motions, walls)
+    classes = labels
+    if stuck is not None:
+        classes = _refine(labels, _with_sticking(labels, group, stuck), len(motions))
+    return labels, classes, count_motion_switches(labels)
+
+
+def _at_edges(t, z, classes, n_classes, edges):
+    """``(n_classes, B + 1)``: the time each class covered from the first collision to each
+    stretch edge (linear within an interval of that class, flat elsewhere; 0 before the
+    first collision)."""
     onehot = classes[None, :] == np.arange(n_classes)[:, None]            # (n_classes, N)
     cover = np.concatenate([np.zeros((n_classes, 1)), np.cumsum(z * onehot, axis=1)], axis=1)
-    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
     j = np.clip(np.searchsorted(t, edges, side="right") - 1, 0, t.size - 1)   # collision before
     inside = (edges > t[0]) & (j < z.size)                                   # within interval j
     jj = np.minimum(j, z.size - 1)
     extra = np.where(inside[None, :] & onehot[:, jj], np.minimum(edges - t[j], z[jj])[None, :],
                      0.0)
-    at_edges = np.where(edges[None, :] > t[0], cover[:, j] + extra, 0.0)
-    batches = np.diff(at_edges, axis=1) * (n_batches / duration)           # (n_classes, B)
+    return np.where(edges[None, :] > t[0], cover[:, j] + extra, 0.0)
+
+
+def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches, at_edges=_at_edges):
+    """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
+    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
+    # in Fortran order, as the fancy-indexed ``cover[:, j]`` makes it: the standard deviation
+    # below sums each class's batches in the order the stored maps were built with
+    covered = np.asfortranarray(at_edges(t, z, classes, n_classes, edges))
+    batches = np.diff(covered, axis=1) * (n_batches / duration)           # (n_classes, B)
     return batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
 
 

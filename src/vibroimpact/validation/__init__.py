@@ -2,7 +2,7 @@
 
 Nothing here is used to compute results. It exists so that the simulator and the orbit solver
 can be checked against something that shares none of their code, by the test suite at full
-size (``tests/stress/``) and by the workflow as a seeded quick sample.
+size (``tests/stress/``) and by the workflow as a seeded sample.
 
 - :mod:`~vibroimpact.validation.reference`: an mpmath simulator of the same closed form
   (34 digits by default), written without importing the rest of the package.
@@ -16,5 +16,5 @@ size (``tests/stress/``) and by the workflow as a seeded quick sample.
 - :mod:`~vibroimpact.validation.streaming`: a long record streamed from disk, checked by
   invariants and by chunk-size equality.
 - :mod:`~vibroimpact.validation.campaign`: every family in one call, full size or a seeded
-  quick sample (``python -m vibroimpact.validation.campaign --quick``).
+  sample (``python -m vibroimpact.validation.campaign --size quick`` or ``--size sample``).
 """

@@ -1,9 +1,24 @@
-"""The whole stress campaign in one call: every family, at full size or as a quick sample.
+"""The whole stress campaign in one call: every family, at full size or as a sample.
 
-``python -m vibroimpact.validation.campaign --quick`` prints one line per family; the test
+``python -m vibroimpact.validation.campaign --size quick`` prints one line per family; the test
 suite runs the same families at full size (``tests/stress/``), and the workflow runs
-:func:`run_campaign` with ``quick=True`` and stores :func:`campaign_dataset` of its reports
+:func:`run_campaign` at the size its config names (``validation.stress.size``: ``sample`` by
+default, or ``quick``) and stores :func:`campaign_dataset` of its reports
 (``results/validation/stress_sample.nc``).
+
+Three sizes (:data:`SIZES`), each drawing the first cases of the same seeded sequence, so a
+smaller size's cases are the first ones of a larger size's:
+
+``full``
+    The campaign of the slow test suite: 3,650 simulator cases, 60 per orbit family, a
+    record of 1e8 samples.
+``quick``
+    About 5 % of it (209 cases, a record of 1e6 samples, 64 replayed flights): ~20 CPU-s.
+``sample``
+    The default build's: every family, at a few cases each, each family at most ~0.3 CPU-s
+    (the dearer a family's case, the fewer: 2 chatter cases of ``stick_onset``, 25 touches of
+    ``release_touch``), a record of 2.5e5 samples streamed in chunks of 2^16, 65,521 (prime)
+    and 2^18 samples, 8 replayed flights: ~3 CPU-s.
 """
 import argparse
 import logging
@@ -14,19 +29,34 @@ import xarray as xr
 
 from vibroimpact.validation.families import FAMILIES, FULL_CASES, run_family
 from vibroimpact.validation.orbit_families import FAMILIES as ORBIT_FAMILIES, run_orbit_family
-from vibroimpact.validation.streaming import run_streamed_record
+from vibroimpact.validation.streaming import DEFAULT_CHUNK_SIZES, run_streamed_record
 
 log = logging.getLogger(__name__)
 
-#: Cases per simulator family in a quick sample (seconds).
+#: Cases per simulator family in a quick sample (5 % of the full campaign, at least 5).
 QUICK_CASES = {name: max(5, n // 20) for name, n in FULL_CASES.items()}
-#: Orbit families: cases at full size and quick.
-ORBIT_CASES = {"full": 60, "quick": 8}
+#: Cases per simulator family in the default build's sample: CPU-s per case of the quick sample
+#: (shared 2-core machine, warm numba cache) release 0.05, release_touch 0.004, start_pulled
+#: 0.03, force_equals_delta 0.04, stick_onset 0.28, grazing 0.08, extreme 0.015.
+SAMPLE_CASES = {"release": 6, "release_touch": 25, "start_pulled": 6, "force_equals_delta": 6,
+                "stick_onset": 2, "grazing": 4, "extreme": 15}
+#: Orbit families: cases per family at each size.
+ORBIT_CASES = {"full": 60, "quick": 8, "sample": 4}
 #: Samples of the streamed record (full: the 1e8 the campaign promises).
-STREAM_SAMPLES = {"full": 100_000_000, "quick": 1_000_000}
+STREAM_SAMPLES = {"full": 100_000_000, "quick": 1_000_000, "sample": 250_000}
+#: Chunk sizes of the streamed record's runs (at least three, one not a power of two, all
+#: shorter than the record but the last).
+CHUNK_SIZES = {"full": DEFAULT_CHUNK_SIZES, "quick": DEFAULT_CHUNK_SIZES,
+               "sample": (2**16, 65_521, 2**18)}
+#: Flights after an impact replayed by the mpmath reference (~0.14 CPU-s each at delta 1.5).
+REPLAYS = {"full": 64, "quick": 64, "sample": 8}
+#: Cases per simulator family at each size.
+CASES = {"full": FULL_CASES, "quick": QUICK_CASES, "sample": SAMPLE_CASES}
+#: The sizes of a campaign.
+SIZES = ("full", "quick", "sample")
 
 
-def run_campaign(seed, quick=False, workdir=None):
+def run_campaign(seed, quick=False, workdir=None, size=None):
     """Run every family; return the list of :class:`FamilyReport`.
 
     Parameters
@@ -34,16 +64,23 @@ def run_campaign(seed, quick=False, workdir=None):
     seed : int
         Seed of every family's case draws.
     quick : bool
-        A seeded quick sample (about a minute) instead of the full campaign.
+        A seeded quick sample (~20 CPU-s) instead of the full campaign (when ``size`` is
+        None).
     workdir : path-like, optional
         Where the streamed record is written (default: a temporary directory).
+    size : {"full", "quick", "sample"}, optional
+        The campaign's size (:data:`SIZES`); overrides ``quick``.
     """
-    size = "quick" if quick else "full"
-    cases = QUICK_CASES if quick else FULL_CASES
+    size = ("quick" if quick else "full") if size is None else size
+    if size not in SIZES:
+        raise ValueError(f"size must be one of {SIZES}, got {size!r}")
+    cases = CASES[size]
     reports = [run_family(name, cases[name], seed) for name in FAMILIES]
     reports += [run_orbit_family(name, ORBIT_CASES[size], seed) for name in ORBIT_FAMILIES]
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
-        reports.append(run_streamed_record(STREAM_SAMPLES[size], seed, tmp))
+        reports.append(run_streamed_record(STREAM_SAMPLES[size], seed, tmp,
+                                           chunk_sizes=CHUNK_SIZES[size],
+                                           n_replay=REPLAYS[size]))
     return reports
 
 
@@ -123,23 +160,30 @@ def campaign_dataset(reports, attrs=None):
                       attrs=dict(attrs or {}))
 
 
-def stress_sample(seed, workdir=None):
-    """The seeded quick sample of every family (:func:`run_campaign` with ``quick=True``) as a
-    dataset (:func:`campaign_dataset`); the attributes give the seed and the sample's size."""
-    reports = run_campaign(seed, quick=True, workdir=workdir)
+def stress_sample(seed, workdir=None, size="quick"):
+    """A seeded sample of every family (:func:`run_campaign` at ``size``, ``"quick"`` or
+    ``"sample"``) as a dataset (:func:`campaign_dataset`); the attributes give the seed and the
+    sample's size."""
+    if size not in ("quick", "sample"):
+        raise ValueError(f"size must be 'quick' or 'sample' (the full campaign runs in the "
+                         f"test suite), got {size!r}")
+    reports = run_campaign(seed, workdir=workdir, size=size)
     for report in reports:
         log.info("%s", report.summary())
-    attrs = dict(seed=int(seed), size="quick", quick_cases=str(QUICK_CASES),
-                 orbit_cases=ORBIT_CASES["quick"], stream_samples=STREAM_SAMPLES["quick"])
+    attrs = dict(seed=int(seed), size=size, cases=str(CASES[size]),
+                 orbit_cases=ORBIT_CASES[size], stream_samples=STREAM_SAMPLES[size],
+                 chunk_sizes=str(list(CHUNK_SIZES[size])), replays=REPLAYS[size])
     return campaign_dataset(reports, attrs)
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="a quick sample, not full size")
+    parser.add_argument("--size", choices=SIZES, default=None,
+                        help="the campaign's size (overrides --quick)")
     parser.add_argument("--seed", type=int, default=20261122)
     args = parser.parse_args(argv)
-    reports = run_campaign(args.seed, quick=args.quick)
+    reports = run_campaign(args.seed, quick=args.quick, size=args.size)
     for report in reports:
         print(report.summary())
     failed = [r for r in reports if not r.ok]

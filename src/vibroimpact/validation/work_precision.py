@@ -15,6 +15,12 @@ same machine in the same process, and measures two things per play delta:
   time units (its cost grows linearly with the record: one restart per sample), and, where the
   compared stretch is longer, the whole stretch once more, untimed, for its errors.
 
+The compared stretch ends just past the ``impacts``-th impact, but not before ``stretch`` and
+not after ``max_stretch``: at a play with rare impacts (delta = 1: one every ~14 time units)
+fewer impacts are compared rather than the peers integrating hundreds of time units for them.
+Every method is compared over the same stretch, so the errors depend on ``impacts``,
+``stretch`` and ``max_stretch`` only, never on the timing (``repeats``, ``long_samples``).
+
 The job should have the machine to itself (the workflow's rule holds every core); the load
 average before and after the run is kept to show whether it had.
 
@@ -184,12 +190,15 @@ def impact_errors(ref, step, offset, velocity, n_impacts, dt=DT):
     return float(np.max(np.abs(d_time))), float(np.max(np.abs(d_velocity)))
 
 
-def stretch_end(impact_time, impact_velocity, impacts, t_min, n_samples):
+def stretch_end(impact_time, impact_velocity, impacts, t_min, n_samples, t_max=math.inf):
     """End of the compared stretch: just past the ``impacts``-th impact faster than `U_TAIL`
-    (a proxy for the reference's comparable impacts), at least ``t_min``, on the sample grid."""
+    (a proxy for the reference's comparable impacts), at least ``t_min`` and at most ``t_max``,
+    on the sample grid."""
     fast = impact_time[impact_velocity >= U_TAIL]
     t_n = fast[min(impacts, fast.size) - 1] if fast.size else t_min
     steps = int(math.ceil(max(1.05 * t_n + 2.0, t_min) / DT))
+    if math.isfinite(t_max):
+        steps = min(steps, max(int(math.floor(t_max / DT + 1e-9)), int(math.ceil(t_min / DT))))
     return min(steps, n_samples - 1) * DT
 
 
@@ -202,14 +211,17 @@ def _runs(solvers, rtol, rk4_steps, clamp_steps):
     return runs
 
 
-def _check_arguments(delta, impacts, stretch, long_samples, rtol, solvers, rk4_steps,
-                     clamp_steps, repeats):
+def _check_arguments(delta, impacts, stretch, max_stretch, long_samples, rtol, solvers,
+                     rk4_steps, clamp_steps, repeats):
     if len(delta) == 0 or not all(math.isfinite(float(d)) for d in delta):
         raise ValueError(f"delta must be a non-empty list of finite plays, got {delta!r}")
     if int(impacts) < 1:
         raise ValueError(f"impacts must be a positive integer, got {impacts!r}")
     if not float(stretch) > 0.0:
         raise ValueError(f"stretch must be positive, got {stretch!r}")
+    if not float(max_stretch) >= float(stretch):
+        raise ValueError(f"max_stretch must be at least stretch ({stretch!r}), "
+                         f"got {max_stretch!r}")
     if int(long_samples) * DT < float(stretch) + 2.0 * DT:
         raise ValueError(f"long_samples = {long_samples} covers less than the stretch "
                          f"({stretch} time units at dt = {DT})")
@@ -225,9 +237,10 @@ def _check_arguments(delta, impacts, stretch, long_samples, rtol, solvers, rk4_s
         raise ValueError(f"repeats must be a positive integer, got {repeats!r}")
 
 
-def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, long_samples=100_000,
-                   seed=19740072, rtol=(1e-3, 1e-6, 1e-9, 1e-12), solvers=SOLVERS,
-                   rk4_steps=(1, 2, 4, 8, 16, 32, 64), clamp_steps=(), repeats=3):
+def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, max_stretch=math.inf,
+                   long_samples=100_000, seed=19740072, rtol=(1e-3, 1e-6, 1e-9, 1e-12),
+                   solvers=SOLVERS, rk4_steps=(1, 2, 4, 8, 16, 32, 64), clamp_steps=(),
+                   repeats=3):
     """Run time against impact error of `vibroimpact.simulate` and its peers, one run.
 
     Parameters
@@ -235,10 +248,13 @@ def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, long_sa
     delta : sequence of float
         Plays; one comparison each.
     impacts : int
-        Impacts compared per play (fewer where the 53-bit reference stops agreeing).
+        Impacts compared per play (fewer where the 53-bit reference stops agreeing, or where
+        they take longer than ``max_stretch``).
     stretch : float
         Shortest compared stretch, in time units: solve_ivp is timed on its first ``stretch``
         time units.
+    max_stretch : float
+        Longest compared stretch, in time units (>= ``stretch``; default: no limit).
     long_samples : int
         Force samples of the record the compiled methods are timed on.
     seed : int
@@ -271,8 +287,8 @@ def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, long_sa
     start, cpu_start = time.perf_counter(), time.process_time()
     load_start = os.getloadavg()[0]
     delta = [float(d) for d in np.atleast_1d(delta)]
-    _check_arguments(delta, impacts, stretch, long_samples, rtol, solvers, rk4_steps,
-                     clamp_steps, repeats)
+    _check_arguments(delta, impacts, stretch, max_stretch, long_samples, rtol, solvers,
+                     rk4_steps, clamp_steps, repeats)
     runs = _runs(solvers, rtol, rk4_steps, clamp_steps)
     noise = np.random.default_rng(seed).standard_normal(int(long_samples) + 1)
     long_span = int(long_samples) * DT
@@ -290,7 +306,8 @@ def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, long_sa
                      n_reference=np.zeros(len(delta), dtype=np.int64))
     repeats_of = np.full(len(runs), int(repeats))
     for i, d in enumerate(delta):
-        _measure_delta(i, d, noise, runs, impacts, float(stretch), int(repeats), out, per_delta)
+        _measure_delta(i, d, noise, runs, impacts, (float(stretch), float(max_stretch)),
+                       int(repeats), out, per_delta)
         log.info("delta = %g done: %d impacts compared, %.1f s so far", d,
                  per_delta["n_compared"][i], time.perf_counter() - start)
 
@@ -298,6 +315,7 @@ def work_precision(delta=(1.0, 0.0, -0.5), *, impacts=40, stretch=100.0, long_sa
                  force="N(0, 1) samples every dt, linear in between",
                  initial_state="from rest at min(0, delta)",
                  long_samples=int(long_samples), stretch_min=float(stretch),
+                 stretch_max=float(max_stretch),
                  impacts_target=int(impacts), repeats=int(repeats), trust_tol=TRUST_TOL,
                  u_tail=U_TAIL,
                  reference="vibroimpact.validation.reference, 34 decimal digits (mpmath)",
@@ -330,14 +348,17 @@ def _warm_up(delta, noise, clamp_steps):
     return time.perf_counter() - t0
 
 
-def _measure_delta(i, delta, noise, runs, impacts, stretch, repeats, out, per_delta):
-    """Fill row ``i`` of ``out`` and ``per_delta`` for one play."""
+def _measure_delta(i, delta, noise, runs, impacts, stretches, repeats, out, per_delta):
+    """Fill row ``i`` of ``out`` and ``per_delta`` for one play; ``stretches`` are the
+    shortest and the longest compared stretch."""
     from vibroimpact import simulate
     from vibroimpact.validation.reference import agreeing_prefix
 
     long_span = (noise.size - 1) * DT
     sim_seconds, sim = timed_runs(lambda: simulate(ZETA, EPS, delta, noise, DT), repeats)
-    t_end = stretch_end(sim.impact_time, sim.impact_velocity, impacts, stretch, noise.size)
+    stretch, max_stretch = stretches
+    t_end = stretch_end(sim.impact_time, sim.impact_velocity, impacts, stretch, noise.size,
+                        max_stretch)
     short = noise[: int(round(t_end / DT)) + 1]
     timed = noise[: int(round(stretch / DT)) + 1]
     t0 = time.perf_counter()

@@ -179,7 +179,7 @@ def _check_figures(config, section, name, entry, problems, grids):
     seen = set()
     for i, item in enumerate(entry["figures"]):
         fig = item if isinstance(item, str) else item["name"]
-        spec = figures.FIGURES[fig]
+        spec = figures.figure_spec(fig, kind) or figures.FIGURES[fig]
         at = f"{where}[{i}]"
         if spec["owner"] != kind:
             allowed_ = sorted(f for f, s in figures.FIGURES.items() if s["owner"] == kind)
@@ -191,7 +191,12 @@ def _check_figures(config, section, name, entry, problems, grids):
             problems.add(at, fig, "listed twice", "each figure once (a list of values under "
                          "its `inv_beta` draws it several times)")
         seen.add(fig)
-        if kind != "study":
+        if kind == "study" and spec.get("needs") and not entry.get("plane"):
+            problems.add(at, fig, f"a study draws {fig} over its plane, and this study has "
+                         "none", f"a `plane: [x, y]` with an `{spec['needs']}:` block, or "
+                         f"{fig} in an orbits entry's figures (the paper's (1/beta_f, delta))")
+            continue
+        if kind != "study" or spec.get("needs"):
             block = spec.get("needs")
             if block and not entry.get(block):
                 problems.add(f"{section}.{name}.{block}", None, f"missing, and {fig} draws it",
@@ -246,6 +251,52 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                      "an `orbits` entry (none defined)")
         return
     other = config["orbits"][orbits]
+    if entry.get("plane") or other.get("plane"):
+        _check_orbits_item_plane(name, entry, at, orbits, other, problems)
+    else:
+        _check_orbits_item_system(entry, at, orbits, other, problems)
+    types = {tuple(t) for t in other["types"]}
+    missing = [m for m in entry["motions"] if tuple(m) not in types]
+    if missing:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
+                     f"which studies.{name}.motions lists", "an `orbits` entry whose types "
+                     "include every motion of the study")
+
+
+#: The parameters a map over a plane and its orbits entry must share (each fixed, or an
+#: axis of both): the harmonic-force problem's.
+SHARED_PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta")
+
+
+def _check_orbits_item_plane(name, entry, at, orbits, other, problems):
+    """fig15_vs_fig16 of a study and an orbits entry, one of them with a plane: the same
+    plane, and the same value of every parameter both hold fixed (a missing amplitude of
+    the orbits entry is 1)."""
+    plane = list(entry.get("plane") or ("inv_beta", "delta"))
+    oplane = list(other.get("plane") or ("inv_beta", "delta"))
+    if plane != oplane:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps the plane {oplane}, the "
+                     f"study the plane {plane}", f"an `orbits` entry with plane: {plane}")
+        return
+    for key in SHARED_PLANE_PARAMETERS:
+        if key in plane:
+            continue
+        a = entry.get(key)
+        b = other.get(key, 1.0 if key == "amplitude" else None)
+        if key == "eps_lower" and entry.get("gap") is not None:
+            a = entry["eps"] if a is None else a        # absent with a gap: the study's eps
+            b = other["eps"] if b is None else b
+        if (a is None) != (b is None) or (a is not None and (
+                isinstance(a, (list, dict)) or isinstance(b, (list, dict))
+                or float(a) != float(b))):
+            def text(v):
+                return _num(v) if isinstance(v, (int, float)) else "none" if v is None else v
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = {text(b)}, the "
+                         f"study {key} = {text(a)}",
+                         f"an `orbits` entry over {plane} with the study's fixed values")
+
+
+def _check_orbits_item_system(entry, at, orbits, other, problems):
     for key in ("zeta", "eps", "gap", "eps_lower"):
         if other.get(key) != entry.get(key) and (
                 other.get(key) is None or entry.get(key) is None
@@ -255,12 +306,6 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                          f"study {key} = "
                          f"{_num(entry[key]) if entry.get(key) is not None else 'none'}",
                          "an `orbits` entry of the same zeta and eps (and walls)")
-    types = {tuple(t) for t in other["types"]}
-    missing = [m for m in entry["motions"] if tuple(m) not in types]
-    if missing:
-        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
-                     f"which studies.{name}.motions lists", "an `orbits` entry whose types "
-                     "include every motion of the study")
 
 
 def _check_walls(where, entry, problems):
@@ -304,6 +349,11 @@ def _check_study(config, name, entry, problems, limits, unforced):
     where = f"studies.{name}"
     if entry.get("plane") is not None:
         return _check_plane_study(config, name, entry, problems, limits, unforced)
+    if entry.get("attractors"):
+        problems.add(f"{where}.attractors", "...", "basins and Lyapunov exponents of a study "
+                     "run over its plane, and this study has none", "a `plane: [x, y]` in the "
+                     "study, or the attractors block of an orbits entry (the paper's (1/beta_f, "
+                     "delta) plane)")
     shapes_ok = True
     for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
         if key in ("inv_beta", "delta"):
@@ -410,13 +460,13 @@ def _check_study(config, name, entry, problems, limits, unforced):
                         "not on the study's delta grid (a spectrum's cell has its impact "
                         "statistics too)", _grid_text(grids["delta"]))
     trace = entry.get("trace")
-    if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
-        problems.add(f"{where}.trace.t_end", trace["t_end"],
-                     f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
-    elif trace and float(trace["t_end"]) < dt * (1 - 1e-9):
-        problems.add(f"{where}.trace.t_end", trace["t_end"], f"shorter than one sample step "
-                     f"(dt = {_num(dt)} of noises.{entry['noise']}): a trace of one point",
-                     f"{_num(dt)} <= t_end <= {tau:.6g}")
+    if trace and trace.get("cell") is not None:
+        problems.add(f"{where}.trace.cell", trace["cell"], "a point [x, y] of a plane, and "
+                     "this study has none", "delta (and inv_beta) of the trace, or a `plane`")
+    if trace and trace.get("delta") is None:
+        problems.add(f"{where}.trace.delta", None, "missing: the play of the trace",
+                     "a number under trace.delta")
+    _check_trace_t_end(where, entry, dt, tau, record, problems)
     _distinct(problems, f"{where}.density_delta", entry["density_delta"])
     if grids["delta"] is not None:
         for j, v in enumerate(entry["density_delta"]):
@@ -444,6 +494,49 @@ def _check_study(config, name, entry, problems, limits, unforced):
     resolved.update(grids)
     return resolved
 
+def _check_trace_t_end(where, entry, dt, tau, record, problems):
+    """A trace (``trace.t_end``) within the noise record and at least one sample step."""
+    trace = entry.get("trace")
+    if trace and float(trace["t_end"]) > tau * (1 + 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"],
+                     f"longer than the noise record ({record})", f"0 < t_end <= {tau:.6g}")
+    elif trace and float(trace["t_end"]) < dt * (1 - 1e-9):
+        problems.add(f"{where}.trace.t_end", trace["t_end"], f"shorter than one sample step "
+                     f"(dt = {_num(dt)} of noises.{entry['noise']}): a trace of one point",
+                     f"{_num(dt)} <= t_end <= {tau:.6g}")
+
+
+def _check_plane_trace(where, entry, plane, grids, dt, tau, problems):
+    """A plane study's trace: at its ``cell`` [x, y] inside the plane (no delta, inv_beta of
+    its own: the plane fixes them or runs over them)."""
+    at = f"{where}.trace"
+    trace = entry["trace"]
+    for key in ("delta", "inv_beta"):
+        if trace.get(key) is not None:
+            problems.add(f"{at}.{key}", trace[key], f"a study with a plane ({plane}) gives its "
+                         "trace's point as cell: [x, y]", f"trace.cell: [{plane[0]}, "
+                         f"{plane[1]}], the others the study's fixed values")
+    cell = trace.get("cell")
+    if cell is None:
+        problems.add(f"{at}.cell", None, f"missing: the trace's point in the plane {plane}",
+                     f"[{plane[0]}, {plane[1]}]")
+    else:
+        for k, v in zip(plane, (float(c) for c in cell)):
+            test, allowed_ = _AXIS_BOUNDS[k]
+            box = grids.get(k)
+            if not test(v):
+                problems.add(f"{at}.cell", cell, f"{k} = {_num(v)} is out of its range",
+                             f"[{plane[0]}, {plane[1]}] with {allowed_}")
+            elif box is not None and not (
+                    float(box.min()) - GRID_RTOL * max(1.0, abs(float(box.min()))) <= v
+                    <= float(box.max()) + GRID_RTOL * max(1.0, abs(float(box.max())))):
+                problems.add(f"{at}.cell", cell, f"outside the study's ({plane[0]}, "
+                             f"{plane[1]}) plane", f"{k} in [{_num(float(box.min()))}, "
+                             f"{_num(float(box.max()))}]")
+    record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
+    _check_trace_t_end(where, entry, dt, tau, record, problems)
+
+
 #: The bounds of each parameter a plane may run over, as (test, allowed) (the schema's for a
 #: number: an axis's values are checked here, after its grid is expanded).
 _AXIS_BOUNDS = {
@@ -456,9 +549,11 @@ _AXIS_BOUNDS = {
     "rms": (lambda v: v >= 0.0, "rms >= 0"),
     "delta": (lambda v: True, "any play"),
 }
-#: The figures a study with a plane draws: its map's (fig15_vs_fig16 needs an orbits entry
-#: over the same plane, which the workflow does not make yet).
-PLANE_FIGURES = ("fig15", "residence")
+#: The figures a study with a plane draws: its map's, its basins and Lyapunov maps (an
+#: `attractors` block), its escape (cells in the plane's coordinates) and its trace (Fig. 10
+#: at a cell); and fig15_vs_fig16 over an orbits entry of the same plane
+#: (`_check_orbits_item`), unless the plane names a noise parameter.
+PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov", "escape_vs_noise", "fig10")
 
 
 def _check_plane_study(config, name, entry, problems, limits, unforced):
@@ -522,10 +617,16 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
         return None
-    for block in ("spectra", "trace", "escape"):
-        if entry.get(block):
-            problems.add(f"{where}.{block}", None, f"a study with a plane ({plane}) draws its "
-                         "map only", f"leave {block} out, or put it in a study without a plane")
+    if entry.get("spectra"):
+        problems.add(f"{where}.spectra", None, f"a study with a plane ({plane}) has no "
+                     "spectra: they run at plays of the (1/beta_f, delta) grid (Figs. 6, "
+                     "11, 12: a curve per play)", "leave spectra out, or put them in a study "
+                     "without a plane at the plane's fixed values")
+    if entry.get("escape") and set(plane) & set(NOISE_PARAMETERS):
+        problems.add(f"{where}.escape", "...", f"the escape runs its own noise levels "
+                     f"(escape.rms), and the plane {plane} has the rms as an axis",
+                     "leave escape out, or a plane without rms")
+        ok = False
     for i, item in enumerate(entry["figures"]):
         fig = item if isinstance(item, str) else item["name"]
         if fig == "fig15_vs_fig16" and set(plane) & set(NOISE_PARAMETERS):
@@ -534,17 +635,13 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
                          f"problem's, which has no {noise_axis} (a parameter of the noise): "
                          f"the plane {plane} has no Fig. 16", ", ".join(PLANE_FIGURES))
             ok = False
-        elif fig == "fig15_vs_fig16":
-            problems.add(f"{where}.figures[{i}]", fig, f"needs Fig. 16 over the plane "
-                         f"{plane}, and an orbits entry maps (1/beta_f, delta) only (over "
-                         f"another plane: vibroimpact.orbits.plane.orbit_plane, not yet a "
-                         f"workflow job)", ", ".join(PLANE_FIGURES))
-            ok = False
-        elif fig not in PLANE_FIGURES:
+        elif fig not in PLANE_FIGURES + ("fig15_vs_fig16",):
             problems.add(f"{where}.figures[{i}]", fig, f"a study with a plane ({plane}) "
-                         "draws its map only", ", ".join(PLANE_FIGURES))
+                         "draws its map only", ", ".join(PLANE_FIGURES + ("fig15_vs_fig16",)))
             ok = False
     _check_motions(where, entry, two_walls, problems)
+    if entry.get("attractors"):
+        ok &= _check_plane_attractors(where, entry, plane, grids, problems)
     n, dt, tau = noise_record(config["noises"][entry["noise"]])
     transient = float(entry["transient"])
     if transient >= tau:
@@ -576,8 +673,72 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         if grids[key].size < 2:
             problems.add(f"{where}.{key}", entry[key], f"fig15 draws contours over the "
                          f"plane {plane}", "at least 2 values")
+    if entry.get("trace"):
+        _check_plane_trace(where, entry, plane, grids, dt, tau, problems)
+    if entry.get("escape") and not set(plane) & set(NOISE_PARAMETERS):
+        amp = grids.get("amplitude")
+        harmonic = bool(float(entry["amplitude"])) if amp is None else bool(np.all(amp != 0))
+        _check_escape(where, entry, grids, harmonic, dt, problems, axes=plane)
     _check_figures(config, "studies", name, entry, problems, grids)
     return dict(grids, spectra_delta=None)
+
+
+def _check_plane_attractors(where, entry, plane, grids, problems):
+    """A plane study's attractors block: a plane of the harmonic problem (no noise axis), a
+    force (amplitude > 0 everywhere), the starts' box on the free side of the wall and within
+    the smallest clearance, one-wall closed-form types, a cap long enough to settle at the
+    smallest zeta. True when it holds."""
+    at = f"{where}.attractors"
+    block = entry["attractors"]
+    before = len(problems)
+    noise_axes = sorted(set(plane) & set(NOISE_PARAMETERS))
+    if noise_axes:
+        problems.add(at, "...", f"basins and Lyapunov exponents are those of the harmonic force "
+                     f"alone, which has no {noise_axes[0]} (a parameter of the noise): the plane "
+                     f"{plane} has none", "leave attractors out, or a plane over zeta, eps, "
+                     "eps_lower, delta, gap, amplitude or inv_beta")
+        return False
+
+    def values(key):
+        if key in plane:
+            return grids.get(key)
+        return None if entry.get(key) is None else np.array([float(entry[key])])
+
+    amp = values("amplitude")
+    if amp is not None and float(amp.min()) <= 0.0:
+        problems.add(f"{where}.amplitude", entry["amplitude"], "the attractors of "
+                     "A sin(beta_f tau) are those of sin(beta_f tau) at delta / A for A > 0 "
+                     "(A < 0 is a half-period shift, A = 0 has no force)", "amplitude > 0")
+    low, high = (float(v) for v in block["gap"])
+    if low < 0.0:
+        problems.add(f"{at}.gap", block["gap"], f"a distance from the wall of {_num(low)} "
+                     "puts starts beyond the wall (x0 = delta - g > delta)",
+                     "[low, high] with 0 <= low < high")
+    elif not low < high:
+        problems.add(f"{at}.gap", block["gap"], "an empty range", "[low, high], low < high")
+    clearance = values("gap")
+    if clearance is not None and high > float(clearance.min()):
+        problems.add(f"{at}.gap", block["gap"], f"starts below the lower wall: the smallest "
+                     f"clearance of the plane is gap = {_num(float(clearance.min()))}",
+                     f"[low, high] with high <= {_num(float(clearance.min()))}")
+    vlow, vhigh = (float(v) for v in block["velocity"])
+    if not vlow < vhigh:
+        problems.add(f"{at}.velocity", block["velocity"], "an empty range",
+                     "[low, high], low < high")
+    for j, t in enumerate(block["types"]):
+        if len(t) != 2 or not 1 <= int(t[0]) <= MAX_M:
+            problems.add(f"{at}.types[{j}]", t, "the attractors match the closed-form "
+                         f"solver's (m/n) orbits, m <= {MAX_M} (with a second wall, those that "
+                         "stay above it)", f"[m, n] pairs with 1 <= m <= {MAX_M}")
+    zeta = values("zeta")
+    if zeta is not None:
+        shortest = attractor_min_time(float(zeta.min()))
+        if float(block["max_time"]) < shortest:
+            problems.add(f"{at}.max_time", block["max_time"], f"too short for a start to "
+                         f"settle: the damping alone needs ln(1/{ATTRACTOR_MATCH_TOL:g})/zeta "
+                         f"= {shortest:.4g} at the plane's smallest zeta",
+                         f">= {shortest:.4g}")
+    return len(problems) == before
 
 
 #: Shortest batch of the batch-means standard errors: a natural period 2 pi (time units),
@@ -608,11 +769,15 @@ def _check_batches(where, entry, length, dt, problems):
 ESCAPE_MAX_SAMPLES = 50_000_000
 
 
-def _check_escape(where, entry, grids, harmonic, dt, problems):
-    """The escape block: cells inside the study's (1/beta_f, delta) plane, distinct levels,
-    a record its job can hold, a fit with two levels at least."""
+def _check_escape(where, entry, grids, harmonic, dt, problems, axes=("inv_beta", "delta")):
+    """The escape block: cells inside the study's plane (``axes``: the paper's (1/beta_f,
+    delta), or the plane a study names, each cell ``[x, y]`` in its coordinates), distinct
+    levels, a record its job can hold, a fit with two levels at least."""
     where = f"{where}.escape"
     block = entry["escape"]
+    pair = f"[{axes[0]}, {axes[1]}]"
+    plane_words = ("(1/beta_f, delta)" if tuple(axes) == ("inv_beta", "delta")
+                   else f"({axes[0]}, {axes[1]})")
     if not harmonic:
         problems.add(where, None, "the escape cells lie in the (1/beta_f, delta) plane of the "
                      "harmonic force, and this study has none (amplitude = 0)",
@@ -620,23 +785,28 @@ def _check_escape(where, entry, grids, harmonic, dt, problems):
         return
     box = {k: (float(g.min()), float(g.max())) for k, g in grids.items() if g is not None}
     for i, cell in enumerate(block["cells"]):
-        inv_beta, delta = (float(v) for v in cell)
-        if inv_beta <= 0.0:
-            problems.add(f"{where}.cells[{i}]", cell, f"1/beta_f = {_num(inv_beta)} is not a "
-                         "forcing period ratio", "[inv_beta, delta] with inv_beta > 0")
+        values = [float(v) for v in cell]
+        bad = [(k, v) for k, v in zip(axes, values) if not _AXIS_BOUNDS[k][0](v)]
+        if bad:
+            k, v = bad[0]
+            if k == "inv_beta":
+                problems.add(f"{where}.cells[{i}]", cell, f"1/beta_f = {_num(v)} is not a "
+                             "forcing period ratio", f"{pair} with inv_beta > 0")
+            else:
+                problems.add(f"{where}.cells[{i}]", cell, f"{k} = {_num(v)} is out of its "
+                             "range", f"{pair} with {_AXIS_BOUNDS[k][1]}")
             continue
-        outside = [f"{k} in [{_num(lo)}, {_num(hi)}]" for k, v in (("inv_beta", inv_beta),
-                                                                  ("delta", delta))
+        outside = [f"{k} in [{_num(lo)}, {_num(hi)}]" for k, v in zip(axes, values)
                    if k in box for lo, hi in [box[k]]
                    if not lo - GRID_RTOL * max(1.0, abs(lo)) <= v
                    <= hi + GRID_RTOL * max(1.0, abs(hi))]
         if outside:
-            problems.add(f"{where}.cells[{i}]", cell, "outside the study's (1/beta_f, delta) "
+            problems.add(f"{where}.cells[{i}]", cell, f"outside the study's {plane_words} "
                          "plane", "a cell with " + " and ".join(outside))
     pairs = [tuple(float(v) for v in c) for c in block["cells"]]
     if len(set(pairs)) != len(pairs):
         problems.add(f"{where}.cells", block["cells"], "a cell is listed twice",
-                     "distinct [inv_beta, delta] pairs")
+                     f"distinct {pair} pairs")
     _distinct(problems, f"{where}.rms", block["rms"])
     n = escape_samples(entry["transient"], block["record_length"], dt)
     if n > ESCAPE_MAX_SAMPLES:
@@ -668,15 +838,37 @@ def _check_orbits(config, name, entry, problems, limits):
         problems.add(where, name, "ends like a dataset an orbits entry derives "
                      "(results/orbits/<name>_basins.nc ...)",
                      f"a name not ending in {', '.join(DERIVED_SUFFIXES)}")
-    two_walls = _check_walls(where, entry, problems)
-    if two_walls:
-        _check_two_wall_orbits(where, entry, problems)
-    grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
-                               limits["max_orbit_cells"], positive=True),
-             "delta": _grid(problems, f"{where}.delta", entry["delta"],
-                            limits["max_orbit_cells"])}
-    if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
-        _plane(problems, where, grids, "fig16")
+    if entry.get("plane"):
+        if not _check_orbits_plane(where, entry, problems, limits):
+            return
+        two_walls = entry.get("gap") is not None
+        if two_walls:
+            _check_two_wall_orbits(where, entry, problems)
+    else:
+        for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta", "delta"):
+            fixed_only = key not in ("inv_beta", "delta")
+            if isinstance(entry.get(key), (list, dict)) == fixed_only:
+                problems.add(f"{where}.{key}", entry[key], "a grid, and this entry has no "
+                             "plane naming it" if fixed_only else "a number, and this "
+                             "entry has no plane that fixes it", f"a number, or `plane: "
+                             f"[{key}, delta]` (say) to map over it" if fixed_only else
+                             f"a grid (a list or {{start, stop, step}}), or a `plane` that "
+                             f"does not name {key}")
+                return
+        if entry.get("amplitude") is not None:
+            problems.add(f"{where}.amplitude", entry["amplitude"], "the amplitude of an entry "
+                         "over the paper's (1/beta_f, delta) plane, whose map is Fig. 16's "
+                         "(A = 1)", "leave it out, or give the entry a `plane` (A is then "
+                         "fixed or an axis)")
+        two_walls = _check_walls(where, entry, problems)
+        if two_walls:
+            _check_two_wall_orbits(where, entry, problems)
+        grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
+                                   limits["max_orbit_cells"], positive=True),
+                 "delta": _grid(problems, f"{where}.delta", entry["delta"],
+                                limits["max_orbit_cells"])}
+        if "fig16" in [f if isinstance(f, str) else f["name"] for f in entry["figures"]]:
+            _plane(problems, where, grids, "fig16")
     for j, t in enumerate(entry["types"]):
         if len(t) == 3:
             if not two_walls:
@@ -701,6 +893,76 @@ def _check_orbits(config, name, entry, problems, limits):
     if entry.get("attractors"):
         _check_attractors(where, entry, problems, limits)
     _check_figures(config, "orbits", name, entry, problems, None)
+
+
+#: Bounds of an orbits plane's axes (the harmonic-force problem: the amplitude is > 0, the
+#: motions at -A being those at A shifted by half a period).
+_ORBIT_AXIS_BOUNDS = dict(_AXIS_BOUNDS, amplitude=(lambda v: v > 0.0, "amplitude > 0"))
+
+
+def _check_orbits_plane(where, entry, problems, limits):
+    """An orbits entry with a ``plane``: no noise parameter on it, its axes grids in their
+    bounds (at least 2 values), every other parameter a number, no attractors block. False
+    when the entry cannot be checked further."""
+    plane = list(entry["plane"])
+    noise = sorted(set(plane) & set(NOISE_PARAMETERS))
+    if noise:
+        problems.add(f"{where}.plane", plane, f"names {noise[0]}, a parameter of the random "
+                     f"force: the periodic motions of Fig. 16 are those of the harmonic force "
+                     f"alone, so a plane over the noise has no Fig. 16",
+                     "two of zeta, eps, delta, amplitude, inv_beta (and gap, eps_lower with "
+                     "a second wall)")
+        return False
+    ok = True
+    two_walls = "gap" in plane or entry.get("gap") is not None
+    if "eps_lower" in plane and not two_walls:
+        problems.add(f"{where}.plane", plane, "names eps_lower, the restitution of a second "
+                     "wall, and this entry has one wall (no gap)", f"give {where}.gap > 0, or "
+                     "a plane without eps_lower")
+        ok = False
+    for key in plane:
+        spec = entry.get(key)
+        if not isinstance(spec, (list, dict)):
+            problems.add(f"{where}.{key}", spec, f"{'missing' if spec is None else 'a number'}"
+                         f", and {key} is an axis of the plane {plane}",
+                         "a grid (a list or {start, stop, step})")
+            ok = False
+            continue
+        values = _grid(problems, f"{where}.{key}", spec, limits["max_orbit_cells"])
+        if values is None:
+            ok = False
+            continue
+        test, allowed_ = _ORBIT_AXIS_BOUNDS[key]
+        bad = [float(v) for v in values if not test(float(v))]
+        if bad:
+            problems.add(f"{where}.{key}", spec, f"holds {_num(bad[0])}", allowed_)
+            ok = False
+        elif values.size < 2:
+            problems.add(f"{where}.{key}", spec, f"fig16 draws contours over the plane "
+                         f"{plane}", "at least 2 values")
+            ok = False
+    for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta", "delta"):
+        if key in plane or entry.get(key) is None:
+            continue
+        if isinstance(entry[key], (list, dict)):
+            problems.add(f"{where}.{key}", entry[key], f"a grid, and {key} is fixed in the "
+                         f"plane {plane} (only the plane's axes are grids)",
+                         f"a number, or name {key} in the plane")
+            ok = False
+        else:
+            test, allowed_ = _ORBIT_AXIS_BOUNDS[key]
+            if not test(float(entry[key])):
+                problems.add(f"{where}.{key}", entry[key], "out of range", allowed_)
+                ok = False
+    if "gap" not in plane:
+        _check_walls(where, entry, problems)
+    if entry.get("attractors"):
+        problems.add(f"{where}.attractors", "...", f"basins and Lyapunov exponents over the "
+                     f"plane {plane} are not a job of an orbits entry", "leave the attractors "
+                     "block out of an entry with a plane (an entry over (inv_beta, delta) "
+                     "has them)")
+        ok = False
+    return ok
 
 
 #: Periods n the two-wall orbit map solves for (the shooting solver's cost grows with n).

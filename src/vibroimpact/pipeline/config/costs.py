@@ -10,10 +10,15 @@ from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_step
 __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
            "simulate_cpu_s",
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
-           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s"]
+           "orbit_plane_cpu_s",
+           "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
+           "work_precision_cpu_s", "stress_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
-JOB_START_S = 1.3          # interpreter, numpy, xarray (and numba) start-up of one job
+#: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
+#: the 15acb54 build took 0.97-1.0 CPU-s (the harmonic trace, noise and the escape levels
+#: that compiled nothing; benchmark files' cpu_time).
+JOB_START_S = 1.0
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
 #: The self-audit of an events cell (`impact.audit.audit_moments`: exact integrals over every
 #: step), per step on top of NS_PER_STEP. CPU ns measured by benchmarks/bench_audit.py (1e6
@@ -38,23 +43,81 @@ MAP_CAP_FRACTION = 0.34
 #: (`plane_map_cpu_s`), whose short caps it dominates; the paper's map keeps the model its
 #: README numbers were measured with (its cells are 15-100 times longer).
 MAP_CELL_S = 0.010
-BOUNDARIES_S = 2.0         # the boundary curves of one (m/n) type
+#: The boundary curves of one (m/n) type: 6.2 CPU-s for the default entry's 5 types, start-up
+#: included (its benchmark file at 15acb54, a fresh clone's `make`).
+BOUNDARIES_S = 1.0
+#: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
+#: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
+#: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
+#: one cell of a two-wall plane (the shooting solver, seeded by the simulator: ~135 ms
+#: measured by h35a, issue 35).
+ORBIT_CELL_S = 1.0e-4
+SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
-#: (`JOB_START_S`): the default build's 19 figure jobs took 42.7 CPU-s, 1.5 to 3.5 each
-#: (each drawn alone as its job does, 2 cores under load; h37a, issue 37).
-FIGURE_S = 1.0
+#: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
+#: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
+FIGURE_S = 0.9
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
-#: twice (nbconvert) in one job, besides its start-up: 1.9 to 2.4 CPU-s a job (best of 2,
-#: load ~7) for the reports that show no map (random_force, performance, stability).
-REPORT_S = 0.8
+#: twice (nbconvert) in one job, besides its start-up: the reports that show no map
+#: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
+#: files' cpu_time, a fresh clone's `make`).
+REPORT_S = 0.3
 #: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
-#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``): 6.6 to 7.5 CPU-s for the three
+#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``; ``nb.map_agreement``): the three
 #: default reports that show the map (the motion_map and harmonic studies' and the orbits
-#: entry's, each computing the same predictors) against 2.1 for one without.
-MAP_REPORT_S = 4.8
-#: The work-precision run and the stress sample together, wall time (the work-precision job
-#: holds every core while it times): 44 + 21 s on the default build.
-VALIDATION_S = 65.0
+#: entry's, each computing the same predictors) took 5.56, 5.37 and 4.55 CPU-s at 15acb54;
+#: the predictors' shared bootstrap (issue 37) takes 0.68-0.71 of that (the jobs' process
+#: trees' CPU, this tree against a13f0b3, best of 3, `benchmarks/job_costs.py --jobs --only
+#: report`): ~3.6 CPU-s a job, 2.3 of it the map's.
+MAP_REPORT_S = 2.3
+#: The rule writing each validation dataset (``results/validation/<name>.nc``).
+VALIDATION_RULES = {"work_precision": "measure_work_precision",
+                    "stress_sample": "sample_stress_families"}
+#: One validation figure drawn, besides its job's start-up.
+VALIDATION_FIGURE_S = FIGURE_S
+#: One aggregation job (tiles joined into a dataset), start-up included, by kind (default
+#: ``"*"``): 0.44-0.48 CPU-s each at 15acb54 (benchmark files of a fresh clone's `make`), the
+#: events joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
+AGGREGATE_S = {"*": 0.5, "aggregate_events": 0.7, "aggregate_spectra": 1.0}
+#: Numba compilation on an empty cache, CPU-s, by the kind of job that compiled in the
+#: default build at 15acb54, a fresh clone whose jobs compiled (solve_orbit_tile 9.6 CPU-s
+#: against 2.4 for the other tiles; simulate_escape 8.0 against 2.0; the random trace 4.9
+#: against 1.0). Since 15572b0 `make` compiles the kernels when it installs
+#: (`vibroimpact.warm`), so the plan of a build charges none of it; `Plan.rule_costs(
+#: cold_cache=True)` adds it, to compare with a build whose jobs compiled.
+COMPILE_S = {"solve_orbit_tile": 7.0, "simulate_escape": 6.0, "simulate_trace": 4.0}
+#: A spectra cell's analysis besides its sample steps (the Welch estimate of its record):
+#: the default build's 4 spectra tiles (10 + 8 cells) took 6.9 CPU-s at 15acb54, 2.2 more
+#: than their start-up and steps at `NS_PER_STEP`.
+SPECTRA_CELL_S = 0.12
+#: A map cell's sample step (the map's own work: the hop check and the collision grouping of
+#: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
+#: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns.
+NS_PER_MAP_STEP = 38.0
+#: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
+#: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
+#: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured
+#: (benchmarks/ab_validation_sizes.py, 3 runs, load ~22; the job's own CPU: 1.8 s timing
+#: solve_ivp, 3.5 its runs over the compared stretches, 1.0 the references, 0.6 RK4); the
+#: sizes before issue 37 give 43.7 against 45.3 (the default build's benchmark file).
+WP_FIXED_S = 1.0
+#: One restarted solve_ivp run per unit of simulated time (CPU s): 1-6 ms over the default
+#: methods, tolerances and plays (restart overhead: one restart per force sample).
+SOLVE_IVP_S_PER_UNIT = 2.6e-3
+#: The 34-digit reference and its 53-bit twin per unit of compared stretch, per play (CPU s):
+#: 2-3 ms without chatter, ~20 ms in the chatter of delta = -0.5; a mean.
+REFERENCE_S_PER_UNIT = 6e-3
+#: A compared stretch is as long as ``impacts`` need at this many time units each (a mean over
+#: the default plays: one impact every ~14 time units at delta = 1, ~3 at 0, ~0.2 at -0.5),
+#: between ``stretch`` and ``max_stretch``.
+UNITS_PER_IMPACT = 2.1
+#: One RK4 step of the event-locating peer (CPU ns).
+RK4_NS_PER_STEP = 30.0
+#: The stress job, besides its start-up, per size (`stress_cpu_s`): every family's cases, the
+#: streamed record written, streamed by three processes (~0.8 CPU-s each to start) and
+#: replayed. Measured with benchmarks/ab_validation_sizes.py (issue 37; load ~22, the job's
+#: process and its children): 6.7-7.1 CPU-s at ``sample`` (3 runs), 22.6 at ``quick``.
+STRESS_S = {"sample": 5.6, "quick": 21.0}
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
 FILE_OVERHEAD = 20_000
@@ -118,6 +181,16 @@ def plane_cap_steps(study, entry, noise):
     return float(sum(per_period[cell.inv_beta] for cell in study.cells()))
 
 
+def map_cpu_s(steps):
+    """CPU seconds of a paper map's cells running ``steps`` sample steps in all."""
+    return steps * NS_PER_MAP_STEP * 1e-9
+
+
+def aggregate_s(rule):
+    """CPU seconds of one aggregation job of kind ``rule`` (`AGGREGATE_S`)."""
+    return AGGREGATE_S.get(rule, AGGREGATE_S["*"])
+
+
 def plane_map_cpu_s(study, entry, noise):
     """CPU seconds of the map cells of a study with a ``plane``: every cell's cap
     (`plane_cap_steps`) at `MAP_CAP_FRACTION`, plus `MAP_CELL_S` a cell."""
@@ -154,6 +227,19 @@ def orbit_cpu_s(cells, types):
     return cells * types * US_PER_ORBIT * 1e-6
 
 
+def orbit_plane_cpu_s(entry, cells):
+    """CPU seconds of an ``orbits`` entry's map over its ``plane`` of ``cells`` cells: along
+    delta the map's branch following (`orbit_cpu_s`); a plane without delta solves each cell
+    alone (`ORBIT_CELL_S` a type: the global scan, the finer m = 3 one included); two walls
+    the shooting solver (`SHOOTING_CELL_S` a cell)."""
+    types = len(entry["types"])
+    if entry.get("gap") is not None or "gap" in entry["plane"]:
+        return cells * SHOOTING_CELL_S
+    if "delta" in entry["plane"]:
+        return orbit_cpu_s(cells, types)
+    return cells * types * ORBIT_CELL_S
+
+
 def attractor_cpu_s(cells, n_starts):
     """CPU seconds of the attractor map's ``n_starts`` starts in each of ``cells`` cells."""
     return cells * n_starts * US_PER_START * 1e-6
@@ -177,3 +263,25 @@ def escape_cpu_s(entry, dt, levels=None):
     levels = len(entry["escape"]["rms"]) if levels is None else int(levels)
     cells = len(entry["escape"]["cells"])
     return levels * (n * NS_PER_SAMPLE * 1e-9 + simulate_cpu_s(cells, n - 1))
+
+
+def work_precision_cpu_s(block):
+    """CPU seconds of the work-precision job at the config block ``validation.work_precision``
+    (start-up excluded): solve_ivp timed ``repeats`` times on ``stretch`` and run once over the
+    compared stretch, at every play and setting; the reference over the compared stretch; RK4
+    with event location ``repeats`` times over ``long_samples`` at every step count."""
+    n_delta = len(block["delta"])
+    stretch, max_stretch = float(block["stretch"]), float(block.get("max_stretch", 1e300))
+    compared = min(max_stretch, max(stretch, UNITS_PER_IMPACT * int(block["impacts"])))
+    ivp_runs = len(block["solvers"]) * len(block["rtol"])
+    repeats = int(block["repeats"])
+    ivp = SOLVE_IVP_S_PER_UNIT * ivp_runs * (repeats * stretch + compared)
+    reference = REFERENCE_S_PER_UNIT * compared
+    rk4 = RK4_NS_PER_STEP * 1e-9 * int(block["long_samples"]) * sum(block["rk4_steps"]) * repeats
+    return WP_FIXED_S + n_delta * (ivp + reference + rk4)
+
+
+def stress_cpu_s(block):
+    """CPU seconds of the stress job at the config block ``validation.stress`` (start-up
+    excluded)."""
+    return STRESS_S[block.get("size", "sample")]

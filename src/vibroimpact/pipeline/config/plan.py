@@ -15,13 +15,18 @@ import shutil
 
 from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
-from vibroimpact.pipeline.config.costs import (FIGURE_BYTES, FIGURE_S, FILE_OVERHEAD,
-                                               JOB_START_S, MAP_REPORT_S, REPORT_BYTES,
-                                               REPORT_S, VALIDATION_S)
+from vibroimpact.pipeline.config.costs import (COMPILE_S, FIGURE_BYTES, FIGURE_S,
+                                               FILE_OVERHEAD, JOB_START_S, MAP_REPORT_S,
+                                               REPORT_BYTES, REPORT_S, VALIDATION_FIGURE_S,
+                                               VALIDATION_RULES)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
-from vibroimpact.pipeline.study import Study, attractor_rows, grid_size, orbit_rows
+from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_plane_cells,
+                                        orbit_rows, plane_attractor_rows)
 
-__all__ = ["Plan", "Row", "make_plan", "built_entries"]
+__all__ = ["Plan", "Row", "make_plan", "built_entries", "WHOLE_MACHINE_RULES"]
+
+#: The kinds of job that hold every core while they run (their cost is wall time).
+WHOLE_MACHINE_RULES = ("measure_work_precision", "sample_stress_families")
 
 
 @dataclass
@@ -35,6 +40,9 @@ class Row:
     jobs: int = 0
     bytes: float = 0.0
     cpu_s: float = 0.0
+    #: ``{kind of job: [jobs, CPU seconds]}``, the kind named as its benchmark files' folder
+    #: (``results/benchmarks/<kind>/``; the three report rules are ``report``)
+    rules: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -69,6 +77,23 @@ class Plan:
     @property
     def cpu_s(self):
         return sum(r.cpu_s for r in self.rows)
+
+    def rule_costs(self, cold_cache=False):
+        """``{kind of job: (jobs, CPU seconds)}`` over every entry, the kind named as its
+        benchmark files' folder (``results/benchmarks/<kind>/``): what
+        ``benchmarks/job_costs.py --plan`` compares with a build's benchmark files. The jobs
+        and seconds sum to the plan's. ``cold_cache``: plus numba's compilation in the
+        jobs (`costs.COMPILE_S`), as in a build whose installation compiled nothing."""
+        out = {}
+        for row in self.rows:
+            for rule, (jobs, cpu) in row.rules.items():
+                n, c = out.get(rule, (0, 0.0))
+                out[rule] = (n + jobs, c + cpu)
+        if cold_cache:
+            for rule, cpu in COMPILE_S.items():
+                if rule in out:
+                    out[rule] = (out[rule][0], out[rule][1] + cpu)
+        return out
 
     def summary(self, cores=2):
         return (f"{_n(self.cells, 'simulation cell')}, {_n(self.orbit_cells, 'orbit cell')}, "
@@ -148,7 +173,7 @@ def _time(s):
     return f"{s:.2g} s"
 
 
-_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace")
+_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace", "plane_basins")
 _ORBIT_KINDS = ("orbits", "boundaries", "basins", "lyapunov")
 
 
@@ -172,7 +197,7 @@ def built_entries(config, own=None):
         kinds = {k for k in _STUDY_KINDS if targets.DATASETS[k].format(name=name) in needed}
         if kinds:
             build["studies"][name] = kinds
-            if kinds - {"escape"}:                  # escape: records of its own
+            if kinds - {"escape", "plane_basins"}:  # escape, attractors: no record file
                 build["noises"].add(config["studies"][name]["noise"])
     for name in config.get("orbits", {}):
         kinds = {k for k in _ORBIT_KINDS if targets.DATASETS[k].format(name=name) in needed}
@@ -218,8 +243,9 @@ def make_plan(config, own=None, *, results="results", studies=None):
     for name in sorted(build["noises"]):
         entry = config["noises"][name]
         n = int(entry["n_samples"])
-        plan.rows.append(Row(f"noises.{name}", f"{n:,} samples", jobs=1,
-                             bytes=8 * n + FILE_OVERHEAD, cpu_s=costs.noise_cpu_s(n)))
+        row = Row(f"noises.{name}", f"{n:,} samples", bytes=8 * n + FILE_OVERHEAD)
+        _charge(row, "generate_noise", 1, costs.noise_cpu_s(n))
+        plan.rows.append(row)
     owners = sorted(set(build["studies"]) | {o for o in build["figures"]
                                              if not o.startswith("orbits/")})
     for name in owners:
@@ -234,54 +260,75 @@ def make_plan(config, own=None, *, results="results", studies=None):
             steps = costs.study_steps("events", entry, noise)
             bins = sum(int(b["n"]) for b in entry["bins"].values())
             per_cell = 12 * (bins + 100)
-            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * per_cell,
-                 costs.simulate_cpu_s(cells, steps, audit=True))
+            tiles = study.n_tiles("events")
+            _add(row, cells, 0, 2 * cells * per_cell, 0.0)
+            _charge(row, "simulate_events", tiles,
+                    costs.simulate_cpu_s(cells, steps, audit=True) + tiles * JOB_START_S)
+            _charge(row, "aggregate_events", 1, costs.aggregate_s("aggregate_events"))
+            row.bytes += (tiles + 1) * FILE_OVERHEAD
             parts.append(f"events {_n(cells, 'cell')}")
         if "map" in needs:
             cells = len(study.cells("events"))
+            tiles = study.n_tiles("events")
             if study.plane is None:
                 cap = sum(len(study.delta) * costs.study_steps("map", entry, noise, float(ib))
                           for ib in study.inv_beta)
-                cpu = costs.simulate_cpu_s(1, cap * costs.MAP_CAP_FRACTION)
+                cpu = costs.map_cpu_s(cap * costs.MAP_CAP_FRACTION)
             else:       # any plane: each cell's cap at its own forcing period
                 cpu = costs.plane_map_cpu_s(study, entry, noise)
-            _add(row, cells, study.n_tiles("events") + 1, 2 * cells * 200, cpu)
+            _add(row, cells, 0, 2 * cells * 200 + (tiles + 1) * FILE_OVERHEAD, 0.0)
+            _charge(row, "simulate_map", tiles, cpu + tiles * JOB_START_S)
+            _charge(row, "aggregate_map", 1, costs.aggregate_s("aggregate_map"))
             if study.plane is None:
                 parts.append(f"map {_n(cells, 'cell')} (CPU at {costs.MAP_CAP_FRACTION:g} of "
                              f"the caps, the paper map's mean; <= "
                              f"x{1 / costs.MAP_CAP_FRACTION:.1f})"
-                             + _hours(cpu, study.n_tiles("events")))
+                             + _hours(cpu, tiles))
             else:
                 parts.append(f"map over ({', '.join(study.plane)}) {_n(cells, 'cell')}, "
                              f"~{_time(cpu)} of cell CPU (at {costs.MAP_CAP_FRACTION:g} of the "
                              f"caps and {costs.MAP_CELL_S * 1e3:g} ms a cell)"
-                             + _hours(cpu, study.n_tiles("events")))
+                             + _hours(cpu, tiles))
         if "spectra" in needs:
             cells = len(study.cells("spectra"))
             spec = entry["spectra"]
             steps = costs.study_steps("spectra", entry, noise)
-            _add(row, cells, study.n_tiles("spectra") + 1,
-                 2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1),
-                 costs.simulate_cpu_s(cells, steps))
+            tiles = study.n_tiles("spectra")
+            _add(row, cells, 0, 2 * cells * 16 * (int(spec["nperseg"]) // 2 + 1)
+                 + (tiles + 1) * FILE_OVERHEAD, 0.0)
+            _charge(row, "simulate_spectra", tiles,
+                    costs.simulate_cpu_s(cells, steps) + cells * costs.SPECTRA_CELL_S
+                    + tiles * JOB_START_S)
+            _charge(row, "aggregate_spectra", 1, costs.aggregate_s("aggregate_spectra"))
             parts.append(f"spectra {_n(cells, 'cell')}")
         if "escape" in needs:
             block = entry["escape"]
             levels, cells = len(block["rms"]), len(block["cells"])
             states = len(entry["motions"]) + 1
             cpu = costs.escape_cpu_s(entry, float(noise["dt"]))
-            _add(row, levels * cells, levels + 1,
-                 2 * levels * cells * states * 40 + cells * states * 60, cpu)
+            _add(row, levels * cells, 0, 2 * levels * cells * states * 40 + cells * states * 60
+                 + (levels + 1) * FILE_OVERHEAD, 0.0)
+            _charge(row, "simulate_escape", levels, cpu + levels * JOB_START_S)
+            _charge(row, "aggregate_escape", 1, costs.aggregate_s("aggregate_escape"))
             cpu += (levels + 1) * JOB_START_S + FIGURE_S     # its jobs' start-up, its figure
             parts.append(f"escape {_n(cells, 'cell')} x {_n(levels, 'noise level')} "
                          f"(~{cpu:.0f} CPU-s with its figure)")
+        if "plane_basins" in needs:        # its attractors block, over the plane
+            a_rows, a_tiles = plane_attractor_rows(entry)
+            a_cells = len(a_rows) * len(study.axes[study.plane[1]])
+            n_starts = int(entry["attractors"]["n_starts"])
+            _add(row, a_cells, a_tiles + 1, a_cells * (8 * 5 * n_starts + 400)
+                 + 2 * FILE_OVERHEAD, costs.attractor_cpu_s(a_cells, n_starts))
+            parts.append(f"attractors over ({', '.join(study.plane)}) {_n(a_cells, 'cell')} x "
+                         f"{_n(n_starts, 'start')}")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
-            _add(row, 0, 1, 40 * steps, 0.0)
+            _add(row, 0, 0, 40 * steps + FILE_OVERHEAD, 0.0)
+            _charge(row, "simulate_trace", 1, costs.simulate_cpu_s(1, steps) + JOB_START_S)
             parts.append("trace")
         n_figs = build["figures"].get(name, 0)
-        row.jobs += n_figs
         row.bytes += n_figs * FIGURE_BYTES
-        row.cpu_s += n_figs * FIGURE_S + row.jobs * JOB_START_S
+        _charge(row, "draw_figure", n_figs, n_figs * (FIGURE_S + JOB_START_S))
         row.detail = ", ".join(parts + [_n(n_figs, "figure")])
         plan.rows.append(row)
     for name in sorted(set(build["orbits"]) | {o.split("/", 1)[1] for o in build["figures"]
@@ -289,21 +336,30 @@ def make_plan(config, own=None, *, results="results", studies=None):
         entry = config["orbits"][name]
         needs = build["orbits"].get(name, set())
         n_figs = build["figures"].get(f"orbits/{name}", 0)
-        row = Row(f"orbits.{name}", "", jobs=n_figs, bytes=n_figs * FIGURE_BYTES,
-                  cpu_s=n_figs * FIGURE_S)
+        row = Row(f"orbits.{name}", "", bytes=n_figs * FIGURE_BYTES)
+        _charge(row, "draw_figure", n_figs, n_figs * (FIGURE_S + JOB_START_S))
         parts = []
         if "orbits" in needs:
             rows, n_tiles = orbit_rows(entry)
-            cells = len(rows) * grid_size(entry["delta"])
+            cells = orbit_plane_cells(entry)
             row.orbit_cells += cells
-            row.jobs += n_tiles + 1
             row.bytes += 2 * cells * len(entry["types"]) * 34
-            row.cpu_s += costs.orbit_cpu_s(cells, len(entry["types"]))
+            # a clearance between two walls: the shooting solver's rule (common.smk)
+            tile_rule = ("solve_clearance_orbit_tile" if entry.get("gap") is not None
+                         else "solve_orbit_tile")
+            if entry.get("plane"):
+                work = costs.orbit_plane_cpu_s(entry, cells)
+            elif tile_rule == "solve_clearance_orbit_tile":
+                work = costs.SHOOTING_CELL_S * cells
+            else:
+                work = costs.orbit_cpu_s(cells, len(entry["types"]))
+            _charge(row, tile_rule, n_tiles, work + n_tiles * JOB_START_S)
+            _charge(row, "aggregate_orbits", 1, costs.aggregate_s("aggregate_orbits"))
             parts.append(f"{_n(cells, 'cell')} x {_n(len(entry['types']), 'type')}")
         if "boundaries" in needs:
-            row.jobs += 1                       # the boundary curves Fig. 16 draws
-            row.bytes += 200_000 * len(entry["types"])
-            row.cpu_s += costs.boundaries_cpu_s(len(entry["types"]))
+            row.bytes += 200_000 * len(entry["types"])       # the boundary curves Fig. 16 draws
+            _charge(row, "trace_boundaries", 1,
+                    costs.boundaries_cpu_s(len(entry["types"])) + JOB_START_S)
             parts.append("boundary curves")
         block = entry.get("attractors")
         if needs & {"basins", "lyapunov"}:
@@ -311,38 +367,47 @@ def make_plan(config, own=None, *, results="results", studies=None):
             a_cells = len(a_rows) * grid_size(block["delta"])
             n_starts = int(block["n_starts"])
             row.orbit_cells += a_cells
-            row.jobs += a_tiles + 1
             row.bytes += a_cells * (8 * 5 * n_starts + 400) + 2 * FILE_OVERHEAD
-            row.cpu_s += costs.attractor_cpu_s(a_cells, n_starts)
+            _charge(row, "solve_attractor_tile", a_tiles,
+                    costs.attractor_cpu_s(a_cells, n_starts) + a_tiles * JOB_START_S)
+            _charge(row, "aggregate_attractors", 1, costs.aggregate_s("aggregate_attractors"))
             parts.append(f"attractors {_n(a_cells, 'cell')} x {_n(n_starts, 'start')}")
-        row.cpu_s += row.jobs * JOB_START_S
         row.detail = ", ".join(parts + [_n(n_figs, "figure")])
         plan.rows.append(row)
     for name in sorted(build["sweeps"]):
         n = len(config["sweeps"][name]["studies"])
-        plan.rows.append(Row(f"sweeps.{name}", f"{_n(n, 'study')} side by side, 1 figure", jobs=1,
-                             bytes=FIGURE_BYTES, cpu_s=FIGURE_S + JOB_START_S))
+        row = Row(f"sweeps.{name}", f"{_n(n, 'study')} side by side, 1 figure",
+                  bytes=FIGURE_BYTES)
+        _charge(row, "draw_sweep", 1, FIGURE_S + JOB_START_S)
+        plan.rows.append(row)
     reports = build["reports"]
     if reports:
-        plan.rows.append(Row("reports", f"{_n(reports, 'notebook')} executed, with HTML",
-                             jobs=reports, bytes=reports * REPORT_BYTES,
-                             cpu_s=reports * (REPORT_S + JOB_START_S)
-                             + build["map_reports"] * MAP_REPORT_S))
+        row = Row("reports", f"{_n(reports, 'notebook')} executed, with HTML",
+                  bytes=reports * REPORT_BYTES)
+        _charge(row, "report", reports, reports * (REPORT_S + JOB_START_S)
+                + build["map_reports"] * MAP_REPORT_S)
+        plan.rows.append(row)
     validation = build["validation"]
     if validation:
         runs = sum(f.endswith(".nc") for f in validation)
         figs = sum(f.endswith(".png") for f in validation)
         notebooks = sum(f.endswith(".html") for f in validation)
-        jobs = len(validation)
-        plan.rows.append(Row("validation", f"work-precision and stress-sample runs ({runs}), "
-                             f"{_n(figs, 'figure')}, {_n(notebooks, 'report')}", jobs=jobs,
-                             bytes=figs * FIGURE_BYTES + notebooks * REPORT_BYTES,
-                             cpu_s=VALIDATION_S * runs / 2 + figs * FIGURE_S
-                             + notebooks * REPORT_S + jobs * JOB_START_S))
+        row = Row("validation", f"work-precision and stress-sample runs ({runs}), "
+                  f"{_n(figs, 'figure')}, {_n(notebooks, 'report')}",
+                  bytes=figs * FIGURE_BYTES + notebooks * REPORT_BYTES)
+        for path in sorted(validation):
+            if path.endswith(".nc"):        # the rule writing it: its file's name
+                rule = VALIDATION_RULES[Path(path).stem]
+                _charge(row, rule, 1,
+                        _validation_runs_cpu_s(config["validation"], [path]) + JOB_START_S)
+        _charge(row, "draw_validation_figure", figs, figs * (VALIDATION_FIGURE_S + JOB_START_S))
+        _charge(row, "report", notebooks, notebooks * (REPORT_S + JOB_START_S))
+        plan.rows.append(row)
     copies = build["copies"]
     if copies:
-        plan.rows.append(Row("paper_figures", _n(copies, "copy"), jobs=copies,
-                             bytes=copies * FIGURE_BYTES))
+        row = Row("paper_figures", _n(copies, "copy"), bytes=copies * FIGURE_BYTES)
+        _charge(row, "copy_paper_figure", copies, 0.0)      # a local copy: no benchmark file
+        plan.rows.append(row)
     try:
         probe = Path(results)
         while not probe.exists():
@@ -353,6 +418,16 @@ def make_plan(config, own=None, *, results="results", studies=None):
     return plan
 
 
+def _validation_runs_cpu_s(block, files):
+    """CPU seconds of the validation runs among ``files`` (start-up excluded)."""
+    cpu_s = 0.0
+    if "results/validation/work_precision.nc" in files:
+        cpu_s += costs.work_precision_cpu_s(block["work_precision"])
+    if "results/validation/stress_sample.nc" in files:
+        cpu_s += costs.stress_cpu_s(block["stress"])
+    return cpu_s
+
+
 def _hours(cpu_s, jobs):
     """``"; runs for hours: ..."`` for a map of more than an hour of CPU (its tiles in
     parallel on every core, at best), else ``""``."""
@@ -361,6 +436,17 @@ def _hours(cpu_s, jobs):
     return (f"; RUNS FOR HOURS: ~{_time(cpu_s)} of CPU, at best ~{_time(cpu_s / jobs)} "
             f"with its {_n(jobs, 'tile')} on as many cores (a smaller grid, a lower "
             f"map.max_periods or a larger map.target_stderr shortens it)")
+
+
+def _charge(row, rule, jobs, cpu_s):
+    """``jobs`` jobs of kind ``rule`` (its benchmark files' folder) costing ``cpu_s`` in all,
+    on ``row`` and its per-rule account (:meth:`Plan.rule_costs`)."""
+    if not jobs:
+        return
+    row.jobs += jobs
+    row.cpu_s += cpu_s
+    n, c = row.rules.get(rule, (0, 0.0))
+    row.rules[rule] = (n + jobs, c + cpu_s)
 
 
 def _add(row, cells, jobs, nbytes, cpu_s):
