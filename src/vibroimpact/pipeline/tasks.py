@@ -630,14 +630,14 @@ def plane_boundaries(entry, orbits_path, out, threads=None):
         return
     import numba
 
-    from vibroimpact.orbits.boundaries import plane_boundaries as trace
+    from vibroimpact.orbits.boundaries import plane_boundaries as trace_plane
 
     if threads is not None:
         numba.set_num_threads(int(threads))
     curves = {}
     for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
-        curves[(m, n)] = trace(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
-                               seed_map=seeds, tol=BOUNDARY_TOL)
+        curves[(m, n)] = trace_plane(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
+                                     seed_map=seeds, tol=BOUNDARY_TOL)
         log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
         lost = sum(c.ends.count("lost") for c in curves[(m, n)])
         if lost:
