@@ -12,7 +12,7 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "orbit_plane_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
-           "work_precision_cpu_s", "stress_cpu_s"]
+           "work_precision_cpu_s", "stress_cpu_s", "predictors_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 #: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
@@ -70,6 +70,11 @@ REPORT_S = 0.3
 #: trees' CPU, this tree against a13f0b3, best of 3, `benchmarks/job_costs.py --jobs --only
 #: report`): ~3.6 CPU-s a job, 2.3 of it the map's.
 MAP_REPORT_S = 2.3
+#: The predictors of a map's P (rule ``map_predictors``: `reports.predictors`' bootstrap, 1,000
+#: resamples of the cells for each motion's P and its four predictors, in the stable domain
+#: and over the plane), per map cell and motion, besides the job's start-up: PREDICTORS_CELL_S
+#: calibrated below on the default map (5,187 cells, 3 motions).
+PREDICTORS_CELL_S = 1.0e-4
 #: The rule writing each validation dataset (``results/validation/<name>.nc``).
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
@@ -243,6 +248,12 @@ def orbit_plane_cpu_s(entry, cells):
 def attractor_cpu_s(cells, n_starts):
     """CPU seconds of the attractor map's ``n_starts`` starts in each of ``cells`` cells."""
     return cells * n_starts * US_PER_START * 1e-6
+
+
+def predictors_cpu_s(cells, motions):
+    """CPU seconds of a map's predictors job (rule ``map_predictors``) besides its start-up:
+    ``cells`` of the map, ``motions`` of its P."""
+    return PREDICTORS_CELL_S * cells * motions
 
 
 def boundaries_cpu_s(types):
