@@ -226,6 +226,9 @@ def jobs_mode(args):
             print(f"{job:52s} {s:7.2f} {c:6.2f} {ps:7.2f} {pc:6.2f} {s / ps:7.2f}{flag}")
         for side in sides:
             ran = {k: v for k, v in best[side].items() if v[0] == v[0]}
+            if not ran:
+                print(f"{side}: none of these jobs (no such rule)")
+                continue
             worst = max(ran.items(), key=lambda kv: kv[1][0])
             print(f"{side}: {len(ran)} jobs, {sum(v[0] for v in ran.values()):.1f} s wall "
                   f"({sum(v[1] for v in ran.values()):.1f} CPU-s) in all, the dearest "
