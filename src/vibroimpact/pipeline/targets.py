@@ -145,7 +145,9 @@ def study_report_inputs(config, study, report=None):
             inputs.setdefault(dataset, path)
         shown += [f"results/figures/{name}/{f}.png"
                   for f in figures.figure_targets(config["studies"][name])]
-    if "map" in inputs:     # its predictors, computed once for every report showing the map
+    # the predictors of the map's P, computed once for every report that shows the map (the
+    # harmonic report reads them; the random-force report has no such table)
+    if "map" in inputs and kind == "harmonic_random":
         inputs["predictors"] = _predictors_of(inputs["map"])
     return {**inputs, "figures": shown}
 
