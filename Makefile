@@ -2,23 +2,30 @@
 # vibroimpact.warm, so that no job of a build compiles one) and builds every figure and report
 # of the default config, then Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
-# of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, the
-# slow (stress/convergence) suite on two workers, the end-to-end workflow and SLURM suites
-# (one session on two workers: the test config is built once, on one worker, while the other
-# runs the suites that build their own copies; the SLURM suite installs and starts a
-# one-node cluster, as root); `make lint` runs Snakemake's linter, ruff and snakefmt.
+# of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, then
+# the slow (stress/convergence), end-to-end workflow and SLURM suites in one session on two
+# workers (the test config is built once, on one worker, while the other runs the suites that
+# build their own copies and the slow tests; whichever worker is free takes the next test,
+# so neither waits for the other at the end of a suite; the SLURM suite installs and starts
+# a one-node cluster, as root); `make lint` runs Snakemake's linter, ruff and snakefmt.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 CORES  ?= all
-# the fast suite's tests and the slow suite's independent stress tests on both cores
-# (pytest-xdist; the fast suite is CPU-bound, mostly numba compilation on a fresh clone)
+# the fast suite's tests on both cores (pytest-xdist; the kernels come compiled from the
+# installation, vibroimpact.warm, and every build and suite loads them from numba's cache)
 FAST_WORKERS ?= -n 2
-SLOW_WORKERS ?= -n 2
-# the workflow and SLURM suites on both cores: every test of the built test config on one
-# worker (xdist group `built`, tests/conftest.py), the other tests grouped by module
-WORKFLOW_WORKERS ?= -n 2 --dist loadgroup
+# the slow, workflow and SLURM suites in one session on both cores: every test of the built
+# test config on one worker (xdist group `built`, tests/conftest.py), the rebuild-scope
+# module's own build on one worker (group `rebuild_scope`), every other test on whichever
+# worker is free. xdist hands out the largest group first, so the two builds start at once.
+LONG_WORKERS ?= -n 2 --dist loadgroup
+LONG_MARKERS := slow or workflow or slurm
+# the installer of the pinned environment: uv (from PyPI, pinned here) downloads and
+# installs in parallel, about a minute on a fresh machine against pip's two and a half
+# (README, "Tests"); pip installs it if uv fails for any reason
+UV_VERSION ?= 0.13.9
 # your own config, layered on config/config.yaml: make CONFIG=my_study.yaml
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
@@ -46,7 +53,9 @@ clean-stale: $(STAMP)
 
 $(STAMP): environment.txt pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -r environment.txt
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION) \
+	  && $(BIN)/uv pip install --quiet --python $(BIN)/python -r environment.txt \
+	  || $(BIN)/python -m pip install --quiet --disable-pip-version-check -r environment.txt
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps -e .
 	$(BIN)/python -m vibroimpact.warm --jobs 2
 	touch $(STAMP)
@@ -57,8 +66,7 @@ test: $(STAMP)
 	$(BIN)/snakefmt --check Snakefile workflow/
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q $(FAST_WORKERS)
-	$(BIN)/python -m pytest -q -m slow $(SLOW_WORKERS)
-	$(BIN)/python -m pytest -q -m "workflow or slurm" $(WORKFLOW_WORKERS)
+	$(BIN)/python -m pytest -q -m "$(LONG_MARKERS)" $(LONG_WORKERS)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py

@@ -1,19 +1,21 @@
 """Fixtures shared by the workflow suites: one build of the test config (helpers.py holds the
 functions that copy the project and run the workflow).
 
-`make test` runs the `workflow` and `slurm` markers in one pytest session on two xdist workers
-with ``--dist loadgroup``. Every test that reads the build of the test config (the ``built``
-fixture, directly or through another fixture) is put in one xdist group, ``built``, so one
-worker builds the test config once and runs all of them in turn, while the other worker runs
-the suites that build their own copies (rebuild scope, faults, sweeps, degenerate and escape
-studies), each test on whichever worker is free. A module whose module-scoped fixture is a
-build of its own (test_rebuild_scope.py) puts its tests in one group itself
-(``pytest.mark.xdist_group``), so that build is made on one worker only; the cheap
-module-scoped copies (test_config_errors.py's ``copy_dir``) are made once per worker, and
-their tests spread over both. Without ``--dist loadgroup`` (plain ``-n 2``, or no xdist) the
-groups are inert and ``built`` is still built once per session.
+`make test` runs the `slow`, `workflow` and `slurm` markers in one pytest session on two xdist
+workers with ``--dist loadgroup`` (xdist hands out the largest group first, then the rest one
+test at a time to whichever worker is free). Every test that reads the build of the test config
+(the ``built`` fixture, directly or through another fixture) is put in one xdist group,
+``built``, so one worker builds the test config once and runs all of them in turn, while the
+other worker runs the suites that build their own copies (rebuild scope, faults, sweeps,
+degenerate and escape studies) and the slow tests, each test on whichever worker is free. A
+module whose module-scoped fixture is a build of its own (test_rebuild_scope.py) puts its tests
+in one group itself (``pytest.mark.xdist_group``), so that build is made on one worker only;
+the cheap module-scoped copies (test_config_errors.py's ``copy_dir``) are made once per worker,
+and their tests spread over both. Without ``--dist loadgroup`` (plain ``-n 2``, or no xdist)
+the groups are inert and ``built`` is still built once per session.
 The numba cache lives beside the installed (editable) package, so every build in every copy
-reuses the kernels compiled by the first.
+reuses the kernels compiled by the first; a copy that imports the package from its own sources
+(test_rebuild_scope.py) gets that cache copied (helpers.copy_kernel_cache).
 """
 from _pytest.nodeid import coerce_node_id
 import pytest
@@ -53,3 +55,62 @@ def built(tmp_path_factory):
     workdir = make_workdir(tmp_path_factory.mktemp("built"))
     snakemake(workdir)
     return workdir
+
+
+# --- CPU seconds per test (`--cpu-durations=N`): the measure of a test's cost on a shared
+# machine, where wall times (`--durations`) follow the load. A phase's CPU time is that of
+# the worker's process and of every child it waited for (the snakemake builds and their jobs;
+# not SLURM's jobs, run by slurmd). Reported by the controller of an xdist session too.
+
+def pytest_addoption(parser):
+    parser.addoption("--cpu-durations", type=int, default=None, metavar="N",
+                     help="show the N tests of most CPU seconds, setup + call + teardown, "
+                          "children included (0: all)")
+
+
+def _cpu_seconds():
+    import os
+
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    if item.config.getoption("cpu_durations") is None:
+        yield
+        return
+    item.stash[_CPU_START] = _cpu_seconds()
+    yield
+
+
+_CPU_START = pytest.StashKey[float]()
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    outcome = yield
+    if item.config.getoption("cpu_durations") is None or _CPU_START not in item.stash:
+        return
+    now = _cpu_seconds()
+    report = outcome.get_result()
+    report.user_properties.append(("cpu_seconds", now - item.stash[_CPU_START]))
+    item.stash[_CPU_START] = now
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    count = config.getoption("cpu_durations")
+    if count is None or getattr(config, "workerinput", None) is not None:
+        return
+    per_test, total = {}, 0.0
+    for reports in terminalreporter.stats.values():
+        for report in reports:
+            for key, value in getattr(report, "user_properties", ()):
+                if key == "cpu_seconds":
+                    per_test[report.nodeid] = per_test.get(report.nodeid, 0.0) + value
+                    total += value
+    rows = sorted(per_test.items(), key=lambda kv: -kv[1])
+    terminalreporter.write_sep("=", f"CPU seconds per test (children included): "
+                                    f"{total:.1f} in all, {len(rows)} tests")
+    for nodeid, seconds in rows[:count or None]:
+        terminalreporter.write_line(f"{seconds:9.2f}  {nodeid}")

@@ -16,7 +16,7 @@ import sys
 import pytest
 import yaml
 
-from helpers import copy_tree
+from helpers import copy_kernel_cache, copy_tree
 
 #: one xdist worker for the module (`make test` runs it with --dist loadgroup): `repo` is a
 #: whole build of the test config, made once
@@ -72,8 +72,10 @@ def scheduled(repo):
 
 @pytest.fixture(scope="module")
 def repo(tmp_path_factory):
-    """A git repository holding the working tree, with the test config built."""
+    """A git repository holding the working tree, with the test config built (with the kernels
+    the session has compiled: numba's cache is not in git, and no case runs a kernel edited)."""
     repo = copy_tree(tmp_path_factory.mktemp("rebuild"))
+    copy_kernel_cache(repo)
     _git(repo, "init", "-q")
     _git(repo, "add", "-A")
     _git(repo, "commit", "-qm", "base")

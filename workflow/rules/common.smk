@@ -22,6 +22,7 @@ from vibroimpact.pipeline.study import (
     attractor_rows,
     grid_values,
     orbit_rows,
+    plane_attractor_rows,
 )
 from vibroimpact.reports import arguments
 
@@ -354,5 +355,21 @@ def attractor_runtime_min(wildcards):
     cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(
         grid_values(entry["attractors"]["delta"])
     )
+    cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
+    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)
+
+
+def plane_attractor_tiles(wildcards):
+    """The attractor tiles of plane study ``{study}``."""
+    _, n = plane_attractor_rows(config["studies"][wildcards.study])
+    return [f"results/cells/{wildcards.study}/attractors/{t}.nc" for t in range(n)]
+
+
+def plane_attractor_runtime_min(wildcards):
+    """Minutes of a plane study's attractor tile: its cells' starts at the cost model's CPU
+    time each, with the simulate jobs' margin and floor."""
+    entry = config["studies"][wildcards.study]
+    rows, n_tiles = plane_attractor_rows(entry)
+    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(grid_values(entry[entry["plane"][1]]))
     cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
     return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)

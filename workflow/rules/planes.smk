@@ -1,26 +1,8 @@
 # A plane study's basins and Lyapunov exponents (its `attractors` block): tiles over the
 # plane's first axis, solved as jobs; joining them is cheap: run where Snakemake runs.
-from vibroimpact.pipeline.study import plane_attractor_rows
-
-
+# (Their input and runtime functions are in common.smk.)
 localrules:
     aggregate_plane_attractors,
-
-
-def plane_attractor_tiles(wildcards):
-    """The attractor tiles of plane study ``{study}``."""
-    _, n = plane_attractor_rows(config["studies"][wildcards.study])
-    return [f"results/cells/{wildcards.study}/attractors/{t}.nc" for t in range(n)]
-
-
-def plane_attractor_runtime_min(wildcards):
-    """Minutes of a plane study's attractor tile: its cells' starts at the cost model's CPU
-    time each, with the simulate jobs' margin and floor."""
-    entry = config["studies"][wildcards.study]
-    rows, n_tiles = plane_attractor_rows(entry)
-    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(grid_values(entry[entry["plane"][1]]))
-    cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
-    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)
 
 
 rule solve_plane_attractor_tile:
