@@ -385,7 +385,7 @@ CASES = [
             transient: 100.0
             figures: [fig13]
             report_with: [motion_map]
-        """, "limits.max_jobs", "this build has 24 jobs"),
+        """, "limits.max_jobs", "this build has 25 jobs"),
     _own("replace_names_no_entry", """
         paper: false
         replace: [studies.random]

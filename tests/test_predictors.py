@@ -196,3 +196,43 @@ def test_resampled_ranks_are_scipys_average_ranks_bit_for_bit():
         idx = rng.integers(0, n, size=(30, n))
         np.testing.assert_array_equal(_resample_ranks(_codes(x), idx),
                                       rankdata(x[idx], axis=-1))
+
+
+def _same(a, b):
+    """Two lists of Correlation equal field by field, NaN equal to NaN."""
+    assert len(a) == len(b)
+    for x, y in zip(a, b):
+        assert (x.predictor, x.motion, x.where, x.n_cells, x.note) == (
+            y.predictor, y.motion, y.where, y.n_cells, y.note)
+        for field in ("rho", "low", "high"):
+            u, v = getattr(x, field), getattr(y, field)
+            assert (np.isnan(u) and np.isnan(v)) or u == v, (x, y)
+
+
+def test_the_predictors_job_writes_what_the_reports_read_back_value_for_value(tmp_path):
+    """Rule map_predictors (`tasks.map_predictors`) computes the correlations once; the
+    reports read them from its dataset (`notebook.predictors`): the same Correlation list,
+    bit for bit, its rows not computed (NaN, with the reason) included, in the same order."""
+    from vibroimpact.pipeline import tasks
+    from vibroimpact.reports import notebook
+
+    x = _plane(7)
+    paths = {}
+    for name, ds in (("map", motion_map(x)), ("orbits", orbit_map(np.where(x > 0.3, x, 0))),
+                     ("basins", basins(x[::2], inv_beta=INV_BETA[::2]))):   # refused grid
+        paths[name] = tmp_path / f"{name}.nc"
+        ds.to_netcdf(paths[name])
+    out = tmp_path / "predictors.nc"
+    tasks.map_predictors(paths["map"], out, paths["orbits"], paths["basins"], None)
+    expected = predictors.predictor_correlations(
+        motion_map(x), orbit_map(np.where(x > 0.3, x, 0)), basins(x[::2], INV_BETA[::2]))
+    got = notebook.predictors(str(out))
+    _same(got, expected)
+    assert any(np.isnan(c.rho) and "not used: the basin grid" in c.note for c in got)
+    assert any(np.isfinite(c.rho) for c in got)
+    assert predictors.predictors_table(got).equals(predictors.predictors_table(expected))
+    assert notebook.predictors("") is None
+    ds = xr.load_dataset(out)
+    assert ds.attrs["n_resamples"] == predictors.N_RESAMPLES and "git_commit" in ds.attrs
+    with pytest.raises(ValueError, match="not a predictors dataset: no variable note"):
+        predictors.read_correlations(ds.drop_vars("note"))

@@ -34,7 +34,9 @@ STUDY_RULES = {"simulate_events", "simulate_spectra", "simulate_trace", "aggrega
 ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits", "trace_boundaries"}
 # the basins and Lyapunov exponents run the simulator's kernel against the orbit solver's
 ATTRACTOR_RULES = {"solve_attractor_tile", "aggregate_attractors"}
-MAP_RULES = {"simulate_map", "aggregate_map"}
+# the predictors of the map's P (rule map_predictors) read the map, Fig. 16 and the attractors
+PREDICTOR_RULES = {"map_predictors"}
+MAP_RULES = {"simulate_map", "aggregate_map"} | PREDICTOR_RULES
 ESCAPE_RULES = {"simulate_escape", "aggregate_escape"}
 
 
@@ -231,7 +233,7 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
     edit("config/test.yaml", _set(("orbits", "harmonic", "delta"),
                                   {"start": -1.5, "stop": 3.0, "step": 0.5}))
     jobs = scheduled(repo)
-    assert set(jobs) == ORBIT_RULES | FIGURE_RULES | {"orbits_report"}
+    assert set(jobs) == ORBIT_RULES | PREDICTOR_RULES | FIGURE_RULES | {"orbits_report"}
     # the basins figure draws the map's stable domains; the attractors do not read its grid
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
         "fig16.png", "fig15_vs_fig16.png", "basins.png"}
@@ -240,14 +242,29 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
     jobs = scheduled(repo)
     # (the test config copies neither to a paper target; the study reports that show the
     # map over this entry read the basins and exponents as predictors of the probabilities)
-    assert set(jobs) == ATTRACTOR_RULES | {"draw_figure", "orbits_report", "study_report",
-                                           "all"}
+    assert set(jobs) == ATTRACTOR_RULES | PREDICTOR_RULES | {"draw_figure", "orbits_report",
+                                                             "study_report", "all"}
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
         "basins.png", "lyapunov.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
     edit("src/vibroimpact/orbits/kernels.py", _append_code)     # the stress sample too
-    assert set(scheduled(repo)) == (ORBIT_RULES | ATTRACTOR_RULES | FIGURE_RULES
-                                    | {"orbits_report"} | STRESS_RULES)
+    assert set(scheduled(repo)) == (ORBIT_RULES | ATTRACTOR_RULES | PREDICTOR_RULES
+                                    | FIGURE_RULES | {"orbits_report"} | STRESS_RULES)
+
+
+def test_a_predictors_edit_reruns_their_job_and_the_reports_showing_the_map(repo, edit):
+    """The predictors of P are computed once (rule map_predictors) and read by the reports
+    that show the map (the two harmonic studies' and the orbits entry's): an edit of their
+    code reruns those, nothing else (no figure, no other report)."""
+    edit("src/vibroimpact/reports/predictors.py", _append_code)
+    jobs = scheduled(repo)
+    assert jobs == {"map_predictors": {"results/datasets/motion_map_predictors.nc"},
+                    "study_report": {f"results/reports/{study}/harmonic_random.{ext}"
+                                     for study in ("harmonic", "motion_map")
+                                     for ext in ("ipynb", "html", "summary.html")},
+                    "orbits_report": {f"results/reports/orbits/harmonic/periodic_motions.{ext}"
+                                      for ext in ("ipynb", "html", "summary.html")},
+                    "all": set()}
 
 
 def test_outputs_record_the_dirty_flag(repo, edit):

@@ -103,6 +103,10 @@ def test_the_harmonic_reports_show_what_predicts_p_and_whether_it_is_markov(buil
             "datasets/motion_map_map.nc", "orbits/harmonic.nc", "orbits/harmonic_basins.nc",
             "orbits/harmonic_lyapunov.nc")))
     table = predictors.predictors_table(expected)
+    # computed once (rule map_predictors), read back by the reports value for value
+    stored = predictors.read_correlations(
+        xr.load_dataset(root / "datasets" / "motion_map_predictors.nc"))
+    assert predictors.predictors_table(stored).equals(table)
     for study in ("harmonic", "motion_map"):
         html = root / "reports" / study / "harmonic_random.html"
         cells = _predictor_cells(html)

@@ -126,7 +126,8 @@ def test_a_users_study_is_built_alone_with_the_papers_noise(workdir, tmp_path):
 
 def test_the_harmonic_reports_read_the_basins_and_exponents_of_the_map_s_orbits(workdir):
     """The map's study draws Fig. 15 over orbits entry `harmonic`, which has attractors: both
-    harmonic reports read its basins and Lyapunov exponents (the predictors of P); the
+    harmonic reports read its basins and Lyapunov exponents and the predictors of P computed
+    from them once (rule map_predictors, with the map and Fig. 16's orbit map); the
     random-force report does not."""
     targets = [f"results/reports/{s}/harmonic_random.html" for s in ("harmonic", "motion_map")]
     jobs = scheduled_jobs(workdir, *targets, "results/reports/random/random_force.html")
@@ -134,8 +135,14 @@ def test_the_harmonic_reports_read_the_basins_and_exponents_of_the_map_s_orbits(
                if j["rule"] == "study_report"}
     for study in ("harmonic", "motion_map"):
         assert {"results/orbits/harmonic_basins.nc", "results/orbits/harmonic_lyapunov.nc",
+                "results/datasets/motion_map_predictors.nc",
                 "results/figures/motion_map/residence.png"} <= reports[study], study
-    assert not any("orbits" in p for p in reports["random"])
+    assert not any("orbits" in p or "predictors" in p for p in reports["random"])
+    (predicting,) = [j for j in jobs if j["rule"] == "map_predictors"]
+    assert predicting["input"] == {"results/datasets/motion_map_map.nc",
+                                   "results/orbits/harmonic.nc",
+                                   "results/orbits/harmonic_basins.nc",
+                                   "results/orbits/harmonic_lyapunov.nc"}
 
 
 def test_residence_needs_only_the_map(workdir):

@@ -232,6 +232,12 @@ VALIDATION_FIGURES = targets.VALIDATION_FIGURES
 PYTHON = shlex.quote(sys.executable)
 
 
+def predictors_inputs(wildcards):
+    """The map of study ``{study}`` and, when it draws Fig. 15 over an orbits entry, that
+    entry's orbit map, basins and Lyapunov datasets: what its predictors are computed from."""
+    return targets.predictors_inputs(config, wildcards.study)
+
+
 def study_report_inputs(wildcards):
     """The notebook, the datasets and the figures of a study and of its ``report_with``, and
     the study's noise record (its provenance row, whether or not a figure draws it); with a

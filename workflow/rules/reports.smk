@@ -21,6 +21,32 @@ wildcard_constraints:
     vreport="performance|stability",
 
 
+# The predictors of a map's P (the bootstrap of rank correlations, the costly part of a map's
+# report) are computed once, by rule map_predictors, for every report that shows the map.
+
+
+rule map_predictors:
+    """The rank correlations of the predictors with P over study {study}'s map."""
+    input:
+        unpack(predictors_inputs),
+    output:
+        "results/datasets/{study}_predictors.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/map_predictors/{study}.log",
+    benchmark:
+        "results/benchmarks/map_predictors/{study}.tsv"
+    threads: 1
+    resources:
+        mem_mb=BASE_MEM_MB + 300,
+        runtime=10,
+    params:
+        code=script_code("map_predictors"),
+    script:
+        "../scripts/map_predictors.py"
+
+
 REPORT_SHELL = (
     'tmp=$(mktemp -d "$(dirname {output.ipynb})/.report.XXXXXX"); '
     "trap 'rm -rf \"$tmp\"' EXIT; "

@@ -15,7 +15,7 @@ from vibroimpact.reports.arguments import study_report_kind
 
 __all__ = ["DATASETS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
            "paper_figure_source", "study_datasets", "attractor_datasets",
-           "study_report_inputs", "maps_over", "orbits_report_inputs",
+           "predictors_inputs", "study_report_inputs", "maps_over", "orbits_report_inputs",
            "validation_report_inputs", "sweep_inputs", "sweep_targets", "validation_targets",
            "report_targets", "all_targets", "needed_files", "rule_inputs"]
 
@@ -27,6 +27,8 @@ DATASETS = {
     "events": "results/datasets/{name}_events.nc",
     "map": "results/datasets/{name}_map.nc",
     "escape": "results/datasets/{name}_escape.nc",
+    # the rank correlations of the predictors with a map's P (the reports that show the map)
+    "predictors": "results/datasets/{name}_predictors.nc",
     "orbits": "results/orbits/{name}.nc",
     "boundaries": "results/orbits/{name}_boundaries.nc",
     "basins": "results/orbits/{name}_basins.nc",
@@ -106,6 +108,25 @@ def attractor_datasets(config, name):
     return {kind: DATASETS[kind].format(name=orbits) for kind in ("basins", "lyapunov")}
 
 
+def predictors_inputs(config, name):
+    """``{map, orbits, basins, lyapunov: path}`` the predictors of study ``name``'s map are
+    computed from (rule ``map_predictors``): its map and, when it draws Fig. 15 over an
+    orbits entry (``fig15_vs_fig16``), that entry's orbit map and its
+    :func:`attractor_datasets`; the datasets it has not are left out."""
+    entry = config["studies"][name]
+    inputs = {"map": DATASETS["map"].format(name=name)}
+    if "fig15_vs_fig16" in figure_names(entry):
+        orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
+        inputs["orbits"] = DATASETS["orbits"].format(name=orbits)
+    return {**inputs, **attractor_datasets(config, name)}
+
+
+def _predictors_of(map_path):
+    """The predictors dataset of the study whose map is ``map_path``."""
+    name = map_path[len("results/datasets/"):-len("_map.nc")]
+    return DATASETS["predictors"].format(name=name)
+
+
 def study_report_inputs(config, study, report=None):
     """The notebook, the datasets and the figures of study ``study`` and of its
     ``report_with``, and its noise record (its provenance row, whether or not a figure draws
@@ -124,6 +145,10 @@ def study_report_inputs(config, study, report=None):
             inputs.setdefault(dataset, path)
         shown += [f"results/figures/{name}/{f}.png"
                   for f in figures.figure_targets(config["studies"][name])]
+    # the predictors of the map's P, computed once for every report that shows the map (the
+    # harmonic report reads them; the random-force report has no such table)
+    if "map" in inputs and kind == "harmonic_random":
+        inputs["predictors"] = _predictors_of(inputs["map"])
     return {**inputs, "figures": shown}
 
 
@@ -147,6 +172,7 @@ def orbits_report_inputs(config, drawn, name):
                           for f in figures.figure_targets(entry)]}
     for path in maps_over(config, drawn, name):
         inputs["map"] = path
+        inputs["predictors"] = _predictors_of(path)
     if "fig16" in figures.figure_targets(entry):
         inputs["boundaries"] = DATASETS["boundaries"].format(name=name)
     if entry.get("attractors"):
@@ -245,6 +271,9 @@ def rule_inputs(config, drawn, path):
         return _flat(orbits_report_inputs(config, drawn, parts[3]))
     if parts[:2] == ["results", "reports"]:
         return _flat(study_report_inputs(config, parts[2], parts[3].rsplit(".", 1)[0]))
+    if path.startswith("results/datasets/") and path.endswith("_predictors.nc"):
+        return _flat(predictors_inputs(config, path[len("results/datasets/"):
+                                                    -len("_predictors.nc")]))
     if path.startswith("results/orbits/") and path.endswith("_boundaries.nc"):
         return [path[:-len("_boundaries.nc")] + ".nc"]
     return []

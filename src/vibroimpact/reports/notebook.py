@@ -741,14 +741,17 @@ def _styled(table, names, caption=None):
     return styler.set_caption(caption) if caption else styler
 
 
-def predictors(motion_map, orbits=None, basins=None, lyapunov=None):
-    """The rank correlations of each candidate predictor with each motion's P
-    (:func:`vibroimpact.reports.predictors.predictor_correlations`), or None without a map."""
-    if motion_map is None:
+def predictors(path):
+    """The rank correlations of each candidate predictor with each motion's P, read from
+    the map's predictors dataset (``results/datasets/{study}_predictors.nc``, rule
+    ``map_predictors``: :func:`vibroimpact.reports.predictors.predictor_correlations`
+    computed once for every report that shows the map), or None for an empty path (no
+    map)."""
+    if not path:
         return None
-    from vibroimpact.reports.predictors import predictor_correlations
+    from vibroimpact.reports.predictors import read_correlations
 
-    return predictor_correlations(motion_map, orbits, basins, lyapunov)
+    return read_correlations(open_dataset(path))
 
 
 def show_predictors(correlations):

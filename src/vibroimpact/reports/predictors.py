@@ -40,7 +40,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["PREDICTORS", "SEED", "N_RESAMPLES", "MIN_CELLS", "Correlation", "on_map_grid",
-           "rank_correlation", "predictor_correlations", "predictors_table"]
+           "rank_correlation", "predictor_correlations", "correlations_dataset",
+           "read_correlations", "predictors_table"]
 
 #: The candidates, in the table's order, with what each is.
 PREDICTORS = {
@@ -347,6 +348,71 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
                                                          n, note)
     return [found[predictor, m, where] for predictor in PREDICTORS for m in motions
             for where in ("domain", "plane")]
+
+
+_FIELDS = ("rho", "low", "high", "n_cells", "note")
+
+
+def correlations_dataset(correlations):
+    """The correlations of :func:`predictor_correlations` as an ``xarray.Dataset`` of dims
+    (predictor, motion, where): ``rho``, ``low``, ``high`` (float64, NaN when not computed),
+    ``n_cells`` and ``note`` (:class:`Correlation`'s fields). What the map's predictors job
+    writes (``results/datasets/{study}_predictors.nc``) and :func:`read_correlations` reads
+    back, value for value."""
+    import xarray as xr
+
+    correlations = list(correlations)
+    motions = list(dict.fromkeys(c.motion for c in correlations))
+    wheres = ["domain", "plane"]
+    shape = (len(PREDICTORS), len(motions), len(wheres))
+    values = {"rho": np.full(shape, np.nan), "low": np.full(shape, np.nan),
+              "high": np.full(shape, np.nan), "n_cells": np.zeros(shape, np.int64),
+              "note": np.full(shape, "", dtype=object)}
+    seen = np.zeros(shape, bool)
+    for c in correlations:
+        at = (list(PREDICTORS).index(c.predictor), motions.index(c.motion),
+              wheres.index(c.where))
+        seen[at] = True
+        for field in _FIELDS:
+            values[field][at] = getattr(c, field)
+    if not seen.all():
+        raise ValueError(f"correlations: {int((~seen).sum())} of the (predictor, motion, "
+                         "where) rows missing; predictor_correlations gives every one")
+    dims = ("predictor", "motion", "where")
+    ds = xr.Dataset({name: (dims, array) for name, array in values.items()},
+                    coords={"predictor": list(PREDICTORS), "motion": motions,
+                            "where": wheres})
+    ds["rho"].attrs["long_name"] = "Spearman's rank correlation of the predictor with P"
+    ds["low"].attrs["long_name"] = "95 % bootstrap interval, lower end"
+    ds["high"].attrs["long_name"] = "95 % bootstrap interval, upper end"
+    ds["n_cells"].attrs["long_name"] = "cells correlated"
+    ds["note"].attrs["long_name"] = "why rho is not computed (empty when it is)"
+    ds["predictor"].attrs["long_name"] = "; ".join(f"{k}: {v}" for k, v in PREDICTORS.items())
+    ds["where"].attrs["long_name"] = "domain: the motion's stable domain; plane: every cell"
+    ds.attrs.update(seed=SEED, n_resamples=N_RESAMPLES)
+    return ds
+
+
+def read_correlations(ds):
+    """The list of :class:`Correlation` a :func:`correlations_dataset` holds, in
+    :func:`predictor_correlations`' order (per predictor, per motion, domain then plane)."""
+    missing = [name for name in _FIELDS if name not in ds]
+    if missing:
+        raise ValueError(f"not a predictors dataset: no variable {', '.join(missing)}")
+    ds = ds.transpose("predictor", "motion", "where")
+    arrays = {name: ds[name].values for name in _FIELDS}
+    out = []
+    for i, predictor in enumerate(ds["predictor"].values):
+        for j, motion in enumerate(ds["motion"].values):
+            for k, where in enumerate(ds["where"].values):
+                note = arrays["note"][i, j, k]
+                out.append(Correlation(str(predictor), str(motion), str(where),
+                                       float(arrays["rho"][i, j, k]),
+                                       float(arrays["low"][i, j, k]),
+                                       float(arrays["high"][i, j, k]),
+                                       int(arrays["n_cells"][i, j, k]),
+                                       "" if note is None else str(note)))
+    return out
 
 
 def _rho_text(c):

@@ -12,7 +12,7 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "orbit_plane_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
-           "work_precision_cpu_s", "stress_cpu_s"]
+           "work_precision_cpu_s", "stress_cpu_s", "predictors_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 #: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
@@ -62,14 +62,22 @@ FIGURE_S = 0.9
 #: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
 #: files' cpu_time, a fresh clone's `make`).
 REPORT_S = 0.3
-#: What a report that shows a map adds (``nb.predictors``: the predictors' bootstrap over the
-#: map's cells, 24 of 1,000 resamples; ``nb.markov_summary``; ``nb.map_agreement``): the three
-#: default reports that show the map (the motion_map and harmonic studies' and the orbits
-#: entry's, each computing the same predictors) took 5.56, 5.37 and 4.55 CPU-s at 15acb54;
-#: the predictors' shared bootstrap (issue 37) takes 0.68-0.71 of that (the jobs' process
-#: trees' CPU, this tree against a13f0b3, best of 3, `benchmarks/job_costs.py --jobs --only
-#: report`): ~3.6 CPU-s a job, 2.3 of it the map's.
-MAP_REPORT_S = 2.3
+#: What a report that shows a map adds (``nb.predictors``, now reading the predictors'
+#: dataset of rule ``map_predictors``; ``nb.markov_summary``; ``nb.map_agreement`` with its
+#: import of matplotlib): the three default reports that show the map (the motion_map and
+#: harmonic studies' and the orbits entry's) took 5.56, 5.37 and 4.55 CPU-s at 15acb54, ~3.6
+#: after the predictors' shared bootstrap (r37), and 0.65-0.74 of that once they read the
+#: predictors' dataset (r37b: the jobs' process trees' CPU against 6d7e783, best of 3,
+#: `benchmarks/job_costs.py --jobs --only report`, load 4-6): 2.9-3.9 CPU-s a job; their
+#: benchmark files' cpu_time in a build, 2.6-3.9. ~2.9 a job, 1.6 of it the map's.
+MAP_REPORT_S = 1.6
+#: The predictors of a map's P (rule ``map_predictors``: `reports.predictors`' bootstrap, 1,000
+#: resamples of the cells for each motion's P and its four predictors, in the stable domain
+#: and over the plane), per map cell and motion, besides the job's start-up: 2.0-2.3 CPU-s on
+#: the default map (5,187 cells, 3 motions; its benchmark file in a build, and forced alone
+#: 3 times by `benchmarks/job_costs.py --jobs --only map_predictors`, load ~4), 1.2 of it
+#: besides `JOB_START_S`.
+PREDICTORS_CELL_S = 7.5e-5
 #: The rule writing each validation dataset (``results/validation/<name>.nc``).
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
@@ -243,6 +251,12 @@ def orbit_plane_cpu_s(entry, cells):
 def attractor_cpu_s(cells, n_starts):
     """CPU seconds of the attractor map's ``n_starts`` starts in each of ``cells`` cells."""
     return cells * n_starts * US_PER_START * 1e-6
+
+
+def predictors_cpu_s(cells, motions):
+    """CPU seconds of a map's predictors job (rule ``map_predictors``) besides its start-up:
+    ``cells`` of the map, ``motions`` of its P."""
+    return PREDICTORS_CELL_S * cells * motions
 
 
 def boundaries_cpu_s(types):

@@ -173,7 +173,7 @@ def _time(s):
     return f"{s:.2g} s"
 
 
-_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace", "plane_basins")
+_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace", "plane_basins", "predictors")
 _ORBIT_KINDS = ("orbits", "boundaries", "basins", "lyapunov")
 
 
@@ -184,7 +184,7 @@ def built_entries(config, own=None):
     all``'s targets through the rules' own input functions): ``{"noises": names, "studies":
     {name: kinds}, "orbits": {name: kinds}, "figures": {owner: count}, "sweeps": names,
     "copies": count, "reports": count, "map_reports": count, "validation": files}``
-    (``map_reports``: the reports that read a map dataset, whose predictors they compute)."""
+    (``map_reports``: the reports that read a map dataset, with its predictors' dataset)."""
     sections = ("studies", "orbits", "paper_figures")
     drawn = {s: set(config.get(s, {})) if own is None else set(own[s]) for s in sections}
     for fig in drawn["paper_figures"]:
@@ -197,7 +197,8 @@ def built_entries(config, own=None):
         kinds = {k for k in _STUDY_KINDS if targets.DATASETS[k].format(name=name) in needed}
         if kinds:
             build["studies"][name] = kinds
-            if kinds - {"escape", "plane_basins"}:  # escape, attractors: no record file
+            # escape, attractors, predictors: no record file
+            if kinds - {"escape", "plane_basins", "predictors"}:
                 build["noises"].add(config["studies"][name]["noise"])
     for name in config.get("orbits", {}):
         kinds = {k for k in _ORBIT_KINDS if targets.DATASETS[k].format(name=name) in needed}
@@ -321,6 +322,12 @@ def make_plan(config, own=None, *, results="results", studies=None):
                  + 2 * FILE_OVERHEAD, costs.attractor_cpu_s(a_cells, n_starts))
             parts.append(f"attractors over ({', '.join(study.plane)}) {_n(a_cells, 'cell')} x "
                          f"{_n(n_starts, 'start')}")
+        if "predictors" in needs:          # rule map_predictors: the map's bootstrap, once
+            cells, motions = len(study.cells("events")), len(entry["motions"])
+            row.bytes += FILE_OVERHEAD
+            _charge(row, "map_predictors", 1,
+                    costs.predictors_cpu_s(cells, motions) + JOB_START_S)
+            parts.append("predictors of P")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
             _add(row, 0, 0, 40 * steps + FILE_OVERHEAD, 0.0)
