@@ -24,8 +24,10 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 #: step), per step on top of NS_PER_STEP. CPU ns measured by benchmarks/bench_audit.py (1e6
 #: steps, zeta 0.05, eps 0.5, band-limited rms 0.5, dt 0.1; shared 2-core node under load):
 #: 5-10 for delta >= 1, ~20 at 0.5, ~40 at 0, 80-105 at -0.5, ~26 at -1 (0.3-0.85 x the
-#: simulation's own cost); a mean over the sweep's cells, most of them beyond delta = 1.
-NS_PER_AUDIT_STEP = 25.0
+#: simulation's own cost); a mean over the sweep's cells, most of them beyond delta = 1: the
+#: default config's five events jobs measured 33.1 CPU-s against 41.3 planned with 25 ns
+#: (`python benchmarks/issue37.py --peer a13f0b3`, idle 2-core node, 2026-11-27), 14 ns fits.
+NS_PER_AUDIT_STEP = 14.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 #: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
@@ -43,9 +45,11 @@ MAP_CAP_FRACTION = 0.34
 #: (`plane_map_cpu_s`), whose short caps it dominates; the paper's map keeps the model its
 #: README numbers were measured with (its cells are 15-100 times longer).
 MAP_CELL_S = 0.010
-#: The boundary curves of one (m/n) type: 6.2 CPU-s for the default entry's 5 types, start-up
-#: included (its benchmark file at 15acb54, a fresh clone's `make`).
-BOUNDARIES_S = 1.0
+#: The boundary curves of one (m/n) type: 2.7 CPU-s for the default entry's 5 types, start-up
+#: (JOB_START_S) included, with the kernels compiled at installation (its benchmark file in
+#: `python benchmarks/issue37.py --peer a13f0b3`, 2026-11-27, idle 2-core node; 6.2 CPU-s at
+#: 15acb54, when the job compiled them).
+BOUNDARIES_S = 0.35
 #: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
 #: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
 #: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
