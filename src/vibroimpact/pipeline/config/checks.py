@@ -556,6 +556,20 @@ _AXIS_BOUNDS = {
 PLANE_FIGURES = ("fig15", "residence", "basins", "lyapunov", "escape_vs_noise", "fig10")
 
 
+
+def _axis_grid(problems, where, spec, max_cells, bounds):
+    """The values of a plane's axis ``spec`` (a list or {start, stop, step}) within
+    ``bounds`` (``(test, allowed)``), or None with the problem recorded."""
+    values = _grid(problems, where, spec, max_cells)
+    if values is None:
+        return None
+    test, allowed = bounds
+    bad = [float(v) for v in values if not test(float(v))]
+    if bad:
+        problems.add(where, spec, f"holds {_num(bad[0])}", allowed)
+        return None
+    return values
+
 def _check_plane_study(config, name, entry, problems, limits, unforced):
     """The checks of a study with a ``plane``: its two axes are grids of values in their
     bounds, every other parameter a number, only map figures (Fig. 16 not over a noise
@@ -579,14 +593,9 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
                          f"plane that does not name {key}")
             ok = False
             continue
-        values = _grid(problems, f"{where}.{key}", spec, limits["max_cells"])
+        values = _axis_grid(problems, f"{where}.{key}", spec, limits["max_cells"],
+                            _AXIS_BOUNDS[key])
         if values is None:
-            ok = False
-            continue
-        test, allowed_ = _AXIS_BOUNDS[key]
-        bad = [float(v) for v in values if not test(float(v))]
-        if bad:
-            problems.add(f"{where}.{key}", spec, f"holds {_num(bad[0])}", allowed_)
             ok = False
             continue
         grids[key] = values
@@ -928,14 +937,9 @@ def _check_orbits_plane(where, entry, problems, limits):
                          "a grid (a list or {start, stop, step})")
             ok = False
             continue
-        values = _grid(problems, f"{where}.{key}", spec, limits["max_orbit_cells"])
+        values = _axis_grid(problems, f"{where}.{key}", spec, limits["max_orbit_cells"],
+                            _ORBIT_AXIS_BOUNDS[key])
         if values is None:
-            ok = False
-            continue
-        test, allowed_ = _ORBIT_AXIS_BOUNDS[key]
-        bad = [float(v) for v in values if not test(float(v))]
-        if bad:
-            problems.add(f"{where}.{key}", spec, f"holds {_num(bad[0])}", allowed_)
             ok = False
         elif values.size < 2:
             problems.add(f"{where}.{key}", spec, f"fig16 draws contours over the plane "
