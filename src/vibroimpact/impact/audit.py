@@ -300,6 +300,24 @@ def _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_x, ev_step, k_first, a, v, 
 
 
 @kernel
+def _before_onset(i, stop, onset, k_first, dt):
+    """The end of a run of free steps from ``i`` (at most ``stop``) before a sticking onset:
+    the first ``j > i`` whose midpoint ``(k_first + j) dt + dt / 2`` is not before ``onset``,
+    found from its estimate and a step or two of the same test, which is what testing each
+    step in turn from ``i + 1`` gives (the midpoints increase with ``j``) at a fraction of its
+    cost (a float product a free step: ~5 % of the audit at large delta)."""
+    estimate = (onset - 0.5 * dt) / dt - k_first
+    if not estimate < stop:         # beyond the run (or no onset: inf)
+        estimate = stop
+    j = min(max(int(math.ceil(estimate)), i + 1), stop)
+    while j > i + 1 and (k_first + j - 1) * dt + 0.5 * dt >= onset:
+        j -= 1
+    while j < stop and (k_first + j) * dt + 0.5 * dt < onset:
+        j += 1
+    return j
+
+
+@kernel
 def _free_run(a, v, r, i0, i1, k_first, dt, zeta, delta, A, beta, q, cos_phi, sin_phi, total):
     """Add ``z z^T`` of the whole free steps ``i0 .. i1 - 1`` to ``total`` (its upper
     triangle), ``z = (r0, b, y0, y0', sin psi, cos psi)`` as stats.identities.step_forms;
@@ -409,13 +427,11 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
         stop = min(n, i + BLOCK, bounds[b + 1] - k_first)
         if e < ev_t.size:
             stop = min(stop, ev_step[e])
-        j = i + 1
-        next_onset = s0[p] if p < s0.size else math.inf
-        while j < stop and (k_first + j) * dt + 0.5 * dt < next_onset:
-            j += 1
-        _free_run(a, v, r, i, j, k_first, dt, zeta, delta, A, beta, q, cos_phi, sin_phi,
+        if p < s0.size:
+            stop = _before_onset(i, stop, s0[p], k_first, dt)
+        _free_run(a, v, r, i, stop, k_first, dt, zeta, delta, A, beta, q, cos_phi, sin_phi,
                   total[b])
-        i = j
+        i = stop
     for bb in range(out.shape[1]):
         for row in range(4):
             acc = 0.0
