@@ -318,6 +318,50 @@ def _before_onset(i, stop, onset, k_first, dt):
 
 
 @kernel
+def _free_run_unforced(a, v, r, i0, i1, dt, zeta, delta, z, total):
+    """:func:`_free_run` without a harmonic force (``z = (r0, b, y0, y0')``), in two passes:
+    ``b, y0, y0'`` of every step into ``z`` (rows 1-3; elementwise, which the compiler
+    vectorizes), then the sums of their products in step order, as the one-pass loop adds
+    them (same values, same order: the same bits). ``z`` holds at least ``i1 - i0`` columns
+    (a run is at most BLOCK steps)."""
+    two_zeta = 2.0 * zeta
+    n = i1 - i0
+    rb, y0b, y1b = z[0], z[1], z[2]
+    for j in range(n):
+        i = i0 + j
+        b = (r[i + 1] - r[i]) / dt
+        rb[j] = b
+        y0b[j] = delta - a[i] - r[i] + two_zeta * b
+        y1b[j] = v[i] - b
+    s00 = s01 = s02 = s03 = s11 = s12 = s13 = s22 = s23 = s33 = 0.0
+    for j in range(n):
+        r0 = r[i0 + j]
+        b = rb[j]
+        y0 = y0b[j]
+        y1 = y1b[j]
+        s00 += r0 * r0
+        s01 += r0 * b
+        s02 += r0 * y0
+        s03 += r0 * y1
+        s11 += b * b
+        s12 += b * y0
+        s13 += b * y1
+        s22 += y0 * y0
+        s23 += y0 * y1
+        s33 += y1 * y1
+    total[0, 0] += s00
+    total[0, 1] += s01
+    total[0, 2] += s02
+    total[0, 3] += s03
+    total[1, 1] += s11
+    total[1, 2] += s12
+    total[1, 3] += s13
+    total[2, 2] += s22
+    total[2, 3] += s23
+    total[3, 3] += s33
+
+
+@kernel
 def _free_run(a, v, r, i0, i1, k_first, dt, zeta, delta, A, beta, q, cos_phi, sin_phi, total):
     """Add ``z z^T`` of the whole free steps ``i0 .. i1 - 1`` to ``total`` (its upper
     triangle), ``z = (r0, b, y0, y0', sin psi, cos psi)`` as stats.identities.step_forms;
@@ -402,6 +446,7 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
         phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
     cos_phi, sin_phi = math.cos(phi), math.sin(phi)
     total = np.zeros((out.shape[1], 6, 6))   # per batch, sum of z z^T over whole free steps
+    z = np.empty((3, BLOCK))                 # b, y0, y0' of a run's steps (no harmonic force)
     e = p = b = 0
     i = 0
     while i < n:
@@ -429,8 +474,11 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
             stop = min(stop, ev_step[e])
         if p < s0.size:
             stop = _before_onset(i, stop, s0[p], k_first, dt)
-        _free_run(a, v, r, i, stop, k_first, dt, zeta, delta, A, beta, q, cos_phi, sin_phi,
-                  total[b])
+        if A == 0.0:
+            _free_run_unforced(a, v, r, i, stop, dt, zeta, delta, z, total[b])
+        else:
+            _free_run(a, v, r, i, stop, k_first, dt, zeta, delta, A, beta, q, cos_phi,
+                      sin_phi, total[b])
         i = stop
     for bb in range(out.shape[1]):
         for row in range(4):
