@@ -420,9 +420,10 @@ class _IdentityRecord:
     """Per-batch integrals of the power balance and the virial, gathered chunk by chunk.
 
     The window runs over whole force steps, from sample ``ceil(transient / dt)`` to sample
-    ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. Each chunk
-    brings the state at its samples (``record_every=1``) and its impacts and sticking
-    phases; :func:`vibroimpact.impact.audit.audit_moments` (the compiled
+    ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. The chunks,
+    added in order, are those of one run from sample 0; each brings the state at its
+    samples (``record_every=1``) and its impacts and sticking phases;
+    :func:`vibroimpact.impact.audit.audit_moments` (the compiled
     :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly. With a second
     wall (``gap``, ``eps_lower`` in ``params``) the identities have a term per wall
     (docs/model.md, "Two walls"): the impact sums are kept per wall.
@@ -443,16 +444,20 @@ class _IdentityRecord:
         shape = (2, n_batches) if self.two else n_batches
         self.sum_u = np.zeros(shape)
         self.sum_u2 = np.zeros(shape)
+        self.k_next = 0     # the first sample of the next chunk
 
     def _batch(self, k):
         n = self.k_stop - self.k_start
         return ((k - self.k_start) * self.n_batches) // max(n, 1)
 
     def add(self, chunk):
-        # the chunk's grid holds every sample from its first, k0 (record_every=1)
-        k0 = int(round(chunk.grid_time[0] / self.dt)) if chunk.grid_time.size else 0
+        # the chunks of one run from sample 0 with every sample recorded (record_every=1):
+        # this one's first is the one after the last chunk's (its times, chunk.grid_time, are
+        # never built)
+        k0 = self.k_next
+        self.k_next += chunk.a.size
         lo = max(self.k_start, k0)
-        hi = min(self.k_stop, k0 + chunk.grid_time.size)
+        hi = min(self.k_stop, k0 + chunk.a.size)
         if hi > lo:
             keep = slice(lo - k0, hi - k0)
             r = np.asarray(self.noise[lo : hi + 1], dtype=float)
