@@ -40,7 +40,13 @@ class SimulationResult:
         plastic impact, or a start at rest on the wall).
     grid_time, a, v : ndarray of float64
         ``a(tau) = delta - x(tau)`` (the paper's displacement from the wall) and the velocity
-        ``x'(tau)`` every ``record_every`` samples; empty unless asked for.
+        ``x'(tau)`` every ``record_every`` samples; empty unless asked for. ``grid_time`` is
+        built on first use from ``grid``.
+    grid : ndarray or tuple
+        The recorded samples' times: an array, or ``(first, stride, n, dt)``, the samples
+        ``first, first + stride, ...`` (``n`` of them) at spacing ``dt`` (a chunk's: its
+        times cost a pass over the chunk that a consumer reading only ``a`` and ``v``, an
+        events cell, does not pay).
     n_steps, n_impacts, n_chatter : int
         Force sample steps taken, impacts, chatter sequences closed at their accumulation point.
     contact_time : float
@@ -98,7 +104,7 @@ class SimulationResult:
     impact_offset: np.ndarray
     stick_start: np.ndarray
     stick_end: np.ndarray
-    grid_time: np.ndarray
+    grid: object
     a: np.ndarray
     v: np.ndarray
     n_steps: int
@@ -122,6 +128,17 @@ class SimulationResult:
             if getattr(self, name) is None:
                 object.__setattr__(self, name,
                                    np.zeros(np.shape(getattr(self, like)), np.int8))
+
+    @cached_property
+    def grid_time(self) -> np.ndarray:
+        """Times of the recorded samples (see ``grid``)."""
+        if not isinstance(self.grid, tuple):
+            return self.grid
+        first, stride, n, dt = self.grid
+        # k as exact floats, then one product each: (arange(n) * stride + first) * dt
+        times = np.arange(first, first + n * stride, stride, dtype=np.float64)[:n]
+        times *= dt
+        return times
 
     # The collision fields are computed on first use (most streaming consumers group the
     # impacts of many chunks themselves) and cached; a frozen dataclass keeps a __dict__.
@@ -512,13 +529,9 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         walls = np.append(walls, np.int8(stick_open[1]))
         stick_open[0] = None
     n = int(buf.grid_n[0])
-    grid_time = np.empty(0)
-    if stride:
-        # the samples' times k dt: k as exact floats, then one product each (what
-        # (arange(n) * stride + first) * dt gives, in two passes over the chunk, not five)
-        first = ((k0 + stride - 1) // stride) * stride
-        grid_time = np.arange(first, first + n * stride, stride, dtype=np.float64)[:n]
-        grid_time *= dt
+    grid = np.empty(0)
+    if stride:      # the times of the samples recorded, built if read (SimulationResult.grid)
+        grid = (((k0 + stride - 1) // stride) * stride, stride, n, dt)
     grid_a, grid_v = buf.take_grid(n)
     return SimulationResult(
         impact_time=imp_step * dt + imp_off,
@@ -527,7 +540,7 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         impact_offset=imp_off,
         stick_start=starts,
         stick_end=ends,
-        grid_time=grid_time,
+        grid=grid,
         a=grid_a,
         v=grid_v,
         n_steps=k1 - k0 + (1 if t_chunk > k1 * dt else 0),
@@ -636,7 +649,7 @@ def concatenate_results(chunks):
         impact_time=cat("impact_time"), impact_velocity=cat("impact_velocity"),
         impact_step=cat("impact_step"), impact_offset=cat("impact_offset"),
         stick_start=cat("stick_start"), stick_end=cat("stick_end"),
-        grid_time=cat("grid_time"), a=cat("a"), v=cat("v"),
+        grid=cat("grid_time"), a=cat("a"), v=cat("v"),
         n_steps=sum(c.n_steps for c in chunks), n_impacts=sum(c.n_impacts for c in chunks),
         n_chatter=sum(c.n_chatter for c in chunks),
         contact_time=float(sum(c.contact_time for c in chunks)),
