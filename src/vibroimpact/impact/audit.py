@@ -207,7 +207,8 @@ def _add_free(out, b, s_a, L, k, x0, v0, r0, r1, dt, zeta, A, beta, xi, wi):
 
     The rule's nodes lie in pairs about the piece's middle ``h = L / 2``, so the exponentials
     at ``h +- d`` are those at ``h`` times those at ``+-d``: three calls of each of exp, cos
-    and sin for five nodes rather than five."""
+    and sin for five nodes rather than five (at ``h`` and at the two pairs' ``d``; the middle
+    node's ``d`` is 0)."""
     wd = math.sqrt(1.0 - zeta * zeta)
     slope = (r1 - r0) / dt
     p_a = r0 + slope * s_a - 2.0 * zeta * slope
@@ -233,10 +234,17 @@ def _add_free(out, b, s_a, L, k, x0, v0, r0, r1, dt, zeta, A, beta, xi, wi):
     for j in range((n + 1) // 2):
         hi = n - 1 - j
         d = h * xi[hi]                                   # >= 0: nodes h - d (j), h + d (hi)
-        ed = math.exp(-zeta * d)
-        cd, sd = math.cos(wd * d), math.sin(wd * d)
-        if A != 0.0:
-            cbd, sbd = math.cos(beta * d), math.sin(beta * d)
+        if d == 0.0:
+            # the middle node (xi = +0 exactly): what exp, cos and sin give at +-0, without
+            # their calls (a quarter of a piece's; the same bits)
+            ed, cd, sd = 1.0, 1.0, 0.0
+            if A != 0.0:
+                cbd, sbd = 1.0, 0.0
+        else:
+            ed = math.exp(-zeta * d)
+            cd, sd = math.cos(wd * d), math.sin(wd * d)
+            if A != 0.0:
+                cbd, sbd = math.cos(beta * d), math.sin(beta * d)
         for sign in (1.0, -1.0):
             node = hi if sign > 0.0 else j
             e = eh * ed if sign > 0.0 else eh / ed
