@@ -8,6 +8,7 @@ the kernel's parameter vector, streams the force record through the kernel in ch
 from dataclasses import dataclass, field
 from functools import cached_property
 import math
+import sys
 
 import numpy as np
 
@@ -290,6 +291,12 @@ def _split_steps(t_end, dt):
     return n_full, rem
 
 
+#: Recording buffers handed over to chunks that `_Buffers.take_grid` keeps to record into
+#: again once their chunks are let go: a consumer looping over the chunks still holds the
+#: last one while the next is simulated, so the one before it is the first free.
+HANDED_KEPT = 2
+
+
 class _Buffers:
     def __init__(self, n_grid):
         self.imp_step = np.empty(_BUFFER, np.int64)
@@ -303,19 +310,34 @@ class _Buffers:
         self.grid = np.empty(max(n_grid, 1))
         self.grid_v = np.empty(max(n_grid, 1))
         self.grid_n = np.zeros(1, np.int64)
+        self.handed = []        # the last buffers handed over (take_grid), oldest first
 
     def take_grid(self, n):
         """The recorded ``a`` and ``v`` (their first ``n`` values) as arrays of their own.
 
         A record filling at least half of the buffers takes the buffers themselves and the
-        next chunk records into new ones: copying 16 bytes a sample cost an events cell
+        next chunk records into others: copying 16 bytes a sample cost an events cell
         (``record_every=1``) ~2 ns a step, a fifth of its simulation. A shorter one (a chunk
         asked short with ``send``, the last) is copied, so that a kept chunk never holds
-        more than twice its record."""
+        more than twice its record.
+
+        The others are a pair handed over two chunks before (`HANDED_KEPT`) that nothing
+        refers to any more (no view of it alive: its reference count is the list's and the
+        call's alone), else new ones: a consumer that reads each chunk and lets it go (the
+        events and spectra cells) records into memory already paged in (a new 8 MB array is
+        zeroed by the system page by page, ~1 ns a step for the pair); one that keeps its
+        chunks (`simulate`) gets new buffers every time."""
         if 2 * n < self.grid.size:
             return self.grid[:n].copy(), self.grid_v[:n].copy()
         a, v = self.grid[:n], self.grid_v[:n]
-        self.grid, self.grid_v = np.empty(self.grid.size), np.empty(self.grid_v.size)
+        self.handed.append((self.grid, self.grid_v))
+        free = [i for i, pair in enumerate(self.handed[:-1])
+                if sys.getrefcount(pair[0]) == 2 and sys.getrefcount(pair[1]) == 2]
+        if free:
+            self.grid, self.grid_v = self.handed.pop(free[0])
+        else:
+            self.grid, self.grid_v = np.empty(self.grid.size), np.empty(self.grid_v.size)
+        del self.handed[:-HANDED_KEPT]
         return a, v
 
     def drain(self, parts):
