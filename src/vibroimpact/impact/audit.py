@@ -184,6 +184,24 @@ def _add_resting(out, b, s_a, L, k, r0, r1, dt, delta, A, beta, lower):
 
 
 @kernel
+def _resting_run(out, b, i, stop, k_first, r, dt, wall, A, beta, lower, end, next_onset):
+    """:func:`_add_resting` of the whole steps from ``i`` (resting) up to ``stop`` while
+    their midpoints lie before ``end`` and ``next_onset``; returns the first step left.
+    The same calls in the same order as one step at a time (the same bits), without the
+    main loop's tests between them."""
+    j = i
+    while True:
+        k = k_first + j
+        _add_resting(out, b, 0.0, dt, k, r[j], r[j + 1], dt, wall, A, beta, lower)
+        j += 1
+        if j >= stop:
+            return j
+        t_mid = (k_first + j) * dt + 0.5 * dt
+        if not (t_mid < end and t_mid < next_onset):
+            return j
+
+
+@kernel
 def _node(sig, wt, c, sn, cb, sb, r0, slope, s_a, zeta, y0, yv0, A, q, beta, sin_psi, cos_psi,
           sin_pp, cos_pp):
     """The weighted v^2, x^2, f v and x f at a node ``sig`` of a free piece, given
@@ -470,10 +488,15 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
         t_mid = k * dt + 0.5 * dt
         p = _phase_after(t_mid, s0, p)
         if p > 0 and t_mid < s1[p - 1]:
+            # a run of whole steps resting in phase p - 1: up to the next event's step, the
+            # batch's end, the phase's end or the next phase's start (where _phase_after
+            # would move on)
+            stop = min(n, bounds[b + 1] - k_first)
+            if e < ev_t.size:
+                stop = min(stop, ev_step[e])
             lower = sw[p - 1] == 1
-            _add_resting(out, b, 0.0, dt, k, r[i], r[i + 1], dt, x_lower if lower else delta,
-                         A, beta, lower)
-            i += 1
+            i = _resting_run(out, b, i, stop, k_first, r, dt, x_lower if lower else delta, A,
+                             beta, lower, s1[p - 1], s0[p] if p < s0.size else math.inf)
             continue
         # a run of free steps: up to the next event's step, the next sticking phase's
         # first step, the batch's end or BLOCK steps
