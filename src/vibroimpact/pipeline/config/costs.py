@@ -26,11 +26,12 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 #: benchmarks/bench_audit.py (5e5 steps, zeta 0.05, eps 0.5, band-limited rms 0.5, dt 0.1;
 #: 2-core node, load ~7): 4-5 at delta 3, ~9 at 0.5, ~18 at 0, ~40 at -0.5 and with the
 #: harmonic force; a mean over the sweep's cells, most of them beyond delta = 1. The default
-#: config's five events jobs measured 33.1 CPU-s at 2ec7353 (idle node) and ~27.8 after
-#: the audit's and the record's cuts of 2026-11-27 (the random study's four jobs 26.0
-#: against 31.3 CPU-s for 2ec7353's, alternated in one run, load 3.5-6.5; the harmonic job
-#: 3.2 against 3.4): 5 s of start-up and 7.26e8 steps at 25 + 6.5 ns.
-NS_PER_AUDIT_STEP = 6.5
+#: config's five events jobs measured 33.1 CPU-s at 2ec7353 (idle node) and ~27.4 after
+#: the audit's and the record's cuts of 2026-11-27 (the random study's four jobs 25.9
+#: against 31.7 CPU-s for 2ec7353's, alternated in one run, load 6.3-7.2; the harmonic job
+#: 3.07 against 3.27; scaled by 2ec7353's idle figures): 5 s of start-up and 7.26e8 steps
+#: at 25 + 6 ns.
+NS_PER_AUDIT_STEP = 6.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 #: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
