@@ -9,7 +9,8 @@ driver's buffers. The arrays they share are laid out in :mod:`vibroimpact.impact
 import math
 
 from vibroimpact.impact._jit import kernel
-from vibroimpact.impact.events import (chatter_tail, first_contact, release_time)
+from vibroimpact.impact.events import (chatter_tail, first_contact, first_contact_inline,
+                                       release_time)
 from vibroimpact.impact.layout import (BAD_NOISE, BUFFER_FULL, C_DF0, C_F0, C_R,
                                        CNT_CHATTER, CNT_IMPACTS, CNT_STICK_EVENTS,
                                        FREE, FT_CONTACT_TIME, FT_GAP, FT_IMPACTS, FT_MODE,
@@ -331,7 +332,7 @@ def _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_ste
             v = 0.0
             at_wall = True
             continue
-        code, sig, u, gH = first_contact(c, P, Hs, at_wall)
+        code, sig, u, gH = first_contact_inline(c, P, Hs, at_wall)
         if code == NO_ROOT:
             return gH + delta, u, FREE, OK
         if code == PRESSED:
@@ -506,6 +507,8 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 continue
             x = w
             v = wv
+            sx = 0.0
+            cx = 1.0
             if has_h:
                 if k != k_exact:
                     theta_x = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta)
@@ -559,15 +562,12 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             break
         if lower is None:
             # one wall: its own step, compiled without any of the second wall's logic
-            if has_h and (mode == FREE or k == k_exact):
-                # sx, cx: sin, cos of theta_x - phi from libm at sample k
-                x, v, mode, status = _slow_step_one(
-                    k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-                    stk_kind, cnt, ftot, theta_x, sx, cx, True)
-            else:
-                x, v, mode, status = _slow_step_one(
-                    k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
-                    stk_kind, cnt, ftot, 0.0, 0.0, 1.0, False)
+            # with a harmonic force, sx, cx are sin, cos of theta_x - phi from libm at sample
+            # k in mode FREE (just computed) and at k_exact
+            exact = has_h and (mode == FREE or k == k_exact)
+            x, v, mode, status = _slow_step_one(
+                k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+                stk_kind, cnt, ftot, theta_x, sx, cx, exact)
         else:
             x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off,
                                            imp_u, stk_step, stk_off, stk_kind, cnt, ftot)
