@@ -117,7 +117,23 @@ Issue 37, session 38 (branch k38): where the kernel's time per collision goes, a
   order, ~500 w^2, so the tail waits for w ~ 1e-5 under CHATTER_TIME_TOL = 1e-7; see k37's
   notes above), which moves bits of every later event. Not attempted in this session (no
   proved bracket), so the map's floor stays ~1 impact at ~340 ns + 4 rebounds at ~340 ns.
-MEASURED_K38
+- Measured 2026-11-27 08:40-09:00 UTC on branch k38 against 2ec7353 (shared machine, load
+  average 2.9-7 on 2 cores; other helpers' jobs and this branch's tests running):
+  ``--kernel 1 --rounds 1 --peer 2ec7353`` (all 5187 cells, 1.42e9 steps, 7.95e7 resolved
+  impacts, 1.59e7 collisions): run_steps 31.10 CPU-s against 34.51 (0.90 x), 391 against
+  434 ns per resolved impact, 1960 against 2175 ns per collision (free steps included),
+  the event digests equal (bit for bit on the whole map). ``--kernel 8 --rounds 3``: best
+  3.905 against 4.286 CPU-s (0.91 x), medians 3.964 / 4.429, digests equal.
+  ``--split 8`` (one process, this tree and 2ec7353 in turn, twice, load 3.8): kernel 3.92 and
+  4.02 s against 4.41 and 4.36 s; less the free steps 336 / 349 ns per resolved impact
+  against 390 / 381, 1692 / 1761 ns per collision against 1965 / 1924; the whole cells 7.48 /
+  7.55 CPU-s against 8.02 / 7.87 (the statistics, 2.3 s, and hops' pressed flights, 0.75 s,
+  unchanged). ``--stride 4 --no-main --peer 2ec7353`` (1297 cells, 2 processes, load 2.9-3.9):
+  cell CPU 13.66 against 14.08 s (0.97 x), walls 39.78 / 37.45 s (fresh caches: compilation
+  included), max |dP| 0; the step without impact 3.96 ns against the prototype's 4.48
+  (0.88 x). ``ab_kernels.py --base 2ec7353 --quick`` (load 3.9-5.6): simulate at delta = -0.5
+  (random force only: the inlining, not the phase reuse) 0.947 x CPU best, 0.949 x median;
+  delta = +0.5 0.974 / 0.988; periodic_orbits 1.009 / 0.970 (not touched).
 
 Usage::
 
