@@ -70,16 +70,30 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
     in that frame, and every free flight also searches the other wall's first contact (in
     its own frame, from a point off it), the earlier of the two ending the flight.
     """
+    return _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step,
+                      stk_off, stk_kind, cnt, ftot, 0.0, 0.0, 1.0, False)
+
+
+@kernel
+def _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+               stk_kind, cnt, ftot, theta0, sp0, cp0, exact):
+    """:func:`slow_step`, handed what :func:`run_steps` already computed at sample ``k``
+    (``theta0, sp0, cp0, exact`` as in :func:`_slow_step_one`). Both walls' frames share the
+    harmonic phase (the lower half of ``P`` differs in ``A``, ``A q``, ``eps`` and ``delta``
+    only), so an event's sin and cos serve the segment in both frames."""
     delta = P[P_DELTA]
     two = P.shape[0] > N_PARAMS
-    theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
+    if exact:
+        theta_k = theta0
+    else:
+        theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
     s = 0.0
     n_events = 0
     side = 1 if (mode == WALL_LO or mode == STUCK_LO) else 0
     if mode == WALL or mode == WALL_LO:
         # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
         if P[P_A] != 0.0:
-            v += P[P_AQ] * P[P_BETA] * math.cos(theta_k - P[P_PHI])
+            v += P[P_AQ] * P[P_BETA] * (cp0 if exact else math.cos(theta_k - P[P_PHI]))
         mode = FREE
     elif mode == STUCK_LO:
         mode = STUCK
@@ -118,7 +132,18 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         Pw = P[N_PARAMS:] if side == 1 else P
         sg = -1.0 if side == 1 else 1.0
         eps = Pw[P_EPS]
-        c = segment(sg * x, sg * v, s, sg * r0, sg * b, theta_k, Pw)
+        # sin, cos of the harmonic phase at s, as segment computes them (the same in both
+        # frames): at the step's start with ``exact`` the ones run_steps holds
+        if P[P_AQ] != 0.0:
+            if exact and n_events == 1:
+                sps, cps = sp0, cp0
+            else:
+                psi0 = theta_k + P[P_BETA] * s - P[P_PHI]
+                sps = math.sin(psi0)
+                cps = math.cos(psi0)
+        else:
+            sps, cps = 0.0, 1.0
+        c = segment_at(sg * x, sg * v, s, sg * r0, sg * b, sps, cps, Pw)
         vf = sg * v
         Hs = H - s
         if just_hit and vf < 0.0 and c[C_F0] > 0.0:
@@ -186,7 +211,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             # the other wall, seen from off it: the earlier contact ends the flight
             o = 1 - side
             Po = P[N_PARAMS:] if o == 1 else P
-            co = segment(-sg * x, -sg * v, s, -sg * r0, -sg * b, theta_k, Po)
+            co = segment_at(-sg * x, -sg * v, s, -sg * r0, -sg * b, sps, cps, Po)
             code2, sig2, u2, gH2 = first_contact(co, Po, Hs, False)
             if code2 != NO_ROOT and (code == NO_ROOT or sig2 < sig):
                 side, sg, Pw, c = o, -sg, Po, co
@@ -569,8 +594,10 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
                 stk_kind, cnt, ftot, theta_x, sx, cx, exact)
         else:
-            x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off,
-                                           imp_u, stk_step, stk_off, stk_kind, cnt, ftot)
+            exact = has_h and (mode == FREE or k == k_exact)
+            x, v, mode, status = _slow_step(
+                k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+                stk_kind, cnt, ftot, theta_x, sx, cx, exact)
         if status != OK:
             return status, k
         if has_h:
