@@ -134,6 +134,12 @@ Issue 37, session 38 (branch k38): where the kernel's time per collision goes, a
   (0.88 x). ``ab_kernels.py --base 2ec7353 --quick`` (load 3.9-5.6): simulate at delta = -0.5
   (random force only: the inlining, not the phase reuse) 0.947 x CPU best, 0.949 x median;
   delta = +0.5 0.974 / 0.988; periodic_orbits 1.009 / 0.970 (not touched).
+- The generic step (two walls: the clearance map and studies) got the same hand-over, and one
+  sin/cos pair per event now serves both walls' frames (the lower half of ``P`` shares the
+  harmonic phase): 20 two-wall simulate calls (gaps 0.6-2, random, harmonic plus random,
+  plastic, partial last step; 3.95e5 impacts), two alternations at 09:03 UTC (load 6):
+  0.54 / 0.54 CPU-s against 0.57 / 0.58 for 2ec7353, event digests equal;
+  ``kernel_identity.py`` now holds three two-wall cases too (IDENTICAL against 2ec7353).
 
 Usage::
 
