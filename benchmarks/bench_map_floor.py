@@ -123,7 +123,8 @@ Issue 37, session 38 (branch k38): where the kernel's time per collision goes, a
   impacts, 1.59e7 collisions): run_steps 31.10 CPU-s against 34.51 (0.90 x), 391 against
   434 ns per resolved impact, 1960 against 2175 ns per collision (free steps included),
   the event digests equal (bit for bit on the whole map). ``--kernel 8 --rounds 3``: best
-  3.905 against 4.286 CPU-s (0.91 x), medians 3.964 / 4.429, digests equal.
+  3.905 against 4.286 CPU-s (0.91 x), medians 3.964 / 4.429, digests equal; again after
+  merging main at 09:12 UTC (load 8): 3.826 against 4.190 (0.91 x), digests equal.
   ``--split 8`` (one process, this tree and 2ec7353 in turn, twice, load 3.8): kernel 3.92 and
   4.02 s against 4.41 and 4.36 s; less the free steps 336 / 349 ns per resolved impact
   against 390 / 381, 1692 / 1761 ns per collision against 1965 / 1924; the whole cells 7.48 /
