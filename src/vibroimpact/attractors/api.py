@@ -103,8 +103,9 @@ def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf):
     n_stable = np.zeros((nt, nb, nd), np.int64)
     oph, ou, oz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     lnmu = np.full(shape[:4], np.nan)
-    ak.cell_orbits(inv_beta, delta, types, float(zeta), float(eps), n_stable, oph, ou, oz,
-                   lnmu, float(clearance))
+    with numba.parallel_chunksize(1):       # blocks handed out as threads come free
+        ak.cell_orbits(inv_beta, delta, types, float(zeta), float(eps), n_stable, oph, ou,
+                       oz, lnmu, float(clearance), min(nb * nd, 8 * numba.get_num_threads()))
     return n_stable, oph, ou, oz, lnmu
 
 
@@ -387,11 +388,12 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
     outf = np.empty((n, ak.N_F))
     outi = np.empty((n, ak.N_I), np.int64)
     n_blocks = min(n, 8 * numba.get_num_threads())
-    ak.run_starts(cell_beta, cell_delta, cell_of, th, x0, vv, float(zeta), float(eps),
-                  float(clearance), float(eps if eps_lower is None else eps_lower),
-                  float(max_time), float(match_tol), types, np.ascontiguousarray(orb_n),
-                  oph.reshape(shape), ou.reshape(shape), oz.reshape(shape), n_blocks, outf,
-                  outi)
+    with numba.parallel_chunksize(1):       # blocks handed out as threads come free
+        ak.run_starts(cell_beta, cell_delta, cell_of, th, x0, vv, float(zeta), float(eps),
+                      float(clearance), float(eps if eps_lower is None else eps_lower),
+                      float(max_time), float(match_tol), types, np.ascontiguousarray(orb_n),
+                      oph.reshape(shape), ou.reshape(shape), oz.reshape(shape), n_blocks,
+                      outf, outi)
     t_c = time.perf_counter()
     return {"outf": outf, "outi": outi, "n_stable": n_stable, "lnmu": lnmu, "theta": th,
             "x0": x0, "v0": vv, "cell_of": cell_of, "unit": u,

@@ -112,10 +112,12 @@ def orbit_floor(y, m, z, beta, delta, zeta, eps, stack):
     return -worst
 
 
-@kernel
+@kernel(parallel=True)
 def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z, orb_lnmu,
-                clearance):
-    """The stable admissible solver orbits of every cell and type (parallel over cells).
+                clearance, n_blocks):
+    """The stable admissible solver orbits of every cell and type, in ``n_blocks`` parallel
+    blocks, block ``b`` taking the cells ``b, b + n_blocks, ...`` (the cost grows with beta
+    along the rows: contiguous blocks would leave a thread idle at the end).
 
     As :func:`vibroimpact.periodic_orbits`: ``solve_type`` with the same scan steps, admissible
     when ``orbit_margin >= -ADMISSIBLE_TOL``, stable when ``lam_of(T) < 1``; with a finite
@@ -126,44 +128,54 @@ def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb
     """
     nb = inv_beta.shape[0]
     nd = deltas.shape[0]
-    for c in prange(nb * nd):
-        ib = c // nd
-        idd = c % nd
-        beta = 1.0 / inv_beta[ib]
-        delta = deltas[idd]
-        tf = 2.0 * math.pi / beta
-        stack = np.empty((FLIGHT_STACK, 2))
-        tmat = np.empty((2, 2))
-        for t in range(types.shape[0]):
-            m = types[t, 0]
-            n = types[t, 1]
-            z = n * tf
-            sols = np.empty((MAX_SOLUTIONS, 2 * m + 1))
-            seeds = np.empty((1, 2 * m + 1))
-            step = SCAN_STEP_M2 if m == 2 else SCAN_STEP_M3
-            cnt = solve_type(m, n, beta, delta, zeta, eps, seeds, 0, step, sols)
-            ns = 0
-            for s in range(cnt):
-                y = sols[s, :2 * m]
-                if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
-                    continue
-                if clearance < np.inf and (orbit_floor(y, m, z, beta, delta, zeta, eps, stack)
-                                           < delta - clearance + ADMISSIBLE_TOL):
-                    continue
-                monodromy(y, m, z, beta, delta, zeta, eps, tmat)
-                lam = lam_of(tmat, m)
-                if not lam < 1.0:
-                    continue
-                if ns < K_ORBITS:
-                    for j in range(m):
-                        ph = y[j] / tf
-                        orb_ph[ib, idd, t, ns, j] = ph - math.floor(ph)
-                        orb_u[ib, idd, t, ns, j] = y[m + j]
-                        nxt = y[j + 1] if j + 1 < m else y[0] + z
-                        orb_z[ib, idd, t, ns, j] = nxt - y[j]
-                    orb_lnmu[ib, idd, t, ns] = m * math.log(lam)
-                ns += 1
-            n_stable[t, ib, idd] = ns
+    for blk in prange(n_blocks):
+        for c in range(blk, nb * nd, n_blocks):
+            _cell_orbits(c, inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u,
+                         orb_z, orb_lnmu, clearance)
+
+
+@kernel
+def _cell_orbits(c, inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z,
+                 orb_lnmu, clearance):
+    """Cell ``c = ib nd + id`` of :func:`cell_orbits`."""
+    nd = deltas.shape[0]
+    ib = c // nd
+    idd = c % nd
+    beta = 1.0 / inv_beta[ib]
+    delta = deltas[idd]
+    tf = 2.0 * math.pi / beta
+    stack = np.empty((FLIGHT_STACK, 2))
+    tmat = np.empty((2, 2))
+    for t in range(types.shape[0]):
+        m = types[t, 0]
+        n = types[t, 1]
+        z = n * tf
+        sols = np.empty((MAX_SOLUTIONS, 2 * m + 1))
+        seeds = np.empty((1, 2 * m + 1))
+        step = SCAN_STEP_M2 if m == 2 else SCAN_STEP_M3
+        cnt = solve_type(m, n, beta, delta, zeta, eps, seeds, 0, step, sols)
+        ns = 0
+        for s in range(cnt):
+            y = sols[s, :2 * m]
+            if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
+                continue
+            if clearance < np.inf and (orbit_floor(y, m, z, beta, delta, zeta, eps, stack)
+                                       < delta - clearance + ADMISSIBLE_TOL):
+                continue
+            monodromy(y, m, z, beta, delta, zeta, eps, tmat)
+            lam = lam_of(tmat, m)
+            if not lam < 1.0:
+                continue
+            if ns < K_ORBITS:
+                for j in range(m):
+                    ph = y[j] / tf
+                    orb_ph[ib, idd, t, ns, j] = ph - math.floor(ph)
+                    orb_u[ib, idd, t, ns, j] = y[m + j]
+                    nxt = y[j + 1] if j + 1 < m else y[0] + z
+                    orb_z[ib, idd, t, ns, j] = nxt - y[j]
+                orb_lnmu[ib, idd, t, ns] = m * math.log(lam)
+            ns += 1
+        n_stable[t, ib, idd] = ns
 
 
 @kernel
