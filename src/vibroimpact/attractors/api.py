@@ -103,9 +103,10 @@ def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf):
     n_stable = np.zeros((nt, nb, nd), np.int64)
     oph, ou, oz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     lnmu = np.full(shape[:4], np.nan)
-    with numba.parallel_chunksize(1):       # blocks handed out as threads come free
+    rows = np.argsort(-inv_beta, kind="stable")      # the costliest rows first
+    with numba.parallel_chunksize(1):       # rows handed out as threads come free
         ak.cell_orbits(inv_beta, delta, types, float(zeta), float(eps), n_stable, oph, ou,
-                       oz, lnmu, float(clearance), min(nb * nd, 8 * numba.get_num_threads()))
+                       oz, lnmu, float(clearance), rows)
     return n_stable, oph, ou, oz, lnmu
 
 

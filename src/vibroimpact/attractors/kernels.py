@@ -33,9 +33,15 @@ from vibroimpact.impact.motion import phase, two_prod
 from vibroimpact.impact.stepping import run_steps
 from vibroimpact.impact.tolerances import STEP_HEADROOM
 from vibroimpact.orbits import _jit as _orbits_jit
-from vibroimpact.orbits.flight import flight_max, lam_of, monodromy, orbit_margin, propagator
+from vibroimpact.orbits.flight import (flight_max, harmonic_constants, lam_of, monodromy,
+                                      orbit_margin, propagator)
+from vibroimpact.orbits.intervals import _fill_interval_system, _start_from_intervals
+from vibroimpact.orbits.linalg import _cofactors
+from vibroimpact.orbits.newton import N_WORK
+from vibroimpact.orbits.scan_m3 import _bilinear_root
 from vibroimpact.orbits.solve import solve_type
-from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, MAX_SOLUTIONS,
+from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, M3_CIRCLE_NEAR,
+                                           M3_MIN_NODES, M3_NODE_OFFSET, MAX_SOLUTIONS,
                                            SCAN_STEP_M2, SCAN_STEP_M3)
 
 #: Stamped with this file and every kernel module of the orbit solver and the simulator that
@@ -114,10 +120,10 @@ def orbit_floor(y, m, z, beta, delta, zeta, eps, stack):
 
 @kernel(parallel=True)
 def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z, orb_lnmu,
-                clearance, n_blocks):
-    """The stable admissible solver orbits of every cell and type, in ``n_blocks`` parallel
-    blocks, block ``b`` taking the cells ``b, b + n_blocks, ...`` (the cost grows with beta
-    along the rows: contiguous blocks would leave a thread idle at the end).
+                clearance, rows):
+    """The stable admissible solver orbits of every cell and type, in parallel over the
+    1/beta rows, taken in the order ``rows`` (the costliest first: the m = 3 scan grows with
+    1/beta, so that the last rows to finish are the cheap ones).
 
     As :func:`vibroimpact.periodic_orbits`: ``solve_type`` with the same scan steps, admissible
     when ``orbit_margin >= -ADMISSIBLE_TOL``, stable when ``lam_of(T) < 1``; with a finite
@@ -125,57 +131,173 @@ def cell_orbits(inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb
     that the orbit is one of the two-wall oscillator, with the same multipliers. Per orbit:
     ``orb_ph`` the impact phases ``(tau_j mod T_f) / T_f``, ``orb_u`` the approach velocities,
     ``orb_z`` the interval from impact j to j + 1, ``orb_lnmu`` ``ln max|mu|``.
+
+    An m = 3 type is solved as ``solve_type`` does it (``_scan_m3``, no seeds) with the scan's
+    node values that do not depend on delta (``det K`` and the null vector of K at fixed
+    intervals) computed once per row (:func:`_m3_nodes`) and shared by its cells
+    (:func:`_m3_cell`): the same operations on the same numbers, bit for bit.
     """
-    nb = inv_beta.shape[0]
     nd = deltas.shape[0]
-    for blk in prange(n_blocks):
-        for c in range(blk, nb * nd, n_blocks):
-            _cell_orbits(c, inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u,
-                         orb_z, orb_lnmu, clearance)
+    for r in prange(rows.shape[0]):
+        ib = rows[r]
+        beta = 1.0 / inv_beta[ib]
+        stack = np.empty((FLIGHT_STACK, 2))
+        tmat = np.empty((2, 2))
+        for t in range(types.shape[0]):
+            m = types[t, 0]
+            n = types[t, 1]
+            sols = np.empty((MAX_SOLUTIONS, 2 * m + 1))
+            seeds = np.empty((1, 2 * m + 1))
+            step = SCAN_STEP_M2 if m == 2 else SCAN_STEP_M3
+            if m == 3:
+                wd = harmonic_constants(beta, zeta)[0]
+                npt = max(M3_MIN_NODES,
+                          int(math.ceil(2.0 * math.pi * n / beta * max(beta, wd) / step)))
+                f1 = np.empty((npt + 1, npt + 1))
+                hyp = np.empty((npt + 1, npt + 1))
+                wt = np.empty((npt + 1, npt + 1))
+                _m3_nodes(n, beta, zeta, eps, npt, f1, hyp, wt)
+            else:
+                f1 = hyp = wt = np.empty((0, 0))
+            for idd in range(nd):
+                delta = deltas[idd]
+                if m == 3:
+                    cnt = _m3_cell(n, beta, delta, zeta, eps, f1, hyp, wt, sols)
+                else:
+                    cnt = solve_type(m, n, beta, delta, zeta, eps, seeds, 0, step, sols)
+                _keep_stable(cnt, sols, m, n, beta, delta, zeta, eps, clearance, stack, tmat,
+                             t, ib, idd, n_stable, orb_ph, orb_u, orb_z, orb_lnmu)
 
 
 @kernel
-def _cell_orbits(c, inv_beta, deltas, types, zeta, eps, n_stable, orb_ph, orb_u, orb_z,
-                 orb_lnmu, clearance):
-    """Cell ``c = ib nd + id`` of :func:`cell_orbits`."""
-    nd = deltas.shape[0]
-    ib = c // nd
-    idd = c % nd
-    beta = 1.0 / inv_beta[ib]
-    delta = deltas[idd]
+def _m3_nodes(n, beta, zeta, eps, npt, f1, hyp, wt):
+    """The node values of ``vibroimpact.orbits.scan_m3._scan_m3`` that do not depend on
+    delta, on its ``npt`` grid: ``f1`` (normalised ``det K``), and of the null vector ``w`` of
+    rows 1-5, ``hyp = |w_SC|`` and ``wt = w_t`` (what its ``_circle_factors`` reads). The
+    same statements as there (K does not involve delta: ``_fill_interval_system`` ignores it).
+    """
+    wd, q, phi = harmonic_constants(beta, zeta)
+    z = 2.0 * math.pi * n / beta
+    m = 3
+    nn = 2 * m
+    ncol = m + 3
+    kmat = np.empty((nn, ncol))
+    sub = np.empty((nn, ncol))
+    nvec = np.empty(ncol)
+    zs = np.empty(m)
+    hz = z / npt
+    for i in range(npt + 1):
+        for k in range(npt + 1 - i):
+            zs[0] = (i + M3_NODE_OFFSET) * hz
+            zs[1] = (k + M3_NODE_OFFSET) * hz
+            zs[2] = z - zs[0] - zs[1]
+            _fill_interval_system(zs, m, beta, 0.0, zeta, eps, wd, kmat)
+            _cofactors(kmat, 1, ncol, sub, nvec)
+            det = 0.0
+            cn = 0.0
+            rn = 0.0
+            for c in range(ncol):
+                det += kmat[0, c] * nvec[c]
+                cn += nvec[c] * nvec[c]
+                rn += kmat[0, c] * kmat[0, c]
+            norm = math.sqrt(cn * rn)
+            f1[i, k] = det / norm if norm > 0.0 else 0.0
+            hyp[i, k] = math.hypot(nvec[0], nvec[1])
+            wt[i, k] = nvec[ncol - 1]
+
+
+@kernel
+def _circle_at(hyp, wt, delta, q):
+    """``vibroimpact.orbits.intervals._circle_factors`` from ``|w_SC|`` and ``w_t``."""
+    r = abs(delta) * hyp
+    t = q * wt
+    if delta < 0.0:
+        r = -r
+    norm = math.hypot(r, t)
+    if norm == 0.0:
+        return 0.0, 0.0
+    return (t - r) / norm, (t + r) / norm
+
+
+@kernel
+def _m3_cell(n, beta, delta, zeta, eps, f1, hyp, wt, sols):
+    """``solve_type(3, n, ...)`` without seeds (``_scan_m3``'s second pass) on the node
+    values of :func:`_m3_nodes`; returns the count of solutions in ``sols``."""
+    wd, q, phi = harmonic_constants(beta, zeta)
+    z = 2.0 * math.pi * n / beta
+    m = 3
+    nn = 2 * m
+    ncol = m + 3
+    npt = f1.shape[0] - 1
+    hz = z / npt
+    count = 0
+    work = np.empty((N_WORK, nn))
+    jac = np.empty((nn, nn))
+    y = np.empty(nn)
+    kmat = np.empty((nn, ncol))
+    sub = np.empty((nn, ncol))
+    nvec = np.empty(ncol)
+    zs = np.empty(m)
+    f2 = np.empty((2, npt + 1, npt + 1))
+    for i in range(npt + 1):
+        for k in range(npt + 1 - i):
+            f2[0, i, k], f2[1, i, k] = _circle_at(hyp[i, k], wt[i, k], delta, q)
+    for i in range(npt):
+        for k in range(npt - i):
+            a00, a10, a01 = f1[i, k], f1[i + 1, k], f1[i, k + 1]
+            a11 = f1[i + 1, k + 1] if i + k + 2 <= npt else a10 + a01 - a00
+            if min(min(a00, a10), min(a01, a11)) > 0.0 or max(max(a00, a10), max(a01, a11)) < 0.0:
+                continue
+            for f in range(2):
+                b00, b10, b01 = f2[f, i, k], f2[f, i + 1, k], f2[f, i, k + 1]
+                b11 = f2[f, i + 1, k + 1] if i + k + 2 <= npt else b10 + b01 - b00
+                lo2 = min(min(b00, b10), min(b01, b11))
+                hi2 = max(max(b00, b10), max(b01, b11))
+                if (lo2 > 0.0 or hi2 < 0.0) and min(abs(lo2), abs(hi2)) > M3_CIRCLE_NEAR:
+                    continue
+                ok_, si, ti = _bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11)
+                if not ok_:
+                    continue
+                zs[0] = (i + M3_NODE_OFFSET + si) * hz
+                zs[1] = (k + M3_NODE_OFFSET + ti) * hz
+                zs[2] = z - zs[0] - zs[1]
+                if zs[0] <= 0.0 or zs[1] <= 0.0 or zs[2] <= 0.0:
+                    continue
+                count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps,
+                                              1.0 if f == 0 else -1.0, kmat, sub, nvec, y,
+                                              sols, count, work, jac)
+    return count
+
+
+@kernel
+def _keep_stable(cnt, sols, m, n, beta, delta, zeta, eps, clearance, stack, tmat, t, ib, idd,
+                 n_stable, orb_ph, orb_u, orb_z, orb_lnmu):
+    """The stable admissible ones of the ``cnt`` solutions of type ``t`` at cell ``(ib,
+    idd)`` into the arrays of :func:`cell_orbits`."""
     tf = 2.0 * math.pi / beta
-    stack = np.empty((FLIGHT_STACK, 2))
-    tmat = np.empty((2, 2))
-    for t in range(types.shape[0]):
-        m = types[t, 0]
-        n = types[t, 1]
-        z = n * tf
-        sols = np.empty((MAX_SOLUTIONS, 2 * m + 1))
-        seeds = np.empty((1, 2 * m + 1))
-        step = SCAN_STEP_M2 if m == 2 else SCAN_STEP_M3
-        cnt = solve_type(m, n, beta, delta, zeta, eps, seeds, 0, step, sols)
-        ns = 0
-        for s in range(cnt):
-            y = sols[s, :2 * m]
-            if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
-                continue
-            if clearance < np.inf and (orbit_floor(y, m, z, beta, delta, zeta, eps, stack)
-                                       < delta - clearance + ADMISSIBLE_TOL):
-                continue
-            monodromy(y, m, z, beta, delta, zeta, eps, tmat)
-            lam = lam_of(tmat, m)
-            if not lam < 1.0:
-                continue
-            if ns < K_ORBITS:
-                for j in range(m):
-                    ph = y[j] / tf
-                    orb_ph[ib, idd, t, ns, j] = ph - math.floor(ph)
-                    orb_u[ib, idd, t, ns, j] = y[m + j]
-                    nxt = y[j + 1] if j + 1 < m else y[0] + z
-                    orb_z[ib, idd, t, ns, j] = nxt - y[j]
-                orb_lnmu[ib, idd, t, ns] = m * math.log(lam)
-            ns += 1
-        n_stable[t, ib, idd] = ns
+    z = n * tf
+    ns = 0
+    for s in range(cnt):
+        y = sols[s, :2 * m]
+        if orbit_margin(y, m, z, beta, delta, zeta, eps, stack) < -ADMISSIBLE_TOL:
+            continue
+        if clearance < np.inf and (orbit_floor(y, m, z, beta, delta, zeta, eps, stack)
+                                   < delta - clearance + ADMISSIBLE_TOL):
+            continue
+        monodromy(y, m, z, beta, delta, zeta, eps, tmat)
+        lam = lam_of(tmat, m)
+        if not lam < 1.0:
+            continue
+        if ns < K_ORBITS:
+            for j in range(m):
+                ph = y[j] / tf
+                orb_ph[ib, idd, t, ns, j] = ph - math.floor(ph)
+                orb_u[ib, idd, t, ns, j] = y[m + j]
+                nxt = y[j + 1] if j + 1 < m else y[0] + z
+                orb_z[ib, idd, t, ns, j] = nxt - y[j]
+            orb_lnmu[ib, idd, t, ns] = m * math.log(lam)
+        ns += 1
+    n_stable[t, ib, idd] = ns
 
 
 @kernel
