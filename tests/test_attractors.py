@@ -351,3 +351,30 @@ def test_a_cell_does_not_depend_on_the_rows_it_is_solved_with():
             np.testing.assert_array_equal(part[key], value[..., sel, :], err_msg=key)
         compared += 1
     assert compared >= 10
+
+
+@pytest.mark.parametrize("inv_beta, n", [(3.0, 1), (1.0, 1), (0.6, 2)])
+def test_shared_m3_scan_is_the_solvers_bit_for_bit(inv_beta, n):
+    """`cell_orbits` computes the m = 3 scan's node values that do not involve delta once per
+    1/beta row (`kernels._m3_nodes`) and finishes each cell from them (`kernels._m3_cell`):
+    its solutions must be `solve_type`'s (the orbit solver's own m = 3 path), every bit of
+    every row, across a row of plays on which solutions exist."""
+    from vibroimpact.orbits.flight import harmonic_constants
+    from vibroimpact.orbits.solve import solve_type
+    from vibroimpact.orbits.tolerances import M3_MIN_NODES, MAX_SOLUTIONS, SCAN_STEP_M3
+
+    beta = 1.0 / inv_beta
+    wd = harmonic_constants(beta, ZETA)[0]
+    npt = max(M3_MIN_NODES,
+              math.ceil(2.0 * math.pi * n / beta * max(beta, wd) / SCAN_STEP_M3))
+    f1, hyp, wt = (np.empty((npt + 1, npt + 1)) for _ in range(3))
+    ak._m3_nodes(n, beta, ZETA, EPS, npt, f1, hyp, wt)
+    found = 0
+    for delta in np.linspace(-1.5, 3.0, 19):
+        mine, theirs = np.empty((MAX_SOLUTIONS, 7)), np.empty((MAX_SOLUTIONS, 7))
+        count = ak._m3_cell(n, beta, delta, ZETA, EPS, f1, hyp, wt, mine)
+        assert count == solve_type(3, n, beta, delta, ZETA, EPS, np.empty((1, 7)), 0,
+                                   SCAN_STEP_M3, theirs)
+        assert np.array_equal(mine[:count].view(np.int64), theirs[:count].view(np.int64))
+        found += count
+    assert found >= 5
