@@ -388,7 +388,7 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
     n = th.size
     outf = np.empty((n, ak.N_F))
     outi = np.empty((n, ak.N_I), np.int64)
-    n_blocks = min(n, 8 * numba.get_num_threads())
+    n_blocks = min(n, 32 * numba.get_num_threads())     # the last block to finish is short
     with numba.parallel_chunksize(1):       # blocks handed out as threads come free
         ak.run_starts(cell_beta, cell_delta, cell_of, th, x0, vv, float(zeta), float(eps),
                       float(clearance), float(eps if eps_lower is None else eps_lower),
