@@ -3,10 +3,11 @@
 #
 # Rebuild scope (README, "What reruns"): each rule's params carry only the config block it
 # reads and the digest of the code its script runs (`provenance.code_digest`: the import
-# closure of the script, docstrings and comments left out), so Snakemake's params trigger
-# reruns exactly the jobs an edit touches, committed or not. Provenance (version, commit,
-# dirty flag, config digest, seed) is written by the jobs at run time, never passed through
-# params (a commit alone must not rerun anything).
+# closure of the script, docstrings and comments left out; kept between runs by
+# `digest_cache`), so Snakemake's params trigger reruns exactly the jobs an edit touches,
+# committed or not. Provenance (version, commit, dirty flag, config digest, seed) is written
+# by the jobs at run time, never passed through params (a commit alone must not rerun
+# anything).
 from pathlib import Path
 import math
 import shlex
@@ -15,7 +16,7 @@ from types import SimpleNamespace
 
 from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
-from vibroimpact.pipeline.provenance import code_digest
+from vibroimpact.pipeline.digest_cache import cached_code_digest
 from vibroimpact.pipeline.study import (
     JOB_KEYS,
     ORBIT_JOB_KEYS,
@@ -48,9 +49,15 @@ wildcard_constraints:
 STUDIES = PLAN.studies
 
 
+# the digests of the last runs, by the bytes of the package and the script (each Snakemake
+# start would parse the whole package again: 2.3 CPU-s, three times a `make`)
+CODE_DIGESTS = Path(workflow.basedir, ".snakemake", "vibroimpact-code-digests.json")
+
+
 def script_code(rule):
     """The code digest of ``workflow/scripts/<rule>.py``: what its job runs."""
-    return code_digest(Path(workflow.basedir, "workflow", "scripts", f"{rule}.py"))
+    script = Path(workflow.basedir, "workflow", "scripts", f"{rule}.py")
+    return cached_code_digest(script, CODE_DIGESTS)
 
 
 # --- config blocks --------------------------------------------------------------------------
@@ -266,7 +273,7 @@ def _report_notebook(wildcards):
 def report_code(wildcards):
     """The code digest of the report's notebook: what its import lines reach."""
     notebook = Path(workflow.basedir, "notebooks", f"{_report_notebook(wildcards)}.ipynb")
-    return code_digest(notebook)
+    return cached_code_digest(notebook, CODE_DIGESTS)
 
 
 def report_arguments(wildcards, input):
