@@ -14,7 +14,7 @@ import shlex
 import sys
 from types import SimpleNamespace
 
-from vibroimpact.pipeline import figures, targets
+from vibroimpact.pipeline import figures, forked, targets
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.digest_cache import cached_code_digest
 from vibroimpact.pipeline.study import (
@@ -54,10 +54,18 @@ STUDIES = PLAN.studies
 CODE_DIGESTS = Path(workflow.basedir, ".snakemake", "vibroimpact-code-digests.json")
 
 
+SCRIPTS = Path(workflow.basedir, "workflow", "scripts")
+
+
 def script_code(rule):
     """The code digest of ``workflow/scripts/<rule>.py``: what its job runs."""
-    script = Path(workflow.basedir, "workflow", "scripts", f"{rule}.py")
-    return cached_code_digest(script, CODE_DIGESTS)
+    return cached_code_digest(SCRIPTS / f"{rule}.py", CODE_DIGESTS)
+
+
+def script_job(input, output, params, wildcards, log):
+    """What a script run by `forked.run_script` finds as ``snakemake`` (a ``run:`` rule has
+    no such object): the job's files, params and wildcards."""
+    return SimpleNamespace(input=input, output=output, params=params, wildcards=wildcards, log=log)
 
 
 # --- config blocks --------------------------------------------------------------------------
