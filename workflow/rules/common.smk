@@ -68,6 +68,17 @@ def script_job(input, output, params, wildcards, log):
     return SimpleNamespace(input=input, output=output, params=params, wildcards=wildcards, log=log)
 
 
+# --- Priorities ------------------------------------------------------------------------------
+# Of the ready jobs Snakemake starts those of highest `priority:` first (its scheduler weighs
+# priority before core load). The heads of the build's longest chains carry one: the noise
+# records (every simulation reads one) 3; the map's tiles, the attractor and orbit tiles and
+# the orbits' join, and the work-precision run (it holds every core, and a figure and a
+# report wait on it) 2; the events tiles, the map's join, its predictors and the boundaries
+# 1; figures, reports and the rest 0. Replayed on the job times of a default build (2ec7353,
+# 2 cores, 270 core-s held), the build ends at 139 s (136-143) over 200 random orders of the
+# jobs of equal priority, against 142 s (136-150) with no priorities.
+
+
 # --- config blocks --------------------------------------------------------------------------
 
 
