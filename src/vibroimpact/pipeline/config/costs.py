@@ -61,6 +61,13 @@ SHOOTING_CELL_S = 0.135
 #: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
 #: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
 FIGURE_S = 0.9
+#: The start-up of a figure job (draw_figure, draw_validation_figure): a fork of Snakemake's
+#: process, which imported the plotting modules and drew one small figure once
+#: (`pipeline.forked`, ~1.2 CPU-s in that process, in no job's benchmark file); the fork
+#: and its first writes to shared pages. fig03 forked: 0.78 CPU-s against 1.49 in a process
+#: of its own, load ~2; the default build's 19 figures 28.2 CPU-s against 43.6 (benchmark
+#: files of `bench_make.py --make --peer 2ec7353`, load 6-7).
+FIGURE_JOB_START_S = 0.05
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
 #: twice (nbconvert) in one job, besides its start-up: the reports that show no map
 #: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
