@@ -183,3 +183,21 @@ def test_an_unreadable_or_unwritable_cache_is_a_miss_not_an_error(package):
     (tmp_path / "a_file").write_text("")               # its folder cannot be made
     assert _cached(tmp_path, root, tmp_path / "a_file" / "digests.json") == expected
     assert not (tmp_path / "a_file").is_dir()
+
+
+def test_the_installation_keeps_the_digest_of_every_script(tmp_path):
+    """`python -m vibroimpact.pipeline.digest_cache` (make's installation step): the digest
+    of each workflow script and notebook of the project, as the rules compute it."""
+    from vibroimpact.pipeline import digest_cache
+
+    scripts = tmp_path / "workflow" / "scripts"
+    scripts.mkdir(parents=True)
+    (scripts / "draw.py").write_text("from vibroimpact.pipeline import tasks\n")
+    (scripts / "noise.py").write_text("from vibroimpact import stats\n")
+    digest_cache._TABLES.clear()
+    digest_cache.main(tmp_path)
+    kept = json.loads((tmp_path / ".snakemake" / "vibroimpact-code-digests.json").read_text())
+    provenance._graph.cache_clear()
+    provenance.code_digest.cache_clear()
+    assert sorted(kept.values()) == sorted(provenance.code_digest(scripts / name)
+                                           for name in ("draw.py", "noise.py"))

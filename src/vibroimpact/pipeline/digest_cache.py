@@ -77,3 +77,21 @@ def cached_code_digest(script, cache_file, package_dir=PACKAGE_DIR):
     except OSError:
         pass        # a read-only project: the digest stands, it is only not kept
     return value
+
+
+def main(root="."):
+    """``python -m vibroimpact.pipeline.digest_cache``: keep the digests of every workflow
+    script and report notebook of project ``root`` (what `make`'s installation step runs, so
+    that a first build's Snakemake start finds them)."""
+    root = Path(root).resolve()
+    cache = root / ".snakemake" / "vibroimpact-code-digests.json"
+    sources = [*sorted((root / "workflow" / "scripts").glob("*.py")),
+               *sorted((root / "notebooks").glob("*.ipynb"))]
+    for script in sources:
+        cached_code_digest(script, cache)
+    print(f"vibroimpact: code digests of {len(sources)} scripts and notebooks kept in "
+          f"{cache.relative_to(root)}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:2])
