@@ -207,3 +207,85 @@ def test_the_defaults_are_the_references():
     assert tally.DEFAULT_REBOUND_FLOOR == stats.DEFAULT_REBOUND_FLOOR
     assert tally.DEFAULT_MOTION_WINDOW == stats.DEFAULT_MOTION_WINDOW
     assert tally.DEFAULT_MOTIONS == tuple(stats.DEFAULT_MOTIONS)
+
+
+@pytest.mark.parametrize("rule", stats.RULES)
+def test_the_collision_firsts_are_the_groupings_fields(rule):
+    """`tally.collision_firsts` (what the map's cell groups with) returns the `first` and
+    `stuck` of `stats.group_collisions(...).after(t0)` and the impacts' instants, to the bit,
+    with one wall and two."""
+    for res, pressed, walls, _ in records():
+        kw = dict(dt=DT, eps=0.5, floor=0.01, pressed=pressed, rule=rule)
+        wall = np.zeros(res.impact_step.size, np.int8)
+        eps = np.full(wall.size, 0.5)
+        if walls:
+            kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
+                      eps_lower=walls["eps_lower"])
+            wall = res.impact_wall
+            eps = np.where(wall == 1, walls["eps_lower"], 0.5)
+        for t0 in (0.0, 200.0, 1e9):
+            ref = stats.group_collisions(res.impact_step, res.impact_offset,
+                                         res.impact_velocity, res.stick_start, res.stick_end,
+                                         **kw).after(t0)
+            first, t, stuck = tally.collision_firsts(
+                res.impact_step, res.impact_offset, res.impact_velocity, res.stick_start,
+                dt=DT, eps=eps, floor=0.01, pressed=pressed if rule == "physical"
+                else np.zeros(0, bool), rule=rule, wall=wall, after=t0)
+            if rule == "rebounds" and ref.first.size == 0:
+                assert first.size == 0
+                continue
+            assert first.tobytes() == ref.first.tobytes()
+            assert stuck.tobytes() == ref.stuck.tobytes()
+            assert t[first].tobytes() == ref.time.tobytes()
+
+
+@pytest.mark.parametrize("motions", [stats.DEFAULT_MOTIONS, ((2, 1), (1, 1), (3, 2), (1, 3))])
+def test_the_motion_tally_is_the_numpy_reference(motions):
+    """`tally.MotionTally` (the map cell's motion statistics, checked once) returns
+    `stats.motion_statistics` with ``stuck`` to the bit, and its `probabilities` the same
+    probabilities; on simulated records (one wall, two) and on none, one or two
+    collisions."""
+    cases = []
+    for res, pressed, walls, beta in records():
+        kw = dict(dt=DT, eps=0.5, pressed=pressed)
+        if walls:
+            kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
+                      eps_lower=walls["eps_lower"])
+        col = stats.group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
+                                     res.stick_start, res.stick_end, **kw).after(200.0)
+        cases += [(col, beta, bool(walls))] + [(col._select(np.arange(col.time.size) < k),
+                                                 beta, False) for k in (0, 1, 2)]
+    for col, beta, two in cases:
+        for m, w in ((motions, None), (motions + ((1, 1, 1),), col.wall)):
+            if w is not None and not two:
+                continue
+            kw = dict(window=0.1, motions=m, n_batches=20)
+            ref = stats.motion_statistics(col.time, col.intervals, beta, 200.0, 4000.0,
+                                          stuck=col.stuck, walls=w, **kw)
+            fast = tally.MotionTally(beta, walls=w is not None, **kw)
+            _same(fast.statistics(col.time, col.step, col.offset, DT, col.stuck, 200.0,
+                                  4000.0, walls=w), ref)
+            p, q = fast.probabilities(col.time, col.step, col.offset, DT, col.stuck, 3800.0,
+                                      walls=w)
+            assert p.tobytes() == ref.probability.tobytes()
+            assert q.tobytes() == ref.stick_probability.tobytes()
+
+
+def test_the_compiled_residence_statistics_are_the_numpy_reference():
+    """`tally.residence_statistics` is `stats.residence_statistics` to the bit: random
+    labelled records (one stretch, two, many; states never seen) and its refusals."""
+    rng = np.random.default_rng(17)
+    for n in (0, 1, 2, 3, 10, 500, 5000):
+        for n_states in (1, 4):
+            edges = np.concatenate([[5.0], 5.0 + np.cumsum(rng.uniform(0.0, 3.0, n + 1))])
+            states = np.minimum(rng.geometric(0.3, n + 1) - 1, n_states - 1)
+            states = np.repeat(states, rng.integers(1, 4, n + 1))[: n + 1]
+            edges = edges[: states.size + 1]
+            _same(tally.residence_statistics(edges, states, n_states),
+                  stats.residence_statistics(edges, states, n_states))
+    with pytest.raises(ValueError, match="edges"):
+        tally.residence_statistics([0.0, 1.0], [0, 0], 2)
+    with pytest.raises(ValueError, match="states"):
+        tally.residence_statistics([0.0, 1.0], [2], 2)
+    with pytest.raises(ValueError, match="non-decreasing"):
+        tally.residence_statistics([0.0, 2.0, 1.0], [0, 1], 2)

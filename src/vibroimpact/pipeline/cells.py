@@ -7,6 +7,7 @@ sampled trace. Inputs are arrays or sliceable records; outputs are dicts of nump
 """
 import logging
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -362,6 +363,8 @@ class _EventRecord:
         (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`; with two walls, onto
         the wall the flight is at); those of earlier checks are kept, only new ones
         computed."""
+        from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
         n = self.steps[0].size if self.steps else 0
         if n > self._n_pressed:
             i = max(self._n_pressed - 1, 0)          # from the last impact already seen
@@ -369,16 +372,13 @@ class _EventRecord:
             step, offset = self.steps[0][i:], self.offsets[0][i:]
             t = step * self.dt + offset
             # a flight with a sticking phase is no hop: left out (it would cost its samples)
-            start = self.sticking()[0]
-            k = np.searchsorted(start, t[:-1], side="left")
-            free = k < start.size
-            free[free] = start[k[free]] < t[1:][free]
+            free = tally.ends_in_sticking(t, self.sticking()[0])[:-1]
             walls = {} if not self.walls else dict(wall=self.wall[0][i:],
                                                    gap=self.walls["gap"])
             new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
                                   amplitude=f["amplitude"], beta=f["beta"], flights=~free,
                                   **walls)
-            self._pressed, self._n_pressed = np.append(self._pressed, new), n
+            self._pressed, self._n_pressed = np.concatenate((self._pressed, new)), n
         return self._pressed
 
     def collisions(self, eps, floor, transient, rule="physical"):
@@ -397,6 +397,41 @@ class _EventRecord:
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
                                       rule=rule, wall=self.wall[0], stick_wall=wall,
                                       eps_lower=self.walls["eps_lower"], after=transient)
+
+
+    def firsts(self, eps, floor, transient, rule="physical"):
+        """`collisions` reduced to what a map cell reads: the `_Firsts` of each collision's
+        first impact (the same values as the `Collisions` fields of those names), grouped by
+        one compiled call without the per-impact fields or the arguments' checks (the
+        simulator's own arrays)."""
+        from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
+        step, offset, u = (self.steps[0], self.offsets[0], self.u[0]) if self.steps else (
+            np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+        wall = self.wall[0] if self.walls else np.zeros(step.size, np.int8)
+        if step.size == 0:
+            return _Firsts(np.zeros(0), step, offset, u, np.zeros(0, bool), wall)
+        pressed = self.pressed() if rule == "physical" else np.zeros(0, bool)
+        eps = (np.full(step.size, float(eps)) if not self.walls
+               else np.where(wall == 1, self.walls["eps_lower"], float(eps)))
+        first, t, stuck = tally.collision_firsts(step, offset, u, self.sticking()[0],
+                                                 dt=self.dt, eps=eps, floor=floor,
+                                                 pressed=pressed, rule=rule, wall=wall,
+                                                 after=transient)
+        return _Firsts(t[first], step[first], offset[first], u[first], stuck, wall[first])
+
+
+class _Firsts(NamedTuple):
+    """A record's collisions as a map cell reads them (`_EventRecord.firsts`): of each one's
+    first impact its instant, split instant, approach velocity and wall, and whether it
+    sticks; the `stats.Collisions` fields of those names."""
+
+    time: np.ndarray
+    step: np.ndarray
+    offset: np.ndarray
+    velocity: np.ndarray
+    stuck: np.ndarray
+    wall: np.ndarray
 
 
 class _IdentityRecord:
@@ -624,9 +659,10 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next, **walls)
     events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
-
-    def wall_of(c):
-        return {} if not walls else dict(walls=events.collision_walls(c))
+    # the motion statistics of every check and rule, their arguments checked once
+    tallied = tally.MotionTally(beta_f, window=window, motions=motions, n_batches=n_batches,
+                                walls=bool(walls))
+    floor = stats.DEFAULT_REBOUND_FLOOR
 
     k, n_checks, request = 0, 0, None
     try:
@@ -635,10 +671,9 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             events.add(chunk)
             k += chunk.n_steps
             n_checks += 1
-            col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-            res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
-                                          window=window, motions=motions, n_batches=n_batches,
-                                          stuck=col.stuck, **wall_of(col))
+            col = events.firsts(eps, floor, transient)
+            res = tallied.statistics(col.time, col.step, col.offset, dt, col.stuck, transient,
+                                     k * dt, walls=col.wall)
             worst = float(max(res.stderr.max(), res.stick_stderr.max()))
             reached = worst <= target_stderr
             mixed_ok = res.n_switches == 0 or res.n_switches >= min_switches
@@ -654,15 +689,14 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     duration = k * dt - transient
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
-    by_rule = [res] + [
-        tally.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
-                                motions=motions, n_batches=n_batches, stuck=c.stuck,
-                                **wall_of(c))
-        for c in (events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient, rule=rule)
+    by_rule = [(res.probability, res.stick_probability)] + [
+        tallied.probabilities(c.time, c.step, c.offset, dt, c.stuck, duration,
+                              walls=c.wall)
+        for c in (events.firsts(eps, floor, transient, rule=rule)
                   for rule in stats.RULES[1:])]
     per_wall = {}
     if walls:
-        wall = events.collision_walls(col)
+        wall = col.wall
         v_after = _rebound_eps(eps, walls, wall) * col.velocity
         n_w = np.array([np.count_nonzero(wall == w) for w in range(len(WALLS))])
         per_wall = dict(
@@ -670,8 +704,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             wall_v_after_mean=np.array([float(v_after[wall == w].mean()) if n_w[w]
                                         else math.nan for w in range(len(WALLS))]))
     return dict(probability=res.probability, stderr=res.stderr,
-                rule_probability=np.stack([r.probability for r in by_rule]),
-                rule_stick_probability=np.stack([r.stick_probability for r in by_rule]),
+                rule_probability=np.stack([p for p, _ in by_rule]),
+                rule_stick_probability=np.stack([q for _, q in by_rule]),
                 stick_probability=res.stick_probability, stick_stderr=res.stick_stderr,
                 n_switches=res.n_switches,
                 n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
@@ -686,8 +720,10 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
     """Residence times and switching rates of a map cell's labelled record, in forcing
     periods (`stats.residence_statistics`; the states are the motions, then "none")."""
     period = 2.0 * math.pi / beta_f
+    from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
     edges, states = stats.label_pieces(impact_time, labels, t_start, t_stop, n_motions)
-    r = stats.residence_statistics(edges, states, n_motions + 1)
+    r = tally.residence_statistics(edges, states, n_motions + 1)
     return dict(residence_time=r.mean / period, residence_time_stderr=r.stderr / period,
                 n_stretches=r.n_stretches, n_censored=r.n_censored,
                 switch_rate=r.rate * period, switch_count=r.count)
@@ -744,11 +780,9 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
                                  beta=beta_f, t_end=n_end * dt, **walls):
         events.add(chunk)
         k += chunk.n_steps
-    col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-    res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
-                                  window=window, motions=motions, stuck=col.stuck,
-                                  **({} if not walls else
-                                     dict(walls=events.collision_walls(col))))
+    col = events.firsts(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
+    res = tally.MotionTally(beta_f, window=window, motions=motions, walls=bool(walls)).statistics(
+        col.time, col.step, col.offset, dt, col.stuck, transient, k * dt, walls=col.wall)
     share = res.probability + res.stick_probability
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     return dict(probability=np.append(share, max(0.0, 1.0 - float(share.sum()))),

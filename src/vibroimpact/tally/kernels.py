@@ -59,24 +59,10 @@ def _chatter_firsts(cont, ends, first):
 
 
 @kernel
-def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
-    """The collisions of a record at or after ``t0`` (``group_collisions(...).after(t0)``).
-
-    ``eps`` holds the restitution of each impact's wall; ``pressed`` the hops (physical rule
-    only, else unread); ``wall`` the wall of each impact (int8). Returns the fields of the
-    kept collisions, ``first, impact_collision, rebounds, stuck, stick_time, duration`` and
-    ``step, offset, time, velocity, wall`` at ``first``), after the number of rebounds that
-    reach ``floor`` (rule "rebounds": none, no collision): ``(n_counted, first,
-    impact_collision, step, offset, time, velocity, rebounds, stuck, stick_time, duration,
-    wall)``."""
+def _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall):
+    """``first_mask[i]``: impact ``i`` starts a collision under ``rule`` (``t`` the impacts'
+    instants, ``ends`` `_ends`, ``counted`` the rebounds that reach the floor)."""
     n = step.size
-    t = np.empty(n)
-    for i in range(n):
-        t[i] = step[i] * dt + offset[i]
-    counted = np.empty(n, np.bool_)
-    for i in range(n):
-        counted[i] = eps[i] * u[i] >= floor
-    ends = _ends(t, start)
     first_mask = np.ones(n, np.bool_)
     if rule == PHYSICAL:
         cont = np.zeros(n, np.bool_)
@@ -102,6 +88,29 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
     for i in range(1, n):
         if wall[i] != wall[i - 1]:
             first_mask[i] = True
+    return first_mask
+
+
+@kernel
+def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
+    """The collisions of a record at or after ``t0`` (``group_collisions(...).after(t0)``).
+
+    ``eps`` holds the restitution of each impact's wall; ``pressed`` the hops (physical rule
+    only, else unread); ``wall`` the wall of each impact (int8). Returns the fields of the
+    kept collisions, ``first, impact_collision, rebounds, stuck, stick_time, duration`` and
+    ``step, offset, time, velocity, wall`` at ``first``), after the number of rebounds that
+    reach ``floor`` (rule "rebounds": none, no collision): ``(n_counted, first,
+    impact_collision, step, offset, time, velocity, rebounds, stuck, stick_time, duration,
+    wall)``."""
+    n = step.size
+    t = np.empty(n)
+    for i in range(n):
+        t[i] = step[i] * dt + offset[i]
+    counted = np.empty(n, np.bool_)
+    for i in range(n):
+        counted[i] = eps[i] * u[i] >= floor
+    ends = _ends(t, start)
+    first_mask = _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall)
     # the collisions and each impact's collision
     n_first = 0
     impact_collision = np.empty(n, np.int64)
@@ -174,6 +183,143 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
             n_counted += 1
     return (n_counted, out_first, impact_collision, step_first, offset_first, time_first, u_first,
             rebounds, stuck, stick_time, duration, wall_first)
+
+
+@kernel
+def firsts(step, offset, u, start, dt, eps, floor, pressed, rule, wall, t0):
+    """The collisions at or after ``t0`` as `group` finds them, reduced to what a map cell
+    reads at each precision check: the index of each one's first impact and whether a
+    sticking phase begins before the next one (`group`'s ``first`` and ``stuck``, the same
+    values: the same mask and merge, without the per-impact and per-collision fields)."""
+    n = step.size
+    t = np.empty(n)
+    counted = np.empty(n, np.bool_)
+    for i in range(n):
+        t[i] = step[i] * dt + offset[i]
+        counted[i] = eps[i] * u[i] >= floor
+    first_mask = _first_mask(step, offset, u, t, _ends(t, start), counted, dt, pressed, rule,
+                             wall)
+    n_first = 0
+    for i in range(n):
+        if first_mask[i] and t[i] >= t0:     # times increase: the dropped ones are a prefix
+            n_first += 1
+    first = np.empty(n_first, np.int64)
+    stuck = np.empty(n_first, np.bool_)
+    c = 0
+    for i in range(n):
+        if first_mask[i] and t[i] >= t0:
+            first[c] = i
+            c += 1
+    m = start.size
+    lo = 0
+    if n_first:
+        while lo < m and start[lo] < t[first[0]]:
+            lo += 1
+    for c in range(n_first):
+        b = first[c + 1] if c + 1 < n_first else n
+        hi = lo
+        if b < n:
+            while hi < m and start[hi] < t[b]:
+                hi += 1
+        else:
+            hi = m
+        stuck[c] = hi > lo
+        lo = hi
+    return first, t, stuck
+
+
+@kernel
+def motion_pass(t, step, offset, dt, scale, stuck, walls, refine, window, lengths, periods,
+                lowers, n_motions, edges):
+    """One pass of `stats.motion_statistics` over the collisions at ``t`` (split ``step,
+    offset``): the intervals ``z`` (``Collisions.intervals``), their ratios ``z * scale``
+    (``scale = beta / (2 pi)``, `stats.interval_ratio`), `label`, and with ``edges`` (not
+    empty) `at_edges`; then each class's intervals gathered in time order, ``gathered[
+    bounds[c] : bounds[c + 1]]`` being ``z[classes == c]`` (numpy sums them as it sums the
+    boolean selection: the same values in the same order). ``stuck`` and ``walls`` are per
+    interval (``stuck`` empty and ``refine`` False: not given, the classes are the labels;
+    ``walls`` empty: one-wall motions only)."""
+    n = max(t.size - 1, 0)
+    z = np.empty(n)
+    ratio = np.empty(n)
+    for i in range(n):
+        z[i] = float(step[i + 1] - step[i]) * dt + (offset[i + 1] - offset[i])
+        ratio[i] = z[i] * scale
+    labels, classes, switches = label(ratio, window, lengths, periods, lowers, walls, stuck,
+                                      n_motions)
+    n_classes = 2 * n_motions if refine else n_motions
+    covered = np.zeros((n_classes, edges.size))
+    if n > 0 and edges.size:
+        covered = at_edges(t, z, classes, n_classes, edges)
+    bounds = np.zeros(n_classes + 1, np.int64)
+    for i in range(n):
+        if classes[i] >= 0:
+            bounds[classes[i] + 1] += 1
+    for c in range(n_classes):
+        bounds[c + 1] += bounds[c]
+    gathered = np.empty(bounds[n_classes])
+    fill = bounds[:n_classes].copy()
+    for i in range(n):
+        c = classes[i]
+        if c >= 0:
+            gathered[fill[c]] = z[i]
+            fill[c] += 1
+    return z, labels, switches, covered, gathered, bounds
+
+
+@kernel
+def residence(edges, states, n_states):
+    """`stats.residence_statistics` in one pass: ``(mean, stderr, n_stretches, n_censored,
+    time, count, rate)``, each sum taken in the order ``numpy.bincount`` takes it (the
+    pieces, or the stretches, in time order)."""
+    k = states.size
+    time = np.zeros(n_states)
+    for i in range(k):
+        time[states[i]] += edges[i + 1] - edges[i]
+    # stretches: runs of one state
+    n_runs = 0
+    for i in range(k):
+        if i == 0 or states[i] != states[i - 1]:
+            n_runs += 1
+    start = np.empty(n_runs, np.int64)
+    r = 0
+    for i in range(k):
+        if i == 0 or states[i] != states[i - 1]:
+            start[r] = i
+            r += 1
+    n = np.zeros(n_states, np.int64)
+    n_censored = np.zeros(n_states, np.int64)
+    total = np.zeros(n_states)
+    length = np.empty(n_runs)
+    count = np.zeros((n_states, n_states), np.int64)
+    for r in range(n_runs):
+        stop = start[r + 1] if r + 1 < n_runs else k
+        length[r] = edges[stop] - edges[start[r]]
+        who = states[start[r]]
+        if r == 0 or r == n_runs - 1:
+            n_censored[who] += 1
+        else:
+            n[who] += 1
+            total[who] += length[r]
+        if r > 0:
+            count[states[start[r - 1]], who] += 1
+    mean = np.empty(n_states)
+    for s in range(n_states):
+        mean[s] = total[s] / max(n[s], 1) if n[s] > 0 else np.nan
+    dev = np.zeros(n_states)
+    for r in range(1, n_runs - 1):
+        who = states[start[r]]
+        d = length[r] - mean[who]
+        dev[who] += d * d
+    stderr = np.empty(n_states)
+    for s in range(n_states):
+        stderr[s] = (np.sqrt(dev[s] / max(n[s] - 1, 1) / max(n[s], 1)) if n[s] > 1
+                     else np.nan)
+    rate = np.empty((n_states, n_states))
+    for a in range(n_states):
+        for b in range(n_states):
+            rate[a, b] = count[a, b] / time[a] if time[a] > 0.0 else np.nan
+    return mean, stderr, n, n_censored, time, count, rate
 
 
 @kernel
