@@ -306,6 +306,10 @@ class _EventRecord:
 
     def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0, gap=None,
                  eps_lower=None):
+        from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
+        self._tally = tally
+        self._sticking = None       # `sticking` of the record as it stands
         self.dt = dt
         self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
         #: the second wall (``{}``: one wall)
@@ -331,6 +335,7 @@ class _EventRecord:
             names += ("wall", "stick_wall")
         self.t_end = chunk.t_end
         self.stuck_since = chunk.stuck_since
+        self._sticking = None
         if len(self.steps) > 1:           # keep one array per kind: checks regroup each time
             for name in names:
                 setattr(self, name, [np.concatenate(getattr(self, name))])
@@ -341,13 +346,16 @@ class _EventRecord:
 
     def sticking(self):
         """Sticking phases so far; one still open ends at the last chunk's end. With two
-        walls ``(start, end, wall)``, the open one on the wall the mass rests on."""
-        if not self.walls:
-            return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
-                                          self.t_end)
-        return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
-                                      self.t_end, stick_wall=self.stick_wall[0],
-                                      stuck_wall=self.stuck_wall)
+        walls ``(start, end, wall)``, the open one on the wall the mass rests on (kept until
+        the next chunk: the checks and the rules read it several times)."""
+        if self._sticking is None:
+            self._sticking = (
+                stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                       self.t_end) if not self.walls else
+                stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                       self.t_end, stick_wall=self.stick_wall[0],
+                                       stuck_wall=self.stuck_wall))
+        return self._sticking
 
     def rebound_speeds(self, eps, floor, transient):
         """Speeds ``eps u`` (two walls: ``eps_w u``) of the rebounds at or after
@@ -363,8 +371,6 @@ class _EventRecord:
         (`stats.pressed_flights`, compiled: `vibroimpact.impact.hops`; with two walls, onto
         the wall the flight is at); those of earlier checks are kept, only new ones
         computed."""
-        from vibroimpact import tally     # compiled: the jobs that group collisions load it
-
         n = self.steps[0].size if self.steps else 0
         if n > self._n_pressed:
             i = max(self._n_pressed - 1, 0)          # from the last impact already seen
@@ -372,7 +378,7 @@ class _EventRecord:
             step, offset = self.steps[0][i:], self.offsets[0][i:]
             t = step * self.dt + offset
             # a flight with a sticking phase is no hop: left out (it would cost its samples)
-            free = tally.ends_in_sticking(t, self.sticking()[0])[:-1]
+            free = self._tally.ends_in_sticking(t, self.sticking()[0])[:-1]
             walls = {} if not self.walls else dict(wall=self.wall[0][i:],
                                                    gap=self.walls["gap"])
             new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
@@ -404,8 +410,6 @@ class _EventRecord:
         first impact (the same values as the `Collisions` fields of those names), grouped by
         one compiled call without the per-impact fields or the arguments' checks (the
         simulator's own arrays)."""
-        from vibroimpact import tally     # compiled: the jobs that group collisions load it
-
         step, offset, u = (self.steps[0], self.offsets[0], self.u[0]) if self.steps else (
             np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
         wall = self.wall[0] if self.walls else np.zeros(step.size, np.int8)
@@ -414,10 +418,9 @@ class _EventRecord:
         pressed = self.pressed() if rule == "physical" else np.zeros(0, bool)
         eps = (np.full(step.size, float(eps)) if not self.walls
                else np.where(wall == 1, self.walls["eps_lower"], float(eps)))
-        first, t, stuck = tally.collision_firsts(step, offset, u, self.sticking()[0],
-                                                 dt=self.dt, eps=eps, floor=floor,
-                                                 pressed=pressed, rule=rule, wall=wall,
-                                                 after=transient)
+        first, t, stuck = self._tally.collision_firsts(
+            step, offset, u, self.sticking()[0], dt=self.dt, eps=eps, floor=floor,
+            pressed=pressed, rule=rule, wall=wall, after=transient)
         return _Firsts(t[first], step[first], offset[first], u[first], stuck, wall[first])
 
 

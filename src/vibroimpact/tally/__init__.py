@@ -102,7 +102,9 @@ class MotionTally:
     def __init__(self, beta, *, window=DEFAULT_MOTION_WINDOW, motions=DEFAULT_MOTIONS,
                  n_batches=20, walls=False):
         from vibroimpact.stats import motions as _motions
+        from vibroimpact.tally import kernels
 
+        self._motions, self._kernels = _motions, kernels
         self.beta = _checks.real("beta", beta, low=0.0, low_open=True)
         self.scale = self.beta / (2.0 * np.pi)      # as `stats.interval_ratio`
         self.window = _checks.real("window", window, low=0.0, high=0.5, low_open=True)
@@ -116,12 +118,10 @@ class MotionTally:
         self._none = np.zeros(0, np.int8)
 
     def _pass(self, time, step, offset, dt, stuck, walls, edges):
-        from vibroimpact.tally import kernels
-
         n = max(time.size - 1, 0)
         if self.walls:
             walls = np.ascontiguousarray(walls[:n], dtype=np.int8)
-        return kernels.motion_pass(
+        return self._kernels.motion_pass(
             np.ascontiguousarray(time, dtype=float), np.ascontiguousarray(step, dtype=np.int64),
             np.ascontiguousarray(offset, dtype=float), float(dt), self.scale,
             np.ascontiguousarray(stuck[:n], dtype=np.bool_),
@@ -130,16 +130,17 @@ class MotionTally:
 
     @staticmethod
     def _fractions(gathered, bounds, duration):
-        """`stats.motions._fractions` of the gathered intervals (the same sums)."""
-        return np.array([float(gathered[bounds[c]:bounds[c + 1]].sum() / duration)
+        """`stats.motions._fractions` of the gathered intervals (the same sums: numpy's
+        ``ndarray.sum`` is ``add.reduce``)."""
+        add = np.add.reduce
+        return np.array([float(add(gathered[bounds[c]:bounds[c + 1]]) / duration)
                          for c in range(bounds.size - 1)])
 
     def statistics(self, time, step, offset, dt, stuck, t_start, t_stop, walls=None):
         """``stats.motion_statistics(time, intervals, beta, t_start, t_stop, window=,
         motions=, n_batches=, stuck=stuck, walls=walls)`` of collisions at ``time`` (split
         ``step * dt + offset``; ``intervals`` their `Collisions.intervals`), to the bit."""
-        from vibroimpact.stats import motions as _motions
-
+        _motions = self._motions
         duration = float(t_stop) - float(t_start)
         if not duration > 0.0:
             raise ValueError(f"t_stop must be > t_start, got [{t_start!r}, {t_stop!r}]")

@@ -28,17 +28,19 @@ PHYSICAL, IMPACTS, REBOUNDS = 0, 1, 2
 
 @kernel
 def _ends(t, start):
-    """``ends[i]``: a sticking phase begins in ``[t_i, t_{i+1})`` (``t_n = inf``); ``start``
-    increasing (the first phase at or after ``t_i`` is found by a merge, as searchsorted
-    ``side='left'`` finds it)."""
+    """``ends[i]``: a sticking phase begins in ``[t_i, t_{i+1})`` (``t_n = inf``); ``t`` and
+    ``start`` increasing. Each phase marks the last impact at or before it (the merge of
+    searchsorted ``side='left'`` run from the phases' side: one unpredictable branch per
+    phase, not one per impact)."""
     n, m = t.size, start.size
     ends = np.zeros(n, np.bool_)
-    p = 0
-    for i in range(n):
-        while p < m and start[p] < t[i]:
-            p += 1
-        if p < m:
-            ends[i] = start[p] < (t[i + 1] if i + 1 < n else np.inf)
+    i = -1
+    for p in range(m):
+        s = start[p]
+        while i + 1 < n and t[i + 1] <= s:
+            i += 1
+        if i >= 0:
+            ends[i] = True
     return ends
 
 
@@ -188,28 +190,41 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
 @kernel
 def firsts(step, offset, u, start, dt, eps, floor, pressed, rule, wall, t0):
     """The collisions at or after ``t0`` as `group` finds them, reduced to what a map cell
-    reads at each precision check: the index of each one's first impact and whether a
-    sticking phase begins before the next one (`group`'s ``first`` and ``stuck``, the same
-    values: the same mask and merge, without the per-impact and per-collision fields)."""
+    reads at each precision check: the index of each one's first impact, the impacts'
+    instants and whether a sticking phase begins before the next collision (`group`'s
+    ``first``, ``t`` and ``stuck``: the same mask and merge, without the per-impact and
+    per-collision fields). The physical rule's backward scan is `_chatter_firsts` with the
+    links formed on the way (no array of them)."""
     n = step.size
     t = np.empty(n)
-    counted = np.empty(n, np.bool_)
     for i in range(n):
         t[i] = step[i] * dt + offset[i]
-        counted[i] = eps[i] * u[i] >= floor
-    first_mask = _first_mask(step, offset, u, t, _ends(t, start), counted, dt, pressed, rule,
-                             wall)
+    ends = _ends(t, start)
+    if rule == PHYSICAL:
+        first_mask = np.ones(n, np.bool_)
+        next_end, next_break = n, n
+        for j in range(n - 1, -1, -1):
+            if ends[j]:
+                next_end = j
+            elif j == n - 1 or not pressed[j]:
+                next_break = j
+            elif next_end < n and next_break > next_end:
+                first_mask[j + 1] = False
+        for i in range(1, n):
+            if wall[i] != wall[i - 1]:
+                first_mask[i] = True
+    else:
+        counted = np.empty(n, np.bool_)
+        for i in range(n):
+            counted[i] = eps[i] * u[i] >= floor
+        first_mask = _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall)
+    kept = np.empty(n + 1, np.int64)
     n_first = 0
-    for i in range(n):
-        if first_mask[i] and t[i] >= t0:     # times increase: the dropped ones are a prefix
-            n_first += 1
-    first = np.empty(n_first, np.int64)
+    for i in range(n):          # times increase: the dropped ones are a prefix
+        kept[n_first] = i
+        n_first += first_mask[i] and t[i] >= t0
+    first = kept[:n_first].copy()
     stuck = np.empty(n_first, np.bool_)
-    c = 0
-    for i in range(n):
-        if first_mask[i] and t[i] >= t0:
-            first[c] = i
-            c += 1
     m = start.size
     lo = 0
     if n_first:
