@@ -211,32 +211,40 @@ def test_the_defaults_are_the_references():
 
 @pytest.mark.parametrize("rule", stats.RULES)
 def test_the_collision_firsts_are_the_groupings_fields(rule):
-    """`tally.collision_firsts` (what the map's cell groups with) returns the `first` and
-    `stuck` of `stats.group_collisions(...).after(t0)` and the impacts' instants, to the bit,
-    with one wall and two."""
+    """`tally.collision_firsts` (what the map's cell groups with) returns the fields of
+    `stats.group_collisions(...).after(t0)` it names, to the bit, with one wall and two,
+    and on a record whose rebounds all fall below the floor at two walls (rule 'rebounds':
+    no event, though the walls change)."""
+    names = ("first", "time", "step", "offset", "velocity", "wall", "stuck")
+    slow = np.array([0.001, 0.001, 0.001])
+    step, wall = np.array([10, 20, 30]), np.array([0, 1, 0], np.int8)
+    got = tally.collision_firsts(step, np.zeros(3), slow, np.zeros(0), dt=DT, eps=0.5,
+                                 eps_lower=0.5, floor=0.01, pressed=np.ones(2, bool),
+                                 rule=rule, wall=wall, after=0.0)
+    ref = stats.group_collisions(step, np.zeros(3), slow, [], [], dt=DT, eps=0.5,
+                                 pressed=np.ones(2, bool), rule=rule, wall=wall)
+    assert [g.tobytes() for g in got] == [getattr(ref, k).tobytes() for k in names]
     for res, pressed, walls, _ in records():
         kw = dict(dt=DT, eps=0.5, floor=0.01, pressed=pressed, rule=rule)
         wall = np.zeros(res.impact_step.size, np.int8)
-        eps = np.full(wall.size, 0.5)
+        eps_lower = 0.5
         if walls:
             kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
                       eps_lower=walls["eps_lower"])
-            wall = res.impact_wall
-            eps = np.where(wall == 1, walls["eps_lower"], 0.5)
+            wall, eps_lower = res.impact_wall, walls["eps_lower"]
         for t0 in (0.0, 200.0, 1e9):
             ref = stats.group_collisions(res.impact_step, res.impact_offset,
                                          res.impact_velocity, res.stick_start, res.stick_end,
                                          **kw).after(t0)
-            first, t, stuck = tally.collision_firsts(
+            got = tally.collision_firsts(
                 res.impact_step, res.impact_offset, res.impact_velocity, res.stick_start,
-                dt=DT, eps=eps, floor=0.01, pressed=pressed if rule == "physical"
-                else np.zeros(0, bool), rule=rule, wall=wall, after=t0)
-            if rule == "rebounds" and ref.first.size == 0:
-                assert first.size == 0
-                continue
-            assert first.tobytes() == ref.first.tobytes()
-            assert stuck.tobytes() == ref.stuck.tobytes()
-            assert t[first].tobytes() == ref.time.tobytes()
+                dt=DT, eps=0.5, eps_lower=eps_lower, floor=0.01,
+                pressed=pressed if rule == "physical" else np.zeros(0, bool), rule=rule,
+                wall=wall, after=t0)
+            for name, value in zip(names, got):
+                expected = getattr(ref, name)
+                assert value.dtype == expected.dtype, name
+                assert value.tobytes() == expected.tobytes(), name
 
 
 @pytest.mark.parametrize("motions", [stats.DEFAULT_MOTIONS, ((2, 1), (1, 1), (3, 2), (1, 3))])

@@ -414,14 +414,13 @@ class _EventRecord:
             np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
         wall = self.wall[0] if self.walls else np.zeros(step.size, np.int8)
         if step.size == 0:
-            return _Firsts(np.zeros(0), step, offset, u, np.zeros(0, bool), wall)
+            return _Firsts(np.zeros(0), step, offset, u, wall, np.zeros(0, bool))
         pressed = self.pressed() if rule == "physical" else np.zeros(0, bool)
-        eps = (np.full(step.size, float(eps)) if not self.walls
-               else np.where(wall == 1, self.walls["eps_lower"], float(eps)))
-        first, t, stuck = self._tally.collision_firsts(
-            step, offset, u, self.sticking()[0], dt=self.dt, eps=eps, floor=floor,
-            pressed=pressed, rule=rule, wall=wall, after=transient)
-        return _Firsts(t[first], step[first], offset[first], u[first], stuck, wall[first])
+        eps_lower = self.walls["eps_lower"] if self.walls else eps
+        _, *fields = self._tally.collision_firsts(
+            step, offset, u, self.sticking()[0], dt=self.dt, eps=eps, eps_lower=eps_lower,
+            floor=floor, pressed=pressed, rule=rule, wall=wall, after=transient)
+        return _Firsts(*fields)
 
 
 class _Firsts(NamedTuple):
@@ -433,8 +432,8 @@ class _Firsts(NamedTuple):
     step: np.ndarray
     offset: np.ndarray
     velocity: np.ndarray
-    stuck: np.ndarray
     wall: np.ndarray
+    stuck: np.ndarray
 
 
 class _IdentityRecord:

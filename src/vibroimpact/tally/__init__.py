@@ -177,20 +177,19 @@ def ends_in_sticking(time, stick_start):
 
 
 def collision_firsts(impact_step, impact_offset, impact_velocity, stick_start, *, dt, eps,
-                     floor, pressed, rule, wall, after):
-    """The collisions at or after ``after`` of `group_collisions` reduced to the index of
-    each one's first impact, the impacts' instants and each collision's ``stuck``:
-    ``(first, time, stuck)``, the same values as ``group_collisions(...)``'s ``first``,
-    ``step * dt + offset`` and ``stuck`` (`kernels.firsts`). Nothing is checked: the
+                     eps_lower, floor, pressed, rule, wall, after):
+    """The collisions at or after ``after`` of `group_collisions`, reduced to what a map cell
+    reads: ``(first, time, step, offset, velocity, wall, stuck)``, the values of the
+    `stats.Collisions` fields of those names (`kernels.firsts`). Nothing is checked: the
     arguments are the simulator's arrays as `group_collisions` takes them after its checks
-    (``eps`` one per impact, ``wall`` int8 per impact, ``pressed`` bool per flight for the
-    physical rule)."""
+    (``wall`` int8 per impact, zeros with one wall; ``eps_lower`` the restitution at wall
+    1; ``pressed`` bool per flight for the physical rule)."""
     from vibroimpact.stats import collisions as _collisions
     from vibroimpact.tally import kernels
 
     return kernels.firsts(impact_step, impact_offset, impact_velocity, stick_start, float(dt),
-                          eps, float(floor), pressed, _collisions.RULES.index(rule), wall,
-                          float(after))
+                          float(eps), float(eps_lower), float(floor), pressed,
+                          _collisions.RULES.index(rule), wall, float(after))
 
 
 def residence_statistics(edges, states, n_states):

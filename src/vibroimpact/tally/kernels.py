@@ -188,13 +188,15 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
 
 
 @kernel
-def firsts(step, offset, u, start, dt, eps, floor, pressed, rule, wall, t0):
+def firsts(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rule, wall, t0):
     """The collisions at or after ``t0`` as `group` finds them, reduced to what a map cell
-    reads at each precision check: the index of each one's first impact, the impacts'
-    instants and whether a sticking phase begins before the next collision (`group`'s
-    ``first``, ``t`` and ``stuck``: the same mask and merge, without the per-impact and
-    per-collision fields). The physical rule's backward scan is `_chatter_firsts` with the
-    links formed on the way (no array of them)."""
+    reads at each precision check: of each one's first impact its index, instant, split
+    instant, velocity and wall, and whether a sticking phase begins before the next
+    collision (`group`'s ``first, time, step, offset, velocity, wall, stuck``: the same mask
+    and merge, without the other fields). ``eps`` and ``eps_lower`` are the walls'
+    restitutions (an impact at wall 1 rebounds at ``eps_lower u``). The physical rule's
+    backward scan is `_chatter_firsts` with the links formed on the way (no array of
+    them)."""
     n = step.size
     t = np.empty(n)
     for i in range(n):
@@ -216,8 +218,10 @@ def firsts(step, offset, u, start, dt, eps, floor, pressed, rule, wall, t0):
     else:
         counted = np.empty(n, np.bool_)
         for i in range(n):
-            counted[i] = eps[i] * u[i] >= floor
+            counted[i] = (eps_lower if wall[i] == 1 else eps) * u[i] >= floor
         first_mask = _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall)
+        if rule == REBOUNDS and not counted.any():
+            first_mask[:] = False       # no rebound reaches the floor: no event at all
     kept = np.empty(n + 1, np.int64)
     n_first = 0
     for i in range(n):          # times increase: the dropped ones are a prefix
@@ -240,7 +244,16 @@ def firsts(step, offset, u, start, dt, eps, floor, pressed, rule, wall, t0):
             hi = m
         stuck[c] = hi > lo
         lo = hi
-    return first, t, stuck
+    time_first = np.empty(n_first)
+    step_first = np.empty(n_first, np.int64)
+    offset_first = np.empty(n_first)
+    u_first = np.empty(n_first)
+    wall_first = np.empty(n_first, np.int8)
+    for c in range(n_first):
+        a = first[c]
+        time_first[c], step_first[c], offset_first[c] = t[a], step[a], offset[a]
+        u_first[c], wall_first[c] = u[a], wall[a]
+    return first, time_first, step_first, offset_first, u_first, wall_first, stuck
 
 
 @kernel
