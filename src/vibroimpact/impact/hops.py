@@ -44,6 +44,39 @@ PUSH_ROUNDOFF = 1e-13
 
 
 @kernel
+def _push_above(r, i, k, s, dt, delta, amplitude, beta, mirror, anchor):
+    """The push at ``k dt + s`` as `_push` computes it, or a lower bound of it when that
+    bound already shows the computed push > 0.
+
+    ``anchor`` holds ``(k, s, sin(beta (k dt + s)), known)`` of the last push computed in
+    full: the sine moves by at most ``beta |tau - tau_anchor|``, so ``linear + amplitude
+    sin_anchor - |amplitude| beta |tau - tau_anchor|`` bounds the push from below (less
+    `PUSH_ROUNDOFF` times its scale for the round-off of both); above that same margin the
+    push `_push` would compute is > 0, and the bound is returned instead (no sine).
+    Otherwise the push is computed as `_push` computes it, to the bit, and becomes the
+    anchor."""
+    r0, r1 = mirror * r[i], mirror * r[i + 1]
+    linear = r0 + (r1 - r0) / dt * s - delta
+    if amplitude == 0.0:
+        return linear
+    if anchor[3] > 0.0:
+        reach = abs((k - anchor[0]) * dt + (s - anchor[1]))
+        slack = PUSH_ROUNDOFF * (1.0 + abs(r0) + abs(r1) + abs(delta)
+                                 + abs(amplitude) * (1.0 + beta * (abs(k * dt) + dt)))
+        low = (linear + amplitude * anchor[2]
+               - abs(amplitude) * beta * reach * (1.0 + LIPSCHITZ_SLACK) - slack)
+        if low > slack:
+            return low
+    sine = math.sin(beta * (k * dt + s))
+    anchor[0], anchor[1], anchor[2], anchor[3] = k, s, sine, 1.0
+    return linear + amplitude * sine
+
+
+#: Relative allowance on the reach ``|tau - tau_anchor|`` of `_push_above` (its rounding).
+LIPSCHITZ_SLACK = 1e-12
+
+
+@kernel
 def _curved_above(p_lo, p_hi, h, r0, r1, delta, amplitude, beta, tau):
     """True when the push is certainly > 0 on a stretch of one step of length ``h`` whose
     ends' pushes are ``p_lo, p_hi`` (computed, both > 0): the linear force adds no
@@ -64,14 +97,18 @@ def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_uppe
     """``out[j]`` for every flight (see `pressed_flights`), walking the examined ones.
 
     The values are those of the plain walk (every step's end, and with a harmonic part its
-    interior minimum when it lies inside), with three shortcuts that evaluate nothing the
-    walk would find <= 0: the push at an impact is computed once for the flight it ends
-    and the one it starts (same wall: the same arguments, the same value), the last step's
-    end is the flight's end already tested, and a step whose ends are pressed and whose
-    curvature cannot bring the push to 0 (`_curved_above`) skips its interior minimum.
+    interior minimum when it lies inside), with four shortcuts that skip only evaluations
+    the walk would find > 0: the push at an impact is taken once for the flight it ends and
+    the one it starts (same wall: the same arguments), the last step's end is the flight's
+    end already tested, a push whose lower bound from the last sine computed is clearly > 0
+    is not computed (`_push_above`: the bound stands for it), and a step whose ends are
+    pressed and whose curvature cannot bring the push to 0 (`_curved_above`, on the ends'
+    pushes or their bounds) skips its interior minimum. Every push it does compute is
+    `_push`'s, to the bit: the answer is the plain walk's.
     """
     two_pi = 2.0 * math.pi
     held_j, held = -1, 0.0      # the push at impact held_j in its flight's frame, if computed
+    anchor = np.zeros(4)        # the last sine computed (`_push_above`)
     for j in range(step.size - 1):
         out[j] = False
         if not examine[j]:
@@ -86,10 +123,12 @@ def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_uppe
         if held_j == j and lower[j - 1] == lower[j]:
             p_a = held
         else:
-            p_a = _push(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta, mirror)
+            p_a = _push_above(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta,
+                              mirror, anchor)
         if p_a <= 0.0:
             continue
-        p_b = _push(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta, mirror)
+        p_b = _push_above(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta,
+                          mirror, anchor)
         held_j, held = j + 1, p_b
         if p_b <= 0.0:
             continue
@@ -102,7 +141,7 @@ def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_uppe
             if k == kb:
                 p_hi = p_b
             else:
-                p_hi = _push(r, i, k, s_hi, dt, delta, amplitude, beta, mirror)
+                p_hi = _push_above(r, i, k, s_hi, dt, delta, amplitude, beta, mirror, anchor)
                 if p_hi <= 0.0:
                     ok = False
                     break
