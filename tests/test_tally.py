@@ -297,3 +297,22 @@ def test_the_compiled_residence_statistics_are_the_numpy_reference():
         tally.residence_statistics([0.0, 1.0], [2], 2)
     with pytest.raises(ValueError, match="non-decreasing"):
         tally.residence_statistics([0.0, 2.0, 1.0], [0, 1], 2)
+
+
+def test_the_rule_probabilities_are_the_motion_tallys():
+    """`tally.rule_probabilities` (one call for the rules a map cell reports besides the
+    physical one) gives, rule by rule, `MotionTally.probabilities` of `collision_firsts`."""
+    for res, _, walls, beta in records():
+        wall = res.impact_wall if walls else np.zeros(res.impact_step.size, np.int8)
+        eps_lower = walls["eps_lower"] if walls else 0.5
+        motions = stats.DEFAULT_MOTIONS + (((1, 1, 1),) if walls else ())
+        fast = tally.MotionTally(beta, motions=motions, walls=bool(walls))
+        kw = dict(dt=DT, eps=0.5, eps_lower=eps_lower, floor=0.01, wall=wall, after=200.0)
+        args = (res.impact_step, res.impact_offset, res.impact_velocity, res.stick_start)
+        rules = stats.RULES[1:]
+        got = tally.rule_probabilities(fast, *args, rules=rules, duration=3800.0, **kw)
+        for rule, (p, q) in zip(rules, got):
+            _, time, step, offset, _, c_wall, stuck = tally.collision_firsts(
+                *args, pressed=np.zeros(0, bool), rule=rule, **kw)
+            ref = fast.probabilities(time, step, offset, DT, stuck, 3800.0, walls=c_wall)
+            assert p.tobytes() == ref[0].tobytes() and q.tobytes() == ref[1].tobytes()

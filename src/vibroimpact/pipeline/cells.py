@@ -423,6 +423,18 @@ class _EventRecord:
         return _Firsts(*fields)
 
 
+    def rule_probabilities(self, tallied, eps, floor, transient, rules, duration):
+        """``[(probability, stick_probability)]`` of the collisions at or after
+        ``transient`` of each rule of ``rules`` (not the physical one), as ``tallied``
+        (`tally.MotionTally`) gives them for `firsts` of that rule: one compiled call for
+        them all (`tally.rule_probabilities`)."""
+        wall = self.wall[0] if self.walls else np.zeros(self.steps[0].size, np.int8)
+        return self._tally.rule_probabilities(
+            tallied, self.steps[0], self.offsets[0], self.u[0], self.sticking()[0], dt=self.dt,
+            eps=eps, eps_lower=self.walls["eps_lower"] if self.walls else eps, floor=floor,
+            rules=rules, wall=wall, after=transient, duration=duration)
+
+
 class _Firsts(NamedTuple):
     """A record's collisions as a map cell reads them (`_EventRecord.firsts`): of each one's
     first impact its instant, split instant, approach velocity and wall, and whether it
@@ -691,11 +703,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     duration = k * dt - transient
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
-    by_rule = [(res.probability, res.stick_probability)] + [
-        tallied.probabilities(c.time, c.step, c.offset, dt, c.stuck, duration,
-                              walls=c.wall)
-        for c in (events.firsts(eps, floor, transient, rule=rule)
-                  for rule in stats.RULES[1:])]
+    by_rule = [(res.probability, res.stick_probability)] + events.rule_probabilities(
+        tallied, eps, floor, transient, stats.RULES[1:], duration)
     per_wall = {}
     if walls:
         wall = col.wall

@@ -27,7 +27,7 @@ import numpy as np
 from vibroimpact import _checks
 
 __all__ = ["group_collisions", "motion_statistics", "MotionTally", "residence_statistics",
-           "ends_in_sticking", "collision_firsts"]
+           "ends_in_sticking", "collision_firsts", "rule_probabilities"]
 
 #: ``stats.collisions.DEFAULT_REBOUND_FLOOR`` and ``stats.motions.DEFAULT_MOTION_WINDOW``,
 #: ``DEFAULT_MOTIONS`` (tests/test_tally.py holds them equal)
@@ -165,6 +165,31 @@ class MotionTally:
                                           np.zeros(0))
         probability = self._fractions(gathered, bounds, duration)
         return probability[:m], probability[m:]
+
+
+def rule_probabilities(tallied, impact_step, impact_offset, impact_velocity, stick_start, *,
+                       dt, eps, eps_lower, floor, rules, wall, after, duration):
+    """``[(probability, stick_probability)]`` of `MotionTally.probabilities` (``tallied``) on
+    the collisions at or after ``after`` of each rule of ``rules`` (not the physical rule:
+    no hops), grouped as `collision_firsts` groups them, all in one compiled call
+    (`kernels.rule_fractions`); the same values."""
+    from vibroimpact.stats import collisions as _collisions
+
+    m = len(tallied.motions)
+    duration = float(duration)
+    if duration <= 0.0:                 # as `stats.motions._fractions`
+        return [(np.zeros(m), np.zeros(m)) for _ in rules]
+    gathered, bounds = tallied._kernels.rule_fractions(
+        impact_step, impact_offset, impact_velocity, stick_start, float(dt), float(eps),
+        float(eps_lower), float(floor), np.zeros(0, np.bool_),
+        np.array([_collisions.RULES.index(r) for r in rules], dtype=np.int64), wall,
+        float(after), tallied.scale, tallied.walls, tallied.window, tallied.lengths,
+        tallied.periods, tallied.lowers, m)
+    out = []
+    for b in bounds:
+        p = MotionTally._fractions(gathered, b, duration)
+        out.append((p[:m], p[m:]))
+    return out
 
 
 def ends_in_sticking(time, stick_start):

@@ -296,6 +296,38 @@ def motion_pass(t, step, offset, dt, scale, stuck, walls, refine, window, length
 
 
 @kernel
+def rule_fractions(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rules, wall, t0,
+                   scale, walls, window, lengths, periods, lowers, n_motions):
+    """For each rule code of ``rules``: `firsts` at or after ``t0``, then `motion_pass` of
+    its collisions with their ``stuck`` flags (and walls when ``walls``), no edges; returns
+    per rule ``(gathered, bounds)`` stacked: the intervals of every class of every rule in
+    one array, ``bounds`` of shape (rules, classes + 1) into it. One call for the rules a
+    map cell reports besides its own (`MotionTally.rule_probabilities`)."""
+    n_classes = 2 * n_motions
+    parts = []
+    bounds = np.zeros((rules.size, n_classes + 1), np.int64)
+    total = 0
+    for q in range(rules.size):
+        _, time, c_step, c_offset, _, c_wall, stuck = firsts(
+            step, offset, u, start, dt, eps, eps_lower, floor, pressed, rules[q], wall, t0)
+        n = max(time.size - 1, 0)
+        w = c_wall[:n].copy() if walls else np.zeros(0, np.int8)
+        _, _, _, _, gathered, b = motion_pass(time, c_step, c_offset, dt, scale,
+                                               stuck[:n].copy(), w, True, window, lengths,
+                                               periods, lowers, n_motions, np.zeros(0))
+        parts.append(gathered)
+        for c in range(n_classes + 1):
+            bounds[q, c] = b[c] + total
+        total += gathered.size
+    out = np.empty(total)
+    o = 0
+    for g in parts:
+        out[o:o + g.size] = g
+        o += g.size
+    return out, bounds
+
+
+@kernel
 def residence(edges, states, n_states):
     """`stats.residence_statistics` in one pass: ``(mean, stderr, n_stretches, n_censored,
     time, count, rate)``, each sum taken in the order ``numpy.bincount`` takes it (the
