@@ -28,6 +28,25 @@ SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
 WORKFLOW_FILES = ("Snakefile", "config", "workflow", "profiles", "notebooks")
 #: Snakemake's metadata of a run, not of its outputs: a copied build starts unlocked.
 RUN_STATE = ("locks", "incomplete", "log")
+#: The test configs' short noise record (the plane tests: tests/test_planes.py,
+#: tests/test_plane_blocks.py), and the map settings their studies share: a short record,
+#: so the identities they check hold whatever precision the cells reach.
+TINY_NOISE = """paper: false
+noises:
+  tiny:
+    kind: band_limited
+    rms: 0.29
+    dt: 0.1
+    beta_c: 4.0
+    n_samples: 20001
+    seed: 36
+"""
+TINY_MAP = """    zeta: 0.05
+    amplitude: 1.0
+    transient: 100.0
+    tile_size: 4
+    map: {target_stderr: 0.1, min_time: 300.0, max_periods: 200, min_switches: 10}
+"""
 
 
 def make_workdir(path, build=None):

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import ROOT
+from helpers import ROOT, TINY_MAP, TINY_NOISE
 from vibroimpact.pipeline import config as configuration
 from vibroimpact.pipeline import figures, tasks, targets
 from vibroimpact.pipeline.config import ConfigError
@@ -18,22 +18,8 @@ from vibroimpact.pipeline.study import JOB_KEYS, ORBIT_JOB_KEYS, plane_attractor
 sys.path.insert(0, str(ROOT / "benchmarks"))
 from same_build import _data  # what same_build compares: no attrs, no timings
 
-NOISE = """paper: false
-noises:
-  tiny:
-    kind: band_limited
-    rms: 0.29
-    dt: 0.1
-    beta_c: 4.0
-    n_samples: 20001
-    seed: 36
-"""
-MAP = """    zeta: 0.05
-    amplitude: 1.0
-    transient: 100.0
-    tile_size: 4
-    map: {target_stderr: 0.1, min_time: 300.0, max_periods: 200, min_switches: 10}
-"""
+NOISE = TINY_NOISE
+MAP = TINY_MAP
 ATTRACTORS = "{n_starts: 6, max_time: 300.0, seed: 3, tile_rows: 1}"
 ORBITS = NOISE + """studies: {}
 orbits:

@@ -10,32 +10,16 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from helpers import ROOT
+from helpers import ROOT, TINY_MAP, TINY_NOISE
 from vibroimpact.pipeline import config as configuration
 from vibroimpact.pipeline import io, tasks
 from vibroimpact.pipeline.config.sweeps import sweep_members
 from vibroimpact.pipeline.study import JOB_KEYS, Study
 
-NOISE = """paper: false
-noises:
-  tiny:
-    kind: band_limited
-    rms: 0.29
-    dt: 0.1
-    beta_c: 4.0
-    n_samples: 20001
-    seed: 36
-studies:
-"""
+NOISE = TINY_NOISE + "studies:\n"
 #: The map settings every study here shares (a short record: the identities hold whatever
 #: the precision reached).
-MAP = """    zeta: 0.05
-    amplitude: 1.0
-    transient: 100.0
-    tile_size: 4
-    map: {target_stderr: 0.1, min_time: 300.0, max_periods: 200, min_switches: 10}
-    figures: [fig15]
-"""
+MAP = TINY_MAP + "    figures: [fig15]\n"
 DEFAULT = NOISE + """  flat:
     noise: tiny
     eps: 0.5
