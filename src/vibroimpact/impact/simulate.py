@@ -457,7 +457,7 @@ def _pair_sticking(time, kind, stick_open):
         on = np.concatenate([[stick_open[0]] if first_open else [], time[first_open::2]])
         on_wall = np.concatenate([[stick_open[1]] if first_open else [],
                                   wall[first_open::2]])
-        off = time[1 - first_open::2]
+        off = time[1 - first_open::2].copy()     # contiguous, as the kernels take it
         stick_open[0] = float(on[-1]) if on.size > off.size else None
         stick_open[1] = int(on_wall[-1]) if on.size > off.size else 0
         return (on[:off.size].astype(np.float64), off,
