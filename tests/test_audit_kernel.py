@@ -123,3 +123,31 @@ def test_no_steps_and_bad_arguments():
     with pytest.raises(ValueError, match="batch_bounds"):
         audit_moments(3, [0.0], [0.0], [0.0, 0.0], 0.1, zeta=ZETA, eps=0.5, delta=0.0,
                       batch_bounds=[0, 3])
+
+
+def test_a_run_ends_before_an_onset_where_testing_each_step_ends_it():
+    """`_before_onset` (the end of a run of free steps, from an estimate) against the test of
+    each step in turn that it replaces, bit for bit: onsets on sample midpoints and one ulp
+    either side, inside and beyond the run, far into a long record, and none (inf)."""
+    from vibroimpact.impact.audit import _before_onset
+
+    def scan(i, stop, onset, k_first, dt):
+        j = i + 1
+        while j < stop and (k_first + j) * dt + 0.5 * dt < onset:
+            j += 1
+        return j
+
+    rng = np.random.default_rng(3)
+    cases = 0
+    for dt in (0.1, 0.05, 0.3):
+        for k_first in (0, 9_437_184, 99_999_000):
+            for _ in range(300):
+                i = int(rng.integers(0, 2000))
+                stop = i + 1 + int(rng.integers(0, 1100))
+                mid = (k_first + i + int(rng.integers(-3, stop - i + 5))) * dt + 0.5 * dt
+                for onset in (mid, np.nextafter(mid, -np.inf), np.nextafter(mid, np.inf),
+                              mid + rng.uniform(-dt, dt), np.inf):
+                    assert _before_onset(i, stop, onset, k_first, dt) == scan(
+                        i, stop, onset, k_first, dt), (i, stop, onset, k_first, dt)
+                    cases += 1
+    assert cases == 3 * 3 * 300 * 5

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from vibroimpact import simulate
+from vibroimpact import simulate, simulate_chunks
 
 
 @pytest.mark.parametrize("r0", [-0.29, -1e-3, -1e-9])
@@ -44,6 +44,39 @@ def test_chunking_and_buffer_flushes_give_identical_results():
                  "collision_time", "collision_stuck", "collision_stick_time",
                  "collision_rebounds"):
         assert np.array_equal(getattr(a, name), getattr(b, name)), name
+
+
+def test_a_streamed_record_is_never_recorded_over():
+    """The driver records each chunk into buffers handed over two chunks before once nothing
+    refers to them (`_Buffers.take_grid`): the a and v a consumer keeps (a chunk, or only a
+    view of its a) hold their values to the end, those it lets go are reused, and each
+    chunk's record is the whole run's (simulate, which keeps every chunk)."""
+    import gc
+
+    r = np.random.default_rng(1).standard_normal(40_001)
+    whole = simulate(0.05, 0.5, 0.3, noise=r, record_every=1)
+    kept, views, reused, seen = [], [], set(), set()
+    k0 = 0
+    for j, chunk in enumerate(simulate_chunks(0.05, 0.5, 0.3, noise=r, record_every=1,
+                                              chunk_size=3000)):
+        base = chunk.a.base if chunk.a.base is not None else chunk.a
+        reused.add(id(base) in seen)
+        seen.add(id(base))
+        n = chunk.a.size
+        assert np.array_equal(chunk.a, whole.a[k0:k0 + n])
+        assert np.array_equal(chunk.v, whole.v[k0:k0 + n])
+        if j % 3 == 0:
+            kept.append((k0, chunk))                   # the chunk kept
+        elif j % 3 == 1:
+            views.append((k0, chunk.a[1:-1]))          # a view of its a kept
+        k0 += n
+        gc.collect()
+    assert k0 == whole.a.size and True in reused       # some buffers were recorded into again
+    for k0, chunk in kept:
+        assert np.array_equal(chunk.a, whole.a[k0:k0 + chunk.a.size])
+        assert np.array_equal(chunk.v, whole.v[k0:k0 + chunk.v.size])
+    for k0, a in views:
+        assert np.array_equal(a, whole.a[k0 + 1:k0 + 1 + a.size])
 
 
 def test_elastic_micro_bounces_end_in_contact():

@@ -184,6 +184,24 @@ def _add_resting(out, b, s_a, L, k, r0, r1, dt, delta, A, beta, lower):
 
 
 @kernel
+def _resting_run(out, b, i, stop, k_first, r, dt, wall, A, beta, lower, end, next_onset):
+    """:func:`_add_resting` of the whole steps from ``i`` (resting) up to ``stop`` while
+    their midpoints lie before ``end`` and ``next_onset``; returns the first step left.
+    The same calls in the same order as one step at a time (the same bits), without the
+    main loop's tests between them."""
+    j = i
+    while True:
+        k = k_first + j
+        _add_resting(out, b, 0.0, dt, k, r[j], r[j + 1], dt, wall, A, beta, lower)
+        j += 1
+        if j >= stop:
+            return j
+        t_mid = (k_first + j) * dt + 0.5 * dt
+        if not (t_mid < end and t_mid < next_onset):
+            return j
+
+
+@kernel
 def _node(sig, wt, c, sn, cb, sb, r0, slope, s_a, zeta, y0, yv0, A, q, beta, sin_psi, cos_psi,
           sin_pp, cos_pp):
     """The weighted v^2, x^2, f v and x f at a node ``sig`` of a free piece, given
@@ -207,7 +225,8 @@ def _add_free(out, b, s_a, L, k, x0, v0, r0, r1, dt, zeta, A, beta, xi, wi):
 
     The rule's nodes lie in pairs about the piece's middle ``h = L / 2``, so the exponentials
     at ``h +- d`` are those at ``h`` times those at ``+-d``: three calls of each of exp, cos
-    and sin for five nodes rather than five."""
+    and sin for five nodes rather than five (at ``h`` and at the two pairs' ``d``; the middle
+    node's ``d`` is 0)."""
     wd = math.sqrt(1.0 - zeta * zeta)
     slope = (r1 - r0) / dt
     p_a = r0 + slope * s_a - 2.0 * zeta * slope
@@ -233,10 +252,17 @@ def _add_free(out, b, s_a, L, k, x0, v0, r0, r1, dt, zeta, A, beta, xi, wi):
     for j in range((n + 1) // 2):
         hi = n - 1 - j
         d = h * xi[hi]                                   # >= 0: nodes h - d (j), h + d (hi)
-        ed = math.exp(-zeta * d)
-        cd, sd = math.cos(wd * d), math.sin(wd * d)
-        if A != 0.0:
-            cbd, sbd = math.cos(beta * d), math.sin(beta * d)
+        if d == 0.0:
+            # the middle node (xi = +0 exactly): what exp, cos and sin give at +-0, without
+            # their calls (a quarter of a piece's; the same bits)
+            ed, cd, sd = 1.0, 1.0, 0.0
+            if A != 0.0:
+                cbd, sbd = 1.0, 0.0
+        else:
+            ed = math.exp(-zeta * d)
+            cd, sd = math.cos(wd * d), math.sin(wd * d)
+            if A != 0.0:
+                cbd, sbd = math.cos(beta * d), math.sin(beta * d)
         for sign in (1.0, -1.0):
             node = hi if sign > 0.0 else j
             e = eh * ed if sign > 0.0 else eh / ed
@@ -297,6 +323,68 @@ def _busy_step(out, i, e, p, ev_t, ev_kind, ev_v, ev_x, ev_step, k_first, a, v, 
             return e, p
         t_a, kind, x0, v0 = ev_t[e], ev_kind[e], ev_x[e], ev_v[e]
         e += 1
+
+
+@kernel
+def _before_onset(i, stop, onset, k_first, dt):
+    """The end of a run of free steps from ``i`` (at most ``stop``) before a sticking onset:
+    the first ``j > i`` whose midpoint ``(k_first + j) dt + dt / 2`` is not before ``onset``,
+    found from its estimate and a step or two of the same test, which is what testing each
+    step in turn from ``i + 1`` gives (the midpoints increase with ``j``) at a fraction of its
+    cost (a float product a free step: ~5 % of the audit at large delta)."""
+    estimate = (onset - 0.5 * dt) / dt - k_first
+    if not estimate < stop:         # beyond the run (or no onset: inf)
+        estimate = stop
+    j = min(max(int(math.ceil(estimate)), i + 1), stop)
+    while j > i + 1 and (k_first + j - 1) * dt + 0.5 * dt >= onset:
+        j -= 1
+    while j < stop and (k_first + j) * dt + 0.5 * dt < onset:
+        j += 1
+    return j
+
+
+@kernel
+def _free_run_unforced(a, v, r, i0, i1, dt, zeta, delta, z, total):
+    """:func:`_free_run` without a harmonic force (``z = (r0, b, y0, y0')``), in two passes:
+    ``b, y0, y0'`` of every step into ``z`` (rows 1-3; elementwise, which the compiler
+    vectorizes), then the sums of their products in step order, as the one-pass loop adds
+    them (same values, same order: the same bits). ``z`` holds at least ``i1 - i0`` columns
+    (a run is at most BLOCK steps)."""
+    two_zeta = 2.0 * zeta
+    n = i1 - i0
+    rb, y0b, y1b = z[0], z[1], z[2]
+    for j in range(n):
+        i = i0 + j
+        b = (r[i + 1] - r[i]) / dt
+        rb[j] = b
+        y0b[j] = delta - a[i] - r[i] + two_zeta * b
+        y1b[j] = v[i] - b
+    s00 = s01 = s02 = s03 = s11 = s12 = s13 = s22 = s23 = s33 = 0.0
+    for j in range(n):
+        r0 = r[i0 + j]
+        b = rb[j]
+        y0 = y0b[j]
+        y1 = y1b[j]
+        s00 += r0 * r0
+        s01 += r0 * b
+        s02 += r0 * y0
+        s03 += r0 * y1
+        s11 += b * b
+        s12 += b * y0
+        s13 += b * y1
+        s22 += y0 * y0
+        s23 += y0 * y1
+        s33 += y1 * y1
+    total[0, 0] += s00
+    total[0, 1] += s01
+    total[0, 2] += s02
+    total[0, 3] += s03
+    total[1, 1] += s11
+    total[1, 2] += s12
+    total[1, 3] += s13
+    total[2, 2] += s22
+    total[2, 3] += s23
+    total[3, 3] += s33
 
 
 @kernel
@@ -384,6 +472,7 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
         phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
     cos_phi, sin_phi = math.cos(phi), math.sin(phi)
     total = np.zeros((out.shape[1], 6, 6))   # per batch, sum of z z^T over whole free steps
+    z = np.empty((3, BLOCK))                 # b, y0, y0' of a run's steps (no harmonic force)
     e = p = b = 0
     i = 0
     while i < n:
@@ -399,23 +488,29 @@ def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, 
         t_mid = k * dt + 0.5 * dt
         p = _phase_after(t_mid, s0, p)
         if p > 0 and t_mid < s1[p - 1]:
+            # a run of whole steps resting in phase p - 1: up to the next event's step, the
+            # batch's end, the phase's end or the next phase's start (where _phase_after
+            # would move on)
+            stop = min(n, bounds[b + 1] - k_first)
+            if e < ev_t.size:
+                stop = min(stop, ev_step[e])
             lower = sw[p - 1] == 1
-            _add_resting(out, b, 0.0, dt, k, r[i], r[i + 1], dt, x_lower if lower else delta,
-                         A, beta, lower)
-            i += 1
+            i = _resting_run(out, b, i, stop, k_first, r, dt, x_lower if lower else delta, A,
+                             beta, lower, s1[p - 1], s0[p] if p < s0.size else math.inf)
             continue
         # a run of free steps: up to the next event's step, the next sticking phase's
         # first step, the batch's end or BLOCK steps
         stop = min(n, i + BLOCK, bounds[b + 1] - k_first)
         if e < ev_t.size:
             stop = min(stop, ev_step[e])
-        j = i + 1
-        next_onset = s0[p] if p < s0.size else math.inf
-        while j < stop and (k_first + j) * dt + 0.5 * dt < next_onset:
-            j += 1
-        _free_run(a, v, r, i, j, k_first, dt, zeta, delta, A, beta, q, cos_phi, sin_phi,
-                  total[b])
-        i = j
+        if p < s0.size:
+            stop = _before_onset(i, stop, s0[p], k_first, dt)
+        if A == 0.0:
+            _free_run_unforced(a, v, r, i, stop, dt, zeta, delta, z, total[b])
+        else:
+            _free_run(a, v, r, i, stop, k_first, dt, zeta, delta, A, beta, q, cos_phi,
+                      sin_phi, total[b])
+        i = stop
     for bb in range(out.shape[1]):
         for row in range(4):
             acc = 0.0

@@ -8,6 +8,7 @@ the kernel's parameter vector, streams the force record through the kernel in ch
 from dataclasses import dataclass, field
 from functools import cached_property
 import math
+import sys
 
 import numpy as np
 
@@ -40,7 +41,13 @@ class SimulationResult:
         plastic impact, or a start at rest on the wall).
     grid_time, a, v : ndarray of float64
         ``a(tau) = delta - x(tau)`` (the paper's displacement from the wall) and the velocity
-        ``x'(tau)`` every ``record_every`` samples; empty unless asked for.
+        ``x'(tau)`` every ``record_every`` samples; empty unless asked for. ``grid_time`` is
+        built on first use from ``grid``.
+    grid : ndarray or tuple
+        The recorded samples' times: an array, or ``(first, stride, n, dt)``, the samples
+        ``first, first + stride, ...`` (``n`` of them) at spacing ``dt`` (a chunk's: its
+        times cost a pass over the chunk that a consumer reading only ``a`` and ``v``, an
+        events cell, does not pay).
     n_steps, n_impacts, n_chatter : int
         Force sample steps taken, impacts, chatter sequences closed at their accumulation point.
     contact_time : float
@@ -98,7 +105,7 @@ class SimulationResult:
     impact_offset: np.ndarray
     stick_start: np.ndarray
     stick_end: np.ndarray
-    grid_time: np.ndarray
+    grid: object
     a: np.ndarray
     v: np.ndarray
     n_steps: int
@@ -122,6 +129,17 @@ class SimulationResult:
             if getattr(self, name) is None:
                 object.__setattr__(self, name,
                                    np.zeros(np.shape(getattr(self, like)), np.int8))
+
+    @cached_property
+    def grid_time(self) -> np.ndarray:
+        """Times of the recorded samples (see ``grid``)."""
+        if not isinstance(self.grid, tuple):
+            return self.grid
+        first, stride, n, dt = self.grid
+        # k as exact floats, then one product each: (arange(n) * stride + first) * dt
+        times = np.arange(first, first + n * stride, stride, dtype=np.float64)[:n]
+        times *= dt
+        return times
 
     # The collision fields are computed on first use (most streaming consumers group the
     # impacts of many chunks themselves) and cached; a frozen dataclass keeps a __dict__.
@@ -273,6 +291,12 @@ def _split_steps(t_end, dt):
     return n_full, rem
 
 
+#: Recording buffers handed over to chunks that `_Buffers.take_grid` keeps to record into
+#: again once their chunks are let go: a consumer looping over the chunks still holds the
+#: last one while the next is simulated, so the one before it is the first free.
+HANDED_KEPT = 2
+
+
 class _Buffers:
     def __init__(self, n_grid):
         self.imp_step = np.empty(_BUFFER, np.int64)
@@ -286,6 +310,35 @@ class _Buffers:
         self.grid = np.empty(max(n_grid, 1))
         self.grid_v = np.empty(max(n_grid, 1))
         self.grid_n = np.zeros(1, np.int64)
+        self.handed = []        # the last buffers handed over (take_grid), oldest first
+
+    def take_grid(self, n):
+        """The recorded ``a`` and ``v`` (their first ``n`` values) as arrays of their own.
+
+        A record filling at least half of the buffers takes the buffers themselves and the
+        next chunk records into others: copying 16 bytes a sample cost an events cell
+        (``record_every=1``) ~2 ns a step, a fifth of its simulation. A shorter one (a chunk
+        asked short with ``send``, the last) is copied, so that a kept chunk never holds
+        more than twice its record.
+
+        The others are a pair handed over two chunks before (`HANDED_KEPT`) that nothing
+        refers to any more (no view of it alive: its reference count is the list's and the
+        call's alone), else new ones: a consumer that reads each chunk and lets it go (the
+        events and spectra cells) records into memory already paged in (a new 8 MB array is
+        zeroed by the system page by page, ~1 ns a step for the pair); one that keeps its
+        chunks (`simulate`) gets new buffers every time."""
+        if 2 * n < self.grid.size:
+            return self.grid[:n].copy(), self.grid_v[:n].copy()
+        a, v = self.grid[:n], self.grid_v[:n]
+        self.handed.append((self.grid, self.grid_v))
+        free = [i for i, pair in enumerate(self.handed[:-1])
+                if sys.getrefcount(pair[0]) == 2 and sys.getrefcount(pair[1]) == 2]
+        if free:
+            self.grid, self.grid_v = self.handed.pop(free[0])
+        else:
+            self.grid, self.grid_v = np.empty(self.grid.size), np.empty(self.grid_v.size)
+        del self.handed[:-HANDED_KEPT]
+        return a, v
 
     def drain(self, parts):
         n, m = int(self.cnt[kernels.CNT_IMPACTS]), int(self.cnt[kernels.CNT_STICK_EVENTS])
@@ -503,8 +556,10 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         walls = np.append(walls, np.int8(stick_open[1]))
         stick_open[0] = None
     n = int(buf.grid_n[0])
-    grid_time = ((np.arange(n) * stride + ((k0 + stride - 1) // stride) * stride) * dt
-                 if stride else np.empty(0))
+    grid = np.empty(0)
+    if stride:      # the times of the samples recorded, built if read (SimulationResult.grid)
+        grid = (((k0 + stride - 1) // stride) * stride, stride, n, dt)
+    grid_a, grid_v = buf.take_grid(n)
     return SimulationResult(
         impact_time=imp_step * dt + imp_off,
         impact_velocity=imp_u,
@@ -512,9 +567,9 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         impact_offset=imp_off,
         stick_start=starts,
         stick_end=ends,
-        grid_time=grid_time,
-        a=buf.grid[:n].copy(),
-        v=buf.grid_v[:n].copy(),
+        grid=grid,
+        a=grid_a,
+        v=grid_v,
         n_steps=k1 - k0 + (1 if t_chunk > k1 * dt else 0),
         n_impacts=len(imp_step),
         n_chatter=parts["n_chatter"],
@@ -621,7 +676,7 @@ def concatenate_results(chunks):
         impact_time=cat("impact_time"), impact_velocity=cat("impact_velocity"),
         impact_step=cat("impact_step"), impact_offset=cat("impact_offset"),
         stick_start=cat("stick_start"), stick_end=cat("stick_end"),
-        grid_time=cat("grid_time"), a=cat("a"), v=cat("v"),
+        grid=cat("grid_time"), a=cat("a"), v=cat("v"),
         n_steps=sum(c.n_steps for c in chunks), n_impacts=sum(c.n_impacts for c in chunks),
         n_chatter=sum(c.n_chatter for c in chunks),
         contact_time=float(sum(c.contact_time for c in chunks)),

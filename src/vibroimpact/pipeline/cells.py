@@ -292,6 +292,24 @@ def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches,
     return {name: np.array([row[name] for row in rows]) for name in rows[0]}
 
 
+class _Joined:
+    """One kind of event of an `_EventRecord` (``steps``, ``u``, ...): the list of its
+    chunks' arrays, joined into one when read. Joining at every chunk instead copied the
+    whole record each time (O(chunks^2): ~10 ms a chunk at 2e6 impacts), which an events
+    cell, reading it once at the end, never needed; a map cell reads it at each check."""
+
+    def __set_name__(self, owner, name):
+        self.name = "_" + name
+
+    def __get__(self, record, owner=None):
+        if record is None:
+            return self
+        parts = getattr(record, self.name)
+        if len(parts) > 1:
+            parts[:] = [np.concatenate(parts)]
+        return parts
+
+
 class _EventRecord:
     """The impacts and sticking phases of a streamed record, gathered chunk by chunk.
 
@@ -303,6 +321,9 @@ class _EventRecord:
     too, and the grouping is per wall (`stats.group_collisions` with ``wall``: a collision
     never spans the two walls, a hop is pressed onto the wall it is at).
     """
+
+    steps, offsets, u, starts, ends = _Joined(), _Joined(), _Joined(), _Joined(), _Joined()
+    wall, stick_wall = _Joined(), _Joined()
 
     def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0, gap=None,
                  eps_lower=None):
@@ -317,28 +338,24 @@ class _EventRecord:
         self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
         self.stuck_wall = 0      # the wall of a rest still going on at the last chunk's end
-        self.steps, self.offsets, self.u, self.starts, self.ends = [], [], [], [], []
-        self.wall, self.stick_wall = [], []
+        # each kind's arrays, chunk by chunk (read through the _Joined attributes)
+        self._steps, self._offsets, self._u, self._starts, self._ends = [], [], [], [], []
+        self._wall, self._stick_wall = [], []
         self.t_end = 0.0
 
     def add(self, chunk):
-        self.steps.append(chunk.impact_step)
-        self.offsets.append(chunk.impact_offset)
-        self.u.append(chunk.impact_velocity)
-        self.starts.append(chunk.stick_start)
-        self.ends.append(chunk.stick_end)
-        names = ("steps", "offsets", "u", "starts", "ends")
+        self._steps.append(chunk.impact_step)
+        self._offsets.append(chunk.impact_offset)
+        self._u.append(chunk.impact_velocity)
+        self._starts.append(chunk.stick_start)
+        self._ends.append(chunk.stick_end)
         if self.walls:
-            self.wall.append(np.asarray(chunk.impact_wall, dtype=np.int8))
-            self.stick_wall.append(np.asarray(chunk.stick_wall, dtype=np.int8))
+            self._wall.append(np.asarray(chunk.impact_wall, dtype=np.int8))
+            self._stick_wall.append(np.asarray(chunk.stick_wall, dtype=np.int8))
             self.stuck_wall = int(chunk.x_end != self.force["delta"])
-            names += ("wall", "stick_wall")
         self.t_end = chunk.t_end
         self.stuck_since = chunk.stuck_since
         self._sticking = None
-        if len(self.steps) > 1:           # keep one array per kind: checks regroup each time
-            for name in names:
-                setattr(self, name, [np.concatenate(getattr(self, name))])
 
     def collision_walls(self, col):
         """The wall of each collision of ``col`` (int8, 0: at delta, 1: at delta - gap)."""
@@ -404,7 +421,6 @@ class _EventRecord:
                                       rule=rule, wall=self.wall[0], stick_wall=wall,
                                       eps_lower=self.walls["eps_lower"], after=transient)
 
-
     def firsts(self, eps, floor, transient, rule="physical"):
         """`collisions` reduced to what a map cell reads: the `_Firsts` of each collision's
         first impact (the same values as the `Collisions` fields of those names), grouped by
@@ -421,7 +437,6 @@ class _EventRecord:
             step, offset, u, self.sticking()[0], dt=self.dt, eps=eps, eps_lower=eps_lower,
             floor=floor, pressed=pressed, rule=rule, wall=wall, after=transient)
         return _Firsts(*fields)
-
 
     def rule_probabilities(self, tallied, eps, floor, transient, rules, duration):
         """``[(probability, stick_probability)]`` of the collisions at or after
@@ -452,9 +467,10 @@ class _IdentityRecord:
     """Per-batch integrals of the power balance and the virial, gathered chunk by chunk.
 
     The window runs over whole force steps, from sample ``ceil(transient / dt)`` to sample
-    ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. Each chunk
-    brings the state at its samples (``record_every=1``) and its impacts and sticking
-    phases; :func:`vibroimpact.impact.audit.audit_moments` (the compiled
+    ``floor(t_end / dt)``, cut into ``n_batches`` contiguous batches of steps. The chunks,
+    added in order, are those of one run from sample 0; each brings the state at its
+    samples (``record_every=1``) and its impacts and sticking phases;
+    :func:`vibroimpact.impact.audit.audit_moments` (the compiled
     :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly. With a second
     wall (``gap``, ``eps_lower`` in ``params``) the identities have a term per wall
     (docs/model.md, "Two walls"): the impact sums are kept per wall.
@@ -475,16 +491,20 @@ class _IdentityRecord:
         shape = (2, n_batches) if self.two else n_batches
         self.sum_u = np.zeros(shape)
         self.sum_u2 = np.zeros(shape)
+        self.k_next = 0     # the first sample of the next chunk
 
     def _batch(self, k):
         n = self.k_stop - self.k_start
         return ((k - self.k_start) * self.n_batches) // max(n, 1)
 
     def add(self, chunk):
-        # the chunk's grid holds every sample from its first, k0 (record_every=1)
-        k0 = int(round(chunk.grid_time[0] / self.dt)) if chunk.grid_time.size else 0
+        # the chunks of one run from sample 0 with every sample recorded (record_every=1):
+        # this one's first is the one after the last chunk's (its times, chunk.grid_time, are
+        # never built)
+        k0 = self.k_next
+        self.k_next += chunk.a.size
         lo = max(self.k_start, k0)
-        hi = min(self.k_stop, k0 + chunk.grid_time.size)
+        hi = min(self.k_stop, k0 + chunk.a.size)
         if hi > lo:
             keep = slice(lo - k0, hi - k0)
             r = np.asarray(self.noise[lo : hi + 1], dtype=float)

@@ -20,14 +20,18 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
 #: that compiled nothing; benchmark files' cpu_time).
 JOB_START_S = 1.0
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
-#: The self-audit of an events cell (`impact.audit.audit_moments`: exact integrals over every
-#: step), per step on top of NS_PER_STEP. CPU ns measured by benchmarks/bench_audit.py (1e6
-#: steps, zeta 0.05, eps 0.5, band-limited rms 0.5, dt 0.1; shared 2-core node under load):
-#: 5-10 for delta >= 1, ~20 at 0.5, ~40 at 0, 80-105 at -0.5, ~26 at -1 (0.3-0.85 x the
-#: simulation's own cost); a mean over the sweep's cells, most of them beyond delta = 1: the
-#: default config's five events jobs measured 33.1 CPU-s against 41.3 planned with 25 ns
-#: (`python benchmarks/issue37.py --peer a13f0b3`, idle 2-core node, 2026-11-27), 14 ns fits.
-NS_PER_AUDIT_STEP = 14.0
+#: What an events cell costs per step on top of NS_PER_STEP: the self-audit
+#: (`impact.audit.audit_moments`: exact integrals over every step), the state recorded at
+#: every sample for it, and the statistics. The audit alone, CPU ns by
+#: benchmarks/bench_audit.py (5e5 steps, zeta 0.05, eps 0.5, band-limited rms 0.5, dt 0.1;
+#: 2-core node, load ~7): 4-5 at delta 3, ~9 at 0.5, ~18 at 0, ~40 at -0.5 and with the
+#: harmonic force; a mean over the sweep's cells, most of them beyond delta = 1. The default
+#: config's five events jobs measured 33.1 CPU-s at 2ec7353 (idle node) and ~27.4 after
+#: the audit's and the record's cuts of 2026-11-27 (the random study's four jobs 25.9
+#: against 31.7 CPU-s for 2ec7353's, alternated in one run, load 6.3-7.2; the harmonic job
+#: 3.07 against 3.27; scaled by 2ec7353's idle figures): 5 s of start-up and 7.26e8 steps
+#: at 25 + 6 ns.
+NS_PER_AUDIT_STEP = 6.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 #: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
