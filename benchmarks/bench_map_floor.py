@@ -71,12 +71,84 @@ inflated by the neighbours, walls meaningless), the default build's map (/work/c
   the step without impact 4.38 against 5.22 ns (0.84 x: at this load the ratio moves by
   +-0.15 between runs).
 
+3. (``--kernel STRIDE``) The kernel alone: every STRIDE-th cell simulated alone to its
+   ``record_end`` (what the map job's kernel computes for it, bit for bit), this tree against
+   ``--peer``, one fresh process per build, in turn over ``--rounds`` rounds: the CPU time of
+   ``run_steps``, per resolved impact and per collision, and a SHA-256 of every event array
+   and end state (equal digests: the two builds agree bit for bit on the map's workload).
+
+Issue 37, session 38 (branch k38): where the kernel's time per collision goes, and what was cut.
+
+- Profile: ``perf record`` on a process that, after the cells, writes ``/tmp/perf-PID.map``
+  from the JIT's symbol addresses (``library._get_compiled_object()`` of every overload,
+  ``nm -S`` for the sizes, the engine's ``get_function_address``; it needs a fresh
+  NUMBA_CACHE_DIR, a library loaded from the cache keeps no object code). It showed that
+  LLVM's inliner leaves as calls ``seg_eval`` (9 call sites), ``first_contact``, ``_polish``,
+  ``safe_step``, ``_hermite_guess``, ``release_time``, ``chatter_tail`` and the one-wall step
+  itself, each passing the 17-slot segment tuple by value; and that the phase of the sample
+  point and its libm ``sin``/``cos`` were computed three times per slow step (after the
+  previous slow step for ``w``, in run_steps' path to the slow step for ``x``, and in the
+  step's first segment). Share of the kernel's samples (649 cells, before): run_steps 29 %
+  (the impact-free steps about half of it), seg_eval 20 %, libm sincos 13 %, the one-wall
+  step (with segment inlined) 11 %, first_contact 10 %, _polish 8 %, safe_step 3 %,
+  _hermite_guess 3 %, release_time 2 %, chatter_tail 1.5 %.
+- Cut, bit for bit (``kernel_identity.py`` IDENTICAL against 2ec7353; the event digests of
+  ``--kernel`` equal): a slow step at a sample point takes the phase and the libm sin/cos
+  that run_steps already holds there (``_slow_step_one``'s ``exact``: one ``phase`` and one
+  sincos pair less per slow step, two when slow steps follow each other); ``first_contact``
+  inlined into the one-wall step (a twin compiled with numba's ``inline="always"``, the
+  generic two-wall step keeps the call) and ``_polish`` into its two callers. Inlining
+  ``seg_eval`` and ``safe_step`` as well gained nothing measurable and cost compile time
+  (simulate's first call 6.6 -> 8.7 s); the one-wall step compiled with a literal ``exact``
+  (two specializations) doubled its compile time: the flag is a run-time bool.
+- What one piece costs (a numba loop over 2e6 calls, throughput, best of 5, load 4):
+  seg_eval 17.9 ns, segment (with its libm sin+cos) 13.5 ns, phase 5.8 ns, libm sin+cos
+  8.0 ns, phase + libm sin/cos 26.0 ns. Per resolved impact (counted in pure Python,
+  NUMBA_DISABLE_JIT, on five cells of 2e4 steps: 1/beta, delta = 0.5, 0; 1, -0.5; 2, 0.5;
+  2.5, -1; 0.2, -0.9): 1.0-1.2 segments, 3.4-7.1 seg_evals (a safe step from the wall, then
+  Halley from a proved bracket; more where flights approach the wall over several steps),
+  1.4-6.1 square roots of the safe steps, one polish, 1.4-2.1 phases (before the
+  cut): 100-200 ns of arithmetic at throughput, more at the latency of the search's dependent
+  chain, plus the bookkeeping; measured 336-349 ns per resolved impact after the cut.
+- Why ~300 ns a collision is out of reach bit for bit: with 5.04 resolved impacts per
+  collision, 300 ns is 60 ns a rebound, less than the three seg_evals any proved root of this
+  search needs. It needs the rebounds not resolved, i.e. the chatter tail summed after the
+  first rebound: a bracket on the accumulation point of order w^5 (chatter_tail's is first
+  order, ~500 w^2, so the tail waits for w ~ 1e-5 under CHATTER_TIME_TOL = 1e-7; see k37's
+  notes above), which moves bits of every later event. Not attempted in this session (no
+  proved bracket), so the map's floor stays ~1 impact at ~340 ns + 4 rebounds at ~340 ns.
+- Measured 2026-11-27 08:40-09:00 UTC on branch k38 against 2ec7353 (shared machine, load
+  average 2.9-7 on 2 cores; other helpers' jobs and this branch's tests running):
+  ``--kernel 1 --rounds 1 --peer 2ec7353`` (all 5187 cells, 1.42e9 steps, 7.95e7 resolved
+  impacts, 1.59e7 collisions): run_steps 31.10 CPU-s against 34.51 (0.90 x), 391 against
+  434 ns per resolved impact, 1960 against 2175 ns per collision (free steps included),
+  the event digests equal (bit for bit on the whole map). ``--kernel 8 --rounds 3``: best
+  3.905 against 4.286 CPU-s (0.91 x), medians 3.964 / 4.429, digests equal; again after
+  merging main at 09:12 UTC (load 8): 3.826 against 4.190 (0.91 x), digests equal.
+  ``--split 8`` (one process, this tree and 2ec7353 in turn, twice, load 3.8): kernel 3.92 and
+  4.02 s against 4.41 and 4.36 s; less the free steps 336 / 349 ns per resolved impact
+  against 390 / 381, 1692 / 1761 ns per collision against 1965 / 1924; the whole cells 7.48 /
+  7.55 CPU-s against 8.02 / 7.87 (the statistics, 2.3 s, and hops' pressed flights, 0.75 s,
+  unchanged). ``--stride 4 --no-main --peer 2ec7353`` (1297 cells, 2 processes, load 2.9-3.9):
+  cell CPU 13.66 against 14.08 s (0.97 x), walls 39.78 / 37.45 s (fresh caches: compilation
+  included), max |dP| 0; the step without impact 3.96 ns against the prototype's 4.48
+  (0.88 x). ``ab_kernels.py --base 2ec7353 --quick`` (load 3.9-5.6): simulate at delta = -0.5
+  (random force only: the inlining, not the phase reuse) 0.947 x CPU best, 0.949 x median;
+  delta = +0.5 0.974 / 0.988; periodic_orbits 1.009 / 0.970 (not touched).
+- The generic step (two walls: the clearance map and studies) got the same hand-over, and one
+  sin/cos pair per event now serves both walls' frames (the lower half of ``P`` shares the
+  harmonic phase): 20 two-wall simulate calls (gaps 0.6-2, random, harmonic plus random,
+  plastic, partial last step; 3.95e5 impacts), two alternations at 09:03 UTC (load 6):
+  0.54 / 0.54 CPU-s against 0.57 / 0.58 for 2ec7353, event digests equal;
+  ``kernel_identity.py`` now holds three two-wall cases too (IDENTICAL against 2ec7353).
+
 Usage::
 
     python benchmarks/bench_map_floor.py --noise results/noise/harmonic_input.nc
     python benchmarks/bench_map_floor.py --stride 4 --no-main     # a quarter of the cells
     python benchmarks/bench_map_floor.py --only-step
     python benchmarks/bench_map_floor.py --split 8 --dataset ... --noise ...
+    python benchmarks/bench_map_floor.py --kernel 8 --peer 2ec7353 --rounds 3 --dataset ...
 """
 import os
 
@@ -205,6 +277,90 @@ def split(dataset, noise_path, stride, n_free):
           f"impact, {ev / collisions * 1e9:.0f} ns per collision")
 
 
+# ---------------------------------------------------------------------------- 3. the kernel
+def kernel_child(dataset, noise_path, stride):
+    """In a child (the build on PYTHONPATH): every ``stride``-th cell of the map simulated
+    alone to its ``record_end`` (what the map job's kernel computes for it, bit for bit), with
+    the CPU time of ``run_steps`` (the driver's calls of it, timed around each) and of the
+    whole ``simulate`` call, the counts, and a SHA-256 of every event array and end state."""
+    import hashlib
+    import xarray as xr
+    from vibroimpact import simulate
+    from vibroimpact.impact import kernels
+    from vibroimpact.pipeline.io import read_noise
+    ds = xr.open_dataset(dataset).load()
+    noise, dt, _ = read_noise(noise_path)
+    noise = np.asarray(noise[:], dtype=float)
+    zeta, eps, amp = (float(ds.attrs[k]) for k in ("zeta", "eps", "amplitude"))
+    cells = [(float(b), float(d), float(ds.record_end.sel(inv_beta=b, delta=d)))
+             for b in ds.inv_beta.values for d in ds.delta.values][::stride]
+    run_steps, spent = kernels.run_steps, [0.0]
+
+    def timed(*a):
+        c0 = time.process_time()
+        out = run_steps(*a)
+        spent[0] += time.process_time() - c0
+        return out
+    kernels.run_steps = timed                # the driver calls kernels.run_steps
+    simulate(zeta, eps, -1.0, noise=noise[:20001], dt=dt, amplitude=amp, beta=0.4)  # warm
+    spent[0] = 0.0
+    digest, cpu, impacts, collisions, steps = hashlib.sha256(), 0.0, 0, 0, 0
+    for inv_beta, delta, t_end in cells:
+        c0 = time.process_time()
+        res = simulate(zeta, eps, delta, noise=noise, dt=dt, amplitude=amp, beta=1.0 / inv_beta,
+                       t_end=t_end)
+        cpu += time.process_time() - c0
+        for f in ("impact_step", "impact_offset", "impact_velocity", "stick_start",
+                  "stick_end"):
+            digest.update(np.ascontiguousarray(getattr(res, f)).tobytes())
+        digest.update(np.array([res.x_end, res.v_end, res.contact_time, res.n_chatter]).tobytes())
+        impacts += int(res.n_impacts)
+        collisions += int(res.n_collisions)
+        steps += int(res.n_steps)
+    json.dump(dict(cells=len(cells), cpu=cpu, kernel=spent[0], impacts=impacts,
+                   collisions=collisions, steps=steps, digest=digest.hexdigest()[:16]),
+              sys.stdout)
+
+
+def kernel_ab(dataset, noise_path, stride, peer, rounds):
+    """The kernel alone, this tree against ``peer``, one fresh process per build and round,
+    in turn (each build's own NUMBA_CACHE_DIR, compiled before the first round)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        builds = [("this tree", REPO / "src"), (f"peer {peer}", extract(peer, Path(tmp) / "p"))]
+        out = {label: [] for label, _ in builds}
+        for r in range(rounds + 1):
+            for label, src in (builds if r % 2 == 0 else builds[::-1]):
+                env = dict(os.environ, PYTHONPATH=str(src), NUMBA_NUM_THREADS="1",
+                           NUMBA_CACHE_DIR=str(Path(tmp) / f"cache-{label[:4]}"))
+                args = [sys.executable, __file__, "--kernel-child",
+                        str(stride if r > 0 else 10**9), "--dataset", dataset, "--noise",
+                        noise_path]               # round 0: one cell, to compile
+                p = subprocess.run(args, env=env, capture_output=True, text=True)
+                if p.returncode != 0:
+                    sys.stderr.write(p.stderr)
+                    raise SystemExit(f"FAIL: build {label} exited with {p.returncode}")
+                if r > 0:                    # round 0 compiles: not timed
+                    out[label].append(json.loads(p.stdout))
+    ref = out["this tree"][0]
+    print(f"\n== 3. The kernel alone: {ref['cells']} cells (every {stride}th) simulated to "
+          f"their record_end, {rounds} rounds in turn, one process each ==")
+    print(f"{ref['steps']:.3e} steps, {ref['impacts']:.3e} resolved impacts, "
+          f"{ref['collisions']:.3e} collisions")
+    print(f"{'build':<16} {'run_steps CPU s (best, median)':>31} {'ns/impact':>10} "
+          f"{'ns/collision':>13} {'/this':>6}  events digest")
+    best_ref = min(o["kernel"] for o in out["this tree"])
+    for label, runs in out.items():
+        k = sorted(o["kernel"] for o in runs)
+        o = runs[0]
+        same = all(x["digest"] == ref["digest"] for x in runs)
+        print(f"{label:<16} {k[0]:15.3f} {np.median(k):15.3f} "
+              f"{k[0] / o['impacts'] * 1e9:10.0f} {k[0] / o['collisions'] * 1e9:13.0f} "
+              f"{k[0] / best_ref:6.3f}  {o['digest']}{'' if same else ' (varies!)'}")
+    print("bit for bit on these cells" if all(
+        o["digest"] == ref["digest"] for runs in out.values() for o in runs)
+        else "DIFFERENT events")
+
+
 # ---------------------------------------------------------------------------- 2. the step
 def prototype_kernel():
     """A minimal numba loop: x_{k+1} = A x_k + g0 f_k + g1 f_{k+1}, nothing else."""
@@ -271,8 +427,18 @@ def main(argv=None):
     p.add_argument("--only-step", action="store_true")
     p.add_argument("--split", type=int, default=0, metavar="STRIDE",
                    help="only the split of a tile's time, over every STRIDE-th cell")
+    p.add_argument("--kernel", type=int, default=0, metavar="STRIDE",
+                   help="only the kernel alone on every STRIDE-th cell, this tree vs --peer")
+    p.add_argument("--kernel-child", type=int, default=0, help=argparse.SUPPRESS)
     args = p.parse_args(argv)
+    if args.kernel_child:
+        kernel_child(args.dataset, args.noise, args.kernel_child)
+        return
     print(f"load average {os.getloadavg()} on {os.cpu_count()} CPUs")
+    if args.kernel:
+        kernel_ab(args.dataset, args.noise, args.kernel, args.peer, args.rounds)
+        print(f"load average {os.getloadavg()} at the end")
+        return
     if args.split:
         split(args.dataset, args.noise, args.split, int(2e6))
         return

@@ -8,7 +8,9 @@ with ``np.save`` (one ``.npy`` per field and case):
   eps = 0.5, 0 (plastic: every impact sticks) and 1 (elastic micro-bounces); the harmonic force
   alone ((2/1) motion at 1/beta = 1.1) and harmonic plus random force (rms 0.29) at
   delta = 0 and -1 (the impact-chatter-stick cycle), eps 0.5 and 0; a record ending inside a
-  sample step (the driver's partial last step); ``a(tau)`` and ``x'`` recorded every 7 samples;
+  sample step (the driver's partial last step); three with a second wall below the mass
+  (random force; harmonic plus random; plastic with a partial last step); ``a(tau)`` and
+  ``x'`` recorded every 7 samples;
 - ``periodic_orbits``: (1/1), (2/1), (1/2), (2/2), (3/1) on a 4 x 4 grid of (1/beta, delta),
   inadmissible solutions included, eps = 0.5 and 0;
 - ``orbit_map``: the default types on a 5 x 6 grid (the parallel map kernel).
@@ -60,6 +62,13 @@ def simulate_cases():
             cases[f"mixed_d{delta:+.1f}_e{eps:.1f}"] = dict(
                 eps=eps, delta=delta, noise=0.29 * noise, amplitude=1.0, beta=1.0 / 2.5)
     cases["partial_last_step"] = dict(eps=0.5, delta=-0.5, noise=noise[:50_002],
+                                      t_end=(50_000 + 0.37) * DT)
+    # a second wall below the mass (the generic step, both walls' frames)
+    cases["two_walls_random"] = dict(eps=0.5, delta=0.3, noise=noise, gap=1.0, eps_lower=0.8)
+    cases["two_walls_mixed"] = dict(eps=0.5, delta=-0.2, noise=0.29 * noise, amplitude=1.0,
+                                    beta=1.0 / 2.5, gap=0.6, eps_lower=0.5)
+    cases["two_walls_partial"] = dict(eps=0.0, delta=0.2, noise=0.29 * noise[:50_002],
+                                      amplitude=1.0, beta=1.0 / 1.1, gap=1.0, eps_lower=0.5,
                                       t_end=(50_000 + 0.37) * DT)
     return cases
 

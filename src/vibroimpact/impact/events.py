@@ -51,9 +51,12 @@ def _hermite_guess(w, glo, vlo, ghi, vhi):
     return t * w
 
 
-@kernel
+@kernel(inline="always")
 def _polish(lo, hi, s, g, v, acc, tolg, M3, c, P):
     """Root of ``g`` in ``[lo, hi]``, where it is proved unique with ``g' > 0``, to round-off.
+
+    Inlined into its two callers by numba (``inline="always"``): as a call it received the
+    17-slot segment tuple and nine floats by value once per impact.
 
     Halley's iteration (``x''`` comes free with every evaluation: cubic convergence) from
     ``s``, where ``(g, v, acc)`` are known, kept inside the bracket by bisection. Stops when
@@ -198,8 +201,7 @@ def leave_wall(c, P, H, tolF, M3, M4):
     return best
 
 
-@kernel
-def first_contact(c, P, H, at_wall):
+def _first_contact(c, P, H, at_wall):
     """Smallest ``sig`` in ``(0, H]`` where the segment's motion reaches the wall.
 
     Parameters
@@ -300,6 +302,15 @@ def first_contact(c, P, H, at_wall):
             if ga >= 0.0:
                 return ROOT, a, va, 0.0
     return TOUCH, a, va, 0.0
+
+
+#: :func:`_first_contact` compiled as a kernel of its own, called by the generic step.
+first_contact = kernel(_first_contact)
+#: The same, inlined into its caller by numba (``inline="always"``): the one-wall step
+#: (:func:`vibroimpact.impact.stepping.slow_step_one`), where a call that passes the
+#: 17-slot segment tuple by value once per event cost ~5 % of the map's kernel (LLVM's own
+#: inliner keeps it a call). Only there: every inlined copy adds to the compile time.
+first_contact_inline = kernel(inline="always")(_first_contact)
 
 
 @kernel

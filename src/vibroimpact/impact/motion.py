@@ -95,16 +95,26 @@ def segment(x0, v0, s, r0, b, theta_k, P):
     (its slots: :data:`vibroimpact.impact.layout.C_FIELDS`), read by :func:`seg_eval`,
     :func:`push_eval` and the searches.
     """
-    zeta, omega, delta = P[P_ZETA], P[P_OMEGA], P[P_DELTA]
-    A, beta, Aq, phi = P[P_A], P[P_BETA], P[P_AQ], P[P_PHI]
-    P0 = r0 + b * s - 2.0 * zeta * b
-    if Aq != 0.0:
-        psi0 = theta_k + beta * s - phi
+    if P[P_AQ] != 0.0:
+        psi0 = theta_k + P[P_BETA] * s - P[P_PHI]
         sp = math.sin(psi0)
         cp = math.cos(psi0)
     else:
         sp = 0.0
         cp = 1.0
+    return segment_at(x0, v0, s, r0, b, sp, cp, P)
+
+
+@kernel(inline="always")
+def segment_at(x0, v0, s, r0, b, sp, cp, P):
+    """:func:`segment` with ``sp, cp = sin psi0, cos psi0`` given (``psi0 = theta_k + beta s -
+    phi``, as :func:`segment` computes it; ``0, 1`` without a harmonic force): the stepping
+    loop hands on the values it already has at a sample point, bit for bit the same.
+    Inlined by numba (``inline="always"``): LLVM's own inliner leaves some calls of the
+    kernels' helpers as calls, and this one returns the 17-slot tuple."""
+    zeta, omega, delta = P[P_ZETA], P[P_OMEGA], P[P_DELTA]
+    A, beta, Aq = P[P_A], P[P_BETA], P[P_AQ]
+    P0 = r0 + b * s - 2.0 * zeta * b
     y0 = x0 - P0 - Aq * sp
     yv0 = v0 - b - Aq * beta * cp
     c2 = (yv0 + zeta * y0) / omega

@@ -9,7 +9,8 @@ driver's buffers. The arrays they share are laid out in :mod:`vibroimpact.impact
 import math
 
 from vibroimpact.impact._jit import kernel
-from vibroimpact.impact.events import (chatter_tail, first_contact, release_time)
+from vibroimpact.impact.events import (chatter_tail, first_contact, first_contact_inline,
+                                       release_time)
 from vibroimpact.impact.layout import (BAD_NOISE, BUFFER_FULL, C_DF0, C_F0, C_R,
                                        CNT_CHATTER, CNT_IMPACTS, CNT_STICK_EVENTS,
                                        FREE, FT_CONTACT_TIME, FT_GAP, FT_IMPACTS, FT_MODE,
@@ -21,7 +22,7 @@ from vibroimpact.impact.layout import (BAD_NOISE, BUFFER_FULL, C_DF0, C_F0, C_R,
                                        P_ZETA, PRESSED, ROOT, S_COS_PSI, S_MODE, S_SIN_PSI,
                                        S_W, S_WV, STICK_LO, STICK_OFF, STICK_ON, STUCK,
                                        STUCK_LO, TOO_MANY_EVENTS, TOUCH, WALL, WALL_LO)
-from vibroimpact.impact.motion import phase, segment
+from vibroimpact.impact.motion import phase, segment, segment_at
 from vibroimpact._law import rebound_velocity
 from vibroimpact.impact.tolerances import (BOUND_SAFETY, CHATTER_ESTIMATE_TOL,
                                            ELASTIC_MICRO_FLIGHT, EPS64,
@@ -69,16 +70,30 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
     in that frame, and every free flight also searches the other wall's first contact (in
     its own frame, from a point off it), the earlier of the two ending the flight.
     """
+    return _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step,
+                      stk_off, stk_kind, cnt, ftot, 0.0, 0.0, 1.0, False)
+
+
+@kernel
+def _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+               stk_kind, cnt, ftot, theta0, sp0, cp0, exact):
+    """:func:`slow_step`, handed what :func:`run_steps` already computed at sample ``k``
+    (``theta0, sp0, cp0, exact`` as in :func:`_slow_step_one`). Both walls' frames share the
+    harmonic phase (the lower half of ``P`` differs in ``A``, ``A q``, ``eps`` and ``delta``
+    only), so an event's sin and cos serve the segment in both frames."""
     delta = P[P_DELTA]
     two = P.shape[0] > N_PARAMS
-    theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
+    if exact:
+        theta_k = theta0
+    else:
+        theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
     s = 0.0
     n_events = 0
     side = 1 if (mode == WALL_LO or mode == STUCK_LO) else 0
     if mode == WALL or mode == WALL_LO:
         # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
         if P[P_A] != 0.0:
-            v += P[P_AQ] * P[P_BETA] * math.cos(theta_k - P[P_PHI])
+            v += P[P_AQ] * P[P_BETA] * (cp0 if exact else math.cos(theta_k - P[P_PHI]))
         mode = FREE
     elif mode == STUCK_LO:
         mode = STUCK
@@ -117,7 +132,18 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
         Pw = P[N_PARAMS:] if side == 1 else P
         sg = -1.0 if side == 1 else 1.0
         eps = Pw[P_EPS]
-        c = segment(sg * x, sg * v, s, sg * r0, sg * b, theta_k, Pw)
+        # sin, cos of the harmonic phase at s, as segment computes them (the same in both
+        # frames): at the step's start with ``exact`` the ones run_steps holds
+        if P[P_AQ] != 0.0:
+            if exact and n_events == 1:
+                sps, cps = sp0, cp0
+            else:
+                psi0 = theta_k + P[P_BETA] * s - P[P_PHI]
+                sps = math.sin(psi0)
+                cps = math.cos(psi0)
+        else:
+            sps, cps = 0.0, 1.0
+        c = segment_at(sg * x, sg * v, s, sg * r0, sg * b, sps, cps, Pw)
         vf = sg * v
         Hs = H - s
         if just_hit and vf < 0.0 and c[C_F0] > 0.0:
@@ -185,7 +211,7 @@ def slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, st
             # the other wall, seen from off it: the earlier contact ends the flight
             o = 1 - side
             Po = P[N_PARAMS:] if o == 1 else P
-            co = segment(-sg * x, -sg * v, s, -sg * r0, -sg * b, theta_k, Po)
+            co = segment_at(-sg * x, -sg * v, s, -sg * r0, -sg * b, sps, cps, Po)
             code2, sig2, u2, gH2 = first_contact(co, Po, Hs, False)
             if code2 != NO_ROOT and (code == NO_ROOT or sig2 < sig):
                 side, sg, Pw, c = o, -sg, Po, co
@@ -231,14 +257,32 @@ def slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step
     the two bit for bit (the far wall, the mirror) and tests/test_simulate*.py hold this one
     to the stress families' references.
     """
+    return _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step,
+                          stk_off, stk_kind, cnt, ftot, 0.0, 0.0, 1.0, False)
+
+
+@kernel
+def _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+                   stk_kind, cnt, ftot, theta0, sp0, cp0, exact):
+    """:func:`slow_step_one`, handed what :func:`run_steps` already computed at sample ``k``.
+
+    With ``exact`` (only with a harmonic force), ``theta0`` is ``phase(k, 0, ...)`` and
+    ``sp0, cp0`` are ``sin, cos`` of ``theta0 - phi`` from libm, the very values the step
+    would compute itself for its first segment (at offset 0: ``theta0 + beta 0 - phi`` is
+    ``theta0 - phi`` exactly, ``phase`` never returning -0) and for ``x'`` in mode ``WALL``:
+    the step skips one ``phase`` and one ``sin``/``cos`` pair, bit for bit the same.
+    """
     zeta, eps, delta = P[P_ZETA], P[P_EPS], P[P_DELTA]
-    theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
+    if exact:
+        theta_k = theta0
+    else:
+        theta_k = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], P[P_BETA]) if P[P_A] != 0.0 else 0.0
     s = 0.0
     n_events = 0
     if mode == WALL:
         # x' arrives as w' = x' - p_h' (run_steps keeps the harmonic part out of its loop)
         if P[P_A] != 0.0:
-            v += P[P_AQ] * P[P_BETA] * math.cos(theta_k - P[P_PHI])
+            v += P[P_AQ] * P[P_BETA] * (cp0 if exact else math.cos(theta_k - P[P_PHI]))
         mode = FREE
     at_wall = x >= delta
     if at_wall:
@@ -258,7 +302,10 @@ def slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step
             ftot[FT_IMPACTS] = cnt[CNT_IMPACTS] - imp0
             ftot[FT_STICK_EVENTS] = cnt[CNT_STICK_EVENTS] - stk0
             return x, v, mode, TOO_MANY_EVENTS
-        c = segment(x, v, s, r0, b, theta_k, P)
+        if exact and n_events == 1:
+            c = segment_at(x, v, s, r0, b, sp0, cp0, P)     # s = 0: the step's own start
+        else:
+            c = segment(x, v, s, r0, b, theta_k, P)
         Hs = H - s
         if just_hit and v < 0.0 and c[C_F0] > 0.0:
             # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
@@ -310,7 +357,7 @@ def slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step
             v = 0.0
             at_wall = True
             continue
-        code, sig, u, gH = first_contact(c, P, Hs, at_wall)
+        code, sig, u, gH = first_contact_inline(c, P, Hs, at_wall)
         if code == NO_ROOT:
             return gH + delta, u, FREE, OK
         if code == PRESSED:
@@ -420,11 +467,19 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
     cap_imp = imp_step.shape[0]
     cap_stk = stk_step.shape[0]
     status, k_stop = OK, k_end
+    # sp, cp are sin, cos of theta_x - phi from libm (not rotated) at sample k_exact (the
+    # step after a slow step, or a resynchronisation): a slow step there reuses them and
+    # theta_x = phase(k_exact, 0, ...) instead of computing them again (slow_step_one's
+    # ``exact``); written only off the impact-free path
+    k_exact = -1
+    theta_x = 0.0
     for k in range(k_begin, k_end):
         if has_h and k % RESYNC_EVERY == 0:
-            psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
+            theta_x = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta)
+            psi = theta_x - P[P_PHI]
             sp = math.sin(psi)
             cp = math.cos(psi)
+            k_exact = k
         if stride > 0 and k % stride == 0:
             if mode != FREE:
                 # on the wall; STUCK keeps w' = -p_h' exactly, so x' = 0 there
@@ -477,10 +532,19 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                 continue
             x = w
             v = wv
+            sx = 0.0
+            cx = 1.0
             if has_h:
-                psi = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
-                x = w + Aq * math.sin(psi)
-                v = wv + Aq * beta * math.cos(psi)
+                if k != k_exact:
+                    theta_x = phase(k, 0.0, P[P_BH_HI], P[P_BH_LO], beta)
+                    psi = theta_x - P[P_PHI]
+                    sx = math.sin(psi)
+                    cx = math.cos(psi)
+                else:
+                    sx = sp
+                    cx = cp
+                x = w + Aq * sx
+                v = wv + Aq * beta * cx
         else:
             if mode == STUCK:
                 # resting on the wall: it stays through the step when the push f - delta is
@@ -509,6 +573,8 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
                     continue
             x = delta if (mode == STUCK or mode == WALL) else low
             v = wv          # w': slow_step adds p_h' in mode WALL, ignores it when STUCK
+            sx = sp
+            cx = cp
         # a non-finite sample always fails the exclusion test, so it is caught here at no cost
         if not (math.isfinite(r0) and math.isfinite(r1)):
             return BAD_NOISE, k
@@ -521,17 +587,25 @@ def run_steps(r, k_begin, k_end, state, P, imp_step, imp_off, imp_u, stk_step, s
             break
         if lower is None:
             # one wall: its own step, compiled without any of the second wall's logic
-            x, v, mode, status = slow_step_one(k, h, x, v, mode, r0, b, P, imp_step, imp_off,
-                                               imp_u, stk_step, stk_off, stk_kind, cnt, ftot)
+            # with a harmonic force, sx, cx are sin, cos of theta_x - phi from libm at sample
+            # k in mode FREE (just computed) and at k_exact
+            exact = has_h and (mode == FREE or k == k_exact)
+            x, v, mode, status = _slow_step_one(
+                k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+                stk_kind, cnt, ftot, theta_x, sx, cx, exact)
         else:
-            x, v, mode, status = slow_step(k, h, x, v, mode, r0, b, P, imp_step, imp_off,
-                                           imp_u, stk_step, stk_off, stk_kind, cnt, ftot)
+            exact = has_h and (mode == FREE or k == k_exact)
+            x, v, mode, status = _slow_step(
+                k, h, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, stk_off,
+                stk_kind, cnt, ftot, theta_x, sx, cx, exact)
         if status != OK:
             return status, k
         if has_h:
-            psi = phase(k + 1, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
+            theta_x = phase(k + 1, 0.0, P[P_BH_HI], P[P_BH_LO], beta)
+            psi = theta_x - P[P_PHI]
             sp1 = math.sin(psi)
             cp1 = math.cos(psi)
+            k_exact = k + 1
         w = x - Aq * sp1
         wv = v - Aq * beta * cp1
         sp = sp1
