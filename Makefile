@@ -1,5 +1,7 @@
 # `make` installs into .venv (and compiles the numba kernels into their cache: python -m
-# vibroimpact.warm, so that no job of a build compiles one) and builds every figure and report
+# vibroimpact.warm, so that no job of a build compiles one; and keeps the workflow's code
+# digests, python -m vibroimpact.pipeline.digest_cache, so that no Snakemake start parses the
+# package) and builds every figure and report
 # of the default config, then Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
 # of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, then
@@ -61,6 +63,7 @@ $(STAMP): environment.txt pyproject.toml
 	  || $(BIN)/python -m pip install --quiet --disable-pip-version-check -r environment.txt
 	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps -e .
 	$(BIN)/python -m vibroimpact.warm --jobs 2
+	$(BIN)/python -m vibroimpact.pipeline.digest_cache
 	touch $(STAMP)
 
 # the seconds-long checks first: a lint failure stops the build before the half-hour suites

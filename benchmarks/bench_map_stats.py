@@ -35,6 +35,24 @@ check (``impact.hops``, compiled already) is about a third. Again after merging 
     peer 9347978            2.488        7.655         2.357       4.845        51.4%
     statistics CPU, this tree / peer: 0.460; whole cell: 0.714; 325 of 325 cells identical
 
+Issue 37 (m38), the cell's statistics at their floor: the lean forms of `vibroimpact.tally`
+(``collision_firsts``, ``MotionTally``, ``rule_probabilities``, ``residence_statistics``) and
+the hops' walk that skips the pushes it can bound; measured 2026-11-27 08:54-08:59 UTC (load
+average 6.3-7.2 on 2 cores), 649 cells (every 8th), best of 3 interleaved rounds, peer = main
+2ec7353 (the "kernel" column is all of ``simulate_chunks``, its driver included):
+
+    build             stats CPU s  per cell ms  kernel CPU s  cell CPU s  stats share
+    this tree               1.289        1.986         4.724       6.013        21.4%
+    peer 2ec7353            2.480        3.821         4.718       7.198        34.5%
+    statistics CPU, this tree / peer: 0.520; whole cell: 0.835
+    results identical to the bit (every field of every cell): 649 of 649 cells
+
+and every cell of the map (``--stride 1 --rounds 1``, 08:59-09:07 UTC, load average 7.1):
+
+    this tree               9.740        1.878        37.059      46.799        20.8%
+    peer 2ec7353           19.460        3.752        38.187      57.648        33.8%
+    statistics CPU, this tree / peer: 0.501; whole cell: 0.812; 5187 of 5187 cells identical
+
 Run it as
 
     python benchmarks/bench_map_stats.py --stride 8 --rounds 3 \\

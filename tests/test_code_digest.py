@@ -4,6 +4,7 @@ docstrings and comments (README, "What reruns").
 A small package ``vibroimpact`` written in a temporary directory: a dispatcher whose functions
 import their modules lazily, as `pipeline.tasks` does, and a lazy ``__getattr__`` table.
 """
+import json
 import textwrap
 
 import pytest
@@ -130,3 +131,73 @@ def test_every_script_and_notebook_of_the_workflow_has_a_digest():
     closure = provenance.code_closure(root / "workflow" / "scripts" / "simulate_events.py")
     assert {"vibroimpact.impact.stepping", "vibroimpact.impact.events",
             "vibroimpact.impact.tolerances"} <= set(closure)      # the kernels, split by concept
+
+
+# --- digests kept between runs (`digest_cache`): every Snakemake start reads them ---------
+
+
+def _cached(tmp_path, root, cache):
+    from vibroimpact.pipeline import digest_cache
+
+    digest_cache._sources_key.cache_clear()     # a new process: nothing known but the file
+    digest_cache._TABLES.clear()
+    provenance._graph.cache_clear()
+    provenance.code_digest.cache_clear()
+    return {name: digest_cache.cached_code_digest(tmp_path / f"{name}.py", cache, root)
+            for name in ("draw", "simulate", "lazy")}
+
+
+def test_a_kept_digest_is_the_computed_one_and_is_read_not_recomputed(package, monkeypatch):
+    from vibroimpact.pipeline import digest_cache
+
+    tmp_path, root = package
+    cache = tmp_path / "project" / ".snakemake" / "digests.json"
+    assert _cached(tmp_path, root, cache) == _digests(tmp_path, root)
+    assert cache.is_file()
+
+    def never(*args):
+        raise AssertionError("computed again although the sources are unchanged")
+
+    monkeypatch.setattr(digest_cache, "code_digest", never)
+    assert _cached(tmp_path, root, cache) == _digests(tmp_path, root)
+
+
+def test_an_edit_of_the_package_or_the_script_is_a_miss_with_the_new_digest(package):
+    tmp_path, root = package
+    cache = tmp_path / "digests.json"
+    before = _cached(tmp_path, root, cache)
+    (root / "sim" / "kernel.py").write_text("def run():\n    return 2\n")
+    after = _cached(tmp_path, root, cache)
+    assert after == _digests(tmp_path, root)
+    assert after["simulate"] != before["simulate"] and after["draw"] == before["draw"]
+    (tmp_path / "draw.py").write_text("from vibroimpact import tasks\ntasks.simulate()\n")
+    assert _cached(tmp_path, root, cache)["draw"] == after["simulate"]
+    assert len(json.loads(cache.read_text())) == 3        # only the current sources' entries
+
+
+def test_an_unreadable_or_unwritable_cache_is_a_miss_not_an_error(package):
+    tmp_path, root = package
+    expected = _digests(tmp_path, root)
+    (tmp_path / "damaged.json").write_text('{"truncated": ')
+    assert _cached(tmp_path, root, tmp_path / "damaged.json") == expected
+    (tmp_path / "a_file").write_text("")               # its folder cannot be made
+    assert _cached(tmp_path, root, tmp_path / "a_file" / "digests.json") == expected
+    assert not (tmp_path / "a_file").is_dir()
+
+
+def test_the_installation_keeps_the_digest_of_every_script(tmp_path):
+    """`python -m vibroimpact.pipeline.digest_cache` (make's installation step): the digest
+    of each workflow script and notebook of the project, as the rules compute it."""
+    from vibroimpact.pipeline import digest_cache
+
+    scripts = tmp_path / "workflow" / "scripts"
+    scripts.mkdir(parents=True)
+    (scripts / "draw.py").write_text("from vibroimpact.pipeline import tasks\n")
+    (scripts / "noise.py").write_text("from vibroimpact import stats\n")
+    digest_cache._TABLES.clear()
+    digest_cache.main(tmp_path)
+    kept = json.loads((tmp_path / ".snakemake" / "vibroimpact-code-digests.json").read_text())
+    provenance._graph.cache_clear()
+    provenance.code_digest.cache_clear()
+    assert sorted(kept.values()) == sorted(provenance.code_digest(scripts / name)
+                                           for name in ("draw.py", "noise.py"))

@@ -469,3 +469,38 @@ def test_a_real_read_only_mount_is_refused(tmp_path):
         f"results -> {mount / 'results'}: no chmod can change that; remount it read-write, or "
         f"give the build a writable folder in its place (e.g. replace the link by a folder on "
         f"a writable disk), or build in a copy of the project; nothing was changed")
+
+
+# --- the pre-pass: asked only when something was built ------------------------------------------
+
+@pytest.mark.parametrize("written", [False, True])
+def test_the_run_asks_snakemake_what_is_missing_only_when_results_hold_a_file(
+        written, tmp_path, monkeypatch):
+    """A first build has no output to miss beneath an up-to-date one: `run` hands over to
+    Snakemake without the `--summary` start; once `results` holds a file it asks, and a
+    missing output it names goes to `--forcerun`."""
+    work = make_workdir(tmp_path / "project")
+    if written:
+        (work / "results" / "logs").mkdir(parents=True)
+        (work / "results" / "logs" / "a.log").write_text("")
+    asked, handed = [], []
+
+    def query(cmd, **kwargs):
+        asked.append(cmd)
+        return subprocess.CompletedProcess(cmd, 0, "Building DAG of jobs...\n" + SUMMARY, "")
+
+    class HandedOver(Exception):
+        pass
+
+    def execv(path, cmd):
+        handed.append(cmd)
+        raise HandedOver
+
+    monkeypatch.setattr(cli.subprocess, "run", query)
+    monkeypatch.setattr(os, "execv", execv)
+    monkeypatch.chdir(work)
+    with pytest.raises(HandedOver):
+        cli.main(["run", "--cores", "1", "--configfile", "config/test.yaml"])
+    assert [cmd[-1] for cmd in asked] == (["--summary"] if written else [])
+    assert ("--forcerun" in handed[0]) == written
+    assert cli.has_written(work / "results") == written

@@ -132,3 +132,22 @@ def test_gave_up_message_says_what_it_saw():
                  "f - delta at the step's ends = (0.0, -0.07"):
         assert part in msg, (part, msg)
     assert "eps" not in msg
+
+
+def test_every_event_array_of_a_chunk_is_contiguous():
+    """The chunks' event arrays are C-contiguous, one wall and two: the compiled statistics
+    and the self-audit take them as they are, and a strided view would compile a second
+    specialisation of their kernels inside a job (numba types the layout)."""
+    from vibroimpact import simulate_chunks
+
+    noise = 0.5 * np.random.default_rng(3).standard_normal(20001)
+    names = ("impact_step", "impact_offset", "impact_velocity", "impact_time", "stick_start",
+             "stick_end", "impact_wall", "stick_wall")
+    seen = 0
+    for walls in ({}, {"gap": 0.8, "eps_lower": 0.6}):
+        for chunk in simulate_chunks(0.05, 0.5, -0.3, noise=noise, dt=0.1, amplitude=1.0,
+                                     beta=0.8, chunk_size=5000, **walls):
+            for name in names:
+                assert getattr(chunk, name).flags.c_contiguous, name
+            seen += chunk.stick_start.size
+    assert seen > 10

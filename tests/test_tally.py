@@ -207,3 +207,112 @@ def test_the_defaults_are_the_references():
     assert tally.DEFAULT_REBOUND_FLOOR == stats.DEFAULT_REBOUND_FLOOR
     assert tally.DEFAULT_MOTION_WINDOW == stats.DEFAULT_MOTION_WINDOW
     assert tally.DEFAULT_MOTIONS == tuple(stats.DEFAULT_MOTIONS)
+
+
+@pytest.mark.parametrize("rule", stats.RULES)
+def test_the_collision_firsts_are_the_groupings_fields(rule):
+    """`tally.collision_firsts` (what the map's cell groups with) returns the fields of
+    `stats.group_collisions(...).after(t0)` it names, to the bit, with one wall and two,
+    and on a record whose rebounds all fall below the floor at two walls (rule 'rebounds':
+    no event, though the walls change)."""
+    names = ("first", "time", "step", "offset", "velocity", "wall", "stuck")
+    slow = np.array([0.001, 0.001, 0.001])
+    step, wall = np.array([10, 20, 30]), np.array([0, 1, 0], np.int8)
+    got = tally.collision_firsts(step, np.zeros(3), slow, np.zeros(0), dt=DT, eps=0.5,
+                                 eps_lower=0.5, floor=0.01, pressed=np.ones(2, bool),
+                                 rule=rule, wall=wall, after=0.0)
+    ref = stats.group_collisions(step, np.zeros(3), slow, [], [], dt=DT, eps=0.5,
+                                 pressed=np.ones(2, bool), rule=rule, wall=wall)
+    assert [g.tobytes() for g in got] == [getattr(ref, k).tobytes() for k in names]
+    for res, pressed, walls, _ in records():
+        kw = dict(dt=DT, eps=0.5, floor=0.01, pressed=pressed, rule=rule)
+        wall = np.zeros(res.impact_step.size, np.int8)
+        eps_lower = 0.5
+        if walls:
+            kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
+                      eps_lower=walls["eps_lower"])
+            wall, eps_lower = res.impact_wall, walls["eps_lower"]
+        for t0 in (0.0, 200.0, 1e9):
+            ref = stats.group_collisions(res.impact_step, res.impact_offset,
+                                         res.impact_velocity, res.stick_start, res.stick_end,
+                                         **kw).after(t0)
+            got = tally.collision_firsts(
+                res.impact_step, res.impact_offset, res.impact_velocity, res.stick_start,
+                dt=DT, eps=0.5, eps_lower=eps_lower, floor=0.01,
+                pressed=pressed if rule == "physical" else np.zeros(0, bool), rule=rule,
+                wall=wall, after=t0)
+            for name, value in zip(names, got):
+                expected = getattr(ref, name)
+                assert value.dtype == expected.dtype, name
+                assert value.tobytes() == expected.tobytes(), name
+
+
+@pytest.mark.parametrize("motions", [stats.DEFAULT_MOTIONS, ((2, 1), (1, 1), (3, 2), (1, 3))])
+def test_the_motion_tally_is_the_numpy_reference(motions):
+    """`tally.MotionTally` (the map cell's motion statistics, checked once) returns
+    `stats.motion_statistics` with ``stuck`` to the bit, and its `probabilities` the same
+    probabilities; on simulated records (one wall, two) and on none, one or two
+    collisions."""
+    cases = []
+    for res, pressed, walls, beta in records():
+        kw = dict(dt=DT, eps=0.5, pressed=pressed)
+        if walls:
+            kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
+                      eps_lower=walls["eps_lower"])
+        col = stats.group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
+                                     res.stick_start, res.stick_end, **kw).after(200.0)
+        cases += [(col, beta, bool(walls))] + [(col._select(np.arange(col.time.size) < k),
+                                                 beta, False) for k in (0, 1, 2)]
+    for col, beta, two in cases:
+        for m, w in ((motions, None), (motions + ((1, 1, 1),), col.wall)):
+            if w is not None and not two:
+                continue
+            kw = dict(window=0.1, motions=m, n_batches=20)
+            ref = stats.motion_statistics(col.time, col.intervals, beta, 200.0, 4000.0,
+                                          stuck=col.stuck, walls=w, **kw)
+            fast = tally.MotionTally(beta, walls=w is not None, **kw)
+            _same(fast.statistics(col.time, col.step, col.offset, DT, col.stuck, 200.0,
+                                  4000.0, walls=w), ref)
+            p, q = fast.probabilities(col.time, col.step, col.offset, DT, col.stuck, 3800.0,
+                                      walls=w)
+            assert p.tobytes() == ref.probability.tobytes()
+            assert q.tobytes() == ref.stick_probability.tobytes()
+
+
+def test_the_compiled_residence_statistics_are_the_numpy_reference():
+    """`tally.residence_statistics` is `stats.residence_statistics` to the bit: random
+    labelled records (one stretch, two, many; states never seen) and its refusals."""
+    rng = np.random.default_rng(17)
+    for n in (0, 1, 2, 3, 10, 500, 5000):
+        for n_states in (1, 4):
+            edges = np.concatenate([[5.0], 5.0 + np.cumsum(rng.uniform(0.0, 3.0, n + 1))])
+            states = np.minimum(rng.geometric(0.3, n + 1) - 1, n_states - 1)
+            states = np.repeat(states, rng.integers(1, 4, n + 1))[: n + 1]
+            edges = edges[: states.size + 1]
+            _same(tally.residence_statistics(edges, states, n_states),
+                  stats.residence_statistics(edges, states, n_states))
+    with pytest.raises(ValueError, match="edges"):
+        tally.residence_statistics([0.0, 1.0], [0, 0], 2)
+    with pytest.raises(ValueError, match="states"):
+        tally.residence_statistics([0.0, 1.0], [2], 2)
+    with pytest.raises(ValueError, match="non-decreasing"):
+        tally.residence_statistics([0.0, 2.0, 1.0], [0, 1], 2)
+
+
+def test_the_rule_probabilities_are_the_motion_tallys():
+    """`tally.rule_probabilities` (one call for the rules a map cell reports besides the
+    physical one) gives, rule by rule, `MotionTally.probabilities` of `collision_firsts`."""
+    for res, _, walls, beta in records():
+        wall = res.impact_wall if walls else np.zeros(res.impact_step.size, np.int8)
+        eps_lower = walls["eps_lower"] if walls else 0.5
+        motions = stats.DEFAULT_MOTIONS + (((1, 1, 1),) if walls else ())
+        fast = tally.MotionTally(beta, motions=motions, walls=bool(walls))
+        kw = dict(dt=DT, eps=0.5, eps_lower=eps_lower, floor=0.01, wall=wall, after=200.0)
+        args = (res.impact_step, res.impact_offset, res.impact_velocity, res.stick_start)
+        rules = stats.RULES[1:]
+        got = tally.rule_probabilities(fast, *args, rules=rules, duration=3800.0, **kw)
+        for rule, (p, q) in zip(rules, got):
+            _, time, step, offset, _, c_wall, stuck = tally.collision_firsts(
+                *args, pressed=np.zeros(0, bool), rule=rule, **kw)
+            ref = fast.probabilities(time, step, offset, DT, stuck, 3800.0, walls=c_wall)
+            assert p.tobytes() == ref[0].tobytes() and q.tobytes() == ref[1].tobytes()

@@ -66,6 +66,7 @@ rule aggregate_map:
     benchmark:
         "results/benchmarks/aggregate_map/{study}.tsv"
     threads: 1
+    priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB,
         runtime=5,

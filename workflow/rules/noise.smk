@@ -9,6 +9,7 @@ rule generate_noise:
     benchmark:
         "results/benchmarks/generate_noise/{noise}.tsv"
     threads: 1
+    priority: 3  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=NOISE_MEM_MB,
         runtime=20,

@@ -17,6 +17,7 @@ rule solve_orbit_tile:
         "results/benchmarks/solve_orbit_tile/{orbits}/{tile}.tsv"
     # rows run in parallel numba threads: exactly the rule's threads (tasks.orbit_tile)
     threads: 2
+    priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 200,
         runtime=30,
@@ -61,6 +62,7 @@ rule aggregate_orbits:
     benchmark:
         "results/benchmarks/aggregate_orbits/{orbits}.tsv"
     threads: 1
+    priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB,
         runtime=5,
@@ -84,6 +86,7 @@ rule trace_boundaries:
     benchmark:
         "results/benchmarks/trace_boundaries/{orbits}.tsv"
     threads: 2
+    priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 200,
         runtime=30,
@@ -106,6 +109,7 @@ rule solve_attractor_tile:
         "results/benchmarks/solve_attractor_tile/{orbits}/{tile}.tsv"
     # starts run in parallel numba threads: exactly the rule's threads (tasks.attractor_tile)
     threads: 2
+    priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 300,
         runtime=attractor_runtime_min,

@@ -38,6 +38,7 @@ rule map_predictors:
     benchmark:
         "results/benchmarks/map_predictors/{study}.tsv"
     threads: 1
+    priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 300,
         runtime=10,

@@ -11,6 +11,7 @@ rule simulate_events:
     benchmark:
         "results/benchmarks/simulate_events/{study}/{tile}.tsv"
     threads: 1
+    priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=simulate_mem_mb,
         runtime=simulate_runtime("events"),
@@ -80,6 +81,7 @@ rule simulate_map:
     benchmark:
         "results/benchmarks/simulate_map/{study}/{tile}.tsv"
     threads: 1
+    priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=simulate_mem_mb,
         runtime=simulate_runtime("map"),

@@ -18,6 +18,7 @@ rule measure_work_precision:
     benchmark:
         "results/benchmarks/measure_work_precision.tsv"
     threads: workflow.cores
+    priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 200,
         runtime=10,
@@ -63,17 +64,18 @@ rule draw_validation_figure:
         pdf="results/figures/{validation_fig}.pdf",
     wildcard_constraints:
         validation_fig="|".join(VALIDATION_FIGURES),
-    conda:
-        "../envs/vibroimpact.yaml"
     log:
         "results/logs/draw_validation_figure/{validation_fig}.log",
-    benchmark:
-        "results/benchmarks/draw_validation_figure/{validation_fig}.tsv"
     threads: 1
     resources:
         mem_mb=BASE_MEM_MB,
         runtime=5,
     params:
         code=script_code("draw_validation_figure"),
-    script:
-        "../scripts/draw_validation_figure.py"
+    # in a fork of this process, as draw_figure (figures.smk)
+    run:
+        forked.run_script(
+            SCRIPTS / "draw_validation_figure.py",
+            script_job(input, output, params, wildcards, log),
+            benchmark=f"results/benchmarks/draw_validation_figure/{wildcards.validation_fig}.tsv",
+        )

@@ -36,10 +36,79 @@ def _push(r, i, k, s, dt, delta, amplitude, beta, mirror):
     return value
 
 
+#: Relative round-off allowance of `_curved_above`: a few hundred times the worst error of a
+#: computed push (the sine's argument beta (k dt + s) loses ~ulp(tau) ~ 1e-16 tau; the linear
+#: force a few ulps of its samples), so that a step it clears is one where every push the
+#: exact walk would evaluate is > 0 as well.
+PUSH_ROUNDOFF = 1e-13
+
+
+@kernel
+def _push_above(r, i, k, s, dt, delta, amplitude, beta, mirror, anchor):
+    """The push at ``k dt + s`` as `_push` computes it, or a lower bound of it when that
+    bound already shows the computed push > 0.
+
+    ``anchor`` holds ``(k, s, sin(beta (k dt + s)), known)`` of the last push computed in
+    full: the sine moves by at most ``beta |tau - tau_anchor|``, so ``linear + amplitude
+    sin_anchor - |amplitude| beta |tau - tau_anchor|`` bounds the push from below (less
+    `PUSH_ROUNDOFF` times its scale for the round-off of both); above that same margin the
+    push `_push` would compute is > 0, and the bound is returned instead (no sine).
+    Otherwise the push is computed as `_push` computes it, to the bit, and becomes the
+    anchor."""
+    r0, r1 = mirror * r[i], mirror * r[i + 1]
+    linear = r0 + (r1 - r0) / dt * s - delta
+    if amplitude == 0.0:
+        return linear
+    if anchor[3] > 0.0:
+        reach = abs((k - anchor[0]) * dt + (s - anchor[1]))
+        slack = PUSH_ROUNDOFF * (1.0 + abs(r0) + abs(r1) + abs(delta)
+                                 + abs(amplitude) * (1.0 + beta * (abs(k * dt) + dt)))
+        low = (linear + amplitude * anchor[2]
+               - abs(amplitude) * beta * reach * (1.0 + LIPSCHITZ_SLACK) - slack)
+        if low > slack:
+            return low
+    sine = math.sin(beta * (k * dt + s))
+    anchor[0], anchor[1], anchor[2], anchor[3] = k, s, sine, 1.0
+    return linear + amplitude * sine
+
+
+#: Relative allowance on the reach ``|tau - tau_anchor|`` of `_push_above` (its rounding).
+LIPSCHITZ_SLACK = 1e-12
+
+
+@kernel
+def _curved_above(p_lo, p_hi, h, r0, r1, delta, amplitude, beta, tau):
+    """True when the push is certainly > 0 on a stretch of one step of length ``h`` whose
+    ends' pushes are ``p_lo, p_hi`` (computed, both > 0): the linear force adds no
+    curvature and ``|d2/ds2 amplitude sin(beta s)| <= |amplitude| beta^2``, so the push stays
+    above ``min(p_lo, p_hi) - |amplitude| beta^2 h^2 / 8``. The bound carries a margin of
+    `PUSH_ROUNDOFF` times the push's scale over the round-off of every computed value, so a
+    stretch it clears has every push the exact walk evaluates on it > 0: the walk may skip
+    its interior minimum (an arccos and a sine) without changing the answer."""
+    scale = (1.0 + abs(r0) + abs(r1) + abs(delta)
+             + abs(amplitude) * (1.0 + beta * (abs(tau) + h)))
+    curve = abs(amplitude) * beta * beta * h * h * 0.125
+    return min(p_lo, p_hi) - curve > PUSH_ROUNDOFF * scale
+
+
 @kernel
 def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_upper, beta,
              examine, lower, out):
+    """``out[j]`` for every flight (see `pressed_flights`), walking the examined ones.
+
+    The values are those of the plain walk (every step's end, and with a harmonic part its
+    interior minimum when it lies inside), with four shortcuts that skip only evaluations
+    the walk would find > 0: the push at an impact is taken once for the flight it ends and
+    the one it starts (same wall: the same arguments), the last step's end is the flight's
+    end already tested, a push whose lower bound from the last sine computed is clearly > 0
+    is not computed (`_push_above`: the bound stands for it), and a step whose ends are
+    pressed and whose curvature cannot bring the push to 0 (`_curved_above`, on the ends'
+    pushes or their bounds) skips its interior minimum. Every push it does compute is
+    `_push`'s, to the bit: the answer is the plain walk's.
+    """
     two_pi = 2.0 * math.pi
+    held_j, held = -1, 0.0      # the push at impact held_j in its flight's frame, if computed
+    anchor = np.zeros(4)        # the last sine computed (`_push_above`)
     for j in range(step.size - 1):
         out[j] = False
         if not examine[j]:
@@ -51,19 +120,33 @@ def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_uppe
             mirror, delta, amplitude = 1.0, delta_upper, amplitude_upper
         sign = 1.0 if amplitude > 0.0 else -1.0
         ka, kb = step[j], step[j + 1]
-        if (_push(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta, mirror) <= 0.0
-                or _push(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta,
-                         mirror) <= 0.0):
+        if held_j == j and lower[j - 1] == lower[j]:
+            p_a = held
+        else:
+            p_a = _push_above(r, ka - k_lo, ka, offset[j], dt, delta, amplitude, beta,
+                              mirror, anchor)
+        if p_a <= 0.0:
+            continue
+        p_b = _push_above(r, kb - k_lo, kb, offset[j + 1], dt, delta, amplitude, beta,
+                          mirror, anchor)
+        held_j, held = j + 1, p_b
+        if p_b <= 0.0:
             continue
         ok = True
+        p_lo = p_a
         for k in range(ka, kb + 1):
             i = k - k_lo
             s_lo = offset[j] if k == ka else 0.0
             s_hi = offset[j + 1] if k == kb else dt
-            if _push(r, i, k, s_hi, dt, delta, amplitude, beta, mirror) <= 0.0:
-                ok = False
-                break
-            if amplitude != 0.0:
+            if k == kb:
+                p_hi = p_b
+            else:
+                p_hi = _push_above(r, i, k, s_hi, dt, delta, amplitude, beta, mirror, anchor)
+                if p_hi <= 0.0:
+                    ok = False
+                    break
+            if amplitude != 0.0 and not _curved_above(
+                    p_lo, p_hi, s_hi - s_lo, r[i], r[i + 1], delta, amplitude, beta, k * dt):
                 # interior minima: cos(beta tau) = c where amplitude sin(beta tau) < 0
                 c = -(mirror * r[i + 1] - mirror * r[i]) / dt / (amplitude * beta)
                 if abs(c) <= 1.0:
@@ -79,6 +162,7 @@ def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_uppe
                                 ok = False
                 if not ok:
                     break
+            p_lo = p_hi
         out[j] = ok
 
 

@@ -506,10 +506,11 @@ def _pair_sticking(time, kind, stick_open):
     onset = (kind - kernels.STICK_LO * wall) == kernels.STICK_ON
     first_open = stick_open[0] is not None
     # onsets and releases alternate, starting with an onset or, with one open, a release
-    if onset.size and np.array_equal(onset, (np.arange(onset.size) + first_open) % 2 == 0):
-        on = np.concatenate([[stick_open[0]] if first_open else [], time[onset]])
-        on_wall = np.concatenate([[stick_open[1]] if first_open else [], wall[onset]])
-        off = time[~onset]
+    if onset.size and onset[first_open::2].all() and not onset[1 - first_open::2].any():
+        on = np.concatenate([[stick_open[0]] if first_open else [], time[first_open::2]])
+        on_wall = np.concatenate([[stick_open[1]] if first_open else [],
+                                  wall[first_open::2]])
+        off = time[1 - first_open::2].copy()     # contiguous, as the kernels take it
         stick_open[0] = float(on[-1]) if on.size > off.size else None
         stick_open[1] = int(on_wall[-1]) if on.size > off.size else 0
         return (on[:off.size].astype(np.float64), off,
@@ -529,7 +530,11 @@ def _pair_sticking(time, kind, stick_open):
 
 def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final,
           noise, model):
-    cat = lambda key, dtype: np.concatenate(parts[key]) if parts[key] else np.empty(0, dtype)
+    def cat(key, dtype):
+        """The chunk's events of one kind (one drain, the usual case: its copy as it is)."""
+        got = parts[key]
+        return got[0] if len(got) == 1 else np.concatenate(got) if got else np.empty(0, dtype)
+
     imp_step = cat("imp_step", np.int64)
     imp_off = cat("imp_off", np.float64)
     imp_u = cat("imp_u", np.float64)

@@ -7,6 +7,7 @@ sampled trace. Inputs are arrays or sliceable records; outputs are dicts of nump
 """
 import logging
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -326,6 +327,10 @@ class _EventRecord:
 
     def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0, gap=None,
                  eps_lower=None):
+        from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
+        self._tally = tally
+        self._sticking = None       # `sticking` of the record as it stands
         self.dt = dt
         self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
         #: the second wall (``{}``: one wall)
@@ -350,6 +355,7 @@ class _EventRecord:
             self.stuck_wall = int(chunk.x_end != self.force["delta"])
         self.t_end = chunk.t_end
         self.stuck_since = chunk.stuck_since
+        self._sticking = None
 
     def collision_walls(self, col):
         """The wall of each collision of ``col`` (int8, 0: at delta, 1: at delta - gap)."""
@@ -357,13 +363,16 @@ class _EventRecord:
 
     def sticking(self):
         """Sticking phases so far; one still open ends at the last chunk's end. With two
-        walls ``(start, end, wall)``, the open one on the wall the mass rests on."""
-        if not self.walls:
-            return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
-                                          self.t_end)
-        return stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
-                                      self.t_end, stick_wall=self.stick_wall[0],
-                                      stuck_wall=self.stuck_wall)
+        walls ``(start, end, wall)``, the open one on the wall the mass rests on (kept until
+        the next chunk: the checks and the rules read it several times)."""
+        if self._sticking is None:
+            self._sticking = (
+                stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                       self.t_end) if not self.walls else
+                stats.close_open_phase(self.starts[0], self.ends[0], self.stuck_since,
+                                       self.t_end, stick_wall=self.stick_wall[0],
+                                       stuck_wall=self.stuck_wall))
+        return self._sticking
 
     def rebound_speeds(self, eps, floor, transient):
         """Speeds ``eps u`` (two walls: ``eps_w u``) of the rebounds at or after
@@ -386,16 +395,13 @@ class _EventRecord:
             step, offset = self.steps[0][i:], self.offsets[0][i:]
             t = step * self.dt + offset
             # a flight with a sticking phase is no hop: left out (it would cost its samples)
-            start = self.sticking()[0]
-            k = np.searchsorted(start, t[:-1], side="left")
-            free = k < start.size
-            free[free] = start[k[free]] < t[1:][free]
+            free = self._tally.ends_in_sticking(t, self.sticking()[0])[:-1]
             walls = {} if not self.walls else dict(wall=self.wall[0][i:],
                                                    gap=self.walls["gap"])
             new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
                                   amplitude=f["amplitude"], beta=f["beta"], flights=~free,
                                   **walls)
-            self._pressed, self._n_pressed = np.append(self._pressed, new), n
+            self._pressed, self._n_pressed = np.concatenate((self._pressed, new)), n
         return self._pressed
 
     def collisions(self, eps, floor, transient, rule="physical"):
@@ -414,6 +420,47 @@ class _EventRecord:
                                       dt=self.dt, eps=eps, floor=floor, pressed=pressed,
                                       rule=rule, wall=self.wall[0], stick_wall=wall,
                                       eps_lower=self.walls["eps_lower"], after=transient)
+
+    def firsts(self, eps, floor, transient, rule="physical"):
+        """`collisions` reduced to what a map cell reads: the `_Firsts` of each collision's
+        first impact (the same values as the `Collisions` fields of those names), grouped by
+        one compiled call without the per-impact fields or the arguments' checks (the
+        simulator's own arrays)."""
+        step, offset, u = (self.steps[0], self.offsets[0], self.u[0]) if self.steps else (
+            np.zeros(0, np.int64), np.zeros(0), np.zeros(0))
+        wall = self.wall[0] if self.walls else np.zeros(step.size, np.int8)
+        if step.size == 0:
+            return _Firsts(np.zeros(0), step, offset, u, wall, np.zeros(0, bool))
+        pressed = self.pressed() if rule == "physical" else np.zeros(0, bool)
+        eps_lower = self.walls["eps_lower"] if self.walls else eps
+        _, *fields = self._tally.collision_firsts(
+            step, offset, u, self.sticking()[0], dt=self.dt, eps=eps, eps_lower=eps_lower,
+            floor=floor, pressed=pressed, rule=rule, wall=wall, after=transient)
+        return _Firsts(*fields)
+
+    def rule_probabilities(self, tallied, eps, floor, transient, rules, duration):
+        """``[(probability, stick_probability)]`` of the collisions at or after
+        ``transient`` of each rule of ``rules`` (not the physical one), as ``tallied``
+        (`tally.MotionTally`) gives them for `firsts` of that rule: one compiled call for
+        them all (`tally.rule_probabilities`)."""
+        wall = self.wall[0] if self.walls else np.zeros(self.steps[0].size, np.int8)
+        return self._tally.rule_probabilities(
+            tallied, self.steps[0], self.offsets[0], self.u[0], self.sticking()[0], dt=self.dt,
+            eps=eps, eps_lower=self.walls["eps_lower"] if self.walls else eps, floor=floor,
+            rules=rules, wall=wall, after=transient, duration=duration)
+
+
+class _Firsts(NamedTuple):
+    """A record's collisions as a map cell reads them (`_EventRecord.firsts`): of each one's
+    first impact its instant, split instant, approach velocity and wall, and whether it
+    sticks; the `stats.Collisions` fields of those names."""
+
+    time: np.ndarray
+    step: np.ndarray
+    offset: np.ndarray
+    velocity: np.ndarray
+    wall: np.ndarray
+    stuck: np.ndarray
 
 
 class _IdentityRecord:
@@ -646,9 +693,10 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next, **walls)
     events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
-
-    def wall_of(c):
-        return {} if not walls else dict(walls=events.collision_walls(c))
+    # the motion statistics of every check and rule, their arguments checked once
+    tallied = tally.MotionTally(beta_f, window=window, motions=motions, n_batches=n_batches,
+                                walls=bool(walls))
+    floor = stats.DEFAULT_REBOUND_FLOOR
 
     k, n_checks, request = 0, 0, None
     try:
@@ -657,10 +705,9 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             events.add(chunk)
             k += chunk.n_steps
             n_checks += 1
-            col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-            res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
-                                          window=window, motions=motions, n_batches=n_batches,
-                                          stuck=col.stuck, **wall_of(col))
+            col = events.firsts(eps, floor, transient)
+            res = tallied.statistics(col.time, col.step, col.offset, dt, col.stuck, transient,
+                                     k * dt, walls=col.wall)
             worst = float(max(res.stderr.max(), res.stick_stderr.max()))
             reached = worst <= target_stderr
             mixed_ok = res.n_switches == 0 or res.n_switches >= min_switches
@@ -676,15 +723,11 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     duration = k * dt - transient
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
-    by_rule = [res] + [
-        tally.motion_statistics(c.time, c.intervals, beta_f, transient, k * dt, window=window,
-                                motions=motions, n_batches=n_batches, stuck=c.stuck,
-                                **wall_of(c))
-        for c in (events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient, rule=rule)
-                  for rule in stats.RULES[1:])]
+    by_rule = [(res.probability, res.stick_probability)] + events.rule_probabilities(
+        tallied, eps, floor, transient, stats.RULES[1:], duration)
     per_wall = {}
     if walls:
-        wall = events.collision_walls(col)
+        wall = col.wall
         v_after = _rebound_eps(eps, walls, wall) * col.velocity
         n_w = np.array([np.count_nonzero(wall == w) for w in range(len(WALLS))])
         per_wall = dict(
@@ -692,8 +735,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             wall_v_after_mean=np.array([float(v_after[wall == w].mean()) if n_w[w]
                                         else math.nan for w in range(len(WALLS))]))
     return dict(probability=res.probability, stderr=res.stderr,
-                rule_probability=np.stack([r.probability for r in by_rule]),
-                rule_stick_probability=np.stack([r.stick_probability for r in by_rule]),
+                rule_probability=np.stack([p for p, _ in by_rule]),
+                rule_stick_probability=np.stack([q for _, q in by_rule]),
                 stick_probability=res.stick_probability, stick_stderr=res.stick_stderr,
                 n_switches=res.n_switches,
                 n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
@@ -708,8 +751,10 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
     """Residence times and switching rates of a map cell's labelled record, in forcing
     periods (`stats.residence_statistics`; the states are the motions, then "none")."""
     period = 2.0 * math.pi / beta_f
+    from vibroimpact import tally     # compiled: the jobs that group collisions load it
+
     edges, states = stats.label_pieces(impact_time, labels, t_start, t_stop, n_motions)
-    r = stats.residence_statistics(edges, states, n_motions + 1)
+    r = tally.residence_statistics(edges, states, n_motions + 1)
     return dict(residence_time=r.mean / period, residence_time_stderr=r.stderr / period,
                 n_stretches=r.n_stretches, n_censored=r.n_censored,
                 switch_rate=r.rate * period, switch_count=r.count)
@@ -766,11 +811,9 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
                                  beta=beta_f, t_end=n_end * dt, **walls):
         events.add(chunk)
         k += chunk.n_steps
-    col = events.collisions(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-    res = tally.motion_statistics(col.time, col.intervals, beta_f, transient, k * dt,
-                                  window=window, motions=motions, stuck=col.stuck,
-                                  **({} if not walls else
-                                     dict(walls=events.collision_walls(col))))
+    col = events.firsts(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
+    res = tally.MotionTally(beta_f, window=window, motions=motions, walls=bool(walls)).statistics(
+        col.time, col.step, col.offset, dt, col.stuck, transient, k * dt, walls=col.wall)
     share = res.probability + res.stick_probability
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     return dict(probability=np.append(share, max(0.0, 1.0 - float(share.sum()))),

@@ -12,8 +12,9 @@
           clears a lock left by a killed run when no run is alive in this directory, asks
           Snakemake which outputs of the requested build are missing and adds them to
           ``--forcerun`` (Snakemake alone never rebuilds a deleted file whose consumers are
-          up to date), and replaces itself with ``snakemake`` (the default profile,
-          ``profiles/default``, reruns the jobs a crash interrupted).
+          up to date; not asked when ``results`` holds no file yet), and replaces itself
+          with ``snakemake`` (the default profile, ``profiles/default``, reruns the jobs a
+          crash interrupted).
 ``report`` writes Snakemake's own report of the build (``snakemake --report``: every figure
           once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
           all: it is rendered elsewhere and moved into place only when complete (``make``
@@ -285,6 +286,12 @@ def missing_outputs(summary):
     return [row[0] for row in rows if len(row) >= 6 and row[-2:] == ["missing", "no update"]]
 
 
+def has_written(results):
+    """Whether folder ``results`` holds a file: only then may an output be missing while
+    what uses it is up to date, which ``run`` asks Snakemake about (``--summary``)."""
+    return any(files for _, _, files in os.walk(results))
+
+
 def with_forcerun(cmd, files):
     """``cmd`` with ``files`` added to its ``--forcerun``: Snakemake keeps only the last
     ``--forcerun``/``-R`` list given, so the user's own list is extended, not replaced (one
@@ -378,18 +385,23 @@ def main(argv=None):
     cmd = [_snakemake(), "--cores", str(args.cores), *extra, *config_args]
     sys.stdout.flush()
     sys.stderr.flush()
-    try:
-        query = subprocess.run([*cmd, "--summary"], cwd=root, capture_output=True, text=True)
-    except KeyboardInterrupt:
-        return _fail("interrupted while asking Snakemake what is missing; nothing was built",
-                     code=130)
-    missing = missing_outputs(query.stdout)
-    if query.returncode != 0 or missing is None:
-        # Snakemake refused the arguments, or this was the user's own mode (--unlock, --dag
-        # ..., which take precedence over --summary): it has run; its output, once
-        sys.stdout.write(query.stdout)
-        sys.stderr.write(query.stderr)
-        return query.returncode
+    # a first build (no file under results yet) has no output to miss beneath an up-to-date
+    # one: no question to ask (a Snakemake start, 1.3-3 s before the first job)
+    missing = []
+    if has_written(root / "results"):
+        try:
+            query = subprocess.run([*cmd, "--summary"], cwd=root, capture_output=True,
+                                   text=True)
+        except KeyboardInterrupt:
+            return _fail("interrupted while asking Snakemake what is missing; nothing was "
+                         "built", code=130)
+        missing = missing_outputs(query.stdout)
+        if query.returncode != 0 or missing is None:
+            # Snakemake refused the arguments, or this was the user's own mode (--unlock,
+            # --dag ..., which take precedence over --summary): it has run; its output, once
+            sys.stdout.write(query.stdout)
+            sys.stderr.write(query.stderr)
+            return query.returncode
     if missing:
         names = ", ".join(missing[:5]) + (f" ... ({len(missing)} files)" if missing[5:] else "")
         print(f"vibroimpact: missing, so rebuilt with what uses them (--forcerun): {names}",

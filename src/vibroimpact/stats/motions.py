@@ -437,10 +437,20 @@ def _at_edges(t, z, classes, n_classes, edges):
 
 def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches, at_edges=_at_edges):
     """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
-    edges = t_start + duration * np.arange(n_batches + 1) / n_batches
+    edges = _batch_edges(t_start, duration, n_batches)
+    return _stderr_of_covered(at_edges(t, z, classes, n_classes, edges), duration, n_batches)
+
+
+def _batch_edges(t_start, duration, n_batches):
+    """The edges of the B stretches of `_batch_stderr`."""
+    return t_start + duration * np.arange(n_batches + 1) / n_batches
+
+
+def _stderr_of_covered(covered, duration, n_batches):
+    """`_batch_stderr` from the time each class covered up to each edge (`_at_edges`)."""
     # in Fortran order, as the fancy-indexed ``cover[:, j]`` makes it: the standard deviation
     # below sums each class's batches in the order the stored maps were built with
-    covered = np.asfortranarray(at_edges(t, z, classes, n_classes, edges))
+    covered = np.asfortranarray(covered)
     batches = np.diff(covered, axis=1) * (n_batches / duration)           # (n_classes, B)
     return batches.std(axis=1, ddof=1) / np.sqrt(n_batches)
 

@@ -26,7 +26,8 @@ import numpy as np
 
 from vibroimpact import _checks
 
-__all__ = ["group_collisions", "motion_statistics"]
+__all__ = ["group_collisions", "motion_statistics", "MotionTally", "residence_statistics",
+           "ends_in_sticking", "collision_firsts", "rule_probabilities"]
 
 #: ``stats.collisions.DEFAULT_REBOUND_FLOOR`` and ``stats.motions.DEFAULT_MOTION_WINDOW``,
 #: ``DEFAULT_MOTIONS`` (tests/test_tally.py holds them equal)
@@ -74,6 +75,165 @@ def motion_statistics(impact_time, intervals, beta, t_start, t_stop, *,
 
     return _motions._motion_statistics(impact_time, intervals, beta, t_start, t_stop, window,
                                        motions, n_batches, stuck, walls, _labelled, _at_edges)
+
+
+class MotionTally:
+    """`stats.motion_statistics` of many records with one set of motions, in one compiled
+    pass each (`kernels.motion_pass`): the arguments are checked once, here, and each call
+    returns the reference's values to the bit.
+
+    The map's cell calls it at every precision check on a record that only grows: what the
+    reference spends on checks, conversions and a dozen numpy calls per record is the larger
+    part of its cost there.
+
+    Parameters
+    ----------
+    beta : float
+        Forcing frequency ratio.
+    window, motions, n_batches
+        As `stats.motion_statistics`.
+    walls : bool
+        Whether the records come with the wall of each collision (two walls).
+
+    Every record comes with ``stuck`` (the impact-stick variants are counted apart), as the
+    map's records do.
+    """
+
+    def __init__(self, beta, *, window=DEFAULT_MOTION_WINDOW, motions=DEFAULT_MOTIONS,
+                 n_batches=20, walls=False):
+        from vibroimpact.stats import motions as _motions
+        from vibroimpact.tally import kernels
+
+        self._motions, self._kernels = _motions, kernels
+        self.beta = _checks.real("beta", beta, low=0.0, low_open=True)
+        self.scale = self.beta / (2.0 * np.pi)      # as `stats.interval_ratio`
+        self.window = _checks.real("window", window, low=0.0, high=0.5, low_open=True)
+        self.motions = _motions._check_motions(motions, walls=bool(walls))
+        self.n_batches = _checks.integer("n_batches", n_batches, low=2)
+        self.walls = bool(walls)
+        self.lengths = np.array([_motions._length(m) for m in self.motions], dtype=np.int64)
+        self.periods = np.array([m[-1] for m in self.motions], dtype=np.int64)
+        self.lowers = np.array([m[1] if len(m) == 3 else -1 for m in self.motions],
+                               dtype=np.int64)
+        self._none = np.zeros(0, np.int8)
+
+    def _pass(self, time, step, offset, dt, stuck, walls, edges):
+        n = max(time.size - 1, 0)
+        if self.walls:
+            walls = np.ascontiguousarray(walls[:n], dtype=np.int8)
+        return self._kernels.motion_pass(
+            np.ascontiguousarray(time, dtype=float), np.ascontiguousarray(step, dtype=np.int64),
+            np.ascontiguousarray(offset, dtype=float), float(dt), self.scale,
+            np.ascontiguousarray(stuck[:n], dtype=np.bool_),
+            walls if self.walls else self._none, True, self.window, self.lengths,
+            self.periods, self.lowers, len(self.motions), edges)
+
+    @staticmethod
+    def _fractions(gathered, bounds, duration):
+        """`stats.motions._fractions` of the gathered intervals (the same sums: numpy's
+        ``ndarray.sum`` is ``add.reduce``)."""
+        add = np.add.reduce
+        return np.array([float(add(gathered[bounds[c]:bounds[c + 1]]) / duration)
+                         for c in range(bounds.size - 1)])
+
+    def statistics(self, time, step, offset, dt, stuck, t_start, t_stop, walls=None):
+        """``stats.motion_statistics(time, intervals, beta, t_start, t_stop, window=,
+        motions=, n_batches=, stuck=stuck, walls=walls)`` of collisions at ``time`` (split
+        ``step * dt + offset``; ``intervals`` their `Collisions.intervals`), to the bit."""
+        _motions = self._motions
+        duration = float(t_stop) - float(t_start)
+        if not duration > 0.0:
+            raise ValueError(f"t_stop must be > t_start, got [{t_start!r}, {t_stop!r}]")
+        edges = _motions._batch_edges(float(t_start), duration, self.n_batches)
+        z, labels, switches, covered, gathered, bounds = self._pass(
+            time, step, offset, dt, stuck, walls, edges)
+        probability = self._fractions(gathered, bounds, duration)
+        m = len(self.motions)
+        stderr = (_motions._stderr_of_covered(covered, duration, self.n_batches) if z.size
+                  else np.zeros(2 * m))
+        return _motions.MotionStatistics(probability[:m], stderr[:m], switches, labels,
+                                         probability[m:], stderr[m:])
+
+    def probabilities(self, time, step, offset, dt, stuck, duration, walls=None):
+        """The ``probability`` and ``stick_probability`` of `statistics` over a record of
+        ``duration`` (no standard errors: no batches)."""
+        duration = float(duration)
+        m = len(self.motions)
+        if duration <= 0.0:                 # as `stats.motions._fractions`
+            return np.zeros(m), np.zeros(m)
+        *_, gathered, bounds = self._pass(time, step, offset, dt, stuck, walls,
+                                          np.zeros(0))
+        probability = self._fractions(gathered, bounds, duration)
+        return probability[:m], probability[m:]
+
+
+def rule_probabilities(tallied, impact_step, impact_offset, impact_velocity, stick_start, *,
+                       dt, eps, eps_lower, floor, rules, wall, after, duration):
+    """``[(probability, stick_probability)]`` of `MotionTally.probabilities` (``tallied``) on
+    the collisions at or after ``after`` of each rule of ``rules`` (not the physical rule:
+    no hops), grouped as `collision_firsts` groups them, all in one compiled call
+    (`kernels.rule_fractions`); the same values."""
+    from vibroimpact.stats import collisions as _collisions
+
+    m = len(tallied.motions)
+    duration = float(duration)
+    if duration <= 0.0:                 # as `stats.motions._fractions`
+        return [(np.zeros(m), np.zeros(m)) for _ in rules]
+    gathered, bounds = tallied._kernels.rule_fractions(
+        impact_step, impact_offset, impact_velocity, stick_start, float(dt), float(eps),
+        float(eps_lower), float(floor), np.zeros(0, np.bool_),
+        np.array([_collisions.RULES.index(r) for r in rules], dtype=np.int64), wall,
+        float(after), tallied.scale, tallied.walls, tallied.window, tallied.lengths,
+        tallied.periods, tallied.lowers, m)
+    out = []
+    for b in bounds:
+        p = MotionTally._fractions(gathered, b, duration)
+        out.append((p[:m], p[m:]))
+    return out
+
+
+def ends_in_sticking(time, stick_start):
+    """``out[i]``: a sticking phase begins in ``[time[i], time[i + 1])`` (``time[n] = inf``),
+    for increasing ``time`` and ``stick_start`` (the ``ends`` of `stats.group_collisions`)."""
+    from vibroimpact.tally import kernels
+
+    return kernels._ends(np.ascontiguousarray(time, dtype=float),
+                         np.ascontiguousarray(stick_start, dtype=float))
+
+
+def collision_firsts(impact_step, impact_offset, impact_velocity, stick_start, *, dt, eps,
+                     eps_lower, floor, pressed, rule, wall, after):
+    """The collisions at or after ``after`` of `group_collisions`, reduced to what a map cell
+    reads: ``(first, time, step, offset, velocity, wall, stuck)``, the values of the
+    `stats.Collisions` fields of those names (`kernels.firsts`). Nothing is checked: the
+    arguments are the simulator's arrays as `group_collisions` takes them after its checks
+    (``wall`` int8 per impact, zeros with one wall; ``eps_lower`` the restitution at wall
+    1; ``pressed`` bool per flight for the physical rule)."""
+    from vibroimpact.stats import collisions as _collisions
+    from vibroimpact.tally import kernels
+
+    return kernels.firsts(impact_step, impact_offset, impact_velocity, stick_start, float(dt),
+                          float(eps), float(eps_lower), float(floor), pressed,
+                          _collisions.RULES.index(rule), wall, float(after))
+
+
+def residence_statistics(edges, states, n_states):
+    """``stats.residence_statistics`` compiled: the same arguments, checks and result, bit for
+    bit."""
+    from vibroimpact.stats import residence as _residence
+    from vibroimpact.tally import kernels
+
+    edges = np.ascontiguousarray(edges, dtype=float)
+    states = np.ascontiguousarray(states, dtype=np.int64)
+    n_states = int(n_states)
+    if edges.size != states.size + 1:
+        raise ValueError(f"edges must hold one more value than states, got {edges.size} and "
+                         f"{states.size}")
+    if states.size and (states.min() < 0 or states.max() >= n_states):
+        raise ValueError(f"states must lie in 0 .. {n_states - 1}")
+    if np.any(edges[1:] < edges[:-1]):
+        raise ValueError("edges must be non-decreasing")
+    return _residence.ResidenceStatistics(*kernels.residence(edges, states, n_states))
 
 
 def _labelled(ratio, window, motions, walls, stuck):

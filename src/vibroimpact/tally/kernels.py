@@ -28,17 +28,19 @@ PHYSICAL, IMPACTS, REBOUNDS = 0, 1, 2
 
 @kernel
 def _ends(t, start):
-    """``ends[i]``: a sticking phase begins in ``[t_i, t_{i+1})`` (``t_n = inf``); ``start``
-    increasing (the first phase at or after ``t_i`` is found by a merge, as searchsorted
-    ``side='left'`` finds it)."""
+    """``ends[i]``: a sticking phase begins in ``[t_i, t_{i+1})`` (``t_n = inf``); ``t`` and
+    ``start`` increasing. Each phase marks the last impact at or before it (the merge of
+    searchsorted ``side='left'`` run from the phases' side: one unpredictable branch per
+    phase, not one per impact)."""
     n, m = t.size, start.size
     ends = np.zeros(n, np.bool_)
-    p = 0
-    for i in range(n):
-        while p < m and start[p] < t[i]:
-            p += 1
-        if p < m:
-            ends[i] = start[p] < (t[i + 1] if i + 1 < n else np.inf)
+    i = -1
+    for p in range(m):
+        s = start[p]
+        while i + 1 < n and t[i + 1] <= s:
+            i += 1
+        if i >= 0:
+            ends[i] = True
     return ends
 
 
@@ -59,24 +61,10 @@ def _chatter_firsts(cont, ends, first):
 
 
 @kernel
-def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
-    """The collisions of a record at or after ``t0`` (``group_collisions(...).after(t0)``).
-
-    ``eps`` holds the restitution of each impact's wall; ``pressed`` the hops (physical rule
-    only, else unread); ``wall`` the wall of each impact (int8). Returns the fields of the
-    kept collisions, ``first, impact_collision, rebounds, stuck, stick_time, duration`` and
-    ``step, offset, time, velocity, wall`` at ``first``), after the number of rebounds that
-    reach ``floor`` (rule "rebounds": none, no collision): ``(n_counted, first,
-    impact_collision, step, offset, time, velocity, rebounds, stuck, stick_time, duration,
-    wall)``."""
+def _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall):
+    """``first_mask[i]``: impact ``i`` starts a collision under ``rule`` (``t`` the impacts'
+    instants, ``ends`` `_ends`, ``counted`` the rebounds that reach the floor)."""
     n = step.size
-    t = np.empty(n)
-    for i in range(n):
-        t[i] = step[i] * dt + offset[i]
-    counted = np.empty(n, np.bool_)
-    for i in range(n):
-        counted[i] = eps[i] * u[i] >= floor
-    ends = _ends(t, start)
     first_mask = np.ones(n, np.bool_)
     if rule == PHYSICAL:
         cont = np.zeros(n, np.bool_)
@@ -102,6 +90,29 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
     for i in range(1, n):
         if wall[i] != wall[i - 1]:
             first_mask[i] = True
+    return first_mask
+
+
+@kernel
+def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
+    """The collisions of a record at or after ``t0`` (``group_collisions(...).after(t0)``).
+
+    ``eps`` holds the restitution of each impact's wall; ``pressed`` the hops (physical rule
+    only, else unread); ``wall`` the wall of each impact (int8). Returns the fields of the
+    kept collisions, ``first, impact_collision, rebounds, stuck, stick_time, duration`` and
+    ``step, offset, time, velocity, wall`` at ``first``), after the number of rebounds that
+    reach ``floor`` (rule "rebounds": none, no collision): ``(n_counted, first,
+    impact_collision, step, offset, time, velocity, rebounds, stuck, stick_time, duration,
+    wall)``."""
+    n = step.size
+    t = np.empty(n)
+    for i in range(n):
+        t[i] = step[i] * dt + offset[i]
+    counted = np.empty(n, np.bool_)
+    for i in range(n):
+        counted[i] = eps[i] * u[i] >= floor
+    ends = _ends(t, start)
+    first_mask = _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall)
     # the collisions and each impact's collision
     n_first = 0
     impact_collision = np.empty(n, np.int64)
@@ -174,6 +185,201 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
             n_counted += 1
     return (n_counted, out_first, impact_collision, step_first, offset_first, time_first, u_first,
             rebounds, stuck, stick_time, duration, wall_first)
+
+
+@kernel
+def firsts(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rule, wall, t0):
+    """The collisions at or after ``t0`` as `group` finds them, reduced to what a map cell
+    reads at each precision check: of each one's first impact its index, instant, split
+    instant, velocity and wall, and whether a sticking phase begins before the next
+    collision (`group`'s ``first, time, step, offset, velocity, wall, stuck``: the same mask
+    and merge, without the other fields). ``eps`` and ``eps_lower`` are the walls'
+    restitutions (an impact at wall 1 rebounds at ``eps_lower u``). The physical rule's
+    backward scan is `_chatter_firsts` with the links formed on the way (no array of
+    them)."""
+    n = step.size
+    t = np.empty(n)
+    for i in range(n):
+        t[i] = step[i] * dt + offset[i]
+    ends = _ends(t, start)
+    if rule == PHYSICAL:
+        first_mask = np.ones(n, np.bool_)
+        next_end, next_break = n, n
+        for j in range(n - 1, -1, -1):
+            if ends[j]:
+                next_end = j
+            elif j == n - 1 or not pressed[j]:
+                next_break = j
+            elif next_end < n and next_break > next_end:
+                first_mask[j + 1] = False
+        for i in range(1, n):
+            if wall[i] != wall[i - 1]:
+                first_mask[i] = True
+    else:
+        counted = np.empty(n, np.bool_)
+        for i in range(n):
+            counted[i] = (eps_lower if wall[i] == 1 else eps) * u[i] >= floor
+        first_mask = _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall)
+        if rule == REBOUNDS and not counted.any():
+            first_mask[:] = False       # no rebound reaches the floor: no event at all
+    kept = np.empty(n + 1, np.int64)
+    n_first = 0
+    for i in range(n):          # times increase: the dropped ones are a prefix
+        kept[n_first] = i
+        n_first += first_mask[i] and t[i] >= t0
+    first = kept[:n_first].copy()
+    stuck = np.empty(n_first, np.bool_)
+    m = start.size
+    lo = 0
+    if n_first:
+        while lo < m and start[lo] < t[first[0]]:
+            lo += 1
+    for c in range(n_first):
+        b = first[c + 1] if c + 1 < n_first else n
+        hi = lo
+        if b < n:
+            while hi < m and start[hi] < t[b]:
+                hi += 1
+        else:
+            hi = m
+        stuck[c] = hi > lo
+        lo = hi
+    time_first = np.empty(n_first)
+    step_first = np.empty(n_first, np.int64)
+    offset_first = np.empty(n_first)
+    u_first = np.empty(n_first)
+    wall_first = np.empty(n_first, np.int8)
+    for c in range(n_first):
+        a = first[c]
+        time_first[c], step_first[c], offset_first[c] = t[a], step[a], offset[a]
+        u_first[c], wall_first[c] = u[a], wall[a]
+    return first, time_first, step_first, offset_first, u_first, wall_first, stuck
+
+
+@kernel
+def motion_pass(t, step, offset, dt, scale, stuck, walls, refine, window, lengths, periods,
+                lowers, n_motions, edges):
+    """One pass of `stats.motion_statistics` over the collisions at ``t`` (split ``step,
+    offset``): the intervals ``z`` (``Collisions.intervals``), their ratios ``z * scale``
+    (``scale = beta / (2 pi)``, `stats.interval_ratio`), `label`, and with ``edges`` (not
+    empty) `at_edges`; then each class's intervals gathered in time order, ``gathered[
+    bounds[c] : bounds[c + 1]]`` being ``z[classes == c]`` (numpy sums them as it sums the
+    boolean selection: the same values in the same order). ``stuck`` and ``walls`` are per
+    interval (``stuck`` empty and ``refine`` False: not given, the classes are the labels;
+    ``walls`` empty: one-wall motions only)."""
+    n = max(t.size - 1, 0)
+    z = np.empty(n)
+    ratio = np.empty(n)
+    for i in range(n):
+        z[i] = float(step[i + 1] - step[i]) * dt + (offset[i + 1] - offset[i])
+        ratio[i] = z[i] * scale
+    labels, classes, switches = label(ratio, window, lengths, periods, lowers, walls, stuck,
+                                      n_motions)
+    n_classes = 2 * n_motions if refine else n_motions
+    covered = np.zeros((n_classes, edges.size))
+    if n > 0 and edges.size:
+        covered = at_edges(t, z, classes, n_classes, edges)
+    bounds = np.zeros(n_classes + 1, np.int64)
+    for i in range(n):
+        if classes[i] >= 0:
+            bounds[classes[i] + 1] += 1
+    for c in range(n_classes):
+        bounds[c + 1] += bounds[c]
+    gathered = np.empty(bounds[n_classes])
+    fill = bounds[:n_classes].copy()
+    for i in range(n):
+        c = classes[i]
+        if c >= 0:
+            gathered[fill[c]] = z[i]
+            fill[c] += 1
+    return z, labels, switches, covered, gathered, bounds
+
+
+@kernel
+def rule_fractions(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rules, wall, t0,
+                   scale, walls, window, lengths, periods, lowers, n_motions):
+    """For each rule code of ``rules``: `firsts` at or after ``t0``, then `motion_pass` of
+    its collisions with their ``stuck`` flags (and walls when ``walls``), no edges; returns
+    per rule ``(gathered, bounds)`` stacked: the intervals of every class of every rule in
+    one array, ``bounds`` of shape (rules, classes + 1) into it. One call for the rules a
+    map cell reports besides its own (`MotionTally.rule_probabilities`)."""
+    n_classes = 2 * n_motions
+    parts = []
+    bounds = np.zeros((rules.size, n_classes + 1), np.int64)
+    total = 0
+    for q in range(rules.size):
+        _, time, c_step, c_offset, _, c_wall, stuck = firsts(
+            step, offset, u, start, dt, eps, eps_lower, floor, pressed, rules[q], wall, t0)
+        n = max(time.size - 1, 0)
+        w = c_wall[:n].copy() if walls else np.zeros(0, np.int8)
+        _, _, _, _, gathered, b = motion_pass(time, c_step, c_offset, dt, scale,
+                                               stuck[:n].copy(), w, True, window, lengths,
+                                               periods, lowers, n_motions, np.zeros(0))
+        parts.append(gathered)
+        for c in range(n_classes + 1):
+            bounds[q, c] = b[c] + total
+        total += gathered.size
+    out = np.empty(total)
+    o = 0
+    for g in parts:
+        out[o:o + g.size] = g
+        o += g.size
+    return out, bounds
+
+
+@kernel
+def residence(edges, states, n_states):
+    """`stats.residence_statistics` in one pass: ``(mean, stderr, n_stretches, n_censored,
+    time, count, rate)``, each sum taken in the order ``numpy.bincount`` takes it (the
+    pieces, or the stretches, in time order)."""
+    k = states.size
+    time = np.zeros(n_states)
+    for i in range(k):
+        time[states[i]] += edges[i + 1] - edges[i]
+    # stretches: runs of one state
+    n_runs = 0
+    for i in range(k):
+        if i == 0 or states[i] != states[i - 1]:
+            n_runs += 1
+    start = np.empty(n_runs, np.int64)
+    r = 0
+    for i in range(k):
+        if i == 0 or states[i] != states[i - 1]:
+            start[r] = i
+            r += 1
+    n = np.zeros(n_states, np.int64)
+    n_censored = np.zeros(n_states, np.int64)
+    total = np.zeros(n_states)
+    length = np.empty(n_runs)
+    count = np.zeros((n_states, n_states), np.int64)
+    for r in range(n_runs):
+        stop = start[r + 1] if r + 1 < n_runs else k
+        length[r] = edges[stop] - edges[start[r]]
+        who = states[start[r]]
+        if r == 0 or r == n_runs - 1:
+            n_censored[who] += 1
+        else:
+            n[who] += 1
+            total[who] += length[r]
+        if r > 0:
+            count[states[start[r - 1]], who] += 1
+    mean = np.empty(n_states)
+    for s in range(n_states):
+        mean[s] = total[s] / max(n[s], 1) if n[s] > 0 else np.nan
+    dev = np.zeros(n_states)
+    for r in range(1, n_runs - 1):
+        who = states[start[r]]
+        d = length[r] - mean[who]
+        dev[who] += d * d
+    stderr = np.empty(n_states)
+    for s in range(n_states):
+        stderr[s] = (np.sqrt(dev[s] / max(n[s] - 1, 1) / max(n[s], 1)) if n[s] > 1
+                     else np.nan)
+    rate = np.empty((n_states, n_states))
+    for a in range(n_states):
+        for b in range(n_states):
+            rate[a, b] = count[a, b] / time[a] if time[a] > 0.0 else np.nan
+    return mean, stderr, n, n_censored, time, count, rate
 
 
 @kernel

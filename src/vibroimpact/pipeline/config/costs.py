@@ -65,6 +65,13 @@ SHOOTING_CELL_S = 0.135
 #: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
 #: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
 FIGURE_S = 0.9
+#: The start-up of a figure job (draw_figure, draw_validation_figure): a fork of Snakemake's
+#: process, which imported the plotting modules and drew one small figure once
+#: (`pipeline.forked`, ~1.2 CPU-s in that process, in no job's benchmark file); the fork
+#: and its first writes to shared pages. fig03 forked: 0.78 CPU-s against 1.49 in a process
+#: of its own, load ~2; the default build's 19 figures 28.2 CPU-s against 43.6 (benchmark
+#: files of `bench_make.py --make --peer 2ec7353`, load 6-7).
+FIGURE_JOB_START_S = 0.05
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
 #: twice (nbconvert) in one job, besides its start-up: the reports that show no map
 #: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
@@ -108,8 +115,12 @@ COMPILE_S = {"solve_orbit_tile": 7.0, "simulate_escape": 6.0, "simulate_trace": 
 SPECTRA_CELL_S = 0.12
 #: A map cell's sample step (the map's own work: the hop check and the collision grouping of
 #: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
-#: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns.
-NS_PER_MAP_STEP = 38.0
+#: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns. The
+#: statistics at their floor (issue 37, m38: the lean tally forms, the hops' bounded walk)
+#: take the cell CPU to 0.82 of 2ec7353's (``benchmarks/bench_map_floor.py --stride 4
+#: --no-main --peer 2ec7353``: 11.90 against 14.48 CPU-s over 1297 cells; 0.835 over 649 in
+#: ``benchmarks/bench_map_stats.py``), the simulator's kernel unchanged: ~38 x 0.83 = 31.5.
+NS_PER_MAP_STEP = 31.5
 #: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
 #: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
 #: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured

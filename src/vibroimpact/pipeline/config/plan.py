@@ -15,10 +15,10 @@ import shutil
 
 from vibroimpact.pipeline import figures, targets
 from vibroimpact.pipeline.config import costs
-from vibroimpact.pipeline.config.costs import (COMPILE_S, FIGURE_BYTES, FIGURE_S,
-                                               FILE_OVERHEAD, JOB_START_S, MAP_REPORT_S,
-                                               REPORT_BYTES, REPORT_S, VALIDATION_FIGURE_S,
-                                               VALIDATION_RULES)
+from vibroimpact.pipeline.config.costs import (COMPILE_S, FIGURE_BYTES, FIGURE_JOB_START_S,
+                                               FIGURE_S, FILE_OVERHEAD, JOB_START_S,
+                                               MAP_REPORT_S, REPORT_BYTES, REPORT_S,
+                                               VALIDATION_FIGURE_S, VALIDATION_RULES)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
 from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_plane_cells,
                                         orbit_rows, plane_attractor_rows)
@@ -335,7 +335,7 @@ def make_plan(config, own=None, *, results="results", studies=None):
             parts.append("trace")
         n_figs = build["figures"].get(name, 0)
         row.bytes += n_figs * FIGURE_BYTES
-        _charge(row, "draw_figure", n_figs, n_figs * (FIGURE_S + JOB_START_S))
+        _charge(row, "draw_figure", n_figs, n_figs * (FIGURE_S + FIGURE_JOB_START_S))
         row.detail = ", ".join(parts + [_n(n_figs, "figure")])
         plan.rows.append(row)
     for name in sorted(set(build["orbits"]) | {o.split("/", 1)[1] for o in build["figures"]
@@ -344,7 +344,7 @@ def make_plan(config, own=None, *, results="results", studies=None):
         needs = build["orbits"].get(name, set())
         n_figs = build["figures"].get(f"orbits/{name}", 0)
         row = Row(f"orbits.{name}", "", bytes=n_figs * FIGURE_BYTES)
-        _charge(row, "draw_figure", n_figs, n_figs * (FIGURE_S + JOB_START_S))
+        _charge(row, "draw_figure", n_figs, n_figs * (FIGURE_S + FIGURE_JOB_START_S))
         parts = []
         if "orbits" in needs:
             rows, n_tiles = orbit_rows(entry)
@@ -407,7 +407,8 @@ def make_plan(config, own=None, *, results="results", studies=None):
                 rule = VALIDATION_RULES[Path(path).stem]
                 _charge(row, rule, 1,
                         _validation_runs_cpu_s(config["validation"], [path]) + JOB_START_S)
-        _charge(row, "draw_validation_figure", figs, figs * (VALIDATION_FIGURE_S + JOB_START_S))
+        _charge(row, "draw_validation_figure", figs,
+                figs * (VALIDATION_FIGURE_S + FIGURE_JOB_START_S))
         _charge(row, "report", notebooks, notebooks * (REPORT_S + JOB_START_S))
         plan.rows.append(row)
     copies = build["copies"]
