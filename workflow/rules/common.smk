@@ -77,6 +77,17 @@ def script_job(input, output, params, wildcards, log):
 # 1; figures, reports and the rest 0. Replayed on the job times of a default build (2ec7353,
 # 2 cores, 270 core-s held), the build ends at 139 s (136-143) over 200 random orders of the
 # jobs of equal priority, against 142 s (136-150) with no priorities.
+# Snakemake's ILP scheduler weighs the sum of the priorities of the jobs it starts together,
+# and starts a job only when its cores are free at once: the work-precision run, which holds
+# every core, has 7 (more than any two other jobs together, 3 + 3), so it starts first, while
+# every core is free, not at the end, when the build would wait for it alone.
+
+# --- Threads of the tiles that run numba threads ---------------------------------------------
+# The orbit, attractor and boundary jobs run their rows and starts on numba threads: half the
+# cores each (one on 2 cores), so that they pack beside the one-core jobs. Asking for every
+# core, such a job waited until the other jobs drained: in a fresh clone of 70e002c on 2
+# cores, the orbit and attractor tiles ran at 73-108 s of a 142 s build, one after the other.
+TILE_THREADS = max(1, workflow.cores // 2)
 
 
 # --- config blocks --------------------------------------------------------------------------

@@ -16,7 +16,7 @@ rule solve_orbit_tile:
     benchmark:
         "results/benchmarks/solve_orbit_tile/{orbits}/{tile}.tsv"
     # rows run in parallel numba threads: exactly the rule's threads (tasks.orbit_tile)
-    threads: 2
+    threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 200,
@@ -85,7 +85,7 @@ rule trace_boundaries:
         "results/logs/trace_boundaries/{orbits}.log",
     benchmark:
         "results/benchmarks/trace_boundaries/{orbits}.tsv"
-    threads: 2
+    threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 200,
@@ -108,7 +108,7 @@ rule solve_attractor_tile:
     benchmark:
         "results/benchmarks/solve_attractor_tile/{orbits}/{tile}.tsv"
     # starts run in parallel numba threads: exactly the rule's threads (tasks.attractor_tile)
-    threads: 2
+    threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 300,

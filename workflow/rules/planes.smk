@@ -16,7 +16,7 @@ rule solve_plane_attractor_tile:
     benchmark:
         "results/benchmarks/solve_plane_attractor_tile/{study}/{tile}.tsv"
     # starts run in parallel numba threads: exactly the rule's threads
-    threads: 2
+    threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     resources:
         mem_mb=BASE_MEM_MB + 300,
         runtime=plane_attractor_runtime_min,

@@ -18,7 +18,7 @@ rule measure_work_precision:
     benchmark:
         "results/benchmarks/measure_work_precision.tsv"
     threads: workflow.cores
-    priority: 2  # a long chain's head (common.smk, "Priorities")
+    priority: 7  # first, while every core is free (common.smk, "Priorities")
     resources:
         mem_mb=BASE_MEM_MB + 200,
         runtime=10,
