@@ -69,18 +69,19 @@ def script_job(input, output, params, wildcards, log):
 
 
 # --- Priorities ------------------------------------------------------------------------------
-# Of the ready jobs Snakemake starts those of highest `priority:` first (its scheduler weighs
-# priority before core load). The heads of the build's longest chains carry one: the noise
-# records (every simulation reads one) 3; the map's tiles, the attractor and orbit tiles and
-# the orbits' join, and the work-precision run (it holds every core, and a figure and a
-# report wait on it) 2; the events tiles, the map's join, its predictors and the boundaries
-# 1; figures, reports and the rest 0. Replayed on the job times of a default build (2ec7353,
-# 2 cores, 270 core-s held), the build ends at 139 s (136-143) over 200 random orders of the
-# jobs of equal priority, against 142 s (136-150) with no priorities.
-# Snakemake's ILP scheduler weighs the sum of the priorities of the jobs it starts together,
-# and starts a job only when its cores are free at once: the work-precision run, which holds
-# every core, has 7 (more than any two other jobs together, 3 + 3), so it starts first, while
-# every core is free, not at the end, when the build would wait for it alone.
+# Of the ready jobs Snakemake starts those of highest `priority:` first (its ILP scheduler
+# maximizes the sum of the priorities of the jobs it starts together, then the cores they
+# use). The heads of the build's longest chains carry one: the noise records (every
+# simulation reads one) 3; the map's tiles, the attractor and orbit tiles and the orbits'
+# join 2; the events tiles, the map's join, its predictors, the boundaries, and the spectra
+# and escape jobs (heads of the chains that end in the reports: in a fresh clone of 4ab3037
+# the escape levels ran last and the map's report waited on their figure) 1; figures,
+# reports and the rest 0. The work-precision run holds every core, and a job starts only
+# when its cores are free at once: it has 7, more than any two other jobs together (3 + 3),
+# so it starts first, while every core is free, not at the end, where the build would wait
+# for it alone. Replayed on the job times of a default build (2ec7353, 2 cores, 270 core-s
+# held), the priorities of the long chains end the build at 139 s (136-143) over 200
+# random orders of the jobs of equal priority, against 142 s (136-150) with none.
 
 # --- Threads of the tiles that run numba threads ---------------------------------------------
 # The orbit, attractor and boundary jobs run their rows and starts on numba threads: half the

@@ -35,6 +35,7 @@ rule simulate_spectra:
     benchmark:
         "results/benchmarks/simulate_spectra/{study}/{tile}.tsv"
     threads: 1
+    priority: 1  # a report chain's head (common.smk, "Priorities")
     resources:
         mem_mb=simulate_mem_mb,
         runtime=simulate_runtime("spectra"),
@@ -103,6 +104,7 @@ rule simulate_escape:
     benchmark:
         "results/benchmarks/simulate_escape/{study}/{level}.tsv"
     threads: 1
+    priority: 1  # a report chain's head (common.smk, "Priorities")
     resources:
         mem_mb=escape_mem_mb,
         runtime=escape_runtime_min,
