@@ -35,8 +35,11 @@ NS_PER_AUDIT_STEP = 6.0
 NS_PER_SAMPLE = 50.0       # noise generation
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 #: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
-#: map's 5,187 cells x 64 starts (68 us a start; its four tiles' benchmark files, 2 cores).
-US_PER_START = 70.0
+#: map's 5,187 cells x 64 starts at 15acb54 (68 us a start); after the solver orbits ran in
+#: parallel and shared their m = 3 scan per row (a38, issue 37), the job took 11.6 CPU-s, its
+#: start-up included (benchmark file of a fresh clone's `make` at 4ab3037, 2 cores, load
+#: ~1.5): (11.6 - JOB_START_S) / 331,968 starts = 32 us.
+US_PER_START = 32.0
 #: The share of its cap (`~vibroimpact.pipeline.study.map_cap_steps`) a map cell runs on
 #: average before its probabilities reach their target standard error: 0.34 on the default
 #: map (its `record_end` summed: 1.42e9 steps against 4.18e9 at the caps). A map whose cells
@@ -62,9 +65,11 @@ BOUNDARIES_S = 0.35
 ORBIT_CELL_S = 1.0e-4
 SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
-#: (`JOB_START_S`): the default build's 19 figure jobs took 36.4 CPU-s at 15acb54 (their
-#: benchmark files' cpu_time, a fresh clone's `make`; 1.0-3.0 each).
-FIGURE_S = 0.9
+#: (`FIGURE_JOB_START_S`): the default build's 19 figure jobs, forked, took 29.0 and 31.0
+#: CPU-s in all (their benchmark files, fresh clones' `make` at 70e002c and 4ab3037, 2
+#: cores, load ~1.5; 0.6-3.3 each): 1.55 a figure, 1.5 besides the fork. At 15acb54, one
+#: process each, they took 36.4 CPU-s (0.9 besides a JOB_START_S).
+FIGURE_S = 1.5
 #: The start-up of a figure job (draw_figure, draw_validation_figure): a fork of Snakemake's
 #: process, which imported the plotting modules and drew one small figure once
 #: (`pipeline.forked`, ~1.2 CPU-s in that process, in no job's benchmark file); the fork
@@ -96,8 +101,9 @@ PREDICTORS_CELL_S = 7.5e-5
 #: The rule writing each validation dataset (``results/validation/<name>.nc``).
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
-#: One validation figure drawn, besides its job's start-up.
-VALIDATION_FIGURE_S = FIGURE_S
+#: One validation figure drawn, besides its job's start-up: the work-precision and stress
+#: figures took 4.1-4.2 CPU-s together in the same builds (2.0-2.1 each).
+VALIDATION_FIGURE_S = 2.0
 #: One aggregation job (tiles joined into a dataset), start-up included, by kind (default
 #: ``"*"``): 0.44-0.48 CPU-s each at 15acb54 (benchmark files of a fresh clone's `make`), the
 #: events joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
