@@ -112,14 +112,20 @@ def make_test(workdir):
 
 def warm(workdir, cache):
     """What `make` compiles when it installs (``python -m vibroimpact.warm``, since 15572b0)
-    into the side's numba cache, before its build is timed: its wall seconds, or 0.0 for a
-    revision without it, whose jobs compile the kernels in the timed build."""
+    into the side's numba cache, and the code digests it keeps (``python -m
+    vibroimpact.pipeline.digest_cache``, since w38), before its build is timed: its wall
+    seconds, or 0.0 for a revision without it, whose jobs compile the kernels in the timed
+    build."""
     if not (workdir / "src" / "vibroimpact" / "warm.py").exists():
         return 0.0
     env = dict(os.environ, PYTHONPATH=str(workdir / "src"), NUMBA_CACHE_DIR=str(cache))
     start = time.perf_counter()
     subprocess.run([sys.executable, "-m", "vibroimpact.warm", "--jobs", "2"], cwd=workdir,
                    env=env, check=True, capture_output=True)
+    if (workdir / "src" / "vibroimpact" / "pipeline" / "digest_cache.py").exists():
+        # and the workflow's code digests, kept for the build's Snakemake starts (since w38)
+        subprocess.run([sys.executable, "-m", "vibroimpact.pipeline.digest_cache"],
+                       cwd=workdir, env=env, check=True, capture_output=True)
     return time.perf_counter() - start
 
 
