@@ -442,7 +442,7 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     larger is narrow; "partly": the spread falls with P(1/1) but such a play is wide; "no":
     it does not fall with P(1/1).
     """
-    from scipy import stats   # scipy.stats for this finding alone
+    from vibroimpact.stats.ranks import spearman
 
     if (why := _without_collision(_row(events, inv_beta))) is not None:
         return not_available(7, why)
@@ -465,7 +465,7 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
                                 f"is not dominant")
     cv = np.array([_cv(ev, x) for x in d])
     limit = 0.5 * (cv[np.argmax(p11)] + cv[small].min())
-    rho = float(stats.spearmanr(p11, cv).statistic)
+    rho = spearman(p11, cv)
     wide = (dominant | (d > d[dominant].min())) & (cv >= limit)
     parts = [f"{x:.3g}: {c:.2f} (P(1/1) {p:.2f})" for x, c, p in zip(d, cv, p11)]
     measured = (f"1/beta_f = {float(ev.inv_beta):.3g}, coefficient of variation at delta = "

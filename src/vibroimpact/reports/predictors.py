@@ -108,9 +108,9 @@ def on_map_grid(ds, motion_map, name):
 
 
 def _ranks(a):
-    from scipy.stats import rankdata
+    from vibroimpact.stats.ranks import average_ranks
 
-    return rankdata(a, axis=-1)
+    return average_ranks(a, axis=-1)
 
 
 def _codes(a):

@@ -15,6 +15,8 @@ the paper plots (Figs. 6-9, 12-15) and hold the exact results used as test oracl
 - `theory`: the wall-free linear response, elastic impacts under white noise (one wall, or
   a clearance between two), and the energy-envelope averaging for eps near 1;
 - `identities`: the power balance and the virial of a stationary record (a self-audit);
+- `ranks`: average ranks, Spearman's correlation and the chi-square tail without importing
+  scipy.stats (imported from its module);
 - `centroid`: the centroid of a spectrum over a band (finding 5, Fig. 12's header), imported
   from its module (not re-exported: the simulation jobs do not reach it).
 

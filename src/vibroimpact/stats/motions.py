@@ -478,7 +478,7 @@ def motion_map_agreement(probability, stable, S, threshold: float = 0.5) -> dict
         correlation of probability and S over the stable domain (NaN with fewer than 3
         cells or no spread), and ``n_domain`` its cells.
     """
-    from scipy.stats import spearmanr
+    from vibroimpact.stats.ranks import spearman
 
     p = np.asarray(probability, dtype=float)
     stable = np.asarray(stable, dtype=bool)
@@ -492,7 +492,7 @@ def motion_map_agreement(probability, stable, S, threshold: float = 0.5) -> dict
     n_dom = int(dominant.sum())
     rho = np.nan
     if domain.sum() >= 3 and np.ptp(p[domain]) > 0 and np.ptp(S[domain]) > 0:
-        rho = float(spearmanr(p[domain], S[domain]).statistic)
+        rho = spearman(p[domain], S[domain])
     return dict(n_dominant=n_dom,
                 dominant_inside=float((dominant & stable).sum() / n_dom) if n_dom else np.nan,
                 domain_covered=(float((dominant & domain).sum() / domain.sum())

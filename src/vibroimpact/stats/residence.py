@@ -294,7 +294,7 @@ def jump_chain_independence(states, n_states: int):
     A sequence that cycles A B A C A B ... fails: from A it goes to C after B and to B after
     C. The cells of a table should hold about 5 triples or more for the chi-square law.
     """
-    from scipy.stats import chi2
+    from vibroimpact.stats.ranks import chi2_sf
 
     states = np.asarray(states, dtype=np.int64)
     runs = states[np.flatnonzero(np.diff(states, prepend=-1) != 0)] if states.size else states
@@ -309,7 +309,7 @@ def jump_chain_independence(states, n_states: int):
         expected = table.sum(axis=1, keepdims=True) * table.sum(axis=0) / table.sum()
         statistic += float(((table - expected) ** 2 / expected).sum())
         dof += (table.shape[0] - 1) * (table.shape[1] - 1)
-    p_value = float(chi2.sf(statistic, dof)) if dof else np.nan
+    p_value = float(chi2_sf(statistic, dof)) if dof else np.nan
     return statistic, dof, p_value
 
 
