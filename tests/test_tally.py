@@ -103,17 +103,21 @@ def test_the_compiled_grouping_refuses_what_the_reference_refuses():
         tally.group_collisions([1], [0.0], [1.0], [], [], dt=DT, eps=0.5, rule="other")
 
 
+def _reference_collisions(res, pressed, walls):
+    """The numpy reference's collisions of a simulated record after t = 200."""
+    kw = dict(dt=DT, eps=0.5, pressed=pressed)
+    if walls:
+        kw.update(wall=res.impact_wall, stick_wall=res.stick_wall, eps_lower=walls["eps_lower"])
+    return stats.group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
+                                  res.stick_start, res.stick_end, **kw).after(200.0)
+
+
 @pytest.mark.parametrize("motions", [stats.DEFAULT_MOTIONS, ((2, 1), (1, 1), (3, 2), (1, 3))])
 def test_the_compiled_motion_statistics_are_the_numpy_reference(motions):
     """`tally.motion_statistics` is `stats.motion_statistics` on each record's collisions,
     with and without the impact-stick refinement, and with the two-wall motions."""
     for res, pressed, walls, beta in records():
-        kw = dict(dt=DT, eps=0.5, pressed=pressed)
-        if walls:
-            kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
-                      eps_lower=walls["eps_lower"])
-        col = stats.group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
-                                     res.stick_start, res.stick_end, **kw).after(200.0)
+        col = _reference_collisions(res, pressed, walls)
         t_stop = res.params["t_end"] if "t_end" in res.params else (40000 * DT)
         for stuck in (None, col.stuck):
             for m, w in ((motions, None), (motions + ((1, 1, 1),), col.wall)):
@@ -255,12 +259,7 @@ def test_the_motion_tally_is_the_numpy_reference(motions):
     collisions."""
     cases = []
     for res, pressed, walls, beta in records():
-        kw = dict(dt=DT, eps=0.5, pressed=pressed)
-        if walls:
-            kw.update(wall=res.impact_wall, stick_wall=res.stick_wall,
-                      eps_lower=walls["eps_lower"])
-        col = stats.group_collisions(res.impact_step, res.impact_offset, res.impact_velocity,
-                                     res.stick_start, res.stick_end, **kw).after(200.0)
+        col = _reference_collisions(res, pressed, walls)
         cases += [(col, beta, bool(walls))] + [(col._select(np.arange(col.time.size) < k),
                                                  beta, False) for k in (0, 1, 2)]
     for col, beta, two in cases:

@@ -61,6 +61,23 @@ def _chatter_firsts(cont, ends, first):
 
 
 @kernel
+def _at_firsts(first, t, step, offset, u, wall):
+    """The time, step, offset, velocity and wall of the impacts ``first`` (the collisions'
+    first impacts), gathered in one loop."""
+    k = first.size
+    time_first = np.empty(k)
+    step_first = np.empty(k, np.int64)
+    offset_first = np.empty(k)
+    u_first = np.empty(k)
+    wall_first = np.empty(k, np.int8)
+    for c in range(k):
+        a = first[c]
+        time_first[c], step_first[c], offset_first[c] = t[a], step[a], offset[a]
+        u_first[c], wall_first[c] = u[a], wall[a]
+    return time_first, step_first, offset_first, u_first, wall_first
+
+
+@kernel
 def _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall):
     """``first_mask[i]``: impact ``i`` starts a collision under ``rule`` (``t`` the impacts'
     instants, ``ends`` `_ends`, ``counted`` the rebounds that reach the floor)."""
@@ -170,15 +187,8 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
         lo = hi
     for i in range(n):
         impact_collision[i] = max(impact_collision[i] - n_before, -1)
-    step_first = np.empty(k, np.int64)
-    offset_first = np.empty(k)
-    time_first = np.empty(k)
-    u_first = np.empty(k)
-    wall_first = np.empty(k, np.int8)
-    for o in range(k):
-        a = out_first[o]
-        step_first[o], offset_first[o], time_first[o] = step[a], offset[a], t[a]
-        u_first[o], wall_first[o] = u[a], wall[a]
+    time_first, step_first, offset_first, u_first, wall_first = _at_firsts(
+        out_first, t, step, offset, u, wall)
     n_counted = 0
     for i in range(n):
         if counted[i]:
@@ -244,15 +254,8 @@ def firsts(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rule, wal
             hi = m
         stuck[c] = hi > lo
         lo = hi
-    time_first = np.empty(n_first)
-    step_first = np.empty(n_first, np.int64)
-    offset_first = np.empty(n_first)
-    u_first = np.empty(n_first)
-    wall_first = np.empty(n_first, np.int8)
-    for c in range(n_first):
-        a = first[c]
-        time_first[c], step_first[c], offset_first[c] = t[a], step[a], offset[a]
-        u_first[c], wall_first[c] = u[a], wall[a]
+    time_first, step_first, offset_first, u_first, wall_first = _at_firsts(
+        first, t, step, offset, u, wall)
     return first, time_first, step_first, offset_first, u_first, wall_first, stuck
 
 
