@@ -24,18 +24,20 @@ FAST_WORKERS ?= -n 2
 # worker is free. xdist hands out the largest group first, so the two builds start at once.
 LONG_WORKERS ?= -n 2 --dist loadgroup
 LONG_MARKERS := slow or workflow or slurm
-# the installer of the pinned environment: uv (from PyPI, pinned here) downloads and
-# installs in parallel, about a minute on a fresh machine against pip's two and a half
-# (README, "Tests"); pip installs it if uv fails for any reason. --compile-bytecode: uv
-# leaves the packages without their .pyc files (pip writes them), and every job then compiled
-# matplotlib, xarray and scipy from source at import: +2.3 CPU-s a figure job, +100 CPU-s a
-# default build (a fresh clone of 5101ed1: 365 CPU-s against 262)
-UV_VERSION ?= 0.13.9
+# The exact environment: requirements.lock (every distribution, its version and hashes,
+# written by uv from pyproject.toml's direct requirements: `make lock`) installed by uv alone,
+# `uv pip sync --require-hashes`: .venv then holds the lock's distributions and nothing else,
+# each file checked against its hash (tests/test_release.py checks the venv against the
+# lock). uv itself comes from the lock too, installed by pip with its hashes checked.
+# --compile-bytecode: uv leaves the packages without their .pyc files (pip writes them), and
+# every job then compiled matplotlib, xarray and scipy from source at import: +2.3 CPU-s a
+# figure job, +100 CPU-s a default build (a fresh clone of 5101ed1: 365 CPU-s against 262)
+LOCK := requirements.lock
 # your own config, layered on config/config.yaml: make CONFIG=my_study.yaml
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
 
-.PHONY: all plan report stale clean-stale test test-fast test-slow bench lint clean
+.PHONY: all plan report stale clean-stale test test-fast test-slow bench lint lock clean
 # checks the config, prints the plan, recovers from a killed run, then runs Snakemake; then
 # writes Snakemake's report of the build, whole or not at all
 all: $(STAMP)
@@ -51,36 +53,48 @@ plan: $(STAMP)
 # outputs of the config's entries that it no longer builds (an earlier config's figures of the
 # same study ...): `stale` lists them, `clean-stale` removes them (README, "Outputs")
 stale: $(STAMP)
-	$(BIN)/python -m vibroimpact.pipeline.stale $(CONFIG_ARGS)
+	$(BIN)/vibroimpact stale $(CONFIG_ARGS)
 
 clean-stale: $(STAMP)
-	$(BIN)/python -m vibroimpact.pipeline.stale --delete $(CONFIG_ARGS)
+	$(BIN)/vibroimpact stale --delete $(CONFIG_ARGS)
 
-$(STAMP): environment.txt pyproject.toml
+$(STAMP): $(LOCK) pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check uv==$(UV_VERSION) \
-	  && $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python -r environment.txt \
-	  || $(BIN)/python -m pip install --quiet --disable-pip-version-check -r environment.txt
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-build-isolation --no-deps -e .
-	$(BIN)/python -m vibroimpact.warm --jobs 2
+	$(BIN)/python tools/environment.py entry uv > $(VENV)/uv.lock
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check --require-hashes \
+	  --no-deps -r $(VENV)/uv.lock
+	$(BIN)/uv pip sync --quiet --compile-bytecode --require-hashes --python $(BIN)/python $(LOCK)
+	$(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python --no-deps \
+	  --no-build-isolation -e .
+	$(BIN)/vibroimpact warm --jobs 2
 	$(BIN)/python -m vibroimpact.pipeline.digest_cache
 	touch $(STAMP)
 
 # the seconds-long checks first: a lint failure stops the build before the half-hour suites
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks workflow/scripts
-	$(BIN)/snakefmt --check Snakefile workflow/
+	$(BIN)/ruff check src tests benchmarks tools workflow/scripts
+	$(BIN)/snakefmt --check workflow/
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q $(FAST_WORKERS)
 	$(BIN)/python -m pytest -q -m "$(LONG_MARKERS)" $(LONG_WORKERS)
+
+# requirements.lock again from pyproject.toml's direct requirements (the package's, the slurm
+# extra, the dev group), keeping every pin that still satisfies them; `make lock UPGRADE=1`
+# moves every distribution to its newest allowed version. Then the conda environment of the
+# rules, from the lock. Python 3.11.5: the oldest 3.11 the locked distributions support.
+lock: $(STAMP)
+	$(BIN)/uv pip compile pyproject.toml --extra slurm --group dev --universal \
+	  --python-version 3.11.5 --generate-hashes --quiet $(if $(UPGRADE),--upgrade) \
+	  --custom-compile-command "make lock" -o $(LOCK)
+	$(BIN)/python tools/environment.py conda
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 
 lint: $(STAMP)
 	$(BIN)/snakemake --lint
-	$(BIN)/ruff check src tests benchmarks workflow/scripts
-	$(BIN)/snakefmt --check Snakefile workflow/
+	$(BIN)/ruff check src tests benchmarks tools workflow/scripts
+	$(BIN)/snakefmt --check workflow/
 
 clean:
 	rm -rf results

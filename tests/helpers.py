@@ -24,8 +24,9 @@ import xarray as xr
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
-#: What a build needs of the repository (the stability report reads notebooks/*.csv).
-WORKFLOW_FILES = ("Snakefile", "config", "workflow", "profiles", "notebooks")
+#: What a build needs of the repository: the workflow (its Snakefile, rules, scripts,
+#: notebooks, schema and profiles) and the configs beside it.
+WORKFLOW_FILES = ("config", "workflow")
 #: Snakemake's metadata of a run, not of its outputs: a copied build starts unlocked.
 RUN_STATE = ("locks", "incomplete", "log")
 #: The test configs' short noise record (the plane tests: tests/test_planes.py,

@@ -124,7 +124,7 @@ def test_every_script_and_notebook_of_the_workflow_has_a_digest():
     root = Path(__file__).resolve().parents[1]
     provenance._graph.cache_clear()
     sources = [*sorted((root / "workflow" / "scripts").glob("*.py")),
-               *sorted((root / "notebooks").glob("*.ipynb"))]
+               *sorted((root / "workflow" / "notebooks").glob("*.ipynb"))]
     assert len(sources) >= 20
     digests = {path.name: provenance.code_digest(path) for path in sources}
     assert all(len(d) == 16 and int(d, 16) >= 0 for d in digests.values())
@@ -195,7 +195,7 @@ def test_the_installation_keeps_the_digest_of_every_script(tmp_path):
     (scripts / "draw.py").write_text("from vibroimpact.pipeline import tasks\n")
     (scripts / "noise.py").write_text("from vibroimpact import stats\n")
     digest_cache._TABLES.clear()
-    digest_cache.main(tmp_path)
+    digest_cache.main(tmp_path, workflow=tmp_path / "workflow")
     kept = json.loads((tmp_path / ".snakemake" / "vibroimpact-code-digests.json").read_text())
     provenance._graph.cache_clear()
     provenance.code_digest.cache_clear()

@@ -663,7 +663,7 @@ def _snakemake_parse(work, configfile):
     with SnakemakeApi(OutputSettings(quiet={Quietness.ALL})) as api:
         api.workflow(resource_settings=ResourceSettings(cores=1),
                      config_settings=ConfigSettings(configfiles=[configfile]),
-                     snakefile=work / "Snakefile", workdir=work).dag()
+                     snakefile=work / "workflow" / "Snakefile", workdir=work).dag()
 
 
 @pytest.mark.workflow

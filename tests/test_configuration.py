@@ -1,7 +1,6 @@
 """Config layering, the plan and its limits, and the fault-recovery helpers (fast)."""
 import os
 from pathlib import Path
-import shutil
 import signal
 import socket
 import subprocess
@@ -120,7 +119,6 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
     assert stale.stale_files(config, plan.drawn, tmp_path) == sorted(old)
     mine, mine_plan = configuration.load(MINE, root=ROOT)
     assert stale.stale_files(mine, mine_plan.drawn, tmp_path) == []    # the paper's: not its
-    shutil.copytree(ROOT / "config", tmp_path / "config")
     assert stale.main(["--directory", str(tmp_path), "--delete"]) == 0
     assert not any((tmp_path / rel).exists() for rel in old)
     assert all((tmp_path / rel).exists() for rel in [*current, *twins, *other])
@@ -270,7 +268,7 @@ def test_every_study_key_reaches_the_jobs_that_read_it():
     # a key that no job's params carry is silently ignored by the jobs (rebound_floor was)
     from vibroimpact.pipeline.study import JOB_KEYS
 
-    schema = yaml.safe_load((ROOT / "config" / "schema.yaml").read_text())
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
     keys = set(schema["$defs"]["study"]["properties"])
     by_jobs = set().union(*JOB_KEYS.values())
     by_figures = {key for fig in figures.FIGURES.values() for key in fig.get("options", ())}

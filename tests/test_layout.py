@@ -83,7 +83,8 @@ def test_every_rule_has_a_one_line_docstring():
 
     root = Path(__file__).resolve().parents[1]
     missing = []
-    for path in [root / "Snakefile", *sorted((root / "workflow" / "rules").glob("*.smk"))]:
+    for path in [root / "workflow" / "Snakefile",
+                 *sorted((root / "workflow" / "rules").glob("*.smk"))]:
         lines = path.read_text().splitlines()
         for k, line in enumerate(lines):
             rule = re.match(r"^\s*rule (\w+):", line)

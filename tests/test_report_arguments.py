@@ -38,4 +38,5 @@ def test_an_orbits_report_is_named_by_its_entry():
 
 def test_the_readme_quotes_the_campaign_table_of_docs():
     quoted = markdown_table(ROOT / "README.md", "| family |")
-    pd.testing.assert_frame_equal(quoted, csv_table(ROOT / "notebooks" / "stress_campaign.csv"))
+    campaign = ROOT / "workflow" / "notebooks" / "stress_campaign.csv"
+    pd.testing.assert_frame_equal(quoted, csv_table(campaign))

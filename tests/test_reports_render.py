@@ -319,13 +319,14 @@ def test_the_provenance_table_has_a_column_per_dataset_and_wraps_its_hashes():
 
 
 def _fake_snakemake(tmp_path, body, code):
-    """A `snakemake` that writes ``body`` to its ``--report`` file and exits with ``code``."""
+    """A `snakemake` command (`cli._snakemake`'s words) that writes ``body`` to its ``--report``
+    file and exits with ``code``."""
     script = tmp_path / "snakemake"
     script.write_text(f"#!{sys.executable}\nimport sys\n"
                       f"path = sys.argv[sys.argv.index('--report') + 1]\n"
                       f"open(path, 'w').write({body!r})\nsys.exit({code})\n")
     script.chmod(0o755)
-    return str(script)
+    return [str(script)]
 
 
 def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):

@@ -7,7 +7,9 @@ The public API is re-exported lazily: ``import vibroimpact`` loads neither numba
 simulator; ``vibroimpact.simulate`` does, on first use. Subpackages (docs/api.md):
 ``impact`` (the simulator), ``orbits`` (periodic motions), ``stats``, ``noise``,
 ``plotting``, ``pipeline`` (the workflow-facing layer), ``validation``. ``__version__`` is
-lazy too: reading it loads ``importlib.metadata``, which a figure job does not otherwise need.
+lazy too: reading it asks git (a checkout) or ``importlib.metadata`` (an installed package),
+which a figure job does not otherwise need. ``snakefile()`` is the workflow's Snakefile, for a
+host workflow that pulls it in as a module.
 """
 import importlib
 
@@ -27,6 +29,7 @@ _LAZY = {
     "periodic_motions": "vibroimpact.attractors.shooting",
     "domain_boundaries": "vibroimpact.orbits.boundaries",
     "attractor_map": "vibroimpact.attractors.api",
+    "snakefile": "vibroimpact.pipeline.layout",
 }
 
 # PLE0604: ruff cannot see that the keys of _LAZY are strings
@@ -34,12 +37,11 @@ __all__ = [*_LAZY, "PAPER_REFERENCE", "__version__"]  # noqa: PLE0604
 
 
 def _version():
-    from importlib.metadata import PackageNotFoundError, version
+    """The version of this copy: from git tags in a checkout, else the installed one's
+    (`vibroimpact._release`)."""
+    from vibroimpact._release import version
 
-    try:
-        return version("vibroimpact")
-    except PackageNotFoundError:  # running from a source tree without installation
-        return "0+unknown"
+    return version()
 
 
 def __getattr__(name):

@@ -105,7 +105,7 @@ def warm(jobs=2, log=print):
 def main(argv=None):
     import argparse
 
-    parser = argparse.ArgumentParser(prog="python -m vibroimpact.warm",
+    parser = argparse.ArgumentParser(prog="vibroimpact warm",
                                      description=__doc__.splitlines()[0])
     parser.add_argument("--jobs", type=int, default=2,
                         help="kernel families compiled at once (default 2)")

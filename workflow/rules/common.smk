@@ -44,28 +44,41 @@ wildcard_constraints:
     paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence|escape_vs_noise",
 
 
+# The figure jobs are drawn in forks of this process, warmed once, whatever the profile
+# (`vibroimpact.pipeline.forked`): its server starts here, in the main process only, and idles
+# until a figure job asks (nothing is imported before).
+if workflow.is_main_process:
+    forked.serve()
+
+
 # every study resolved once, by `configuration.load` (the Snakefile's PLAN): its grids are
 # those the config checks expanded
 STUDIES = PLAN.studies
 
 
 # the digests of the last runs, by the bytes of the package and the script (each Snakemake
-# start would parse the whole package again: 2.3 CPU-s, three times a `make`)
-CODE_DIGESTS = Path(workflow.basedir, ".snakemake", "vibroimpact-code-digests.json")
+# start would parse the whole package again: 2.3 CPU-s, three times a `make`), kept in the
+# working directory's .snakemake folder, beside Snakemake's own records
+CODE_DIGESTS = Path(".snakemake", "vibroimpact-code-digests.json")
 
 
-SCRIPTS = Path(workflow.basedir, "workflow", "scripts")
+# the workflow's own files, from the Snakefile's folder (WORKFLOW_DIR), wherever it runs
+SCRIPTS = WORKFLOW_DIR / "scripts"
 
 
 def script_code(rule):
-    """The code digest of ``workflow/scripts/<rule>.py``: what its job runs."""
+    """The code digest of ``scripts/<rule>.py``: what its job runs."""
     return cached_code_digest(SCRIPTS / f"{rule}.py", CODE_DIGESTS)
 
 
-def script_job(input, output, params, wildcards, log):
-    """What a script run by `forked.run_script` finds as ``snakemake`` (a ``run:`` rule has
-    no such object): the job's files, params and wildcards."""
-    return SimpleNamespace(input=input, output=output, params=params, wildcards=wildcards, log=log)
+def own_files(inputs):
+    """``inputs`` with the workflow's own files among them (the report notebook, the stress
+    campaign's table: `targets.WORKFLOW_INPUTS`, relative to the workflow's folder) made
+    paths of this workflow's copy, so that a module reads its own notebooks."""
+    return {
+        key: str(WORKFLOW_DIR / path) if key in targets.WORKFLOW_INPUTS else path
+        for key, path in inputs.items()
+    }
 
 
 # --- Priorities ------------------------------------------------------------------------------
@@ -280,18 +293,18 @@ def study_report_inputs(wildcards):
     """The notebook, the datasets and the figures of a study and of its ``report_with``, and
     the study's noise record (its provenance row, whether or not a figure draws it); with a
     map over an orbits entry that has attractors, their basins and Lyapunov datasets."""
-    return targets.study_report_inputs(config, wildcards.study, wildcards.report)
+    return own_files(targets.study_report_inputs(config, wildcards.study, wildcards.report))
 
 
 def orbits_report_inputs(wildcards):
     """The notebook, the dataset and the figures of orbits entry ``{orbits}``, and the map
     drawn over it (Fig. 15 against Fig. 16), if a built study draws one."""
-    return targets.orbits_report_inputs(config, PLAN.drawn, wildcards.orbits)
+    return own_files(targets.orbits_report_inputs(config, PLAN.drawn, wildcards.orbits))
 
 
 def validation_report_inputs(wildcards):
     """The notebook, the dataset and the figure of validation report ``{vreport}``."""
-    return targets.validation_report_inputs(wildcards.vreport)
+    return own_files(targets.validation_report_inputs(wildcards.vreport))
 
 
 def _report_notebook(wildcards):
@@ -303,7 +316,7 @@ def _report_notebook(wildcards):
 
 def report_code(wildcards):
     """The code digest of the report's notebook: what its import lines reach."""
-    notebook = Path(workflow.basedir, "notebooks", f"{_report_notebook(wildcards)}.ipynb")
+    notebook = WORKFLOW_DIR / "notebooks" / f"{_report_notebook(wildcards)}.ipynb"
     return cached_code_digest(notebook, CODE_DIGESTS)
 
 

@@ -31,17 +31,17 @@ rule draw_figure:
     resources:
         mem_mb=BASE_MEM_MB,
         runtime=5,
+    conda:
+        "../envs/vibroimpact.yaml"
     params:
         options=figure_options,
         code=script_code("draw_figure"),
-    # the script in a fork of this process, its imports and matplotlib's first drawing done
-    # once (`pipeline.forked`: 1.1 CPU-s a figure less); its benchmark file written there
-    run:
-        forked.run_script(
-            SCRIPTS / "draw_figure.py",
-            script_job(input, output, params, wildcards, log),
-            benchmark=f"results/benchmarks/draw_figure/{wildcards.owner}/{wildcards.fig}.tsv",
-        )
+        # written by the fork that draws, from its own resource use (`pipeline.forked`)
+        benchmark="results/benchmarks/draw_figure/{owner}/{fig}.tsv",
+    # drawn in a fork of Snakemake's process, its imports and matplotlib's first drawing
+    # done once (`pipeline.forked`: 1.1 CPU-s a figure less), with any profile
+    script:
+        "../scripts/draw_figure.py"
 
 
 rule copy_paper_figure:

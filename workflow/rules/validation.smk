@@ -70,12 +70,11 @@ rule draw_validation_figure:
     resources:
         mem_mb=BASE_MEM_MB,
         runtime=5,
+    conda:
+        "../envs/vibroimpact.yaml"
     params:
         code=script_code("draw_validation_figure"),
-    # in a fork of this process, as draw_figure (figures.smk)
-    run:
-        forked.run_script(
-            SCRIPTS / "draw_validation_figure.py",
-            script_job(input, output, params, wildcards, log),
-            benchmark=f"results/benchmarks/draw_validation_figure/{wildcards.validation_fig}.tsv",
-        )
+        benchmark="results/benchmarks/draw_validation_figure/{validation_fig}.tsv",
+    # drawn in a fork of Snakemake's process, as draw_figure (figures.smk)
+    script:
+        "../scripts/draw_validation_figure.py"

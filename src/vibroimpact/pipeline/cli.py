@@ -1,4 +1,7 @@
-"""``python -m vibroimpact``: the project's entry point (``make`` calls ``run``).
+"""``vibroimpact`` (also ``python -m vibroimpact``): the tool's entry point (``make`` calls
+``run``), in a checkout or installed, from any working directory: the results go there, the
+workflow is the one this package carries (`vibroimpact.pipeline.layout`), and the paper's
+config is the base layer of the user's.
 
 ``plan``  reads and checks the config (the paper's, with ``--configfile`` files layered on
           it) and prints what a build would make: cells, jobs, disk and a rough time.
@@ -19,6 +22,12 @@
           once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
           all: it is rendered elsewhere and moved into place only when complete (``make``
           runs it after ``run``).
+``stale``  lists (``--delete``: removes) the outputs of the config's entries that it no longer
+          builds (`vibroimpact.pipeline.stale`).
+``warm``   compiles every numba kernel the jobs call into numba's cache, once per installation
+          (`vibroimpact.warm`, dispatched by ``vibroimpact.__main__``), so that no job and no
+          notebook compiles one.
+``--version`` prints the version (`vibroimpact._release`).
 
 A config file with a YAML syntax error is reported with its file, line and column here,
 before Snakemake's own loader (which drops the location) ever sees it.
@@ -31,24 +40,41 @@ import subprocess
 import sys
 
 from vibroimpact import _files
-from vibroimpact.pipeline import config, io
+from vibroimpact.pipeline import config, io, layout
 
 __all__ = ["main"]
 
 
+class _Version(argparse.Action):
+    """``--version``: found only when asked (in a checkout it asks git)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS,
+                         help="print the version and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        from vibroimpact._release import version
+
+        print(f"vibroimpact {version()}")
+        parser.exit()
+
+
 def _parser():
     parser = argparse.ArgumentParser(
-        prog="python -m vibroimpact",
-        description="Check, plan and build the vibroimpact workflow (README).")
+        prog="vibroimpact",
+        description="Check, plan and build the vibroimpact workflow in the working directory "
+                    "(README).")
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in (("plan", "check the config and print what a build would make"),
                        ("run", "check, prepare and build (extra arguments go to snakemake)"),
                        ("report", "write Snakemake's report of the build (after run)")):
         p = sub.add_parser(name, help=text, description=text)
         p.add_argument("--configfile", action="extend", nargs="+", default=[], metavar="FILE",
-                       help="your config files, layered on config/config.yaml in order "
-                            "(README): several after one --configfile, as Snakemake takes "
-                            "them, or the option repeated; targets go before it")
+                       help="your config files, layered on the paper's config "
+                            "(config/config.yaml) in order (README): several after one "
+                            "--configfile, as Snakemake takes them, or the option repeated; "
+                            "targets go before it")
         if name == "report":
             p.add_argument("--output", default=REPORT, metavar="FILE",
                            help=f"the report, relative to the project directory (default "
@@ -56,9 +82,14 @@ def _parser():
         else:
             p.add_argument("--cores", type=_cores, default="all",
                            help="cores of the build: a number, or all (default: all of them)")
-        p.add_argument("--directory", default=".", help="the project directory (default .)")
+        p.add_argument("--directory", default=".",
+                       help="the working directory, where results/ is (default .)")
         p.add_argument("-v", "--verbose", action="store_true",
                        help="also print the schema validator's full output on a config error")
+    text = "list the outputs of the config's entries that it no longer builds"
+    p = sub.add_parser("stale", help=text, description=text, add_help=False)
+    text = "compile every numba kernel of the jobs into numba's cache, once per installation"
+    p = sub.add_parser("warm", help=text, description=text, add_help=False)
     return parser
 
 
@@ -235,8 +266,12 @@ _HELD = {}
 
 
 def _snakemake():
+    """Snakemake on the workflow this package carries (`vibroimpact.pipeline.layout`): the
+    ``snakemake`` beside this interpreter, ``--snakefile`` given, so that it runs from any
+    working directory (in a checkout it is the one Snakemake would find there)."""
     exe = Path(sys.executable).with_name("snakemake")
-    return str(exe) if exe.exists() else (shutil.which("snakemake") or "snakemake")
+    exe = str(exe) if exe.exists() else (shutil.which("snakemake") or "snakemake")
+    return [exe, "--snakefile", str(layout.snakefile())]
 
 
 def _clear_stale_lock(root, config_args):
@@ -251,7 +286,7 @@ def _clear_stale_lock(root, config_args):
                      f"finish, or stop it (kill {pids}) and run again", code=1)
     print("vibroimpact: clearing the lock left by a run that did not finish (no run is alive "
           "here)", file=sys.stderr)
-    out = subprocess.run([_snakemake(), "--unlock", *config_args], cwd=root,
+    out = subprocess.run([*_snakemake(), "--unlock", *config_args], cwd=root,
                          capture_output=True, text=True)
     if out.returncode != 0:
         return _fail(f"snakemake --unlock failed:\n{out.stderr[-2000:]}", code=1)
@@ -318,7 +353,7 @@ def write_report(root, config_args, output=REPORT):
     with tempfile.TemporaryDirectory(prefix="vibroimpact-report-") as scratch:
         draft = Path(scratch) / "report.html"
         sys.stdout.flush()
-        code = subprocess.run([_snakemake(), "--report", str(draft), *config_args],
+        code = subprocess.run([*_snakemake(), "--report", str(draft), *config_args],
                               cwd=root).returncode
         if code != 0 or not draft.is_file():
             return _fail(f"snakemake --report failed (exit {code}); {output} is left as it was",
@@ -331,6 +366,12 @@ def write_report(root, config_args, output=REPORT):
 
 
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    command = next((a for a in argv if not a.startswith("-")), None)
+    if command == "stale":      # its own options, after the command's name
+        from vibroimpact.pipeline import stale
+
+        return stale.main(argv[argv.index(command) + 1:])
     args, extra = _parser().parse_known_args(argv)
     if args.command in ("plan", "report") and extra:
         return _fail(f"unknown arguments {extra}; {args.command} takes --configfile, "
@@ -382,7 +423,7 @@ def main(argv=None):
     if code:
         return code
     # targets before --configfile, which would take them as more config files
-    cmd = [_snakemake(), "--cores", str(args.cores), *extra, *config_args]
+    cmd = [*_snakemake(), "--cores", str(args.cores), *extra, *config_args]
     sys.stdout.flush()
     sys.stderr.flush()
     # a first build (no file under results yet) has no output to miss beneath an up-to-date

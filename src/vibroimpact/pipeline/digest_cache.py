@@ -15,6 +15,7 @@ from pathlib import Path
 import sys
 
 from vibroimpact import _files
+from vibroimpact.pipeline import layout
 from vibroimpact.pipeline.provenance import PACKAGE_DIR, code_digest
 
 __all__ = ["cached_code_digest"]
@@ -79,14 +80,16 @@ def cached_code_digest(script, cache_file, package_dir=PACKAGE_DIR):
     return value
 
 
-def main(root="."):
-    """``python -m vibroimpact.pipeline.digest_cache``: keep the digests of every workflow
-    script and report notebook of project ``root`` (what `make`'s installation step runs, so
-    that a first build's Snakemake start finds them)."""
+def main(root=".", workflow=None):
+    """``python -m vibroimpact.pipeline.digest_cache``: keep the digests of every script and
+    report notebook of ``workflow`` (by default the workflow this package runs,
+    `vibroimpact.pipeline.layout`) in working directory ``root`` (what `make`'s installation
+    step runs, so that a first build's Snakemake start finds them)."""
     root = Path(root).resolve()
     cache = root / ".snakemake" / "vibroimpact-code-digests.json"
-    sources = [*sorted((root / "workflow" / "scripts").glob("*.py")),
-               *sorted((root / "notebooks").glob("*.ipynb"))]
+    workflow = Path(workflow) if workflow is not None else layout.workflow_dir()
+    sources = [*sorted((workflow / "scripts").glob("*.py")),
+               *sorted((workflow / "notebooks").glob("*.ipynb"))]
     for script in sources:
         cached_code_digest(script, cache)
     print(f"vibroimpact: code digests of {len(sources)} scripts and notebooks kept in "

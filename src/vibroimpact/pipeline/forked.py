@@ -1,15 +1,29 @@
-"""Figure jobs run in forks of the workflow's own process, warmed once.
+"""Figure jobs run in forks of the workflow's own process, warmed once, whatever the profile.
 
 A figure job in a fresh Python process pays its start-up before it draws: importing numpy,
 pandas, xarray, netCDF4, matplotlib and the plotting package (~0.8 CPU-s) and matplotlib's
 first drawing (fonts, ~0.3 CPU-s), against ~1.2 CPU-s of drawing. The default build's 19
 figures took 45 CPU-s one process each and 28 drawn four processes in all (one an owner,
-`benchmarks/figure_start.py`). The figure rules run their scripts here instead: Snakemake's
-own process imports those modules and draws one small figure once (:func:`warm`), then
-forks for each job (:func:`run_script`). A job pays only its drawing and still runs in a
-process of its own: two figures draw on two cores at once, a crash or a leak stays in its
-fork, a drawing sees the state of a fresh warm process and never another figure's (every
-figure is byte for byte what its own process draws).
+`benchmarks/figure_start.py`). The figure jobs are drawn in forks of Snakemake's own process
+instead, which imports those modules and draws one small figure once (:func:`warm`): a job
+pays only its drawing and still runs in a process of its own: two figures draw on two cores
+at once, a crash or a leak stays in its fork, a drawing sees the state of a fresh warm process
+and never another figure's (every figure is byte for byte what its own process draws).
+
+The figure rules are ``script:`` rules, which Snakemake starts from a thread of its own
+process whatever the profile says (a ``run:`` job runs in that process only with
+``force-use-threads``; without it Snakemake starts a whole new Snakemake for each, which
+parses the workflow and warms again: 84 CPU-s for the 21 figure jobs of the default build
+against 35, and 13 s a figure in a host workflow that pulls this one in as a module). The
+Snakefile starts a server in Snakemake's process (:func:`serve`: a thread accepting on a Unix
+socket in a private temporary folder, named in the environment every job inherits); the
+job's script (Snakemake's preamble, then the workflow script, which calls :func:`run`) is a
+client: it sends the server the path of its own file and waits. The server forks; the fork
+runs that file, whose preamble binds ``snakemake`` again (its modules already loaded), and
+:func:`run` there draws. The client exits with the fork's status (~0.1 CPU-s: Python and the
+preamble). A job that finds no server (on another machine, in a container, a script run by
+hand) forks its own process: the same drawing, paying the imports. A client that goes away
+(Snakemake stopping the job) has its fork stopped.
 
 Only the thread that forks survives in the child: a lock that another of Snakemake's threads
 held at that instant stays held there. The child therefore touches nothing those threads
@@ -18,32 +32,38 @@ leaves by ``os._exit`` (no interpreter shutdown, no Snakemake exit handlers). Th
 child uses (matplotlib, xarray, netCDF4) are used by no thread of the parent besides the
 warm-up, which no fork overlaps (:data:`_LOCK`).
 
-Snakemake runs a ``run:`` job in a thread of its own process only with ``force-use-threads``
-(set in ``profiles/default``); without it, it starts a whole new Snakemake for each such job,
-which parses the workflow and warms up again: the 21 figure jobs of the default build then
-cost 84 CPU-s against 59 as script jobs (load ~5), and 35 against 52 with it.
-
 The job's benchmark file is written here, in Snakemake's columns, from the fork's own
-resource use (``os.wait4``): Snakemake's ``benchmark:`` of a ``run:`` job would sample its
-own process with every other running job under it.
+resource use (``os.wait4``): Snakemake's ``benchmark:`` would sample the client.
 """
+import atexit
 import contextlib
 import io
+import json
 import os
 import runpy
+import select
+import shutil
 import signal
+import socket
 import sys
+import tempfile
 import threading
 import time
 import traceback
 
 from vibroimpact import _files
 
-__all__ = ["run_script", "warm"]
+__all__ = ["SERVER_ENV", "run", "run_script", "serve", "warm"]
 
 #: Held while the modules are warmed, and at each fork: no fork copies a half-done warm-up.
 _LOCK = threading.Lock()
 _WARM = []
+#: The path of this process's server socket, once :func:`serve` has started it.
+_SERVER = []
+#: Set in a fork that runs a job: :func:`run` draws there.
+_IN_JOB = []
+#: The environment variable naming the server's socket, for the jobs a build starts.
+SERVER_ENV = "VIBROIMPACT_FIGURE_SERVER"
 
 #: Snakemake's benchmark columns (``snakemake.benchmark``), in its order.
 BENCHMARK_COLUMNS = ("s", "h:m:s", "max_rss", "max_vms", "max_uss", "max_pss", "io_in",
@@ -72,10 +92,11 @@ def warm():
         _WARM.append(True)
 
 
-def _child(script, job, log):
-    """In the fork: the script with ``snakemake`` bound to ``job``; never returns."""
+def _child(target, log):
+    """In the fork: ``target()`` (a job's drawing), its output on ``log``; never returns."""
     code = 1
     try:
+        _IN_JOB.append(True)
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         fd = os.open(log, os.O_WRONLY | os.O_CREAT | os.O_APPEND, 0o644)
@@ -84,8 +105,10 @@ def _child(script, job, log):
         os.close(fd)
         sys.stdout = open(1, "w", closefd=False)
         sys.stderr = open(2, "w", closefd=False)
-        runpy.run_path(str(script), init_globals={"snakemake": job}, run_name="__main__")
+        target()
         code = 0
+    except SystemExit as stop:      # a script's own exit (tasks.logged: a damaged input)
+        code = stop.code if isinstance(stop.code, int) else int(stop.code is not None)
     except BaseException:           # the fork reports every failure and exits
         with contextlib.suppress(BaseException):
             traceback.print_exc()
@@ -94,6 +117,35 @@ def _child(script, job, log):
             sys.stdout.flush()
             sys.stderr.flush()
         os._exit(code)
+
+
+def _wait(pid, client=None):
+    """``os.wait4`` of the fork ``pid``; when ``client`` (a socket) closes first, the fork is
+    stopped (SIGTERM) before it is reaped."""
+    if client is not None and hasattr(os, "pidfd_open"):
+        with contextlib.suppress(OSError), contextlib.closing(_PidFd(pid)) as pidfd:
+            while True:
+                ready, _, _ = select.select([pidfd, client], [], [])
+                if pidfd in ready:
+                    break
+                if not client.recv(1, socket.MSG_PEEK):     # the client went away
+                    with contextlib.suppress(ProcessLookupError):
+                        os.kill(pid, signal.SIGTERM)
+                    break
+    return os.wait4(pid, 0)
+
+
+class _PidFd:
+    """A process's file descriptor (``os.pidfd_open``): readable once it has exited."""
+
+    def __init__(self, pid):
+        self.fd = os.pidfd_open(pid)
+
+    def fileno(self):
+        return self.fd
+
+    def close(self):
+        os.close(self.fd)
 
 
 def run_script(script, job, benchmark=None):
@@ -116,13 +168,20 @@ def run_script(script, job, benchmark=None):
         The script failed: its exit status, and the log holding its traceback.
     """
     warm()
-    log = str(job.log[0])
+    _fork(lambda: runpy.run_path(str(script), init_globals={"snakemake": job},
+                                 run_name="__main__"),
+          os.path.basename(str(script)), str(job.log[0]), benchmark)
+
+
+def _fork(target, name, log, benchmark, client=None):
+    """``target()`` in a fork of this process (:func:`_child`), waited for; its benchmark row
+    written; RuntimeError naming ``name`` and ``log`` if it failed."""
     with _LOCK:
         start = time.perf_counter()
         pid = os.fork()
         if pid == 0:
-            _child(script, job, log)
-    _, status, usage = os.wait4(pid, 0)
+            _child(target, log)
+    _, status, usage = _wait(pid, client)
     wall = time.perf_counter() - start
     if benchmark is not None:
         cpu = usage.ru_utime + usage.ru_stime
@@ -135,4 +194,123 @@ def run_script(script, job, benchmark=None):
     code = os.waitstatus_to_exitcode(status)
     if code != 0:
         what = f"signal {-code}" if code < 0 else f"exit {code}"
-        raise RuntimeError(f"{os.path.basename(str(script))} failed ({what}); see {log}")
+        raise RuntimeError(f"{name} failed ({what}); see {log}")
+
+
+# --- the server in Snakemake's process, and its clients: the jobs' scripts -----------------
+
+def serve():
+    """Start this process's figure server, once, and name its socket in the environment
+    (:data:`SERVER_ENV`) of every process this one starts from now on.
+
+    A daemon thread accepts on a Unix socket in a new private folder (mode 0700: this user
+    only), removed when the process exits; each connection is one job, served in a thread of
+    its own (:func:`run_script` of the file the client names). Nothing is imported or drawn
+    before the first job asks (a dry run pays a thread and a socket). Returns the socket's
+    path.
+    """
+    with _LOCK:
+        if _SERVER:
+            return _SERVER[0]
+        folder = tempfile.mkdtemp(prefix="vibroimpact-figures-")
+        atexit.register(shutil.rmtree, folder, True)
+        path = os.path.join(folder, "socket")
+        server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        server.bind(path)
+        server.listen(64)
+        threading.Thread(target=_accept, args=(server,), name="vibroimpact-figures",
+                         daemon=True).start()
+        os.environ[SERVER_ENV] = path
+        _SERVER.append(path)
+        return path
+
+
+def _accept(server):
+    while True:
+        connection, _ = server.accept()
+        threading.Thread(target=_serve_one, args=(connection,), daemon=True).start()
+
+
+def _serve_one(connection):
+    """One job: its request (the script file, its name, log and benchmark), the fork, the
+    exit status."""
+    with connection:
+        code = 1
+        try:
+            request = json.loads(_line(connection))
+            script = request["script"]      # the job's file: Snakemake's preamble binds its job
+            warm()
+            _fork(lambda: runpy.run_path(script, run_name="__main__"), request["name"],
+                  request["log"], request.get("benchmark"), client=connection)
+            code = 0
+        except RuntimeError as err:        # the job failed: its log says why
+            message = str(err)
+        except Exception as err:           # the client reports it
+            message = f"the figure server failed: {err!r}"
+        else:
+            message = ""
+        with contextlib.suppress(OSError):
+            connection.sendall(json.dumps({"code": code, "message": message}).encode() + b"\n")
+
+
+def _line(connection):
+    """One line of the connection (a JSON request or reply), without its newline."""
+    data = b""
+    while not data.endswith(b"\n"):
+        chunk = connection.recv(65536)
+        if not chunk:
+            break
+        data += chunk
+    return data.decode()
+
+
+def run(draw, job, benchmark=None):
+    """Draw a figure job: ``draw(job)`` in a fork of the workflow's warm process.
+
+    Called by a workflow script with its ``snakemake``. In the server's fork (the script run
+    again there) it draws; in the job's own process it asks the server to run this script
+    (:func:`serve`), or, with no server to ask, runs ``draw(job)`` in a fork of its own.
+
+    Parameters
+    ----------
+    draw : callable
+        ``draw(job)`` draws and saves the figure (the script's own function).
+    job : object
+        The script's ``snakemake``; its ``log[0]`` receives the fork's standard streams.
+    benchmark : path, optional
+        The job's benchmark file, from the fork's resource use.
+
+    Raises
+    ------
+    SystemExit
+        The job failed (its exit status; the log says why).
+    """
+    if _IN_JOB:
+        draw(job)
+        return
+    log = str(job.log[0])
+    # the workflow script's name (Snakemake's preamble sets __file__ to it; argv[0] is the
+    # copy it runs, preamble first)
+    name = os.path.basename(getattr(sys.modules["__main__"], "__file__", None) or sys.argv[0])
+    path = os.environ.get(SERVER_ENV)
+    if path:
+        try:
+            with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:
+                connection.connect(path)
+                request = {"script": os.path.abspath(sys.argv[0]), "name": name,
+                           "log": os.path.abspath(log),
+                           "benchmark": benchmark and os.path.abspath(benchmark)}
+                connection.sendall(json.dumps(request).encode() + b"\n")
+                reply = _line(connection)
+        except OSError:
+            reply = None            # no server here (another machine, a container)
+        if reply is not None:
+            answer = json.loads(reply) if reply else {
+                "code": 1, "message": f"the figure server closed without an answer; see {log}"}
+            if answer["code"] != 0:
+                raise SystemExit(answer["message"])
+            return
+    try:
+        _fork(lambda: draw(job), name, log, benchmark)
+    except RuntimeError as err:
+        raise SystemExit(str(err)) from None

@@ -62,12 +62,13 @@ def main(argv=None):
     from vibroimpact.pipeline import config as configuration
 
     parser = argparse.ArgumentParser(
-        prog="python -m vibroimpact.pipeline.stale",
+        prog="vibroimpact stale",
         description="list (or delete) the outputs of the config's entries that the config "
                     "no longer builds")
     parser.add_argument("--configfile", action="append", default=[], metavar="FILE",
-                        help="your config file, layered on config/config.yaml; repeat")
-    parser.add_argument("--directory", default=".", help="the project directory")
+                        help="your config file, layered on the paper's config; repeat")
+    parser.add_argument("--directory", default=".",
+                        help="the working directory, where results/ is (default .)")
     parser.add_argument("--delete", action="store_true", help="remove the listed files")
     args = parser.parse_args(argv)
     try:
@@ -80,7 +81,8 @@ def main(argv=None):
         print(rel)
         if args.delete:
             (Path(args.directory) / rel).unlink()
-    what = "removed" if args.delete else "not built by this config (make clean-stale removes them)"
+    what = "removed" if args.delete else ("not built by this config (make clean-stale, or "
+                                          "vibroimpact stale --delete, removes them)")
     print(f"{len(files)} file(s) {what}", file=sys.stderr)
     return 0
 

@@ -4,9 +4,9 @@ A study's plane is (1/beta, delta) unless its ``plane`` names two other paramete
 `PLANE_PARAMETERS` (a map over, e.g., (eps, delta)): the two named are grids, every other
 parameter is fixed.
 
-Pure functions of the config mapping (validated by ``config/schema.yaml``): the workflow
-uses them to enumerate cells and tiles, the cell jobs to find their parameters. Cells are
-addressed by an integer index; the files store both the index and the parameter values.
+Pure functions of the config mapping (validated by ``workflow/schemas/config.schema.yaml``):
+the workflow uses them to enumerate cells and tiles, the cell jobs to find their parameters.
+Cells are addressed by an integer index; the files store both the index and the parameter values.
 """
 from dataclasses import dataclass
 import math

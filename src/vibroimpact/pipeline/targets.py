@@ -7,13 +7,14 @@ closure of ``rule all``'s targets through the same functions, so it counts the j
 schedules (a study drawn only in another's report, ``report_with``, included), not a second
 estimate of them. ``drawn`` is :attr:`~vibroimpact.pipeline.config.Plan.drawn`: ``{section:
 names}`` of the entries whose figures ``rule all`` draws. Paths are relative to the project
-directory; no Snakemake, no numerics.
+directory, but for the workflow's own files among the report rules' inputs
+(:data:`WORKFLOW_INPUTS`), relative to its folder; no Snakemake, no numerics.
 """
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.sweeps import sweep_figures
 from vibroimpact.reports.arguments import study_report_kind
 
-__all__ = ["DATASETS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
+__all__ = ["DATASETS", "WORKFLOW_INPUTS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
            "paper_figure_source", "study_datasets", "attractor_datasets",
            "predictors_inputs", "study_report_inputs", "maps_over", "orbits_report_inputs",
            "validation_report_inputs", "sweep_inputs", "sweep_targets", "validation_targets",
@@ -37,6 +38,10 @@ DATASETS = {
     "plane_basins": "results/datasets/{name}_basins.nc",
     "plane_lyapunov": "results/datasets/{name}_lyapunov.nc",
 }
+
+#: The inputs of the report rules that are the workflow's own files, not results: their paths
+#: are relative to the workflow's folder (``workflow/`` of a checkout), which the rules prefix.
+WORKFLOW_INPUTS = ("notebook", "campaign")
 
 #: Each validation figure and the dataset it draws.
 VALIDATION_FIGURES = {
@@ -182,7 +187,8 @@ def orbits_report_inputs(config, drawn, name):
 
 def validation_report_inputs(vreport):
     """The notebook, the dataset and the figure of validation report ``vreport``; the
-    stability report also quotes the full stress campaign (notebooks/stress_campaign.csv)."""
+    stability report also quotes the full stress campaign
+    (workflow/notebooks/stress_campaign.csv)."""
     if vreport == "performance":
         return {"notebook": "notebooks/performance.ipynb",
                 "work_precision": VALIDATION_FIGURES["work_precision"],

@@ -1,5 +1,5 @@
-"""Helpers the report notebooks (``notebooks/*.ipynb``) call, so their cells stay one line,
-and the HTML rendering of an executed notebook (:func:`render_html`).
+"""Helpers the report notebooks (``workflow/notebooks/*.ipynb``) call, so their cells stay one
+line, and the HTML rendering of an executed notebook (:func:`render_html`).
 
 The notebooks are executed by papermill from the workflow (``workflow/rules/reports.smk``),
 every input path passed as a parameter; a path given as ``""`` means "this study has no such
@@ -18,13 +18,16 @@ import numpy as np
 
 
 def at_project_root():
-    """Move to the project directory (the one holding the ``Snakefile``) when run by hand
-    from ``notebooks/``, where the default paths of the parameters cell would not resolve."""
+    """Move to the project directory (the one holding ``workflow/Snakefile``) when run by
+    hand from ``workflow/notebooks/``, where the default paths of the parameters cell would
+    not resolve."""
     import os
 
     here = Path.cwd()
-    if not (here / "Snakefile").exists() and (here.parent / "Snakefile").exists():
-        os.chdir(here.parent)
+    root = here.parents[1] if len(here.parents) > 1 else here
+    if not (here / "workflow" / "Snakefile").exists() \
+            and (root / "workflow" / "Snakefile").exists():
+        os.chdir(root)
 
 
 def paths(text):
@@ -397,7 +400,7 @@ def markdown_table(path, header):
 
 
 def csv_table(path):
-    """A CSV table (e.g. ``notebooks/stress_campaign.csv``, the full stress campaign) as a
+    """A CSV table (e.g. ``workflow/notebooks/stress_campaign.csv``, the full stress campaign) as a
     DataFrame of strings, empty cells as ``""``."""
     import pandas as pd
 

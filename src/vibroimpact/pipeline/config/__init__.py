@@ -9,7 +9,8 @@ per step, in the order :func:`load` takes them:
   user's file on the paper's config (``config/config.yaml``).
 - `sweeps`: :func:`expand_sweeps` turns a study that lists values (a sweep) into one
   ordinary study per combination.
-- `messages`: :func:`validate` checks against ``config/schema.yaml``, filling the schema's
+- `messages`: :func:`validate` checks against the schema
+  (``workflow/schemas/config.schema.yaml``), filling its
   defaults (the one place a default is written), and words every problem.
 - `checks`: :func:`check`, the cross-field relations (records, grids, figures).
 - `plan` and `costs`: the :class:`Plan` of the build (cells, jobs, disk, CPU), refused
@@ -21,6 +22,7 @@ package loads no numba, no scipy and no kernel.
 """
 from pathlib import Path
 
+from vibroimpact.pipeline import layout
 from vibroimpact.pipeline.config.checks import check
 from vibroimpact.pipeline.config.layering import (SECTIONS, check_size, compose, deep_merge,
                                                   read_yaml)
@@ -38,7 +40,7 @@ __all__ = ["ConfigError", "Plan", "Sweeps", "read_yaml", "compose", "expand_swee
            "sweep_labels", "SECTIONS", "SWEEP_KEYS", "VERBOSE_ENV"]
 
 
-def load(user=None, *, root=".", user_files=()):
+def load(user=None, *, root=".", user_files=(), schema=None, paper=None):
     """Read the paper's config, layer ``user`` on it, expand its sweeps, validate and check.
 
     Returns ``(config, plan)``; ``config["sweeps"]`` records each sweep's studies and values
@@ -47,13 +49,20 @@ def load(user=None, *, root=".", user_files=()):
     Parameters
     ----------
     user : dict, optional
-        The user's config (what ``--configfile`` files gave Snakemake), or None.
+        The user's config (what ``--configfile`` files gave Snakemake, or a host workflow's
+        ``module ...: config:``), or None.
     root : path
-        The project directory (holding ``config/config.yaml`` and ``config/schema.yaml``).
+        The working directory: the build's ``results/`` is there.
     user_files : sequence of paths
         Files to read as the user's config (deep-merged in order) when ``user`` is None.
+    schema, paper : path, optional
+        The workflow's schema and the paper's config; by default those of the workflow this
+        package runs (`vibroimpact.pipeline.layout`). The Snakefile passes its own.
     """
     root = Path(root)
+    workflow = layout.workflow_dir()
+    schema = Path(schema) if schema is not None else workflow / layout.SCHEMA
+    paper = Path(paper) if paper is not None else workflow / layout.PAPER_CONFIG
     if user is None and user_files:
         user = {}
         for path in user_files:
@@ -63,8 +72,8 @@ def load(user=None, *, root=".", user_files=()):
     keys = non_text_keys(user or {})
     if keys:        # before anything sorts or looks up the names
         raise ConfigError(keys)
-    schema = read_yaml(root / "config" / "schema.yaml", user=False)
-    paper = read_yaml(root / "config" / "config.yaml", user=False)
+    schema = read_yaml(schema, user=False)
+    paper = read_yaml(paper, user=False)
     config, own = compose(paper, user or {})
     if own is not None and "build" not in ((user or {}).get("validation") or {}):
         # paper: false builds the file's own entries; the validation runs are the paper's

@@ -132,7 +132,8 @@ def _check_noises(config, problems):
             try:        # the generator's own limits (the FIR length), without loading it
                 cutoff(kind, float(beta_c), dt)
             except ValueError as err:
-                problems.add(where, None, str(err), "see config/schema.yaml, noises")
+                problems.add(where, None, str(err),
+                             "see workflow/schemas/config.schema.yaml, noises")
 
 
 #: Correlation times a lowpass2 record must span: the sample variance of a record T long
@@ -200,7 +201,8 @@ def _check_figures(config, section, name, entry, problems, grids):
             block = spec.get("needs")
             if block and not entry.get(block):
                 problems.add(f"{section}.{name}.{block}", None, f"missing, and {fig} draws it",
-                             f"an `{block}:` block (config/schema.yaml), or drop {fig}")
+                             f"an `{block}:` block (workflow/schemas/config.schema.yaml), "
+                             f"or drop {fig}")
             continue
         if spec.get("harmonic") and not entry.get("amplitude"):
             problems.add(f"studies.{name}.amplitude", entry.get("amplitude", 0.0),
@@ -209,7 +211,8 @@ def _check_figures(config, section, name, entry, problems, grids):
             if block in spec["reads"] and not entry.get(block):
                 problems.add(f"studies.{name}.{block}", None,
                              f"missing, and {fig} draws it",
-                             f"a `{block}:` block (config/schema.yaml), or drop {fig}")
+                             f"a `{block}:` block (workflow/schemas/config.schema.yaml), "
+                             f"or drop {fig}")
         item = {} if isinstance(item, str) else item
         for key in item:
             if key == "name":

@@ -1,12 +1,13 @@
 """How a problem of a config is worded: one or two lines naming the key path, the value and
 what is allowed, for the schema's errors and for the cross-field checks alike.
 
-:func:`validate` checks a config against ``config/schema.yaml`` with jsonschema, filling the
-schema's defaults in place, and turns each jsonschema error into such a line. jsonschema
-gives the key path (``error.absolute_path``), the failing keyword (``error.validator``) and
-the failing schema node (``error.schema``); written here is only what it does not give: the
-allowed values in words, which branch of a ``oneOf`` (a number, or a list of numbers: a
-sweep) the value meant, and a number YAML read as text.
+:func:`validate` checks a config against its schema
+(``workflow/schemas/config.schema.yaml``) with jsonschema, filling the schema's defaults in
+place, and turns each jsonschema error into such a line. jsonschema gives the key path
+(``error.absolute_path``), the failing keyword (``error.validator``) and the failing schema
+node (``error.schema``); written here is only what it does not give: the allowed values in
+words, which branch of a ``oneOf`` (a number, or a list of numbers: a sweep) the value
+meant, and a number YAML read as text.
 """
 import copy
 import math
@@ -218,7 +219,7 @@ class _Words:
     def describe(self, parts, node=None):
         """What the node at ``parts`` (or ``node``) allows, with its description."""
         node = node if node is not None else self.at(parts)
-        text = self.allowed(node) if node else "see config/schema.yaml"
+        text = self.allowed(node) if node else "see workflow/schemas/config.schema.yaml"
         desc = node.get("description", "").strip() if node else ""
         if desc and desc != text and "oneOf" not in node:
             text += f" ({desc})"

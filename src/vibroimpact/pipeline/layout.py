@@ -1,0 +1,43 @@
+"""Where the workflow's own files are, in a checkout and in an installed package.
+
+The workflow follows the Snakemake catalog's standardized layout: ``workflow/Snakefile``,
+``workflow/rules``, ``workflow/scripts``, ``workflow/notebooks``, ``workflow/schemas``,
+``workflow/profiles`` and, beside ``workflow/``, ``config/`` (the paper's ``config.yaml``, the
+test config, the examples). A checkout holds them at its root; an installed vibroimpact holds
+the same files as package data at ``vibroimpact/workflow`` and ``vibroimpact/config``
+(pyproject.toml's ``package-dir``), placed the same way relative to each other. Every path
+inside the workflow is therefore one relative to its Snakefile, whichever copy runs; the
+results go to the working directory, never beside the workflow.
+
+The Snakefile takes these paths from its own location (``workflow.source_path``), so that a
+host workflow that pulls it in as a module reads this workflow's files, not its own; this
+module answers the same question for the command line, which has no Snakefile yet.
+"""
+from pathlib import Path
+
+__all__ = ["PACKAGE_DIR", "SCHEMA", "PAPER_CONFIG", "workflow_dir", "snakefile"]
+
+PACKAGE_DIR = Path(__file__).resolve().parents[1]
+
+#: The config's JSON Schema, relative to the workflow folder.
+SCHEMA = "schemas/config.schema.yaml"
+#: The paper's config, the base layer of every user's config, relative to the workflow folder.
+PAPER_CONFIG = "../config/config.yaml"
+
+
+def workflow_dir():
+    """The folder holding the Snakefile this copy of the package runs: ``<checkout>/workflow``
+    when the package is imported from a checkout's ``src/`` (an editable install), else the
+    package data of the installed package, ``<site-packages>/vibroimpact/workflow``."""
+    checkout = PACKAGE_DIR.parents[1]
+    if PACKAGE_DIR == checkout / "src" / "vibroimpact" \
+            and (checkout / "workflow" / "Snakefile").is_file():
+        return checkout / "workflow"
+    return PACKAGE_DIR / "workflow"
+
+
+def snakefile():
+    """The workflow's Snakefile (:func:`workflow_dir`): what ``vibroimpact run`` hands to
+    Snakemake, and what a host workflow names in ``module ...: snakefile:`` to pull in the
+    installed release (README, "As a Snakemake module")."""
+    return workflow_dir() / "Snakefile"
