@@ -1,13 +1,9 @@
 # Aggregation reads small tiles and writes one dataset: cheap, run where Snakemake runs.
-localrules:
-    aggregate_events,
-    aggregate_spectra,
-    aggregate_map,
-    aggregate_escape,
 
 
 rule aggregate_events:
     """The events dataset of study {study}, from its tiles."""
+    localrule: True
     input:
         tiles("events"),
     output:
@@ -31,6 +27,7 @@ rule aggregate_events:
 
 rule aggregate_spectra:
     """The spectra dataset of study {study}, from its tiles and noise record."""
+    localrule: True
     input:
         tiles=tiles("spectra"),
         noise=study_noise,
@@ -55,6 +52,7 @@ rule aggregate_spectra:
 
 rule aggregate_map:
     """The motion-map dataset of study {study}, from its tiles."""
+    localrule: True
     input:
         tiles("map"),
     output:
@@ -79,6 +77,7 @@ rule aggregate_map:
 
 rule aggregate_escape:
     """The escape dataset of study {study}, from its noise levels, with the escape fits."""
+    localrule: True
     input:
         escape_levels,
     output:

@@ -10,11 +10,14 @@
 # anything).
 from pathlib import Path
 import math
+import os
 import shlex
 import sys
 from types import SimpleNamespace
 
-from vibroimpact.pipeline import figures, forked, targets
+from snakemake_interface_executor_plugins.settings import DeploymentMethod
+
+from vibroimpact.pipeline import figures, forked, layout, targets
 from vibroimpact.pipeline.config import costs
 from vibroimpact.pipeline.digest_cache import cached_code_digest
 from vibroimpact.pipeline.study import (
@@ -42,6 +45,14 @@ wildcard_constraints:
     # sweep.png, nor the validation figures)
     fig="(fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence|escape_vs_noise)(-[0-9]+)?",
     paper_fig="fig[0-9][0-9](_vs_fig[0-9][0-9])?|basins|lyapunov|residence|escape_vs_noise",
+
+
+# With `--sdm conda` a job runs in the conda environment of envs/vibroimpact.yaml (the pins of
+# requirements.lock, no path: it works from any folder) and imports vibroimpact from the copy
+# this Snakemake runs, through PYTHONPATH, alone (not the other distributions beside it): the
+# workflow and the package are one release.
+if DeploymentMethod.CONDA in workflow.deployment_settings.deployment_method:
+    os.environ["PYTHONPATH"] = layout.importable_alone(".snakemake/vibroimpact-package")
 
 
 # The figure jobs are drawn in forks of this process, warmed once, whatever the profile
@@ -279,8 +290,11 @@ VALIDATION_FIGURES = targets.VALIDATION_FIGURES
 
 # --- reports (reports.smk): one notebook per study, per orbits entry, two for validation -----
 
-#: The interpreter running Snakemake (the .venv's): reports call its papermill and nbconvert.
-PYTHON = shlex.quote(sys.executable)
+#: The interpreter running Snakemake (the .venv's): reports call its papermill and nbconvert;
+#: with `--sdm conda` or `apptainer`, the environment's own `python`.
+PYTHON = (
+    "python" if workflow.deployment_settings.deployment_method else shlex.quote(sys.executable)
+)
 
 
 def predictors_inputs(wildcards):

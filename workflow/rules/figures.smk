@@ -1,8 +1,7 @@
 # One rule draws every figure: its inputs and options come from the figure table
-# (vibroimpact.pipeline.figures) through common.smk. Drawing is cheap: run locally.
-localrules:
-    draw_figure,
-    copy_paper_figure,
+# (vibroimpact.pipeline.figures) through common.smk. Drawing is cheap: run locally (each
+# rule's `localrule: True`: a `localrules:` list would name rules by the names a host that
+# pulls this workflow in as a module renames).
 
 
 # What each figure shows, with its parameters, for the report's caption (figure.rst reads it
@@ -13,6 +12,7 @@ config["figure_captions"] = figure_captions()
 
 rule draw_figure:
     """Figure {fig} of study or orbits entry {owner}, as PNG and PDF."""
+    localrule: True
     input:
         figure_inputs,
     output:
@@ -46,6 +46,7 @@ rule draw_figure:
 
 rule copy_paper_figure:
     """The paper figure {paper_fig}: a copy of the study figure it names."""
+    localrule: True
     input:
         unpack(paper_figure_source),
     output:

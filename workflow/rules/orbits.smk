@@ -1,8 +1,5 @@
 # Orbit tiles are solved as jobs (SLURM: grouped, workflow/profiles/slurm); joining
 # them into one dataset is cheap: run where Snakemake runs.
-localrules:
-    aggregate_orbits,
-    aggregate_attractors,
 
 
 rule solve_orbit_tile:
@@ -51,6 +48,7 @@ rule solve_clearance_orbit_tile:
 
 rule aggregate_orbits:
     """The orbits dataset of entry {orbits}, from its tiles."""
+    localrule: True
     input:
         orbit_tiles,
     output:
@@ -122,6 +120,7 @@ rule solve_attractor_tile:
 
 rule aggregate_attractors:
     """The basins and Lyapunov datasets of orbits entry {orbits}, from its tiles."""
+    localrule: True
     input:
         attractor_tiles,
     output:

@@ -1,8 +1,6 @@
 # A plane study's basins and Lyapunov exponents (its `attractors` block): tiles over the
 # plane's first axis, solved as jobs; joining them is cheap: run where Snakemake runs.
 # (Their input and runtime functions are in common.smk.)
-localrules:
-    aggregate_plane_attractors,
 
 
 rule solve_plane_attractor_tile:
@@ -29,6 +27,7 @@ rule solve_plane_attractor_tile:
 
 rule aggregate_plane_attractors:
     """The basins and Lyapunov datasets of plane study {study}, from its tiles."""
+    localrule: True
     input:
         plane_attractor_tiles,
     output:

@@ -10,12 +10,6 @@
 # One process a report (`python -m vibroimpact.reports.notebook --execute`): papermill's
 # Python API executes the notebook (its kernel a child process), then nbconvert renders both
 # HTML forms (`--summary`); papermill, nbformat and nbconvert start once.
-localrules:
-    study_report,
-    orbits_report,
-    validation_report,
-
-
 wildcard_constraints:
     report="random_force|harmonic_random",
     vreport="performance|stability",
@@ -61,6 +55,7 @@ REPORT_SHELL = (
 
 rule study_report:
     """The executed report notebook {report} of study {study}, and its HTML."""
+    localrule: True
     input:
         unpack(study_report_inputs),
     output:
@@ -93,6 +88,7 @@ rule study_report:
 
 rule orbits_report:
     """The executed periodic-motions report of orbits entry {orbits}, and its HTML."""
+    localrule: True
     input:
         unpack(orbits_report_inputs),
     output:
@@ -124,6 +120,7 @@ rule orbits_report:
 
 rule validation_report:
     """The executed validation report {vreport}, and its HTML."""
+    localrule: True
     input:
         unpack(validation_report_inputs),
     output:

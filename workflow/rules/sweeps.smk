@@ -4,12 +4,11 @@
 # One figure per sweep sets their means side by side; drawing is cheap, so it runs locally.
 # results/figures/<sweep>/sweep.png is never draw_figure's {owner}/{fig}.png: `fig` excludes
 # `sweep`, and a name that is not a sweep fails in sweep_inputs, naming the sweeps.
-localrules:
-    draw_sweep,
 
 
 rule draw_sweep:
     """The means of the studies of sweep {sweep} side by side, as PNG and PDF."""
+    localrule: True
     input:
         sweep_inputs,
     output:

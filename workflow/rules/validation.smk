@@ -3,8 +3,6 @@
 # cheap and runs locally. The work-precision job compares wall times, so it holds every core
 # of the run (threads = --cores): no other job of the build runs beside it. On SLURM its
 # profile asks for a node to itself (workflow/profiles/slurm).
-localrules:
-    draw_validation_figure,
 
 
 rule measure_work_precision:
@@ -52,6 +50,7 @@ rule sample_stress_families:
 
 rule draw_validation_figure:
     """Validation figure {validation_fig}, as PNG and PDF."""
+    localrule: True
     input:
         lookup(dpath="{validation_fig}", within=VALIDATION_FIGURES),
     output:

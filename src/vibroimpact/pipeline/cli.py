@@ -266,12 +266,11 @@ _HELD = {}
 
 
 def _snakemake():
-    """Snakemake on the workflow this package carries (`vibroimpact.pipeline.layout`): the
-    ``snakemake`` beside this interpreter, ``--snakefile`` given, so that it runs from any
-    working directory (in a checkout it is the one Snakemake would find there)."""
-    exe = Path(sys.executable).with_name("snakemake")
-    exe = str(exe) if exe.exists() else (shutil.which("snakemake") or "snakemake")
-    return [exe, "--snakefile", str(layout.snakefile())]
+    """Snakemake on the workflow this package carries (`vibroimpact.pipeline.layout`): this
+    interpreter's (``python -m snakemake``, whether or not its command is on the PATH),
+    ``--snakefile`` given, so that it runs from any working directory (in a checkout it is
+    the one Snakemake would find there)."""
+    return [sys.executable, "-m", "snakemake", "--snakefile", str(layout.snakefile())]
 
 
 def _clear_stale_lock(root, config_args):

@@ -62,7 +62,8 @@ _WARM = []
 _SERVER = []
 #: Set in a fork that runs a job: :func:`run` draws there.
 _IN_JOB = []
-#: The environment variable naming the server's socket, for the jobs a build starts.
+#: The environment variable naming the server's socket and its Python environment
+#: (``sys.prefix``), for the jobs a build starts.
 SERVER_ENV = "VIBROIMPACT_FIGURE_SERVER"
 
 #: Snakemake's benchmark columns (``snakemake.benchmark``), in its order.
@@ -220,7 +221,7 @@ def serve():
         server.listen(64)
         threading.Thread(target=_accept, args=(server,), name="vibroimpact-figures",
                          daemon=True).start()
-        os.environ[SERVER_ENV] = path
+        os.environ[SERVER_ENV] = json.dumps([sys.prefix, path])
         _SERVER.append(path)
         return path
 
@@ -264,12 +265,24 @@ def _line(connection):
     return data.decode()
 
 
+def _server_for_this_environment():
+    """The socket of the build's server, if this job runs in the server's own Python
+    environment; None in another one (``--sdm conda`` or ``apptainer``: the job's drawing
+    is that environment's, so it draws in its own fork), or with no server."""
+    try:
+        prefix, path = json.loads(os.environ.get(SERVER_ENV, ""))
+    except ValueError:
+        return None
+    return path if os.path.realpath(prefix) == os.path.realpath(sys.prefix) else None
+
+
 def run(draw, job, benchmark=None):
     """Draw a figure job: ``draw(job)`` in a fork of the workflow's warm process.
 
     Called by a workflow script with its ``snakemake``. In the server's fork (the script run
     again there) it draws; in the job's own process it asks the server to run this script
-    (:func:`serve`), or, with no server to ask, runs ``draw(job)`` in a fork of its own.
+    (:func:`serve`), or, with no server to ask in its own Python environment, runs
+    ``draw(job)`` in a fork of its own.
 
     Parameters
     ----------
@@ -292,7 +305,7 @@ def run(draw, job, benchmark=None):
     # the workflow script's name (Snakemake's preamble sets __file__ to it; argv[0] is the
     # copy it runs, preamble first)
     name = os.path.basename(getattr(sys.modules["__main__"], "__file__", None) or sys.argv[0])
-    path = os.environ.get(SERVER_ENV)
+    path = _server_for_this_environment()
     if path:
         try:
             with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:

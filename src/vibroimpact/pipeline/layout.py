@@ -13,9 +13,11 @@ The Snakefile takes these paths from its own location (``workflow.source_path``)
 host workflow that pulls it in as a module reads this workflow's files, not its own; this
 module answers the same question for the command line, which has no Snakefile yet.
 """
+import os
 from pathlib import Path
 
-__all__ = ["PACKAGE_DIR", "SCHEMA", "PAPER_CONFIG", "workflow_dir", "snakefile"]
+__all__ = ["PACKAGE_DIR", "SCHEMA", "PAPER_CONFIG", "workflow_dir", "snakefile",
+           "importable_alone"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -41,3 +43,19 @@ def snakefile():
     Snakemake, and what a host workflow names in ``module ...: snakefile:`` to pull in the
     installed release (README, "As a Snakemake module")."""
     return workflow_dir() / "Snakefile"
+
+
+def importable_alone(folder):
+    """``folder``, made to hold this package alone (a link named ``vibroimpact`` to it), for
+    ``PYTHONPATH``: a job in another environment (``--sdm conda``) then imports the very
+    package this process runs and none of the other distributions installed beside it.
+    Returns the folder's absolute path."""
+    folder = Path(folder).resolve()
+    folder.mkdir(parents=True, exist_ok=True)
+    link = folder / "vibroimpact"
+    if not (link.is_symlink() and link.resolve() == PACKAGE_DIR):
+        temporary = folder / f".vibroimpact.{os.getpid()}"
+        temporary.unlink(missing_ok=True)
+        temporary.symlink_to(PACKAGE_DIR, target_is_directory=True)
+        os.replace(temporary, link)         # one rename: a job never sees no link
+    return str(folder)

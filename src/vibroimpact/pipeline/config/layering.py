@@ -9,7 +9,7 @@
   name, e.g. a noise record or an orbits map). Every other top-level block follows the same
   rule (`BLOCKS`): a block that makes results (``validation``) is the paper's unless the
   file lists it under ``replace``; only the build's settings (`SETTINGS`: ``paper``,
-  ``replace``, ``limits``, ``validation.build``) are the file's own.
+  ``replace``, ``limits``, ``container``, ``validation.build``) are the file's own.
 """
 import copy
 import json
@@ -35,7 +35,7 @@ SECTIONS = ("noises", "studies", "orbits", "paper_figures")
 BLOCKS = {"validation": ("build",)}
 
 #: Top-level keys that set how this build runs, not what a result holds: the user's own.
-SETTINGS = ("paper", "replace", "limits")
+SETTINGS = ("paper", "replace", "limits", "container")
 
 #: Values a config may hold once YAML aliases are expanded (the paper's config holds ~600);
 #: a file beyond it (nested aliases: a "billion laughs") is refused before anything walks it.
