@@ -8,6 +8,11 @@
 ARG BASE=python:3.11-slim-bookworm
 FROM ${BASE}
 
+# git: the package's version comes from the clone's tags (setuptools-scm)
+RUN apt-get update \
+    && apt-get install -y --no-install-recommends git \
+    && rm -rf /var/lib/apt/lists/*
+
 ENV VIRTUAL_ENV=/opt/vibroimpact \
     PATH=/opt/vibroimpact/bin:$PATH
 RUN python3 -m venv /opt/vibroimpact

@@ -1,12 +1,18 @@
 """Figure jobs in forks of the workflow's process (`vibroimpact.pipeline.forked`): the script
 runs as in a process of its own, writes what it writes, reports its failure in its log, and
-draws the same bytes as a fresh process."""
+draws the same bytes as a fresh process; a job's script asks the server in Snakemake's process
+to run it in a fork there, in the job's folder, or draws in a fork of its own where there is
+no server of its Python environment, and a job stopped stops its fork."""
 import csv
+import json
 import os
 from pathlib import Path
+import re
+import signal
 import subprocess
 import sys
 import threading
+import time
 from types import SimpleNamespace
 
 import pytest
@@ -113,3 +119,112 @@ def test_figure_jobs_started_from_two_threads_at_once_both_finish(tmp_path):
     assert not errors
     pngs = {Path(tmp_path / f"fig{i}.png").read_bytes() for i in range(2)}
     assert len(pngs) == 1
+
+
+# --- the server in Snakemake's process and its clients, the figure jobs' scripts ------------
+
+#: A figure job's script as Snakemake runs it: its "preamble" binds ``snakemake`` (as
+#: Snakemake's does, from values written into the file), then the workflow script calls
+#: `forked.run`. The drawing records where it ran: its process, its parent and its working
+#: directory.
+CLIENT_SCRIPT = '''\
+import json, os, sys, time
+from types import SimpleNamespace as N
+snakemake = N(log=[LOG], output=N(png="fig.png"), wildcards=N(fig="fig"))
+
+from vibroimpact.pipeline import forked
+
+
+def draw(job):
+    where = {"pid": os.getpid(), "parent": os.getppid(), "cwd": os.getcwd()}
+    with open(job.output.png, "w") as out:
+        json.dump(where, out)
+    print("drawn")
+    if os.environ.get("FAIL"):
+        raise ValueError("no such motion: (7/3)")
+    time.sleep(float(os.environ.get("SLEEP", "0")))
+
+
+forked.run(draw, snakemake, benchmark=os.environ.get("BENCH"))
+'''
+
+
+@pytest.fixture
+def server(monkeypatch):
+    """This process's figure server, its variable removed from the environment afterwards
+    (the server itself, a daemon thread, stays for the session)."""
+    monkeypatch.setenv(forked.SERVER_ENV, "")
+    path = forked.serve()
+    monkeypatch.setenv(forked.SERVER_ENV, json.dumps([sys.prefix, path]))
+    return path
+
+
+def _client(tmp_path, env=None, **kwargs):
+    script = _script(tmp_path, CLIENT_SCRIPT.replace("LOG", repr(str(tmp_path / "fig.log"))),
+                     "tmp.draw_figure.py")
+    work = tmp_path / "work"
+    work.mkdir(exist_ok=True)
+    return subprocess.Popen([sys.executable, str(script)],
+                            cwd=work, env={**os.environ, **(env or {})},
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **kwargs)
+
+
+def test_a_job_script_draws_in_a_fork_of_the_server_in_its_own_folder(tmp_path, server):
+    client = _client(tmp_path, {"BENCH": str(tmp_path / "bench.tsv")})
+    assert client.wait(60) == 0, client.stderr.read()
+    where = json.loads((tmp_path / "work" / "fig.png").read_text())
+    assert where["parent"] == os.getpid()            # a fork of the serving process
+    assert where["cwd"] == str(tmp_path / "work")    # in the job's working directory
+    assert "drawn" in (tmp_path / "fig.log").read_text()
+    rows = list(csv.DictReader((tmp_path / "bench.tsv").open(), delimiter="\t"))
+    assert len(rows) == 1 and float(rows[0]["cpu_time"]) >= 0
+
+
+def test_without_a_server_a_job_draws_in_a_fork_of_its_own(tmp_path, monkeypatch):
+    monkeypatch.delenv(forked.SERVER_ENV, raising=False)
+    client = _client(tmp_path)
+    assert client.wait(60) == 0, client.stderr.read()
+    where = json.loads((tmp_path / "work" / "fig.png").read_text())
+    assert where["parent"] == client.pid
+
+
+def test_a_server_of_another_python_environment_is_not_asked(tmp_path, server, monkeypatch):
+    """A job in a conda environment or a container draws with its own environment."""
+    monkeypatch.setenv(forked.SERVER_ENV, json.dumps(["/another/environment", server]))
+    client = _client(tmp_path)
+    assert client.wait(60) == 0, client.stderr.read()
+    assert json.loads((tmp_path / "work" / "fig.png").read_text())["parent"] == client.pid
+
+
+def test_a_failed_drawing_fails_the_job_naming_its_log(tmp_path, server):
+    client = _client(tmp_path, {"FAIL": "1"})
+    assert client.wait(60) == 1
+    assert re.search(r"tmp\.draw_figure\.py failed \(exit 1\); see .*fig\.log",
+                     client.stderr.read())
+    log = (tmp_path / "fig.log").read_text()
+    assert "Traceback" in log and "ValueError: no such motion: (7/3)" in log
+
+
+def test_a_job_stopped_by_snakemake_stops_its_fork(tmp_path, server):
+    client = _client(tmp_path, {"SLEEP": "60"})
+    drawing = tmp_path / "work" / "fig.png"
+    deadline = time.monotonic() + 30
+    while not drawing.is_file() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(0.2)                         # the fork is sleeping in its drawing now
+    fork = json.loads(drawing.read_text())["pid"]
+    client.send_signal(signal.SIGTERM)      # what Snakemake does to a job it cancels
+    client.wait(10)
+    deadline = time.monotonic() + 10
+    while _alive(fork) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert not _alive(fork)
+
+
+def _alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    with open(f"/proc/{pid}/stat") as stat:         # a zombie not yet reaped is gone
+        return stat.read().split(") ")[-1].split()[0] != "Z"

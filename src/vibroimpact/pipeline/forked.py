@@ -19,11 +19,13 @@ Snakefile starts a server in Snakemake's process (:func:`serve`: a thread accept
 socket in a private temporary folder, named in the environment every job inherits); the
 job's script (Snakemake's preamble, then the workflow script, which calls :func:`run`) is a
 client: it sends the server the path of its own file and waits. The server forks; the fork
-runs that file, whose preamble binds ``snakemake`` again (its modules already loaded), and
-:func:`run` there draws. The client exits with the fork's status (~0.1 CPU-s: Python and the
-preamble). A job that finds no server (on another machine, in a container, a script run by
-hand) forks its own process: the same drawing, paying the imports. A client that goes away
-(Snakemake stopping the job) has its fork stopped.
+runs that file in the job's folder with the job's environment variables, its preamble binding
+``snakemake`` again (its modules already loaded), and :func:`run` there draws. The client
+exits with the fork's status (~0.1 CPU-s: Python and the preamble). A job that finds no server
+of its own Python environment (on another machine; in a conda environment or a container,
+whose drawing must be that environment's; a script run by hand) forks its own process: the
+same drawing, paying the imports. A client that goes away (Snakemake stopping the job) has its
+fork stopped.
 
 Only the thread that forks survives in the child: a lock that another of Snakemake's threads
 held at that instant stays held there. The child therefore touches nothing those threads
@@ -233,16 +235,23 @@ def _accept(server):
 
 
 def _serve_one(connection):
-    """One job: its request (the script file, its name, log and benchmark), the fork, the
-    exit status."""
+    """One job: its request (the script file, its name, working directory, environment, log
+    and benchmark), the fork, the exit status."""
     with connection:
         code = 1
         try:
             request = json.loads(_line(connection))
             script = request["script"]      # the job's file: Snakemake's preamble binds its job
+
+            def job():
+                os.chdir(request["cwd"])    # the job's working directory, its paths' base
+                os.environ.clear()          # and its environment (threads, temporaries ...)
+                os.environ.update(request["env"])
+                runpy.run_path(script, run_name="__main__")
+
             warm()
-            _fork(lambda: runpy.run_path(script, run_name="__main__"), request["name"],
-                  request["log"], request.get("benchmark"), client=connection)
+            _fork(job, request["name"], request["log"], request.get("benchmark"),
+                  client=connection)
             code = 0
         except RuntimeError as err:        # the job failed: its log says why
             message = str(err)
@@ -311,6 +320,7 @@ def run(draw, job, benchmark=None):
             with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as connection:
                 connection.connect(path)
                 request = {"script": os.path.abspath(sys.argv[0]), "name": name,
+                           "cwd": os.getcwd(), "env": dict(os.environ),
                            "log": os.path.abspath(log),
                            "benchmark": benchmark and os.path.abspath(benchmark)}
                 connection.sendall(json.dumps(request).encode() + b"\n")
