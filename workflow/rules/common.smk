@@ -10,7 +10,6 @@
 # anything).
 from pathlib import Path
 import math
-import os
 import shlex
 import sys
 from types import SimpleNamespace
@@ -52,7 +51,7 @@ wildcard_constraints:
 # this Snakemake runs, through PYTHONPATH, alone (not the other distributions beside it): the
 # workflow and the package are one release.
 if DeploymentMethod.CONDA in workflow.deployment_settings.deployment_method:
-    os.environ["PYTHONPATH"] = layout.importable_alone(".snakemake/vibroimpact-package")
+    layout.import_alone_in_jobs(".snakemake/vibroimpact-package")
 
 
 # The figure jobs are drawn in forks of this process, warmed once, whatever the profile

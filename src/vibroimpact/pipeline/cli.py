@@ -86,10 +86,13 @@ def _parser():
                        help="the working directory, where results/ is (default .)")
         p.add_argument("-v", "--verbose", action="store_true",
                        help="also print the schema validator's full output on a config error")
-    text = "list the outputs of the config's entries that it no longer builds"
-    p = sub.add_parser("stale", help=text, description=text, add_help=False)
-    text = "compile every numba kernel of the jobs into numba's cache, once per installation"
-    p = sub.add_parser("warm", help=text, description=text, add_help=False)
+    # listed for --help only: main() (stale) and vibroimpact.__main__ (warm) hand them over
+    # before this parser sees them, with their own options
+    for name, text in (("stale", "list the outputs of the config's entries that it no longer "
+                                 "builds (--delete: remove them)"),
+                       ("warm", "compile every numba kernel of the jobs into numba's cache, "
+                                "once per installation")):
+        sub.add_parser(name, help=text, description=text, add_help=False)
     return parser
 
 

@@ -131,7 +131,7 @@ def _wait(pid, client=None):
                 ready, _, _ = select.select([pidfd, client], [], [])
                 if pidfd in ready:
                     break
-                if not client.recv(1, socket.MSG_PEEK):     # the client went away
+                if not client.recv(4096):       # the client went away (it sends nothing more)
                     with contextlib.suppress(ProcessLookupError):
                         os.kill(pid, signal.SIGTERM)
                     break

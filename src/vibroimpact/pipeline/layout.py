@@ -17,7 +17,7 @@ import os
 from pathlib import Path
 
 __all__ = ["PACKAGE_DIR", "SCHEMA", "PAPER_CONFIG", "workflow_dir", "snakefile",
-           "importable_alone"]
+           "importable_alone", "import_alone_in_jobs"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
 
@@ -59,3 +59,9 @@ def importable_alone(folder):
         temporary.symlink_to(PACKAGE_DIR, target_is_directory=True)
         os.replace(temporary, link)         # one rename: a job never sees no link
     return str(folder)
+
+
+def import_alone_in_jobs(folder):
+    """Make the processes this one starts from now on (a build's jobs) import this package,
+    alone, from ``folder`` (:func:`importable_alone`): ``PYTHONPATH`` is that folder."""
+    os.environ["PYTHONPATH"] = importable_alone(folder)
