@@ -3,7 +3,8 @@
 1. ``fresh``: one fresh Python process a figure, as a ``script:`` job (Snakemake's preamble
    imports, then ``workflow/scripts/draw_figure.py``'s imports and its drawing);
 2. ``forks``: one process that warms up once and forks for each figure
-   (`vibroimpact.pipeline.forked.run_script`, what the figure rules run), its warm-up counted;
+   (`vibroimpact.pipeline.forked.run_script`: what the figure server in Snakemake's process
+   does for each figure job, without the job's client, ~0.1 CPU-s), its warm-up counted;
 3. ``owner``: one process per owner (study or orbits entry) drawing all its figures in turn
    (a batched rule; loses the one-figure rebuild scope, measured for comparison only).
 

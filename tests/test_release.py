@@ -10,6 +10,7 @@ and through a host workflow, and compare them with the session's build of the sa
 import os
 from pathlib import Path
 import re
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -144,15 +145,35 @@ def test_the_command_names_its_version_and_plans_from_an_empty_folder(tmp_path):
 
 # --- the wheel ----------------------------------------------------------------------------
 
-def _wheel(folder):
-    """The wheel of this tree, built without network (uv, setuptools and setuptools-scm of
-    the lock)."""
+def _wheel(folder, tree=ROOT):
+    """The wheel of ``tree``, built without network (uv, setuptools and setuptools-scm of
+    this environment: the lock's)."""
     uv = Path(sys.executable).with_name("uv")
-    subprocess.run([str(uv), "build", "--wheel", "--no-build-isolation", "--quiet", "-o",
-                    str(folder), str(ROOT)], check=True, capture_output=True)
-    subprocess.run(["rm", "-rf", str(ROOT / "build")], check=True)     # setuptools' scratch
+    subprocess.run([str(uv), "build", "--python", sys.executable, "--wheel",
+                    "--no-build-isolation", "--quiet", "-o", str(folder), str(tree)],
+                   check=True, capture_output=True)
+    shutil.rmtree(Path(tree) / "build", ignore_errors=True)      # setuptools' scratch
     (wheel,) = Path(folder).glob("vibroimpact-*.whl")
     return wheel
+
+
+def test_a_release_tarball_without_git_names_its_version(tmp_path):
+    """`git archive` (a release tarball: no .git) fills .git_archival.txt, from which the
+    wheel built there takes the version of the commit archived."""
+    clone = tmp_path / "clone"
+    subprocess.run(["git", "clone", "-q", str(ROOT), str(clone)], check=True)
+    _git(clone, "tag", "-f", "v2.3.4")
+    _git(clone, "commit", "-q", "--allow-empty", "-m", "after the release")
+    head = _git(clone, "rev-parse", "HEAD")
+    tree = tmp_path / "tarball"
+    tree.mkdir()
+    archive = subprocess.run(["git", "archive", "HEAD"], cwd=clone, capture_output=True,
+                             check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(tree)], input=archive, check=True)
+    assert not (tree / ".git").exists()
+    wheel = _wheel(tmp_path / "dist", tree)
+    assert re.fullmatch(rf"vibroimpact-2\.3\.5\.dev1\+g{head[:7]}[0-9a-f]*-py3-none-any\.whl",
+                        wheel.name), wheel.name
 
 
 def test_the_wheel_carries_the_package_and_the_whole_workflow(tmp_path):
