@@ -333,15 +333,15 @@ def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
     workdir = make_workdir(tmp_path / "wd")
     (workdir / "results").mkdir()
     report = workdir / "results" / "report.html"
-    monkeypatch.setattr(cli, "_snakemake", lambda: _fake_snakemake(tmp_path, "<html>half", 1))
+    monkeypatch.setattr(cli, "_snakemake", lambda root: _fake_snakemake(tmp_path, "<html>half", 1))
     assert cli.main(["report", "--directory", str(workdir)]) == 1
     assert not report.exists()
     assert list((workdir / "results").iterdir()) == []     # no temporary either
     monkeypatch.setattr(cli, "_snakemake",
-                        lambda: _fake_snakemake(tmp_path, "<html>whole</html>", 0))
+                        lambda root: _fake_snakemake(tmp_path, "<html>whole</html>", 0))
     assert cli.main(["report", "--directory", str(workdir)]) == 0
     assert report.read_text() == "<html>whole</html>"
-    monkeypatch.setattr(cli, "_snakemake", lambda: _fake_snakemake(tmp_path, "<html>half", 1))
+    monkeypatch.setattr(cli, "_snakemake", lambda root: _fake_snakemake(tmp_path, "<html>half", 1))
     assert cli.main(["report", "--directory", str(workdir)]) == 1
     assert report.read_text() == "<html>whole</html>"
     assert [p.name for p in (workdir / "results").iterdir()] == ["report.html"]

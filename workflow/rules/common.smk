@@ -84,9 +84,11 @@ def script_code(rule):
 def own_files(inputs):
     """``inputs`` with the workflow's own files among them (the report notebook, the stress
     campaign's table: `targets.WORKFLOW_INPUTS`, relative to the workflow's folder) made
-    paths of this workflow's copy, so that a module reads its own notebooks."""
+    paths of this workflow's copy, so that a module reads its own notebooks: relative to the
+    working directory when the workflow lies under it (a checkout: a copy of the project and
+    its build stays up to date, its inputs' paths unchanged), else absolute."""
     return {
-        key: str(WORKFLOW_DIR / path) if key in targets.WORKFLOW_INPUTS else path
+        key: layout.input_path(WORKFLOW_DIR / path) if key in targets.WORKFLOW_INPUTS else path
         for key, path in inputs.items()
     }
 

@@ -268,12 +268,12 @@ def take_build_lock(root):
 _HELD = {}
 
 
-def _snakemake():
-    """Snakemake on the workflow this package carries (`vibroimpact.pipeline.layout`): this
-    interpreter's (``python -m snakemake``, whether or not its command is on the PATH),
-    ``--snakefile`` given, so that it runs from any working directory (in a checkout it is
-    the one Snakemake would find there)."""
-    return [sys.executable, "-m", "snakemake", "--snakefile", str(layout.snakefile())]
+def _snakemake(root):
+    """Snakemake on the workflow a build in ``root`` runs (`vibroimpact.pipeline.layout`: the
+    folder's own ``workflow/``, as plain ``snakemake`` there, or the one this package
+    carries), this interpreter's (``python -m snakemake``, whether or not its command is on
+    the PATH), ``--snakefile`` given, so that it runs from any working directory."""
+    return [sys.executable, "-m", "snakemake", "--snakefile", str(layout.snakefile(root))]
 
 
 def _clear_stale_lock(root, config_args):
@@ -288,7 +288,7 @@ def _clear_stale_lock(root, config_args):
                      f"finish, or stop it (kill {pids}) and run again", code=1)
     print("vibroimpact: clearing the lock left by a run that did not finish (no run is alive "
           "here)", file=sys.stderr)
-    out = subprocess.run([*_snakemake(), "--unlock", *config_args], cwd=root,
+    out = subprocess.run([*_snakemake(root), "--unlock", *config_args], cwd=root,
                          capture_output=True, text=True)
     if out.returncode != 0:
         return _fail(f"snakemake --unlock failed:\n{out.stderr[-2000:]}", code=1)
@@ -355,7 +355,7 @@ def write_report(root, config_args, output=REPORT):
     with tempfile.TemporaryDirectory(prefix="vibroimpact-report-") as scratch:
         draft = Path(scratch) / "report.html"
         sys.stdout.flush()
-        code = subprocess.run([*_snakemake(), "--report", str(draft), *config_args],
+        code = subprocess.run([*_snakemake(root), "--report", str(draft), *config_args],
                               cwd=root).returncode
         if code != 0 or not draft.is_file():
             return _fail(f"snakemake --report failed (exit {code}); {output} is left as it was",
@@ -425,7 +425,7 @@ def main(argv=None):
     if code:
         return code
     # targets before --configfile, which would take them as more config files
-    cmd = [*_snakemake(), "--cores", str(args.cores), *extra, *config_args]
+    cmd = [*_snakemake(root), "--cores", str(args.cores), *extra, *config_args]
     sys.stdout.flush()
     sys.stderr.flush()
     # a first build (no file under results yet) has no output to miss beneath an up-to-date

@@ -82,12 +82,12 @@ def cached_code_digest(script, cache_file, package_dir=PACKAGE_DIR):
 
 def main(root=".", workflow=None):
     """``python -m vibroimpact.pipeline.digest_cache``: keep the digests of every script and
-    report notebook of ``workflow`` (by default the workflow this package runs,
-    `vibroimpact.pipeline.layout`) in working directory ``root`` (what `make`'s installation
-    step runs, so that a first build's Snakemake start finds them)."""
+    report notebook of ``workflow`` (by default the workflow a build in ``root`` runs,
+    `vibroimpact.pipeline.layout.workflow_dir`) in working directory ``root`` (what `make`'s
+    installation step runs, so that a first build's Snakemake start finds them)."""
     root = Path(root).resolve()
     cache = root / ".snakemake" / "vibroimpact-code-digests.json"
-    workflow = Path(workflow) if workflow is not None else layout.workflow_dir()
+    workflow = Path(workflow) if workflow is not None else layout.workflow_dir(root)
     sources = [*sorted((workflow / "scripts").glob("*.py")),
                *sorted((workflow / "notebooks").glob("*.ipynb"))]
     for script in sources:

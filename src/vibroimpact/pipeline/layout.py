@@ -9,14 +9,16 @@ the same files as package data at ``vibroimpact/workflow`` and ``vibroimpact/con
 inside the workflow is therefore one relative to its Snakefile, whichever copy runs; the
 results go to the working directory, never beside the workflow.
 
-The Snakefile takes these paths from its own location (``workflow.source_path``), so that a
-host workflow that pulls it in as a module reads this workflow's files, not its own; this
-module answers the same question for the command line, which has no Snakefile yet.
+The Snakefile takes these paths from its own location (``workflow.current_basedir``), so
+that a host workflow that pulls it in as a module reads this workflow's files, not its own;
+this module answers the same question for the command line, which has no Snakefile yet: in a
+folder that holds the workflow (a checkout), that workflow, as plain ``snakemake`` would run
+there; anywhere else, the one this package carries.
 """
 import os
 from pathlib import Path
 
-__all__ = ["PACKAGE_DIR", "SCHEMA", "PAPER_CONFIG", "workflow_dir", "snakefile",
+__all__ = ["PACKAGE_DIR", "SCHEMA", "PAPER_CONFIG", "workflow_dir", "snakefile", "input_path",
            "importable_alone", "import_alone_in_jobs"]
 
 PACKAGE_DIR = Path(__file__).resolve().parents[1]
@@ -27,10 +29,17 @@ SCHEMA = "schemas/config.schema.yaml"
 PAPER_CONFIG = "../config/config.yaml"
 
 
-def workflow_dir():
-    """The folder holding the Snakefile this copy of the package runs: ``<checkout>/workflow``
-    when the package is imported from a checkout's ``src/`` (an editable install), else the
-    package data of the installed package, ``<site-packages>/vibroimpact/workflow``."""
+def workflow_dir(root=None):
+    """The folder holding the Snakefile a build runs.
+
+    In working directory ``root``, when it holds a ``workflow/Snakefile`` of its own (a
+    checkout, or a copy of the workflow), that one: the workflow plain ``snakemake`` finds
+    there. Else the one of this copy of the package: ``<checkout>/workflow`` when the package
+    is imported from a checkout's ``src/`` (an editable install), else the package data of the
+    installed package, ``<site-packages>/vibroimpact/workflow``.
+    """
+    if root is not None and (Path(root) / "workflow" / "Snakefile").is_file():
+        return Path(root).resolve() / "workflow"
     checkout = PACKAGE_DIR.parents[1]
     if PACKAGE_DIR == checkout / "src" / "vibroimpact" \
             and (checkout / "workflow" / "Snakefile").is_file():
@@ -38,11 +47,19 @@ def workflow_dir():
     return PACKAGE_DIR / "workflow"
 
 
-def snakefile():
-    """The workflow's Snakefile (:func:`workflow_dir`): what ``vibroimpact run`` hands to
-    Snakemake, and what a host workflow names in ``module ...: snakefile:`` to pull in the
-    installed release (README, "As a Snakemake module")."""
-    return workflow_dir() / "Snakefile"
+def snakefile(root=None):
+    """The workflow's Snakefile (:func:`workflow_dir`): what ``vibroimpact run`` in ``root``
+    hands to Snakemake, and (no ``root``) what a host workflow names in ``module ...:
+    snakefile:`` to pull in the installed release (README, "As a Snakemake module")."""
+    return workflow_dir(root) / "Snakefile"
+
+
+def input_path(path, root="."):
+    """``path`` as a job's input: relative to working directory ``root`` when it lies under it
+    (a checkout's own workflow files: the same path in any copy of the project), else
+    absolute (an installed package's, a module's)."""
+    path, root = Path(path).resolve(), Path(root).resolve()
+    return str(path.relative_to(root)) if path.is_relative_to(root) else str(path)
 
 
 def importable_alone(folder):

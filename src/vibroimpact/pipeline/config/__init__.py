@@ -56,11 +56,12 @@ def load(user=None, *, root=".", user_files=(), schema=None, paper=None):
     user_files : sequence of paths
         Files to read as the user's config (deep-merged in order) when ``user`` is None.
     schema, paper : path, optional
-        The workflow's schema and the paper's config; by default those of the workflow this
-        package runs (`vibroimpact.pipeline.layout`). The Snakefile passes its own.
+        The workflow's schema and the paper's config; by default those of the workflow a
+        build in ``root`` runs (`vibroimpact.pipeline.layout.workflow_dir`). The Snakefile
+        passes its own.
     """
     root = Path(root)
-    workflow = layout.workflow_dir()
+    workflow = layout.workflow_dir(root)
     schema = Path(schema) if schema is not None else workflow / layout.SCHEMA
     paper = Path(paper) if paper is not None else workflow / layout.PAPER_CONFIG
     if user is None and user_files:
