@@ -208,7 +208,8 @@ def serve():
 
     A daemon thread accepts on a Unix socket in a new private folder (mode 0700: this user
     only), removed when the process exits; each connection is one job, served in a thread of
-    its own (:func:`run_script` of the file the client names). Nothing is imported or drawn
+    its own: the file the client names run in a fork, in the client's folder and environment.
+    Nothing is imported or drawn
     before the first job asks (a dry run pays a thread and a socket). Returns the socket's
     path.
     """
