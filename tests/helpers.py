@@ -9,7 +9,8 @@ its path itself.
   repository.
 - :func:`copy_tree`: every tracked and new file, the package's sources included, for runs
   that import the package from the copy (``PYTHONPATH=<copy>/src``); :func:`copy_kernel_cache`:
-  the kernels numba has compiled for those sources, so such a run need not compile them again.
+  the kernels numba has compiled for those sources, so such a run need not compile them again
+  (:func:`copy_kernel_files`: between any two copies of the package).
 - :func:`snakemake`, :func:`scheduled_rules`, :func:`scheduled_jobs`: the real ``snakemake``
   command in a copy.
 - :func:`data_files`, :func:`data`, :func:`assert_same_data`: the datasets of two builds.
@@ -97,13 +98,18 @@ def copy_kernel_cache(path, root=ROOT):
     an index without its data file, or one being rewritten, makes numba compile, as if
     nothing were copied. Returns the number of files copied (none before any compilation).
     """
-    path = Path(path)
+    return copy_kernel_files(root / "src", Path(path) / "src")
+
+
+def copy_kernel_files(source, target):
+    """numba's cache files under folder ``source`` (``**/__pycache__/*.nbi``, ``*.nbc``)
+    copied to the same places under folder ``target``; the number copied."""
     copied = 0
-    for name in sorted((root / "src").rglob("__pycache__/*.nb[ic]")):
-        target = path / name.relative_to(root)
-        target.parent.mkdir(parents=True, exist_ok=True)
+    for name in sorted(Path(source).rglob("__pycache__/*.nb[ic]")):
+        into = Path(target) / name.relative_to(source)
+        into.parent.mkdir(parents=True, exist_ok=True)
         try:
-            shutil.copy2(name, target)
+            shutil.copy2(name, into)
         except FileNotFoundError:       # replaced by a compiling process meanwhile
             continue
         copied += 1

@@ -23,7 +23,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from helpers import ROOT
+from helpers import ROOT, copy_kernel_files
 from vibroimpact import _release
 from vibroimpact.pipeline import layout
 
@@ -262,16 +262,7 @@ def _seed_kernel_cache(installed):
         if twin.is_file() and twin.read_bytes() == path.read_bytes():
             stat = twin.stat()
             os.utime(path, ns=(stat.st_atime_ns, stat.st_mtime_ns))
-    copied = 0
-    for cache in sorted(src.rglob("__pycache__/*.nb[ic]")):
-        target = installed / cache.relative_to(src)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            shutil.copy2(cache, target)
-        except FileNotFoundError:       # replaced by a compiling process meanwhile
-            continue
-        copied += 1
-    return copied
+    return copy_kernel_files(src, installed)
 
 
 @pytest.mark.workflow
