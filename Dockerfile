@@ -1,6 +1,6 @@
-# The exact environment of a vibroimpact release, as an image (README, "Containers"): Python 3.11,
-# requirements.lock installed by pip with every file's hash checked, this package, and its numba
-# kernels compiled into the image. From a clone at the release's tag:
+# The exact environment of a vibroimpact release, as an image (README, "Containers and conda"):
+# Python 3.11, requirements.lock installed by pip with every file's hash checked, this package,
+# and its numba kernels compiled into the image. From a clone at the release's tag:
 #   docker build -t vibroimpact:<version> .          (or podman build; buildah bud)
 #   apptainer build vibroimpact.sif docker-daemon://vibroimpact:<version>
 # then `container: vibroimpact.sif` in your config and `snakemake --sdm apptainer`.

@@ -94,11 +94,12 @@ def conda_env(lock=LOCK):
     """The text of the conda environment file: Python 3.11 (the lock's, `make lock`) and pip
     from conda-forge, and every pin of the lock (its marker kept) installed by pip."""
     lines = [
-        "# The software of every rule under `snakemake --sdm conda` (README, \"Releases\"): the",
-        "# pins of requirements.lock, written by `make lock` (tools/environment.py conda); do",
-        "# not edit. The jobs import vibroimpact from the copy the Snakemake process runs",
-        "# (workflow/rules/common.smk, PYTHONPATH), so this file holds no path and works from",
-        "# any folder, and its content, which names Snakemake's environment, follows the lock.",
+        "# The software of every rule under `snakemake --sdm conda` (README, \"Containers and",
+        "# conda\"): the pins of requirements.lock, written by `make lock` (tools/environment.py",
+        "# conda); do not edit. The jobs import vibroimpact from the copy the Snakemake process",
+        "# runs (workflow/rules/common.smk, PYTHONPATH), so this file holds no path and works",
+        "# from any folder, and its content, which names Snakemake's environment, follows the",
+        "# lock.",
         "channels:",
         "  - conda-forge",
         "  - nodefaults",
