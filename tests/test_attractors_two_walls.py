@@ -185,3 +185,63 @@ def test_a_far_wall_below_changes_nothing():
     assert one["n_stable"].sum() > 0 and np.any(one["class_start"] == ak.CHAOTIC)
     for key, value in one.items():
         np.testing.assert_array_equal(far[key], value, err_msg=key)
+
+
+# (1/beta, delta, clearance, eps, eps_lower): a (1/1) at the wall above, restitutions alike
+# and unlike, and a (2/1) with an impact at each wall, faster than 1 at the wall below
+MIRROR_CELLS = [(1.1, 0.5, 5.5, 0.5, 0.5), (1.1, 0.5, 3.0, 0.6, 0.8),
+                (1.0, 1.5, 3.0, 0.7, 0.9)]
+
+
+@pytest.mark.parametrize("inv_beta, delta, clearance, eps, eps_lower", MIRROR_CELLS)
+def test_the_mirror_image_of_a_cell_settles_alike(inv_beta, delta, clearance, eps, eps_lower):
+    """x -> -x maps the oscillator with walls at (delta - c, delta) under sin(beta tau) onto
+    the one with walls at (-delta, c - delta) under -sin(beta tau) = sin(beta (tau + T_f/2)),
+    restitutions swapped: the start (theta, x0, v0) onto (theta + pi, -x0, -v0). Every start
+    and its mirror image settle in the same class on the same type, with the walls' impacts
+    swapped; on a listed orbit the exponents are equal bit for bit (the mirror cell solves
+    the same one-wall orbit, play and restitution, for its wall below), on another periodic
+    motion within 1e-5 (each is taken along its trajectory's last period, within match_tol =
+    1e-6 of the motion)."""
+    _, theta, g, v0 = A.sobol_starts(12, (0.0, clearance), (-3.0, 3.0), 1)
+    x0 = delta - g
+    kw = dict(clearance=clearance)
+    f, i, _ = A._starts_at_cell(inv_beta, delta, ZETA, eps, theta, x0, v0,
+                                eps_lower=eps_lower, **kw)
+    fm, im, _ = A._starts_at_cell(inv_beta, clearance - delta, ZETA, eps_lower,
+                                  np.mod(theta + math.pi, 2 * math.pi), -x0, -v0,
+                                  eps_lower=eps, **kw)
+    settled = np.isin(i[:, ak.I_CLASS], (ak.LISTED, ak.PERIODIC_OTHER))
+    assert settled.all()
+    for slot in (ak.I_CLASS, ak.I_MOTION, ak.I_PERIOD_M, ak.I_PERIOD_P):
+        np.testing.assert_array_equal(im[:, slot], i[:, slot])
+    np.testing.assert_array_equal(fm[:, ak.F_IMPACTS_LO],
+                                  f[:, ak.F_IMPACTS] - f[:, ak.F_IMPACTS_LO])
+    listed = i[:, ak.I_CLASS] == ak.LISTED
+    for slot in (ak.F_LYAP1, ak.F_LYAP2):
+        np.testing.assert_array_equal(fm[listed, slot], f[listed, slot])
+        np.testing.assert_allclose(fm[~listed, slot], f[~listed, slot], rtol=0, atol=1e-5)
+    # an impact faster than 1 at the wall below in the cell or its mirror: a tolerance
+    # relative to 1 + u (u < 0 there) would be negative, and no motion recognised
+    lowest = []
+    for d, e, e_lo, start in ((delta, eps, eps_lower, (theta[0], x0[0], v0[0])),
+                              (clearance - delta, eps_lower, eps,
+                               (np.mod(theta[0] + math.pi, 2 * math.pi), -x0[0], -v0[0]))):
+        _, _, (_, _, tu) = A._starts_at_cell(inv_beta, d, ZETA, e, *start, trace=400,
+                                             eps_lower=e_lo, **kw)
+        lowest.append(np.min(tu[np.isfinite(tu)][-20:]))
+    assert min(lowest) < -1.0
+
+
+def test_the_issue_cell_and_its_mirror_are_listed_alike():
+    """The map's own starts (Sobol, not mirror images of each other) at a cell and its mirror:
+    every start on the (1/1) orbit, at the wall above in one and below in the other, with
+    the same exponent."""
+    one = attractor_map([1.1], [0.5], ZETA, 0.5, n_starts=16, gap=(0, 4), clearance=5.5)
+    mirror = attractor_map([1.1], [5.0], ZETA, 0.5, n_starts=16, gap=(1.5, 5.5), clearance=5.5)
+    for res in (one, mirror):
+        assert res["count"][0, 0, 0] == 16 and res["class_count"][0, 0, 0] == 16
+        assert res["n_stable"][0, 0, 0] == 1
+    assert mirror["lyapunov"][0, 0] == one["lyapunov"][0, 0]
+    assert one["impact_rate_lower"][0, 0] == 0.0
+    assert mirror["impact_rate_lower"][0, 0] == mirror["impact_rate"][0, 0] > 0

@@ -93,20 +93,34 @@ def clopper_pearson(k, n, confidence=CONFIDENCE):
     return lo, hi
 
 
-def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf):
+def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf, eps_lower=None):
     """Stable admissible solver orbits per cell and type (arrays of
-    :func:`kernels.cell_orbits`): ``n_stable (n_types, nb, nd)``, and per cell,
-    type and orbit the phases, approach velocities, intervals and ``ln max|mu|``. With a
-    finite ``clearance`` only the orbits that stay above the wall below."""
+    :func:`kernels.cell_orbits`): ``n_stable (n_rows, nb, nd)``, and per cell, row and orbit
+    the phases, approach velocities, intervals and ``ln max|mu|``. One wall: a row per type.
+    With a finite ``clearance``, the rows of the wall above (the orbits that stay above the
+    wall below), then those of the wall below: the one-wall orbits of the mirrored frame
+    ``x -> -x``, play ``clearance - delta`` and restitution ``eps_lower``, that stay below
+    the wall above (the mirror image of a cell holds the same numbers the other way round)."""
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
-    shape = (nb, nd, nt, ak.K_ORBITS, ak.M_COLS)
-    n_stable = np.zeros((nt, nb, nd), np.int64)
+    walls = [(delta, eps)]
+    if clearance < math.inf:
+        walls.append((clearance - delta, eps if eps_lower is None else eps_lower))
+    shape = (nb, nd, len(walls) * nt, ak.K_ORBITS, ak.M_COLS)
+    n_stable = np.zeros((len(walls) * nt, nb, nd), np.int64)
     oph, ou, oz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
     lnmu = np.full(shape[:4], np.nan)
     rows = np.argsort(-inv_beta, kind="stable")      # the costliest rows first
-    with numba.parallel_chunksize(1):       # rows handed out as threads come free
-        ak.cell_orbits(inv_beta, delta, types, float(zeta), float(eps), n_stable, oph, ou,
-                       oz, lnmu, float(clearance), rows)
+    for w, (plays, eps_w) in enumerate(walls):
+        part = slice(w * nt, (w + 1) * nt)
+        arrays = [np.zeros((nt, nb, nd), np.int64)] + [np.zeros(shape[:2] + (nt,) + shape[3:])
+                                                       for _ in range(3)]
+        lnmu_w = np.full(shape[:2] + (nt, ak.K_ORBITS), np.nan)
+        with numba.parallel_chunksize(1):       # rows handed out as threads come free
+            ak.cell_orbits(inv_beta, np.ascontiguousarray(plays), types, float(zeta),
+                           float(eps_w), *arrays, lnmu_w, float(clearance), rows)
+        n_stable[part] = arrays[0]
+        for full, got in zip((oph, ou, oz, lnmu), arrays[1:] + [lnmu_w]):
+            full[:, :, part] = got
     return n_stable, oph, ou, oz, lnmu
 
 
@@ -186,7 +200,8 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
           motion with m collisions per n forcing periods of a listed type (in "other");
         - ``fraction``, ``fraction_lo``, ``fraction_hi`` (n_types + 1, nb, nd): ``count /
           n_starts`` and its Clopper-Pearson 95 % interval;
-        - ``n_stable`` int (n_types, nb, nd): stable admissible solver orbits;
+        - ``n_stable`` int (n_types, nb, nd): stable admissible solver orbits (at either wall
+          with a ``clearance``);
         - ``class_count`` int (6, nb, nd) and ``cell_class`` int8 (nb, nd), the most frequent
           class (the first of a tie);
         - ``lyapunov`` (nb, nd): the largest exponent over the cell's starts (``-inf`` when
@@ -285,10 +300,13 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     ``-(delta - clearance)``, restitution ``eps_lower``), so the exponents' sum is
     ``-2 zeta + 2 sum_w nu_w ln eps_w`` over the walls. The closed-form solver knows one wall:
     its orbits whose flights stay above the wall below (``min x >= delta - clearance``) are
-    orbits of the two-wall oscillator with the same multipliers, and are listed
-    (``n_stable`` counts those); a motion that meets both walls settles as "periodic_other",
-    with its exponents from its own last period. An impact at the other wall always starts a
-    new collision.
+    orbits of the two-wall oscillator with the same multipliers, and so are, in the mirrored
+    frame, its orbits at the play ``clearance - delta`` with restitution ``eps_lower`` that
+    stay below the wall above: both are listed under their type (``n_stable`` counts both
+    walls' orbits, ``impact_rate_lower`` tells the wall), so that a cell and its mirror image
+    (walls swapped, starts mirrored) settle alike. A motion that meets both walls settles as
+    "periodic_other", with its exponents from its own last period. An impact at the other
+    wall always starts a new collision.
     """
     (inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time, match_tol,
      seed) = _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,
@@ -373,10 +391,13 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
 
     nb, nd = inv_beta.size, delta.size
     t_a = time.perf_counter()
-    n_stable, oph, ou, oz, lnmu = stable_orbits(inv_beta, delta, types, zeta, eps, clearance)
+    n_stable, oph, ou, oz, lnmu = stable_orbits(inv_beta, delta, types, zeta, eps, clearance,
+                                                eps_lower)
     t_b = time.perf_counter()
     u, theta, g, v0 = sobol_starts(n_starts, gap, velocity, seed)
     n_cells = nb * nd
+    nt = types.shape[0]
+    n_walls = n_stable.shape[0] // nt
     cell_beta = np.repeat(1.0 / inv_beta, nd)
     cell_delta = np.tile(delta, nb)
     cell_of = np.repeat(np.arange(n_cells), n_starts)
@@ -392,10 +413,13 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
     with numba.parallel_chunksize(1):       # blocks handed out as threads come free
         ak.run_starts(cell_beta, cell_delta, cell_of, th, x0, vv, float(zeta), float(eps),
                       float(clearance), float(eps if eps_lower is None else eps_lower),
-                      float(max_time), float(match_tol), types, np.ascontiguousarray(orb_n),
+                      float(max_time), float(match_tol), np.tile(types, (n_walls, 1)), nt,
+                      np.ascontiguousarray(orb_n),
                       oph.reshape(shape), ou.reshape(shape), oz.reshape(shape), n_blocks,
                       outf, outi)
     t_c = time.perf_counter()
+    # a type's stable orbits at either wall, pooled
+    n_stable = n_stable.reshape(n_walls, nt, nb, nd).sum(axis=0)
     return {"outf": outf, "outi": outi, "n_stable": n_stable, "lnmu": lnmu, "theta": th,
             "x0": x0, "v0": vv, "cell_of": cell_of, "unit": u,
             "seconds_orbits": t_b - t_a, "seconds_starts": t_c - t_b}
@@ -412,7 +436,9 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
     clearance, eps_lower = _validate_walls(clearance, eps_lower, eps, (0.0, 0.0))
     ib = np.array([float(inv_beta)])
     dd = np.array([float(delta)])
-    n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps, clearance)
+    n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps, clearance, eps_lower)
+    n_walls = n_stable.shape[0] // types.shape[0]
+    rows = np.tile(types, (n_walls, 1))
     theta, x0, v0 = (np.ascontiguousarray(a, dtype=float).ravel() for a in (theta, x0, v0))
     n = theta.size
     outf = np.empty((n, ak.N_F))
@@ -422,12 +448,12 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
         tk, ts, tu = np.zeros(trace, np.int64), np.full(trace, np.nan), np.full(trace, np.nan)
         ak.trace_start(1.0 / ib[0], dd[0], float(zeta), float(eps), clearance, eps_lower,
                        theta[0], x0[0], v0[0],
-                       float(max_time), float(match_tol), types, orb_n, oph[0, 0], ou[0, 0],
-                       oz[0, 0], outf[0], outi[0], tk, ts, tu)
+                       float(max_time), float(match_tol), rows, types.shape[0], orb_n,
+                       oph[0, 0], ou[0, 0], oz[0, 0], outf[0], outi[0], tk, ts, tu)
         return outf[:1], outi[:1], (tk, ts, tu)
     ak.run_starts(np.repeat(1.0 / ib, 1), dd, np.zeros(n, np.int64), theta, x0, v0,
                   float(zeta), float(eps), clearance, eps_lower, float(max_time),
-                  float(match_tol), types,
+                  float(match_tol), rows, types.shape[0],
                   orb_n[None, :], oph[0], ou[0], oz[0], min(n, 8 * numba.get_num_threads()),
                   outf, outi)
     return outf, outi, None

@@ -383,30 +383,36 @@ def _dt(rk, rs, i, j, h):
 
 
 @kernel
-def _match_orbit(rk, rs, ru, rph, n_imp, h, tf, t_now_k, m, oph, ou, oz, tol, last_stick):
+def _match_orbit(rk, rs, ru, rph, n_imp, h, tf, t_now_k, m, oph, ou, oz, tol, last_stick,
+                 lower):
     """Whether the last REPEATS m impacts follow the solver orbit (``oph, ou, oz``) within
-    ``tol``: phase / T_f, velocity relative to ``1 + u``, every interval / T_f; no sticking
+    ``tol``: phase / T_f, velocity relative to ``1 + |u|``, every interval / T_f; no sticking
     in between, and no impact missing at the end (``t_now`` is within one interval of the
-    last impact)."""
+    last impact). With ``lower`` the orbit is one of the wall below, solved in the mirrored
+    frame ``x -> -x`` (:func:`vibroimpact.attractors.api.stable_orbits`): its impacts are
+    met half a forcing period later (the force ``-sin(beta tau)`` of that frame is
+    ``sin(beta (tau + T_f / 2))``) with the lab-frame velocity ``-u``."""
     L = REPEATS * m
     if n_imp < L or L > RING:
         return False
+    shift = 0.5 if lower else 0.0
+    sign = -1.0 if lower else 1.0
     i0 = n_imp - L
     t_first = rk[i0 % RING] * h + rs[i0 % RING]
     if last_stick >= t_first:
         return False
     for j0 in range(m):
-        if _circ(rph[i0 % RING], oph[j0]) > tol:
+        if _circ(rph[i0 % RING], oph[j0] + shift) > tol:
             continue
-        if abs(ru[i0 % RING] - ou[j0]) > tol * (1.0 + ou[j0]):
+        if abs(ru[i0 % RING] - sign * ou[j0]) > tol * (1.0 + ou[j0]):
             continue
         ok = True
         for l in range(1, L):
             i = i0 + l
             j = (j0 + l) % m
             jp = (j0 + l - 1) % m
-            if (_circ(rph[i % RING], oph[j]) > tol
-                    or abs(ru[i % RING] - ou[j]) > tol * (1.0 + ou[j])
+            if (_circ(rph[i % RING], oph[j] + shift) > tol
+                    or abs(ru[i % RING] - sign * ou[j]) > tol * (1.0 + ou[j])
                     or abs(_dt(rk, rs, i, i - 1, h) - oz[jp]) > tol * tf):
                 ok = False
                 break
@@ -424,7 +430,7 @@ def _match_orbit(rk, rs, ru, rph, n_imp, h, tf, t_now_k, m, oph, ou, oz, tol, la
 def _period_of(rk, rs, ru, n_imp, h, tf, t_now_k, p, tol):
     """m' > 0 when the last REPEATS + 1 returns of the impact sequence repeat with period
     ``p`` forcing periods and m' impacts (instants shifted by p T_f and velocities equal,
-    within ``tol``), 0 otherwise."""
+    within ``tol`` relative to ``1 + |u|``, at either wall), 0 otherwise."""
     if n_imp < 2:
         return 0
     last = n_imp - 1
@@ -445,7 +451,7 @@ def _period_of(rk, rs, ru, n_imp, h, tf, t_now_k, p, tol):
     for i in range(last, last - L, -1):
         if abs(_dt(rk, rs, i, i - mm, h) - zp) > tol * tf:
             return 0
-        if abs(ru[i % RING] - ru[(i - mm) % RING]) > tol * (1.0 + ru[i % RING]):
+        if abs(ru[i % RING] - ru[(i - mm) % RING]) > tol * (1.0 + abs(ru[i % RING])):
             return 0
     gap = (t_now_k - rk[last % RING]) * h - rs[last % RING]
     if gap > _dt(rk, rs, last - mm + 1, last - mm, h) + tol * tf:
@@ -681,15 +687,19 @@ def _carry(q, acc, seg, t_to, t_b, zeta, omega):
 
 @kernel
 def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_time, tol,
-               types, orb_n, oph, ou, oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf,
-               outi, trace_k, trace_s, trace_u):
+               types, n_upper, orb_n, oph, ou, oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind,
+               outf, outi, trace_k, trace_s, trace_u):
     """One start until it settles or reaches ``max_time``; results into ``outf``/``outi``
     (slots ``F_*``, ``I_*``). ``trace_*`` (length > 0) receive its first impacts.
 
     A finite ``clearance`` adds the wall at ``lower = delta - clearance`` (restitution
     ``eps_lower``): the simulator follows both walls, impacts there are recorded with their
     lab-frame velocity ``< 0`` (``ru``, ``trace_u``) and the tangent crosses them by their own
-    saltation (:func:`wall_saltation`)."""
+    saltation (:func:`wall_saltation`). The orbit tables (``types``, ``orb_n``, ``oph``, ``ou``,
+    ``oz``) then hold each listed type twice: rows ``< n_upper`` the orbits at the wall above,
+    the rest those at the wall below (:func:`_match_orbit`); a start settled on one gets the
+    type's index either way (``I_MOTION``) and its impacts at the wall below count in
+    ``F_IMPACTS_LO``."""
     tf = 2.0 * math.pi / beta
     omega = math.sqrt(1.0 - zeta * zeta)
     lower = delta - clearance                   # -inf with one wall
@@ -892,24 +902,29 @@ def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_
             outi[I_PERIOD_P] = 1
             outi[I_STICK_P] = 1                # no collision per forcing period: (0/1)
             return
-        # (c) on a stable solver orbit of a listed type
+        # (c) on a stable solver orbit of a listed type, at the wall above (t < n_upper) or
+        # below (the same types again, solved in the mirrored frame)
         for t in range(types.shape[0]):
             m = types[t, 0]
+            at_lower = t >= n_upper
             for o in range(min(orb_n[t], K_ORBITS)):
                 if _match_orbit(rk, rs, ru, rph, n_imp, h, tf, k, m, oph[t, o], ou[t, o],
-                                oz[t, o], tol, last_stick):
+                                oz[t, o], tol, last_stick, at_lower):
                     z = types[t, 1] * tf
-                    big, small = _orbit_tangent_product(oph[t, o], ou[t, o], oz[t, o], m, z,
-                                                        zeta, omega, eps, delta)
+                    # the mirrored frame's own wall: the product is that of the one-wall
+                    # orbit the table holds, the same numbers as at a wall above
+                    big, small = _orbit_tangent_product(
+                        oph[t, o], ou[t, o], oz[t, o], m, z, zeta, omega,
+                        eps_lower if at_lower else eps, -lower if at_lower else delta)
                     i0 = n_imp - REPEATS * m
                     outf[F_SETTLE] = rk[i0 % RING] * h + rs[i0 % RING] - t0
                     outf[F_LYAP1] = math.log(big) / z
                     outf[F_LYAP2] = math.log(small) / z
                     outf[F_RATE] = m / z
                     outf[F_IMPACTS] = m
-                    outf[F_IMPACTS_LO] = 0.0
+                    outf[F_IMPACTS_LO] = m if at_lower else 0.0
                     outf[F_WINDOW] = z
-                    outi[I_MOTION] = t
+                    outi[I_MOTION] = t - n_upper if at_lower else t
                     outi[I_CLASS] = LISTED
                     outi[I_PERIOD_M] = m
                     outi[I_PERIOD_P] = types[t, 1]
@@ -924,7 +939,7 @@ def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_
                 m = types[t, 0]
                 for o in range(min(orb_n[t], K_ORBITS)):
                     if _match_orbit(rk, rs, ru, rph, n_imp, h, tf, k, m, oph[t, o], ou[t, o],
-                                    oz[t, o], loose, last_stick):
+                                    oz[t, o], loose, last_stick, t >= n_upper):
                         near = True
             if near:
                 break                   # still converging onto a listed orbit: run on
@@ -943,7 +958,7 @@ def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_
                 outi[I_CLASS] = STICKING
                 outi[I_STICK_M] = mc
                 outi[I_STICK_P] = p
-                for t in range(types.shape[0]):
+                for t in range(n_upper):
                     if types[t, 0] == mc and types[t, 1] == p:
                         outi[I_MOTION] = -2 - t          # impact-stick variant of type t
                 return
@@ -997,7 +1012,7 @@ def _alloc_ring():
 
 @kernel(parallel=True)
 def run_starts(cell_beta, cell_delta, cell_of, theta, x0, v0, zeta, eps, clearance, eps_lower,
-               max_time, tol, types, orb_n, oph, ou, oz, n_blocks, outf, outi):
+               max_time, tol, types, n_upper, orb_n, oph, ou, oz, n_blocks, outf, outi):
     """Every start ``i`` (cell ``cell_of[i]``) through :func:`_run_start`; ``n_blocks``
     parallel blocks, block ``b`` taking the starts ``b, b + n_blocks, ...`` (so that the cost,
     which varies across the plane, is shared evenly), each with its own buffers."""
@@ -1011,18 +1026,18 @@ def run_starts(cell_beta, cell_delta, cell_of, theta, x0, v0, zeta, eps, clearan
         for i in range(b, n, n_blocks):
             c = cell_of[i]
             _run_start(cell_beta[c], cell_delta[c], zeta, eps, clearance, eps_lower, theta[i],
-                       x0[i], v0[i], max_time, tol, types, orb_n[c], oph[c], ou[c], oz[c],
-                       bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf[i], outi[i], tr_k,
-                       tr_s, tr_s)
+                       x0[i], v0[i], max_time, tol, types, n_upper, orb_n[c], oph[c], ou[c],
+                       oz[c], bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf[i], outi[i],
+                       tr_k, tr_s, tr_s)
 
 
 @kernel
 def trace_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_time, tol,
-                types, orb_n, oph, ou, oz, outf, outi, trace_k, trace_s, trace_u):
+                types, n_upper, orb_n, oph, ou, oz, outf, outi, trace_k, trace_s, trace_u):
     """One start, serially, recording its first impacts (tests)."""
     bufs_i = np.empty((2, CAPACITY), np.int64)
     bufs_f = np.empty((4, CAPACITY))
     rk, rs, ru, rph, sk, ss, skind = _alloc_ring()
     _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_time, tol,
-               types, orb_n, oph, ou, oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind, outf,
-               outi, trace_k, trace_s, trace_u)
+               types, n_upper, orb_n, oph, ou, oz, bufs_i, bufs_f, rk, rs, ru, rph, sk, ss, skind,
+               outf, outi, trace_k, trace_s, trace_u)
