@@ -18,6 +18,12 @@ nothing else:
 - ``report``: the size of that build's ``results/report.html``.
 - ``figures``: which entry lists each figure, the config blocks it needs and its options,
   from the figure table `vibroimpact.pipeline.figures.FIGURES` that the checks read.
+- ``plan_clearance``, ``plan_planes``: ``make plan`` on the shipped examples.
+
+``--docs docs/figures.md`` rewrites that file's blocks the same way, from the finished
+build's datasets: ``fig08_tail`` (the quantiles of the interval at the lowest play) and
+``fig09_rice`` (the measured mean interval against Rice's, `results/datasets/
+random_events.nc`).
 
 Re-run it after a build that changes what the README quotes (a new job, a new cost): the
 README's numbers then come from one build, named by its commit.
@@ -29,6 +35,7 @@ import re
 import subprocess
 import sys
 
+import numpy as np
 import xarray as xr
 
 from vibroimpact.pipeline import config as configuration, figures
@@ -50,6 +57,74 @@ def plan_text(root=ROOT):
     _, plan = configuration.load(root=root)
     return (f"`make plan` on the default config (generated at {_commit(root)} by "
             f"`benchmarks/readme_numbers.py`): {plan.summary(2)}")
+
+
+#: The shipped examples whose plan the README quotes: block name, config file.
+EXAMPLES = {"plan_clearance": "config/examples/clearance.yaml",
+            "plan_planes": "config/examples/planes.yaml"}
+
+
+def example_plan_text(name, root=ROOT):
+    """A ``plan_*`` block: the plan of a shipped example (:data:`EXAMPLES`)."""
+    _, plan = configuration.load(root=root, user_files=[Path(root) / EXAMPLES[name]])
+    return f"`make plan CONFIG={EXAMPLES[name]}` (generated): {plan.summary(2)}"
+
+
+def _fmt(x, digits=2):
+    return f"{x:.{digits}f}".rstrip("0").rstrip(".") if abs(x) < 100 else f"{x:,.0f}"
+
+
+def docs_blocks(results):
+    """The blocks of docs/figures.md, from the finished build's random-force events."""
+    from vibroimpact import stats
+
+    ds = xr.open_dataset(Path(results) / "datasets" / "random_events.nc").isel(inv_beta=0)
+    low = ds.isel(delta=0)
+    x = low.interval.values
+    width = x[1] - x[0]
+    mass = low.interval_density.values * width
+    edges = np.r_[x - width / 2, x[-1] + width / 2]
+    cdf = np.r_[0.0, np.cumsum(mass)]
+    q50, q99 = (np.interp(q * cdf[-1], cdf, edges) for q in (0.5, 0.99))
+    longest = edges[np.nonzero(mass)[0][-1] + 1]
+    tail = (f"at δ = {float(low.delta):g} the median interval is {q50:.1f}, the 99 % quantile "
+            f"{q99:.0f} and the longest below {longest:.0f} (bin edges; generated)")
+    d = ds.delta.values
+    n = ds.n_collisions.values
+    tn = ds.simulated_time.values / np.where(n > 0, n, np.nan)
+    lo, hi = ds.interval_mean_lo.values, ds.interval_mean_hi.values
+    rice = 1.0 / stats.upcrossing_rate(d, ds.attrs["linear_sigma_x"],
+                                       ds.attrs["linear_sigma_v"])
+    ratio = tn / rice
+    many = n >= 20                     # the figure's filled points
+    r = np.where(many, ratio, np.nan)
+    i_min = int(np.nanargmin(r))        # the run of plays around the least ratio, below 1
+    a = b = i_min
+    while a > 0 and r[a - 1] < 1.0:
+        a -= 1
+    while b + 1 < r.size and r[b + 1] < 1.0:
+        b += 1
+    c = b + 1                           # the run after it, at or above 1
+    while c + 1 < r.size and r[c + 1] >= 1.0:
+        c += 1
+    short, longer = slice(a, b + 1), slice(b + 1, c + 1)
+    i_max = b + 1 + int(np.nanargmax(r[longer]))
+    i_b = b + 1 + int(np.nonzero(rice[longer] < lo[longer])[0][-1])
+    after = many & (np.arange(d.size) > i_b)
+    inside = after & (rice >= lo) & (rice <= hi)
+    far = after & (d >= d[i_b] + 0.4)
+    return {"fig08_tail": tail, "fig09_rice": (
+        f"On the default build (generated from `results/datasets/random_events.nc`, plays with "
+        f"at least 20 collisions) the measured T/N is shorter than $1/\\nu^+$ for "
+        f"{d[a]:g} ≤ δ ≤ {d[b]:g} ({_fmt(ratio[short].min())}-{_fmt(ratio[short].max())} of "
+        f"it, least at δ = {d[i_min]:g}) and longer for {d[b + 1]:g} ≤ δ ≤ {d[c]:g}, by "
+        f"{100 * (ratio[longer].min() - 1):.0f}-{100 * (ratio[i_max] - 1):.0f} % (most near "
+        f"δ = {d[i_max]:g}); Rice's value is below "
+        f"the 95 % interval up to δ = {d[i_b]:g} ({rice[i_b]:,.0f} against {tn[i_b]:,.0f} "
+        f"[{lo[i_b]:,.0f}, {hi[i_b]:,.0f}]). Beyond, Rice lies inside the interval at "
+        f"{int(inside.sum())} of the {int(after.sum())} plays; T/N·ν⁺ is "
+        f"{_fmt(ratio[far].min())}-{_fmt(ratio[far].max())} at δ = {d[far].min():g}-"
+        f"{d[far].max():g}")}
 
 
 def _minsec(s):
@@ -157,16 +232,23 @@ def main(argv=None):
                         help="a finished default build's results/ (default: this tree's)")
     parser.add_argument("--write", metavar="README", help="rewrite the blocks of this file")
     parser.add_argument("--plan-only", action="store_true",
-                        help="only the plan (no finished build needed)")
+                        help="only the plans (no finished build needed)")
+    parser.add_argument("--docs", metavar="FIGURES_MD",
+                        help="rewrite the blocks of this file (docs/figures.md)")
     args = parser.parse_args(argv)
     blocks = {"plan": plan_text(), "figures": figures_text()}
+    blocks.update({name: example_plan_text(name) for name in EXAMPLES})
+    docs = {}
     if not args.plan_only:
         numbers = build_numbers(args.results)
         blocks.update(build=build_text(numbers), report=report_text(numbers))
-    for name, value in blocks.items():
+        docs = docs_blocks(args.results)
+    for name, value in {**blocks, **docs}.items():
         print(f"{name}: {value}")
     if args.write:
         rewrite(args.write, blocks)
+    if args.docs and docs:
+        rewrite(args.docs, docs)
     return 0
 
 

@@ -126,9 +126,10 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
 
 def test_the_readme_quotes_the_current_plan_and_figure_table():
     """The README's generated blocks (benchmarks/readme_numbers.py --write README.md) are
-    those of this tree: the plan of the default config, and the table of which figure an
-    entry may list and what it needs. A change to either fails here until the script is
-    re-run; the build's own numbers name their build's commit and are not checked."""
+    those of this tree: the plans of the default config and of the shipped examples, and the
+    table of which figure an entry may list and what it needs. A change to any fails here
+    until the script is re-run; the build's own numbers name their build's commit and are
+    not checked."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("readme_numbers",
@@ -145,6 +146,8 @@ def test_the_readme_quotes_the_current_plan_and_figure_table():
     _, plan = configuration.load(root=ROOT)
     assert block("plan").endswith(f"`benchmarks/readme_numbers.py`): {plan.summary(2)}")
     assert block("figures") == module.figures_text()
+    for name in module.EXAMPLES:        # the shipped examples' plans, e.g. their job counts
+        assert block(name) == module.example_plan_text(name)
     for fig in figures.FIGURES:
         assert f"| `{fig}` |" in block("figures")
 
