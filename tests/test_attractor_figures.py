@@ -538,3 +538,23 @@ def test_boundary_table_one_column_per_pair_of_kinds():
     assert table.loc["(2/1)", "codim-2: grazing + period_doubling"] == ""
     # every cell short enough for pandas' default column width (50 characters)
     assert max(len(str(v)) for v in table.values.ravel()) < 50
+
+
+def test_the_class_words_follow_the_system():
+    """The paper's grid has Fig. 16 beside it; a plane study has no Fig. 16, and with a
+    second wall its listed orbits are found at either wall and its wall-free response must
+    clear the wall below too."""
+    from vibroimpact.plotting import attractors as pa
+
+    grid = xr.Dataset(attrs={})
+    plane = xr.Dataset(attrs={"axes": ["eps", "delta"]})
+    walls = xr.Dataset(attrs={"axes": ["gap", "inv_beta"]})
+    fixed_gap = xr.Dataset(attrs={"axes": ["eps", "delta"], "gap": 2.0})
+    assert "Fig. 16" in pa._class_words(grid)["listed"]
+    assert "Fig. 16" not in pa._class_words(plane)["listed"]
+    assert pa._short(plane, "listed") == "a listed type"
+    for ds in (walls, fixed_gap):
+        words = pa._class_words(ds)
+        assert "either wall" in words["listed"]
+        assert r"\delta - g" in words["wall_free"] and r"q < \delta" in words["wall_free"]
+    assert r"\delta - g" not in pa._class_words(plane)["wall_free"]

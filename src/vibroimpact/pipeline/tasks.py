@@ -704,8 +704,9 @@ def plane_attractor_tile(name, entry, tile, out, threads=None):
     attrs = dict(study=name, n_starts=int(block["n_starts"]),
                  max_time=float(block["max_time"]), seed=int(block["seed"]), gap=list(gap),
                  velocity=list(vel),
-                 box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
-                     f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
+                 box=f"forcing phase in [0, 2 pi), x0 = delta - s (s: distance below the "
+                     f"wall at delta) with s in [{gap[0]:g}, {gap[1]:g}], v0 in "
+                     f"[{vel[0]:g}, {vel[1]:g}]")
     result = attractor_plane(x, rows[tile::n_tiles], y, study.axes[y], study.fixed(),
                              types=[tuple(int(k) for k in t) for t in block["types"]],
                              n_starts=attrs["n_starts"], gap=gap, velocity=vel,

@@ -266,7 +266,9 @@ def basins(basins, orbits=None):
     if shown["wall_free"]:
         handles.append(Line2D([], [], color=WALL_FREE_LINE_COLOR, lw=1.6,
                               label=f"other: >= {100 * WALL_FREE_SHARE:.0f} % of starts on the "
-                                    r"wall-free response ($q < \delta$, no impact)"))
+                                    + (WALL_FREE_TWO_WALLS[:-1] + ", no impact)"
+                                       if _two_walls(basins) else
+                                       r"wall-free response ($q < \delta$, no impact)")))
     if shown["stick"]:
         handles.append(Line2D([], [], color=STICK_LINE_COLOR, lw=1.2, ls="--",
                               label=f"{STICK_LEVEL} % of starts on the type's impact-stick "
@@ -293,6 +295,32 @@ def _starts_text(basins):
     return text
 
 
+def _two_walls(ds):
+    """Whether ``ds`` is over a plane study with a second wall (``gap`` on an axis or fixed)."""
+    return "axes" in ds.attrs and ("gap" in list(np.atleast_1d(ds.attrs["axes"]))
+                                   or "gap" in ds.attrs)
+
+
+def _class_words(ds):
+    """The words of `CLASSES` for the system of ``ds``: the paper's grid has Fig. 16 beside
+    it; a plane study lists the types of its attractors block, found with a second wall on
+    either wall (`vibroimpact.attractor_map`), and its wall-free response clears both walls
+    (``-q > delta - gap``)."""
+    words = {k: w for k, (_, w) in CLASSES.items()}
+    if "axes" not in ds.attrs:
+        return words
+    if _two_walls(ds):
+        words["listed"] = "periodic, a stable one-wall orbit of a listed type, at either wall"
+        words["wall_free"] = WALL_FREE_TWO_WALLS
+    else:
+        words["listed"] = "periodic, of a listed type (m/n)"
+    return words
+
+
+#: The wall-free response between two walls: it reaches neither.
+WALL_FREE_TWO_WALLS = r"wall-free response ($q < \delta$, $-q > \delta - g$)"
+
+
 def _class_names(ds, name="cell_class"):
     """The classes of the codes of ``ds[name]``: its ``flag_meanings`` in order when it has
     them (each one of `CLASSES`; a dataset written before the wall-free class has codes 0-4),
@@ -303,7 +331,15 @@ def _class_names(ds, name="cell_class"):
     if unknown:
         raise ValueError(f"{name} has the flag_meanings {meanings!r}; this figure knows the "
                          f"classes {list(CLASSES)}, not {unknown}")
-    return names, [CLASSES[n][1] for n in names]
+    words = _class_words(ds)
+    return names, [words[n] for n in names]
+
+
+def _short(ds, name):
+    """`CLASS_SHORT` of a class, "a listed type" where ``ds`` has no Fig. 16 beside it."""
+    if name == "listed" and "axes" in ds.attrs:
+        return "a listed type"
+    return CLASS_SHORT[name]
 
 
 def _tick_text(value, _pos=None):
@@ -427,7 +463,8 @@ def lyapunov(lyapunov):
                           **OWNER_MARKER)
                 handles_l.append(Line2D([], [], color=CLASSES[name][0], **OWNER_MARKER,
                                         label=f"largest from fewer starts: "
-                                              f"{CLASS_SHORT[name]} ({int(here.sum())} cells)"))
+                                              f"{_short(lyapunov, name)} "
+                                              f"({int(here.sum())} cells)"))
     bar = fig.colorbar(shaded, ax=ax_l, shrink=0.85, extend=extend, ticks=ticks,
                        format=FuncFormatter(_tick_text),
                        label="largest Lyapunov exponent (per unit $\\tau$)\n"
