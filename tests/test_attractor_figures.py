@@ -547,9 +547,11 @@ def test_the_class_words_follow_the_system():
     from vibroimpact.plotting import attractors as pa
 
     grid = xr.Dataset(attrs={})
-    plane = xr.Dataset(attrs={"axes": ["eps", "delta"]})
-    walls = xr.Dataset(attrs={"axes": ["gap", "inv_beta"]})
-    fixed_gap = xr.Dataset(attrs={"axes": ["eps", "delta"], "gap": 2.0})
+    plane = xr.Dataset(coords={"eps": [0.5], "delta": [1.0]}, attrs={"axes": ["eps", "delta"]})
+    walls = xr.Dataset(coords={"gap": [1.0, 2.0], "inv_beta": [1.0]},
+                       attrs={"axes": ["gap", "inv_beta"]})
+    fixed_gap = xr.Dataset(coords={"eps": [0.5], "delta": [1.0]},
+                           attrs={"axes": ["eps", "delta"], "gap": 2.0})
     assert "Fig. 16" in pa._class_words(grid)["listed"]
     assert "Fig. 16" not in pa._class_words(plane)["listed"]
     assert pa._short(plane, "listed") == "a listed type"

@@ -245,3 +245,31 @@ def test_the_issue_cell_and_its_mirror_are_listed_alike():
     assert mirror["lyapunov"][0, 0] == one["lyapunov"][0, 0]
     assert one["impact_rate_lower"][0, 0] == 0.0
     assert mirror["impact_rate_lower"][0, 0] == mirror["impact_rate"][0, 0] > 0
+
+
+def test_a_two_wall_plane_counts_the_studys_own_motions():
+    """The basins of a two-wall plane are over the study's motions (m_upper, m_lower, n): a
+    start counts for one when it settled periodic with m_upper + m_lower impacts per n
+    forcing periods, m_lower of them below (here the (2/1) with an impact at each wall of
+    MIRROR_CELLS and its mirror image, counted start by start)."""
+    from vibroimpact.attractors.plane import attractor_plane
+    from vibroimpact.pipeline import datasets
+
+    fixed = dict(zeta=ZETA, eps=0.7, eps_lower=0.9, delta=1.5, amplitude=1.0)
+    res = attractor_plane("gap", [3.0], "inv_beta", [1.0], fixed, types=((1, 1), (2, 1)),
+                          n_starts=12, gap=(0.0, 3.0), velocity=(-3.0, 3.0))
+    tiles = datasets.attractor_tile_dataset(res, dict(n_starts=12))
+    motions = [(1, 1, 1), (1, 0, 1), (0, 1, 1)]
+    basins = datasets.basins_dataset(tiles, motions)
+    assert list(basins["motion"].values) == ["(1,1)/1", "(1,0)/1", "(0,1)/1", "other"]
+    cls = res["class_start"][:, 0, 0]
+    m, n = res["period_start"][:, :, 0, 0]
+    low = res["impacts_lower_start"][:, 0, 0]
+    want = [0, 0, 0, 0]
+    for s in range(12):
+        periodic = cls[s] in (ak.LISTED, ak.PERIODIC_OTHER)
+        key = (int(m[s] - low[s]), int(low[s]), int(n[s]))
+        want[motions.index(key) if periodic and key in motions else 3] += 1
+    assert basins["count"].values[:, 0, 0].tolist() == want
+    assert want[0] > 0                  # the motion at both walls is there
+    assert basins["fraction"].sum("motion").values.tolist() == [[1.0]]

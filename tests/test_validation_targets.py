@@ -20,6 +20,7 @@ from helpers import assert_figure, make_workdir, scheduled_jobs
 from vibroimpact import plotting
 from vibroimpact.validation import peers
 from vibroimpact.validation.campaign import (CASES, CHUNK_SIZES, COUNTS, ORBIT_CASES, REPLAYS,
+                                             SLOW_ORBIT_CASES,
                                              STREAM_SAMPLES, campaign_dataset, run_campaign,
                                              stress_sample)
 from vibroimpact.validation.families import run_family
@@ -233,10 +234,11 @@ def test_the_campaign_sizes_nest():
     """Every family at every size; the sample no larger than the quick sample, itself no larger
     than the full campaign; the sample's record streamed in three chunk sizes (one not a power
     of two), all but the last shorter than the record."""
+    orbit_cases = dict(ORBIT_CASES, full=min(SLOW_ORBIT_CASES.values()))
     for small, large in (("sample", "quick"), ("quick", "full")):
         assert CASES[small].keys() == CASES[large].keys()
         assert all(1 <= CASES[small][k] <= CASES[large][k] for k in CASES[small])
-        assert 1 <= ORBIT_CASES[small] <= ORBIT_CASES[large]
+        assert 1 <= orbit_cases[small] <= orbit_cases[large]
         assert STREAM_SAMPLES[small] <= STREAM_SAMPLES[large]
         assert 1 <= REPLAYS[small] <= REPLAYS[large]
     chunks = CHUNK_SIZES["sample"]
@@ -416,3 +418,34 @@ def test_the_plan_costs_the_validation_runs_from_their_sizes():
         assert costs.work_precision_cpu_s(dict(block, **change)) > base, change
     assert costs.work_precision_cpu_s(dict(block, impacts=1)) < base
     assert costs.stress_cpu_s({"size": "quick"}) > costs.stress_cpu_s({"size": "sample"})
+
+
+def test_the_campaign_table_is_the_slow_suites():
+    """``workflow/notebooks/stress_campaign.csv`` (the stability report's and the README's
+    table) is :func:`campaign_table` of a full campaign: every family in the campaign's
+    order, at the slow suite's sizes, with its columns."""
+    from vibroimpact.reports.notebook import csv_table
+    from vibroimpact.validation.campaign import TABLE_COLUMNS
+    from vibroimpact.validation.families import FULL_CASES
+    from vibroimpact.validation.orbit_families import FAMILIES as ORBIT_FAMILIES
+    from vibroimpact.validation.streaming import FAMILY as STREAMED
+
+    table = csv_table(Path(__file__).parents[1] / "workflow" / "notebooks"
+                      / "stress_campaign.csv")
+    assert tuple(table.columns) == TABLE_COLUMNS
+    sizes = dict(FULL_CASES, **SLOW_ORBIT_CASES, **{STREAMED: 3})
+    assert list(table["family"]) == list(FULL_CASES) + list(ORBIT_FAMILIES) + [STREAMED]
+    assert [int(c) for c in table["cases"]] == [sizes[f] for f in table["family"]]
+
+
+def test_the_campaign_table_reads_the_reports():
+    from vibroimpact.validation.campaign import campaign_table
+    from vibroimpact.validation.report import FamilyReport
+
+    a = FamilyReport("a", tolerance=1e-3, measure="m", cases=5, compared=40, missed=1,
+                     worst_error=2.5e-4, extra={"ambiguous": 3})
+    b = FamilyReport("b", tolerance=1e-9, measure="m", cases=3, compared=7,
+                     worst_error=2.1e-14)
+    got = campaign_table([a, b])
+    assert got.values.tolist() == [["a", "5", "40", "1", "0", "0", "0.25", "3"],
+                                   ["b", "3", "7", "0", "0", "0", "2.1e-05", ""]]

@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from vibroimpact import periodic_orbits
+from vibroimpact.validation.campaign import SLOW_ORBIT_CASES, SLOW_ORBIT_SEED
 from vibroimpact.validation.orbit_families import (
     FAMILIES, check_case, dop853_return, fold_deltas_m1, mp_orbit, mu_tolerance,
     period_doubling_points, reference_orbits, run_orbit_family)
@@ -21,8 +22,8 @@ from vibroimpact.validation.report import FamilyReport
 # Cases per family for the slow suite: together ~60 s on 2 cores (the fold family ~0.03 s a
 # case, period doubling ~0.08 s, grazing ~0.015 s; a failing case costs ~0.3 s more for the
 # mpmath/DOP853 re-examination).
-SLOW_CASES = {"orbit_fold": 600, "orbit_period_doubling": 300, "orbit_grazing": 800}
-SEED = 20240601
+SLOW_CASES = SLOW_ORBIT_CASES
+SEED = SLOW_ORBIT_SEED
 
 
 # ------------------------------------------------------------------------------------------

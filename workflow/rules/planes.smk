@@ -44,7 +44,7 @@ rule aggregate_plane_attractors:
         mem_mb=BASE_MEM_MB,
         runtime=5,
     params:
-        entry=study_block("attractors"),
+        entry=study_block("attractor_basins"),
         code=script_code("aggregate_plane_attractors"),
     script:
         "../scripts/aggregate_plane_attractors.py"

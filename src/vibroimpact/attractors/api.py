@@ -18,6 +18,7 @@ import numpy as np
 from vibroimpact import _checks
 from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time
 from vibroimpact.attractors import kernels as ak
+from vibroimpact.stats.events import clopper_pearson
 
 __all__ = ["attractor_map", "CLASSES", "DEFAULT_TYPES"]
 
@@ -79,18 +80,6 @@ def sobol_starts(n_starts, gap, velocity, seed):
     g = gap[0] + (gap[1] - gap[0]) * u[:, 1]
     v0 = velocity[0] + (velocity[1] - velocity[0]) * u[:, 2]
     return u, theta, g, v0
-
-
-def clopper_pearson(k, n, confidence=CONFIDENCE):
-    """Clopper-Pearson interval ``(lo, hi)`` of a binomial proportion ``k / n`` (vectorised)."""
-    from scipy.stats import beta as beta_dist
-
-    k = np.asarray(k, dtype=float)
-    a = 0.5 * (1.0 - confidence)
-    with np.errstate(invalid="ignore"):
-        lo = np.where(k > 0, beta_dist.ppf(a, k, n - k + 1), 0.0)
-        hi = np.where(k < n, beta_dist.ppf(1.0 - a, k + 1, n - k), 1.0)
-    return lo, hi
 
 
 def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf, eps_lower=None):
@@ -218,7 +207,10 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         - ``settle_time`` (n_starts, nb, nd), NaN if not settled; ``motion_start`` int
           (n_starts, nb, nd): index into ``motions``; ``class_start`` int8 (n_starts, nb,
           nd); ``period_start`` int (2, n_starts, nb, nd): (m', k) of a settled periodic
-          motion (impacts and forcing periods; collisions for an impact-stick motion).
+          motion (impacts and forcing periods; collisions for an impact-stick motion);
+          ``impacts_lower_start`` int (n_starts, nb, nd): of a start settled on a periodic
+          impact motion (listed or periodic_other), the m' impacts, those at the wall below
+          (so the motion is ``(m' - that, that)/k`` in the two-wall names; 0 otherwise).
 
     Notes
     -----
@@ -326,7 +318,7 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     stick_count = np.stack([(motion_raw == -2 - t).sum(axis=0) for t in range(nt)])
     class_count = np.stack([(cls == c).sum(axis=0) for c in range(len(CLASSES))])
     frac = count / n_starts
-    lo, hi = clopper_pearson(count, n_starts)
+    lo, hi = clopper_pearson(count, n_starts, CONFIDENCE)
     status = to_s(outi[:, ak.I_STATUS])
     if np.any(status != 0):
         # the simulator's kernel refused a step (as simulate() would raise): no result of
@@ -365,6 +357,9 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         "settle_time": to_s(outf[:, ak.F_SETTLE]),
         "motion_start": motion, "class_start": cls,
         "period_start": np.stack([to_s(outi[:, ak.I_PERIOD_M]), to_s(outi[:, ak.I_PERIOD_P])]),
+        "impacts_lower_start": np.where(
+            (cls == ak.LISTED) | (cls == ak.PERIODIC_OTHER),
+            np.nan_to_num(to_s(outf[:, ak.F_IMPACTS_LO])), 0).astype(np.int64),
     }
 
 

@@ -65,7 +65,8 @@ MAP_AXES = ("inv_beta", "delta")
 _ARRAYS = ("count", "stick_count", "fraction", "fraction_lo", "fraction_hi", "n_stable",
            "class_count", "cell_class", "lyapunov", "lyapunov_class", "lyapunov_start",
            "lyapunov_second_start", "lyapunov_stderr", "impact_rate", "impact_rate_lower",
-           "settle_time", "motion_start", "class_start", "period_start")
+           "settle_time", "motion_start", "class_start", "period_start",
+           "impacts_lower_start")
 
 
 def attractor_plane(x_name, x_values, y_name, y_values, fixed, types=None, *,

@@ -620,6 +620,8 @@ ATTRACTOR_META = {
     "stick_fraction": ("share of the starts that settle on this type's impact-stick variant "
                        "(counted in other)", "1"),
     "class_fraction": ("share of the starts in each class", "1"),
+    "other_class_fraction": ("share of the starts in each class that settle on none of the "
+                             "motions (counted in other)", "1"),
     "lyapunov": ("largest Lyapunov exponent over the cell's starts (-inf: every start sticks)",
                  "1/tau"),
     "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle",
@@ -633,6 +635,10 @@ ATTRACTOR_META = {
     "lyapunov_second_start": ("second Lyapunov exponent of each start", "1/tau"),
     "settle_time": ("time a start takes to settle on a periodic motion (NaN: not settled)",
                     "1"),
+    "period_impacts_start": ("impacts per period of the periodic motion a start settles on "
+                             "(collisions of an impact-stick motion; 0: none)", "1"),
+    "period_periods_start": ("forcing periods of that period (0: none)", "1"),
+    "impacts_lower_start": ("of those impacts, the ones at the wall below", "1"),
 }
 
 
@@ -657,6 +663,11 @@ def attractor_tile_dataset(result, attrs):
     for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
         data[name] = (("start", *plane), result[name])
     data["class_start"] = (("start", *plane), result["class_start"].astype(np.int8))
+    if "gap" in plane or "gap" in result.get("fixed", {}):
+        # two walls: what each settled start's motion is in the study's own names
+        data["period_impacts_start"] = (("start", *plane), result["period_start"][0])
+        data["period_periods_start"] = (("start", *plane), result["period_start"][1])
+        data["impacts_lower_start"] = (("start", *plane), result["impacts_lower_start"])
     ds = xr.Dataset(data, coords=coords, attrs=dict(attrs))
     if "axes" in result:        # a named plane (attractors.plane.attractor_plane)
         ds.attrs.update(axes=list(plane), fixed=json.dumps(result["fixed"], sort_keys=True),
@@ -681,11 +692,15 @@ def _described(ds):
     return ds
 
 
-def basins_dataset(tiles):
+def basins_dataset(tiles, motions=None):
     """The basins dataset (``results/orbits/<name>_basins.nc``) of the joined attractor tiles:
     ``fraction``, its interval, ``count`` over ``(motion, inv_beta, delta)``; ``n_stable`` and
     ``stick_fraction`` over the same (the ``other`` row 0 and NaN); ``class_fraction`` over
-    ``(class, inv_beta, delta)``."""
+    ``(class, inv_beta, delta)``. With two walls (tiles holding ``impacts_lower_start``) and
+    the study's ``motions`` ``(m_upper, m_lower, n)``, the basins of those motions instead
+    (:func:`two_wall_basins`)."""
+    if motions and "impacts_lower_start" in tiles:
+        return two_wall_basins(tiles, motions)
     n_starts = int(tiles.attrs["n_starts"])
     other = xr.zeros_like(tiles["n_stable"].isel(type=0)).expand_dims(type=["other"])
     n_stable = xr.concat([tiles["n_stable"], other], dim="type").rename(type="motion")
@@ -699,6 +714,42 @@ def basins_dataset(tiles):
          "stick_fraction": stick.assign_coords(motion=tiles["motion"].values),
          "class_fraction": tiles["class_count"] / n_starts,
          "motion_start": tiles["motion_start"]},
+        attrs=dict(tiles.attrs))
+    return _described(ds)
+
+
+def two_wall_basins(tiles, motions):
+    """The basins of a two-wall plane over the study's own motions ``(m_upper, m_lower, n)``
+    (named ``"(m_upper,m_lower)/n"``, as its Fig. 15): a start counts for a motion when it
+    settles on a periodic impact motion (a listed one-wall orbit at either wall, or another
+    periodic motion) of ``m_upper + m_lower`` impacts per ``n`` forcing periods, its least
+    period, ``m_lower`` of them at the wall below; ``other`` is every other start. No
+    ``n_stable`` (the closed-form solver knows one wall) nor ``stick_fraction``;
+    ``motion_start`` indexes these motions (``len(motions)``: other)."""
+    n_starts = int(tiles.attrs["n_starts"])
+    cls = tiles["class_start"].values
+    m = tiles["period_impacts_start"].values
+    k = tiles["period_periods_start"].values
+    low = tiles["impacts_lower_start"].values
+    periodic = np.isin(cls, [ATTRACTOR_CLASSES.index("listed"),
+                             ATTRACTOR_CLASSES.index("periodic_other")])
+    index = np.full(cls.shape, len(motions), np.int64)
+    for t, (m_up, m_lo, n) in enumerate(motions):
+        index[periodic & (m - low == int(m_up)) & (low == int(m_lo)) & (k == int(n))] = t
+    count = np.stack([(index == t).sum(axis=0) for t in range(len(motions) + 1)])
+    lo, hi = stats.clopper_pearson(count, n_starts)
+    dims = ("motion",) + tiles["class_start"].dims[1:]
+    names = _motion_names(motions) + ["other"]
+    ds = xr.Dataset(
+        {"fraction": (dims, count / n_starts), "fraction_lo": (dims, lo),
+         "fraction_hi": (dims, hi), "count": (dims, count),
+         "class_fraction": tiles["class_count"] / n_starts,
+         "other_class_fraction": (("class",) + dims[1:], np.stack(
+             [((index == len(motions)) & (cls == c)).sum(axis=0)
+              for c in range(len(ATTRACTOR_CLASSES))]) / n_starts),
+         "motion_start": (tiles["class_start"].dims, index)},
+        coords={"motion": names, "class": list(ATTRACTOR_CLASSES),
+                **{d: tiles[d] for d in dims[1:]}},
         attrs=dict(tiles.attrs))
     return _described(ds)
 

@@ -60,6 +60,9 @@ JOB_KEYS = {
     # record), over the study's plane
     "attractors": ("zeta", "eps", "amplitude", "inv_beta", "delta", "tile_size", "plane",
                    "attractors") + _WALLS,
+    # joining them: with two walls the basins are counted over the study's own motions
+    "attractor_basins": ("zeta", "eps", "amplitude", "inv_beta", "delta", "tile_size", "plane",
+                         "attractors", "motions") + _WALLS,
 }
 
 #: The keys of an ``orbits`` entry each of its job kinds reads (the rest, ``figures``, reruns

@@ -678,11 +678,12 @@ def attractor_tile(entry, tile, out, threads=None):
     io.write_dataset(datasets.attractor_tile_dataset(result, attrs), out)
 
 
-def aggregate_attractors(entry, tiles, out_basins, out_lyapunov):
-    """Rule ``aggregate_attractors``: the basins and Lyapunov datasets of one entry."""
+def aggregate_attractors(entry, tiles, out_basins, out_lyapunov, motions=None):
+    """Rule ``aggregate_attractors``: the basins and Lyapunov datasets of one entry (with
+    two walls, the basins of ``motions``, the study's own)."""
     joined = datasets.concat_attractor_tiles([io.load_dataset(p) for p in tiles])
     joined.attrs.update(provenance(entry))
-    io.write_dataset(datasets.basins_dataset(joined), out_basins)
+    io.write_dataset(datasets.basins_dataset(joined, motions), out_basins)
     io.write_dataset(datasets.lyapunov_dataset(joined), out_lyapunov)
 
 
@@ -716,8 +717,10 @@ def plane_attractor_tile(name, entry, tile, out, threads=None):
 
 
 def aggregate_plane_attractors(entry, tiles, out_basins, out_lyapunov):
-    """Rule ``aggregate_plane_attractors``: a plane study's basins and Lyapunov datasets."""
-    aggregate_attractors(entry, tiles, out_basins, out_lyapunov)
+    """Rule ``aggregate_plane_attractors``: a plane study's basins and Lyapunov datasets;
+    with two walls the basins are those of the study's motions."""
+    two_walls = [tuple(int(v) for v in m) for m in entry.get("motions", ()) if len(m) == 3]
+    aggregate_attractors(entry, tiles, out_basins, out_lyapunov, two_walls or None)
 
 
 def map_predictors(map_path, out, orbits_path=None, basins_path=None, lyapunov_path=None):

@@ -18,7 +18,8 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FuncFormatter
 
 from vibroimpact.plotting._common import (_attr, _header, _same_system, _styled, _system_text,
-                                          axis_label, custom_plane, plane_axes, plane_caption)
+                                          axis_label, custom_plane, motion_title, plane_axes,
+                                          plane_caption)
 from vibroimpact.plotting.maps import cell_edges, cell_outline, cell_rectangles, label_contours
 
 #: The basin fraction (%) is filled in bands of `BASIN_BAND` and its labelled lines drawn
@@ -142,10 +143,35 @@ def _composition_text(ds):
     """What the starts that settle on none of the listed types do, over the whole map."""
     if "class_fraction" not in ds:
         return None
+    words = _class_words(ds)
+    if "other_class_fraction" in ds:        # a two-wall study's motions: any class may be other
+        share = ds["other_class_fraction"].mean(plane_axes(ds))
+        parts = [f"{words.get(str(c), str(c))}: {_pct(float(share.sel({'class': c})))}"
+                 for c in ds["class"].values]
+        return _wrapped("other, of all starts over the map:  ", parts)
     share = ds["class_fraction"].mean(plane_axes(ds))
-    parts = [f"{CLASSES.get(str(c), (None, str(c)))[1]}: {_pct(float(share.sel({'class': c})))}"
+    parts = [f"{words.get(str(c), str(c))}: {_pct(float(share.sel({'class': c})))}"
              for c in ds["class"].values if str(c) != "listed"]
-    return "other, of all starts over the map:  " + ";  ".join(parts)
+    return _wrapped("other, of all starts over the map:  ", parts)
+
+
+#: Characters of a legend title's line: the figure is 10 in wide, the title 7 pt (the default
+#: grid's one-line title, 189 characters, fits).
+TITLE_WIDTH = 200
+
+
+def _wrapped(head, parts):
+    """``head`` and ``parts`` joined by ``";  "``, a new line before a part that would pass
+    `TITLE_WIDTH` (the one-line title of a short list stays as it was)."""
+    lines = [head]
+    for k, part in enumerate(parts):
+        sep = "" if k == 0 else ";  "
+        if k and len(lines[-1]) + len(sep) + len(part) > TITLE_WIDTH:
+            lines[-1] += ";"
+            lines.append(part)
+        else:
+            lines[-1] += sep + part
+    return "\n".join(lines)
 
 
 @_styled
@@ -200,7 +226,8 @@ def basins(basins, orbits=None):
     for ax, name in zip(axes, panels):
         sel = basins.sel(motion=name)
         p = 100.0 * np.asarray(sel["fraction"].values, dtype=float)
-        has = (np.asarray(sel["n_stable"].values) > 0 if name != "other"
+        # a two-wall study's own motions have no closed-form solver count: no grey cells
+        has = (np.asarray(sel["n_stable"].values) > 0 if name != "other" and "n_stable" in sel
                else np.isfinite(p))
         if name != "other" and (~has).any():
             ax.pcolormesh(xe, ye, np.ma.masked_where(has, np.ones_like(p)).T,
@@ -246,7 +273,7 @@ def basins(basins, orbits=None):
                                                  capstyle="projecting", gid="wall-free"),
                                   autolim=False)
                 shown["wall_free"] = True
-        ax.set_title("other: none of these types" if name == "other" else f"({name})")
+        ax.set_title("other: none of these types" if name == "other" else motion_title(name))
     for ax in axes[len(panels):]:
         ax.set_visible(False)
     _finish_axes(axes[:len(panels)], basins, axes[max(len(panels) - ncols, 0):len(panels)])
@@ -297,8 +324,7 @@ def _starts_text(basins):
 
 def _two_walls(ds):
     """Whether ``ds`` is over a plane study with a second wall (``gap`` on an axis or fixed)."""
-    return "axes" in ds.attrs and ("gap" in list(np.atleast_1d(ds.attrs["axes"]))
-                                   or "gap" in ds.attrs)
+    return "axes" in ds.attrs and ("gap" in plane_axes(ds) or "gap" in ds.attrs)
 
 
 def _class_words(ds):
@@ -310,7 +336,7 @@ def _class_words(ds):
     if "axes" not in ds.attrs:
         return words
     if _two_walls(ds):
-        words["listed"] = "periodic, a stable one-wall orbit of a listed type, at either wall"
+        words["listed"] = "periodic, a listed one-wall orbit (either wall)"
         words["wall_free"] = WALL_FREE_TWO_WALLS
     else:
         words["listed"] = "periodic, of a listed type (m/n)"
@@ -318,7 +344,7 @@ def _class_words(ds):
 
 
 #: The wall-free response between two walls: it reaches neither.
-WALL_FREE_TWO_WALLS = r"wall-free response ($q < \delta$, $-q > \delta - g$)"
+WALL_FREE_TWO_WALLS = r"wall-free ($q < \delta$, $-q > \delta - g$)"
 
 
 def _class_names(ds, name="cell_class"):

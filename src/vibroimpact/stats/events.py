@@ -343,6 +343,19 @@ def poisson_interval(count, level: float = 0.95) -> tuple[float, float]:
     return _garwood(k, 1.0 - level)
 
 
+def clopper_pearson(k, n, confidence=0.95):
+    """Clopper-Pearson interval ``(lo, hi)`` of a binomial proportion ``k / n``
+    (vectorised): exact, conservative; ``lo = 0`` at ``k = 0``, ``hi = 1`` at ``k = n``."""
+    from scipy.stats import beta as beta_dist
+
+    k = np.asarray(k, dtype=float)
+    a = 0.5 * (1.0 - confidence)
+    with np.errstate(invalid="ignore"):
+        lo = np.where(k > 0, beta_dist.ppf(a, k, n - k + 1), 0.0)
+        hi = np.where(k < n, beta_dist.ppf(1.0 - a, k + 1, n - k), 1.0)
+    return lo, hi
+
+
 class EventRate(NamedTuple):
     """Rate of a stationary point process with an interval honest for few, bursty events."""
 
