@@ -400,3 +400,26 @@ def test_the_planes_example_draws_fig16_over_its_restitution_plane():
         config["studies"]["restitution"]["figures"])
     row = next(r for r in plan.rows if r.key == "orbits.restitution")
     assert row.orbit_cells == 41 * 201 and row.jobs == 2 + 1 + 1 + 1
+
+
+@pytest.mark.parametrize("grid", ["[0.5, 1.0]", "{start: 0.5, stop: 1.0, step: 0.5}"])
+def test_an_amplitude_plane_is_planned_with_its_report_and_captions(tmp_path, grid):
+    """The amplitude is an axis the README offers: a plane over it plans (its targets, its
+    report, the figures' captions), its report the harmonic one, its amplitude argument NaN
+    (no one amplitude)."""
+    from vibroimpact.pipeline import figures, targets
+    from vibroimpact.reports import arguments
+
+    text = EPS_DELTA.replace("plane: [eps, delta]", "plane: [amplitude, delta]").replace(
+        "    eps: [0.3, 0.5]\n", "    eps: 0.5\n").replace("    amplitude: 1.0\n",
+                                                          f"    amplitude: {grid}\n")
+    config, plan = _load(tmp_path, text)
+    entry = config["studies"]["plane"]
+    assert plan.studies["plane"].plane == ("amplitude", "delta")
+    assert arguments.study_report_kind(entry) == "harmonic_random"
+    assert "results/reports/plane/harmonic_random.html" in targets.report_targets(
+        config, {"studies": ["plane"], "orbits": []})
+    assert "1/beta\\_f = 1.1" in figures.caption("study", "plane", entry, "fig15")
+    got = arguments.notebook_parameters("harmonic_random", {}, study="plane", entry=entry,
+                                        inv_beta=[1.1])
+    assert got["amplitude"] == "nan"

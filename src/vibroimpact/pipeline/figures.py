@@ -25,6 +25,7 @@ import importlib
 import re
 
 from vibroimpact.pipeline.study import grid_values
+from vibroimpact.reports import arguments
 
 __all__ = ["FIGURES", "VALIDATION_FIGURES", "figure_spec", "drawing_function", "figure_targets",
            "figure_variant", "figure_options", "figure_item", "figure_sources", "paper_target",
@@ -309,7 +310,7 @@ def caption(kind, name, entry, target):
         parts.insert(0, f"over the plane ({entry['plane'][0]}, {entry['plane'][1]}), every "
                         f"other parameter fixed")
     if kind == "study":
-        if float(entry.get("amplitude", 0.0)) != 0.0 and "inv_beta" in entry:
+        if arguments.harmonic(entry) and "inv_beta" in entry:
             parts.append(f"1/beta_f = {_values_text(entry['inv_beta'])}")
         parts.append(f"delta = {_values_text(entry['delta'])}")
         options = figure_options(entry, target)

@@ -27,9 +27,22 @@ REPORT_PARAMETERS = {
 DENSITY_INV_BETA = 1.1
 
 
+def harmonic(entry):
+    """Whether a study's force has a harmonic part: an amplitude, or an amplitude axis of a
+    plane (a list or ``{start, stop, step}``), with any value but 0."""
+    amp = entry.get("amplitude", 0.0)
+    if isinstance(amp, dict):                   # a grid {start, stop, step}
+        values = [amp.get("start", 0.0), amp.get("stop", 0.0)]
+    elif isinstance(amp, (list, tuple)):
+        values = amp
+    else:
+        values = [amp]
+    return any(float(v) != 0.0 for v in values)
+
+
 def study_report_kind(entry):
     """The notebook of a study's report: random force alone, or harmonic plus random."""
-    return "harmonic_random" if float(entry.get("amplitude", 0.0)) != 0.0 else "random_force"
+    return "harmonic_random" if harmonic(entry) else "random_force"
 
 
 def nearest(values, target):
@@ -61,7 +74,11 @@ def notebook_parameters(notebook, inputs, study=None, entry=None, inv_beta=(), o
     given = {name: " ".join(value) if name == "figures" else str(value)
              for name, value in inputs.items()}
     if study is not None:
-        given.update(study=study, amplitude=float(entry.get("amplitude", 0.0)),
+        amp = entry.get("amplitude", 0.0)
+        # an amplitude axis (a plane over it) has no one amplitude: NaN (only finding 5, on
+        # the spectra, reads it)
+        given.update(study=study,
+                     amplitude=float(amp) if isinstance(amp, (int, float)) else float("nan"),
                      inv_beta=nearest([float(v) for v in inv_beta], DENSITY_INV_BETA),
                      density_delta=" ".join(str(float(d))
                                             for d in entry.get("density_delta") or ()))
