@@ -1,10 +1,11 @@
-"""The density figures of a two-wall study (Figs. 7, 8, 14) held to the one-wall rules.
+"""The density figures of a two-wall study (Figs. 7, 8, 13, 14) held to the one-wall rules.
 
 A two-wall events dataset is made by the workflow's own tasks (a clearance of 2 under
 sin(tau/1.1) + r(tau), as config/examples/clearance.yaml, on a short record). Each wall's
 panel of Figs. 7 and 8 is compared, artist for artist, with the one-wall figure drawn from a
 one-wall dataset that holds that wall's statistics under the one-wall names: the same curves,
 sparse-bin runs and bands (issue 43: the two-wall panels had no merging and their own band).
+Fig. 13 marks the study's own motions.
 """
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ import xarray as xr
 from vibroimpact import plotting
 from vibroimpact.pipeline import tasks
 from vibroimpact.plotting._common import MIN_BIN_COUNT, bin_counts
+from vibroimpact.plotting.harmonic import ratio_marks
 from vibroimpact.plotting.walls import wall_view
 
 NOISE = dict(kind="band_limited", rms=0.29, dt=0.1, beta_c=4.0, n_samples=60_001,
@@ -121,3 +123,37 @@ def test_the_legend_names_each_plays_collisions_at_each_wall(events):
         n = at["wall_n_collisions"].isel(delta=k)
         assert f"upper {int(n.sel(wall='upper')):,}" in text
         assert f"lower {int(n.sel(wall='lower')):,}" in text
+
+
+def test_fig13_of_a_clearance_names_its_own_motions(events):
+    """Issue 43: the peak at z_j/z = 1/2 of the symmetric motion was labelled "(2/1): pairs",
+    where the study's own Fig. 15 calls that motion (1,1)/1."""
+    fig = plotting.fig13(events, inv_beta=1.1)
+    for ax in fig.axes:
+        texts = {(t.get_position()[0], t.get_text()) for t in ax.texts}
+        assert not any("(2/1)" in text or "(1/1)" in text for _, text in texts)
+        (half,) = [text for x, text in texts if x == 0.5]
+        assert "(1,1)/1: pairs" in half
+        at_one = sorted(text for x, text in texts if x == 1.0)
+        assert at_one[0] == " (1,0)/1, (0,1)/1" and "(1,1)/2: pairs" in at_one[1]
+        assert "= 2z" in at_one[1]
+        lines = sorted((float(ln.get_xdata()[0]), ln.get_linestyle()) for ln in ax.get_lines()
+                       if ln.get_transform() is not ln.axes.transData)
+        assert lines == [(0.5, "-."), (1.0, ":")]
+
+
+def test_ratio_marks_of_the_paper_motions_are_fig13s_marks():
+    """The paper's (1/1), (2/1), (1/2) give the one-wall Fig. 13 its marks: dash-dot at 1/2
+    for the (2/1) pairs, dotted at 1 and 2."""
+    assert ratio_marks(["1/1", "2/1", "1/2"]) == [
+        (0.5, "-.", [(r"$\leftarrow$ (2/1): pairs $z_j + z_{j+1} = z$ $\rightarrow$",
+                      "center")]),
+        (1.0, ":", [(" (1/1)", "left")]),
+        (2.0, ":", [(" (1/2)", "left")])]
+    (third,) = ratio_marks(["3/1"])
+    assert third[0] == pytest.approx(1 / 3) and r"z_{j+2} = z" in third[2][0][0]
+
+
+def test_a_motion_name_fig13_cannot_read_is_refused_naming_it():
+    with pytest.raises(ValueError, match=r"'1-1'"):
+        ratio_marks(["1-1"])
