@@ -9,6 +9,7 @@ import contextlib
 import functools
 import json
 import re
+from dataclasses import dataclass
 from pathlib import Path
 
 import matplotlib
@@ -797,16 +798,11 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     Panel (a) has a log density axis (the tails matter as much as the bulk); with `linear`,
     panel (b) draws the same curves on a linear axis, where the spread of the bulk reads;
     with `zoom` (a value of x), panel (a) shows every drawn bin and panel (b) the same
-    curves, log too, on ``[0, zoom]``, where the bulk reads.
-    Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`): a curve
-    joins the bins drawn on their own; a merged run of sparse bins is a bar over its width
-    apart from the curve (gid ``"sparse_run"``), with a vertical 95 % interval. The band
-    (gid ``"band"``) is +-t batch-means standard errors (``{var}_stderr``), t the Student
-    quantile of B - 1 dof (`CONFIDENCE`, B = ``n_batches``), joined with Garwood's interval
-    of the bin's count (a density of few values is never drawn surer than its Poisson
-    count allows); each legend entry gives the cell's number of
-    collisions and, when above `BEYOND_SHOWN`, the fraction of values beyond the last bin
-    (``{quantity}_beyond``). The x axis ends at the last drawn bin.
+    curves, log too, on ``[0, zoom]``, where the bulk reads. The curves, their bands and
+    the legend's title are :func:`_draw_densities` and :func:`_density_rule_text`, which the
+    two-wall figures (`plotting.walls.wall_density_figure`) draw with too. Each legend entry
+    gives the cell's number of collisions and, when above `BEYOND_SHOWN`, the fraction of
+    values beyond the last bin (``{quantity}_beyond``). The x axis ends at the last drawn bin.
 
     Returns
     -------
@@ -819,7 +815,98 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     index = _density_deltas(events, density_delta)
     x = _require(ds, var, "this figure").dims[-1]
     beyond = _require(ds, f"{var.removesuffix('_density')}_beyond", "this figure")
+    labels = []
+    for k in index:
+        n = int(ds["n_collisions"][k])
+        impacts = f"{n:,} collision{'' if n == 1 else 's'}" if n else "no collision"
+        labels.append(rf"$\delta$ = {_num(ds['delta'][k])}  ({impacts}{_beyond_text(beyond[k])})")
+    drawn = _draw_densities(axes, ds, var, index, labels)
+    edges = _bin_edges(ds[x])
+    for ax in axes if zoom is not None else axes[:1]:
+        _density_log_limits(ax, drawn)
+    if drawn.top <= 0.0:
+        shown = ds.isel(delta=index)
+        empty = (no_collision_text(shown, where=r"in this record at any $\delta$ drawn")
+                 if int(shown["n_collisions"].sum()) == 0 else SPARSE_TEXT)
+        for ax in axes:
+            note_on_axes(ax, empty)
+    for ax in axes[1:] if linear else ():
+        ax.set_ylim(0.0, 1.08 * drawn.top if drawn.top > 0.0 else 1.0)
+    for ax in axes:
+        ax.set_xlim(edges[0], drawn.x_end if drawn.x_end > edges[0] else edges[-1])
+        ax.set_ylabel(axis_label(ds[var]))
+    axes[-1].set_xlabel(axis_label(ds[x]))
+    if linear:
+        _panel_tag(axes[0], "(a) log scale")
+        _panel_tag(axes[1], "(b) linear scale")
+    if zoom is not None:
+        axes[1].set_xlim(edges[0], min(float(zoom), axes[0].get_xlim()[1]))
+        axes[0].set_xlabel(axis_label(ds[x]))
+        _panel_tag(axes[0], "(a) every bin drawn")
+        _panel_tag(axes[1], f"(b) the bulk, up to {_num(axes[1].get_xlim()[1])}")
+    title_text = _density_rule_text(ds, index, drawn)
+    if len(index) > LEGEND_INSIDE or two:
+        # a legend this tall would hide the curves' peaks: below the axes instead
+        fig.set_figheight(fig.get_figheight() * (1.2 if two else 1.3))
+        fig.legend(loc="outside lower center", ncols=2, title=title_text, title_fontsize=7.5,
+                   fontsize=7.5)
+    else:
+        axes[0].legend(loc="upper right", title=title_text, title_fontsize=7.5)
+    _header(fig, title, params)
+    return fig, axes
+
+
+#: What a density panel says when no curve is drawn although there were collisions.
+SPARSE_TEXT = (f"no bin run holds {MIN_BIN_COUNT} values at any $\\delta$ drawn:\n"
+               "too few collisions for a density")
+
+
+@dataclass(frozen=True)
+class DrawnDensities:
+    """What :func:`_draw_densities` drew: the x axis's end (the last drawn bin's right
+    edge, or the first edge when nothing was drawn), the largest and smallest densities
+    drawn (``top`` 0 and ``low`` inf when none), whether a merged run was drawn, and the
+    band's Student quantile per delta of the dataset (None without a band)."""
+    x_end: float
+    top: float
+    low: float
+    any_run: bool
+    t: np.ndarray | None
+
+
+def _draw_densities(axes, ds, var, index, labels=None):
+    """Draw the densities `var` of the cells ``ds.isel(delta=k)``, k in `index`, on each of `axes`.
+
+    Bins follow the sparse-bin rule (`MIN_BIN_COUNT`, :func:`merge_sparse_bins`): a curve
+    joins the bins drawn on their own; a merged run of sparse bins is a bar over its width
+    apart from the curve (gid ``"sparse_run"``), with a vertical 95 % interval. The band
+    (gid ``"band"``) is +-t batch-means standard errors (``{var}_stderr``), t the Student
+    quantile of B - 1 dof (`CONFIDENCE`, B = ``n_batches``), joined with Garwood's interval
+    of the bin's count (a density of few values is never drawn surer than its Poisson
+    count allows).
+
+    Parameters
+    ----------
+    axes : sequence of matplotlib.axes.Axes
+        Every axes gets every curve.
+    ds : xarray.Dataset
+        One inv_beta row of an events dataset (or a wall's view of it,
+        `plotting.walls.wall_view`): ``var``, optionally ``{var}_stderr``, ``n_collisions``
+        and ``n_batches`` over ``delta``.
+    var : str
+        ``"v_after_density"``, ``"interval_density"`` or ``"ratio_density"``.
+    index : sequence of int
+        The deltas drawn, in the order of `family_styles`.
+    labels : sequence of str, optional
+        The legend entry of each curve, on ``axes[0]``; None: no entry.
+
+    Returns
+    -------
+    DrawnDensities
+    """
+    x = _require(ds, var, "this figure").dims[-1]
     band = f"{var}_stderr" if f"{var}_stderr" in ds else None
+    t = None
     if band is not None:
         t = t_quantile(np.asarray(_require(ds, "n_batches", "the confidence band")), CONFIDENCE)
     styles = family_styles(len(index))
@@ -828,11 +915,9 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
     any_run = False
     for j, (style, k) in enumerate(zip(styles, index)):
         cell = ds.isel(delta=k)
-        n = int(cell["n_collisions"])
         (xs, y, se, c), (r_left, r_right, r_y, r_se, r_c) = _drawn_density(cell, var, band)
         n_values = bin_counts(cell, var)[2]
-        impacts = f"{n:,} collision{'' if n == 1 else 's'}" if n else "no collision"
-        label = rf"$\delta$ = {_num(cell['delta'])}  ({impacts}{_beyond_text(beyond[k])})"
+        label = None if labels is None else labels[j]
         if band is not None and xs.size:
             b_lo, b_hi = _density_bounds(y, t[k] * se, c, n_values, np.diff(edges)[0])
         if band is not None and r_y.size:
@@ -857,57 +942,38 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
             all_y = np.concatenate([y[np.isfinite(y)], r_y])
             top = max(top, float(all_y.max()))
             low = min(low, float(all_y.min()))
-    ax_log = axes[0]
-    for ax in axes if zoom is not None else axes[:1]:
-        ax.set_yscale("log")
-        if top > 0.0:
-            ax.set_ylim(max(low / 2.0, top * DENSITY_DECADES), top * 3.0)
-        else:
-            ax.set_ylim(DENSITY_DECADES, 1.0)
-    if top <= 0.0:
-        drawn = ds.isel(delta=index)
-        empty = (no_collision_text(drawn, where=r"in this record at any $\delta$ drawn")
-                 if int(drawn["n_collisions"].sum()) == 0 else
-                 f"no bin run holds {MIN_BIN_COUNT} values at any $\\delta$ drawn:\n"
-                 "too few collisions for a density")
-        for ax in axes:
-            note_on_axes(ax, empty)
-    for ax in axes[1:] if linear else ():
-        ax.set_ylim(0.0, 1.08 * top if top > 0.0 else 1.0)
-    for ax in axes:
-        ax.set_xlim(edges[0], x_end if x_end > edges[0] else edges[-1])
-        ax.set_ylabel(axis_label(ds[var]))
-    axes[-1].set_xlabel(axis_label(ds[x]))
-    if linear:
-        _panel_tag(axes[0], "(a) log scale")
-        _panel_tag(axes[1], "(b) linear scale")
-    if zoom is not None:
-        axes[1].set_xlim(edges[0], min(float(zoom), axes[0].get_xlim()[1]))
-        axes[0].set_xlabel(axis_label(ds[x]))
-        _panel_tag(axes[0], "(a) every bin drawn")
-        _panel_tag(axes[1], f"(b) the bulk, up to {_num(axes[1].get_xlim()[1])}")
+    return DrawnDensities(x_end, top, low, any_run, t)
+
+
+def _density_log_limits(ax, drawn):
+    """A log density axis from the smallest drawn density (halved), at most `DENSITY_DECADES`
+    below the largest, to three times the largest."""
+    ax.set_yscale("log")
+    if drawn.top > 0.0:
+        ax.set_ylim(max(drawn.low / 2.0, drawn.top * DENSITY_DECADES), drawn.top * 3.0)
+    else:
+        ax.set_ylim(DENSITY_DECADES, 1.0)
+
+
+def _density_rule_text(ds, index, drawn):
+    """The title of a density figure's legend: the band (when drawn) and the sparse-bin rule.
+
+    `ds` and `index` as for :func:`_draw_densities`, `drawn` what it returned (``t`` None:
+    no band).
+    """
     rule = (f"bins with < {MIN_BIN_COUNT} values merged with their neighbours until they hold "
             f"{MIN_BIN_COUNT}, runs still below not drawn")
-    if any_run:
+    if drawn.any_run:
         rule += ("\nbars apart from the curves: a merged run's mean density over its width"
-                 + (" (vertical: its 95 % interval)" if band is not None else ""))
-    title_text = rule
-    if band is not None:
-        b = np.unique(np.asarray(ds["n_batches"])[index])
-        t_text = (f"t = {_num(t[index[0]])}, B = {int(b[0])} batches" if b.size == 1
-                  else "t of B - 1 dof")
-        title_text = (rf"band: $\pm$t$\cdot$batch-means s.e. "
-                      f"({100 * CONFIDENCE:g} %, {t_text}), at least Garwood's interval "
-                      f"of the count\n{rule}")
-    if len(index) > LEGEND_INSIDE or two:
-        # a legend this tall would hide the curves' peaks: below the axes instead
-        fig.set_figheight(fig.get_figheight() * (1.2 if two else 1.3))
-        fig.legend(loc="outside lower center", ncols=2, title=title_text, title_fontsize=7.5,
-                   fontsize=7.5)
-    else:
-        ax_log.legend(loc="upper right", title=title_text, title_fontsize=7.5)
-    _header(fig, title, params)
-    return fig, axes
+                 + (" (vertical: its 95 % interval)" if drawn.t is not None else ""))
+    if drawn.t is None:
+        return rule
+    b = np.unique(np.asarray(ds["n_batches"])[index])
+    t_text = (f"t = {_num(drawn.t[index[0]])}, B = {int(b[0])} batches" if b.size == 1
+              else "t of B - 1 dof")
+    return (rf"band: $\pm$t$\cdot$batch-means s.e. "
+            f"({100 * CONFIDENCE:g} %, {t_text}), at least Garwood's interval "
+            f"of the count\n{rule}")
 
 
 def _require_harmonic(events, figure):

@@ -1,6 +1,8 @@
 """Figures of the harmonic-plus-random study (paper section 5): Figs. 10-14."""
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 from vibroimpact.plotting._common import (
@@ -10,6 +12,7 @@ from vibroimpact.plotting._common import (
 from vibroimpact.plotting._common import two_wall_dataset
 from vibroimpact.plotting.walls import two_walls, wall_density_figure
 from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
+from vibroimpact.stats.motions import DEFAULT_MOTIONS, motion_key
 
 
 def fig10(trace):
@@ -147,10 +150,15 @@ def fig13(events, inv_beta, density_delta=None):
     Returns
     -------
     matplotlib.figure.Figure
-        (a) log and (b) linear density axes: one line per density delta, a dash-dot line at
-        z_j/z = 1/2, the mirror axis of the (2/1) motion's pairs of intervals (no (2/1)
-        interval lies on it: its label points to both sides), and dotted marks at 1 ((1/1)
-        motion) and 2 ((1/2) motion).
+        (a) log and (b) linear density axes: one line per density delta, and the marks of
+        the study's motions (the dataset's ``motion`` coordinate; the paper's (1/1), (2/1),
+        (1/2) without one; :func:`ratio_marks`): a dotted line where a motion's intervals
+        stand (one collision per n periods: z_j/z = n), a dash-dot line at the centre of a
+        motion's groups of intervals (m >= 2 collisions per n periods: z_j/z = n/m; its
+        label points to both sides, where the intervals of an uneven group lie). With the
+        paper's motions: dash-dot at 1/2 ((2/1) pairs), dotted at 1 ((1/1)) and 2 ((1/2));
+        with a clearance's motions the line at 1/2 is (1,1)/1's, whose symmetric form peaks
+        on it (stops symmetric about the rest position).
 
     Raises
     ------
@@ -163,19 +171,72 @@ def fig13(events, inv_beta, density_delta=None):
         events, i, "ratio_density",
         r"Fig. 13  Probability density of $z_j/z$, the interval over the forcing period",
         _events_params(events, i, ("interval",)), density_delta, linear=True)
-    marks = ((0.5, "-.", PAIR_LABEL, "center"), (1.0, ":", " (1/1)", "left"),
-             (2.0, ":", " (1/2)", "left"))
+    names = (events["motion"].values if "motion" in events.coords
+             else [motion_key(m) for m in DEFAULT_MOTIONS])
+    marks = ratio_marks(names)
     for ax in axes:
-        for x, ls, text, ha in marks:
+        for x, ls, texts in marks:
             ax.axvline(x, color="0.3", ls=ls, lw=1.0)
-            ax.text(x, 0.97, text, transform=ax.get_xaxis_transform(), ha=ha, va="top",
-                    fontsize=8, color="0.3")
+            for row, (text, ha) in enumerate(texts):
+                ax.text(x, 0.97 - MARK_ROW * row, text, transform=ax.get_xaxis_transform(),
+                        ha=ha, va="top", fontsize=8, color="0.3")
     return fig
 
 
-#: fig13's label on z_j/z = 1/2: the (2/1) motion's intervals lie on both sides of it, in
-#: pairs that add up to one forcing period (z_j + z_{j+1} = z), none on it.
-PAIR_LABEL = r"$\leftarrow$ (2/1): pairs $z_j + z_{j+1} = z$ $\rightarrow$"
+#: Height (a fraction of the axes) between two labels of fig13 on one line.
+MARK_ROW = 0.08
+
+
+def ratio_marks(names):
+    """Where fig13 marks each motion on the z_j/z axis, and how.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Motion names, ``"m/n"`` (m collisions per n forcing periods, either wall) or
+        ``"(m_upper,m_lower)/n"`` (two walls; `stats.motions.motion_key`).
+
+    Returns
+    -------
+    list of (x, linestyle, [(text, ha), ...])
+        One entry per position, ascending. A motion of one collision per n periods has its
+        intervals at z_j/z = n: dotted, its name to the right of the line. A motion of m >= 2
+        collisions has groups of m intervals adding up to n periods, centred on n/m (on it
+        when the group is even, on both sides otherwise, as the (2/1) pairs of the paper):
+        dash-dot (unless a one-collision motion stands there too), its label centred,
+        pointing both ways. Motions with the same m and n share a label; labels at one
+        position are stacked, the one-collision motions' first.
+    """
+    groups = {}
+    for name in names:
+        name = str(name)
+        found = re.fullmatch(r"\((\d+),(\d+)\)/(\d+)|(\d+)/(\d+)", name)
+        if found is None:
+            raise ValueError(f"a motion name is 'm/n' or '(m_upper,m_lower)/n', got {name!r}")
+        mu, ml, n2, m1, n1 = found.groups()
+        m, n = (int(mu) + int(ml), int(n2)) if m1 is None else (int(m1), int(n1))
+        if m < 1 or n < 1:
+            raise ValueError(f"motion {name!r} has no collision or no period")
+        groups.setdefault((m, n), []).append(name if name.startswith("(") else f"({name})")
+    at = {}
+    for (m, n), shown in groups.items():
+        joined = ", ".join(shown)
+        period = "z" if n == 1 else f"{n}z"
+        if m == 1:
+            text = (f" {joined}", "left")
+        elif m == 2:
+            text = (rf"$\leftarrow$ {joined}: pairs $z_j + z_{{j+1}} = {period}$ $\rightarrow$",
+                    "center")
+        else:
+            text = (rf"$\leftarrow$ {joined}: $z_j + \dots + z_{{j+{m - 1}}} = {period}$ "
+                    r"$\rightarrow$", "center")
+        at.setdefault(n / m, []).append((m, text))
+    marks = []
+    for x in sorted(at):
+        entries = sorted(at[x], key=lambda e: e[0] != 1)      # one-collision motions first
+        ls = ":" if entries[0][0] == 1 else "-."
+        marks.append((x, ls, [text for _, text in entries]))
+    return marks
 
 
 @_styled

@@ -11,9 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from dataclasses import replace
+
 from vibroimpact.plotting._common import (
-    _events_params, _figure, _header, _num, _panel_tag, _require, _density_deltas, axis_label,
-    family_styles, note_on_axes)
+    SPARSE_TEXT, _beyond_text, _bin_edges, _density_deltas, _density_log_limits,
+    _density_rule_text, _draw_densities, _events_params, _figure, _header, _num, _panel_tag,
+    _require, _two_wall_note, axis_label, note_on_axes)
 
 #: How the figures name each wall (the ``wall`` coordinate's values).
 WALL_NAMES = {"upper": "upper wall, x = $\\delta$ (hit from below)",
@@ -21,8 +24,6 @@ WALL_NAMES = {"upper": "upper wall, x = $\\delta$ (hit from below)",
 #: Colour and marker of each wall in the means figure.
 WALL_STYLES = {"upper": dict(color="C0", marker="o", ls="-"),
                "lower": dict(color="C3", marker="s", ls="--")}
-#: Densities below this fraction of the panel's peak are not drawn on the log axis.
-DENSITY_DECADES = 1e-5
 
 
 def two_walls(ds):
@@ -30,8 +31,41 @@ def two_walls(ds):
     return "wall" in ds.dims
 
 
+def wall_view(ds, quantity, wall):
+    """One wall's density of `quantity` under the one-wall names, for the one-wall drawing.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        One inv_beta row of a two-wall events dataset.
+    quantity : {"v_after", "interval", "ratio"}
+        The density's quantity.
+    wall : str
+        A value of the ``wall`` coordinate.
+
+    Returns
+    -------
+    xarray.Dataset
+        ``{quantity}_density``, ``{quantity}_density_stderr`` (when the dataset has it),
+        ``{quantity}_beyond`` and ``n_collisions`` of that wall (its ``wall_*`` variables),
+        with ``n_batches``, over ``delta``: what `_common._draw_densities` reads of a
+        one-wall dataset. A wall's densities are normalised by its own collisions
+        (`stats.wall_statistics`), as the one-wall ones by all of them.
+    """
+    names = {f"wall_{quantity}_density": f"{quantity}_density",
+             f"wall_{quantity}_density_stderr": f"{quantity}_density_stderr",
+             f"wall_{quantity}_beyond": f"{quantity}_beyond",
+             "wall_n_collisions": "n_collisions"}
+    for name in (f"wall_{quantity}_density", f"wall_{quantity}_beyond", "wall_n_collisions",
+                 "n_batches"):
+        _require(ds, name, "a two-wall density figure")
+    names = {old: new for old, new in names.items() if old in ds}
+    return ds.sel(wall=wall)[[*names, "n_batches"]].rename(names)
+
+
 def wall_density_figure(events, i_beta, quantity, title, density_delta=None):
-    """One density panel per wall of ``wall_{quantity}_density``, one curve per density delta.
+    """One log-density panel per wall of ``wall_{quantity}_density``, one curve per density
+    delta, drawn as the one-wall density figures draw theirs.
 
     Parameters
     ----------
@@ -49,50 +83,50 @@ def wall_density_figure(events, i_beta, quantity, title, density_delta=None):
     Returns
     -------
     matplotlib.figure.Figure
-        Two stacked log-density axes (upper wall, lower wall), each curve with a band of
-        +-2 batch-means standard errors; the legend gives each play's collisions at that
-        wall.
+        Two stacked log-density axes (upper wall, lower wall) sharing x. Each wall's curves
+        are `_common._draw_densities` of its `wall_view`: the sparse-bin rule
+        (`_common.MIN_BIN_COUNT`, merged runs drawn as bars apart from the curves) and the
+        band of +-t batch-means standard errors joined with Garwood's interval of the count,
+        as in Figs. 7, 8, 13, 14 of one wall. One legend below the axes, its title the band
+        and the rule (`_common._density_rule_text`); each entry gives the play's collisions
+        at each wall and, when above `_common.BEYOND_SHOWN`, the fraction beyond the last bin.
     """
-    var = f"wall_{quantity}_density"
+    var = f"{quantity}_density"
     ds = events.isel(inv_beta=i_beta)
-    density = _require(ds, var, "this figure")
-    stderr = ds.get(f"{var}_stderr")
-    x = density.dims[-1]
-    centres = np.asarray(ds[x], dtype=float)
+    _require(ds, f"wall_{var}", "this figure")
     index = _density_deltas(events, density_delta)
-    styles = family_styles(len(index))
-    fig, axes = _figure(len(ds["wall"]), sharex=True)
-    for ax, wall in zip(axes, ds["wall"].values):
-        wall = str(wall)
-        top, x_end = 0.0, centres[0]
-        for style, k in zip(styles, index):
-            cell = ds.isel(delta=k).sel(wall=wall)
-            y = np.asarray(cell[var], dtype=float)
-            n = int(cell["wall_n_collisions"])
-            shown = y > 0.0
-            label = (rf"$\delta$ = {_num(cell['delta'])}  "
-                     f"({n:,} collision{'' if n == 1 else 's'})")
-            ax.plot(centres, np.where(shown, y, np.nan), color=style["color"], ls=style["ls"],
-                    label=label)
-            if stderr is not None and shown.any():
-                se = np.asarray(cell[f"{var}_stderr"], dtype=float)
-                ax.fill_between(centres, np.where(shown, np.maximum(y - 2 * se, y * 1e-3),
-                                                  np.nan),
-                                np.where(shown, y + 2 * se, np.nan), color=style["color"],
-                                alpha=0.15, lw=0, gid="band")
-            if shown.any():
-                top = max(top, float(y.max()))
-                x_end = max(x_end, float(centres[shown].max()))
-        ax.set_yscale("log")
-        if top > 0.0:
-            ax.set_ylim(top * DENSITY_DECADES, top * 3.0)
-            ax.set_xlim(0.0, x_end * 1.05)
-        else:
-            note_on_axes(ax, "no collision at this wall at any $\\delta$ drawn")
+    walls = [str(w) for w in ds["wall"].values]
+    views = [wall_view(ds, quantity, wall) for wall in walls]
+    labels = []
+    for k in index:
+        parts = [f"{wall} {int(view['n_collisions'][k]):,}"
+                 f"{_beyond_text(view[f'{quantity}_beyond'][k])}"
+                 for wall, view in zip(walls, views)]
+        labels.append(rf"$\delta$ = {_num(ds['delta'][k])}  (collisions: {'; '.join(parts)})")
+    fig, axes = _figure(len(walls), sharex=True)
+    x = ds[f"wall_{var}"].dims[-1]
+    edges = _bin_edges(ds[x])
+    x_end, drawn_any = edges[0], []
+    for j, (ax, wall, view) in enumerate(zip(axes, walls, views)):
+        drawn = _draw_densities([ax], view, var, index, labels if j == 0 else None)
+        _density_log_limits(ax, drawn)
+        if drawn.top <= 0.0:
+            hit = int(view["n_collisions"].isel(delta=index).sum()) > 0
+            note_on_axes(ax, SPARSE_TEXT if hit
+                         else "no collision at this wall at any $\\delta$ drawn")
+        x_end = max(x_end, drawn.x_end)
+        drawn_any.append(drawn)
         ax.set_ylabel(_density_label(quantity))
         _panel_tag(ax, WALL_NAMES.get(wall, wall))
-        ax.legend(loc="upper right", fontsize="small")
-    axes[-1].set_xlabel(axis_label(ds[x]))
+    axes[0].set_xlim(edges[0], x_end if x_end > edges[0] else edges[-1])
+    axes[-1].set_xlabel(_two_wall_note(events, axis_label(ds[x])))    # eps_w u
+    # one title for both walls: a merged run drawn at either wall is explained
+    rule = _density_rule_text(views[0], index, replace(
+        drawn_any[0], any_run=any(d.any_run for d in drawn_any)))
+    # an entry per play, each naming both walls: one column, below the axes
+    fig.set_figheight(fig.get_figheight() * (1.15 + 0.04 * len(index)))
+    fig.legend(loc="outside lower center", ncols=1, title=rule, title_fontsize=7.5,
+               fontsize=7.5)
     _header(fig, title, _events_params(events, i_beta, (quantity,)))
     return fig
 
