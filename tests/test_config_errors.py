@@ -386,6 +386,132 @@ CASES = [
             figures: [fig13]
             report_with: [motion_map]
         """, "limits.max_jobs", "this build has 25 jobs"),
+    # a plane study gets the checks every study gets (issue 44)
+    _own("plane_report_with_unknown", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+            report_with: [no_such_study]
+        """, "studies.pl.report_with", "no other study of this name"),
+    _own("plane_report_with_itself", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+            report_with: [pl]
+        """, "studies.pl.report_with", "allowed: flat"),
+    _own("plane_t_end_ignored", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+            t_end: 1.0e+9
+        """, "studies.pl.t_end", "draws its map alone"),
+    _own("plane_density_delta_ignored", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+            density_delta: [7.0]
+        """, "studies.pl.density_delta", "draws its map alone"),
+    _own("plane_n_batches_beyond_min_time", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+            n_batches: 1000
+        """, "studies.pl.n_batches", "map.min_time"),
     _own("replace_names_no_entry", """
         paper: false
         replace: [studies.random]

@@ -373,14 +373,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
     if not shapes_ok:
         return None
     two_walls = _check_walls(where, entry, problems)
-    siblings = {name}           # itself, or every study of its sweep
-    if "sweep" in entry:
-        siblings = set(config.get("sweeps", {}).get(entry["sweep"]["name"], {}).get(
-            "studies", [name]))
-    for other in entry.get("report_with", []):
-        if other in siblings or other not in config["studies"]:
-            problems.add(f"{where}.report_with", other, "no other study of this name",
-                         ", ".join(sorted(set(config["studies"]) - siblings)) or "none")
+    _check_report_with(config, name, entry, problems)
     if entry["noise"] not in config["noises"]:
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
@@ -496,6 +489,25 @@ def _check_study(config, name, entry, problems, limits, unforced):
         _check_figures(config, "studies", name, entry, problems, grids)
     resolved.update(grids)
     return resolved
+
+def _check_report_with(config, name, entry, problems):
+    """``report_with``: other studies of the config (not itself, nor its sweep's own)."""
+    siblings = {name}           # itself, or every study of its sweep
+    if "sweep" in entry:
+        siblings = set(config.get("sweeps", {}).get(entry["sweep"]["name"], {}).get(
+            "studies", [name]))
+    for other in entry.get("report_with", []):
+        if other in siblings or other not in config["studies"]:
+            problems.add(f"studies.{name}.report_with", other, "no other study of this name",
+                         ", ".join(sorted(set(config["studies"]) - siblings)) or "none")
+
+
+#: Keys of a study that only its event statistics read (Figs. 3-14), with the schema's
+#: defaults: a plane study draws its map alone, which runs each cell from rest to its own
+#: target or cap (``map``), so a value other than the default would be ignored. (Its
+#: ``n_batches`` cut the map's records: checked against the shortest, ``map.min_time``.)
+_EVENT_ONLY = {"t_end": None, "density_delta": []}
+
 
 def _check_trace_t_end(where, entry, dt, tau, record, problems):
     """A trace (``trace.t_end``) within the noise record and at least one sample step."""
@@ -625,6 +637,13 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
     if "gap" not in plane:
         _check_walls(where, entry, problems)
     two_walls = entry.get("gap") is not None
+    _check_report_with(config, name, entry, problems)
+    for key, default in _EVENT_ONLY.items():
+        if entry.get(key, default) != default:
+            problems.add(f"{where}.{key}", entry[key], f"read by the event statistics only, "
+                         f"and a study with a plane ({plane}) draws its map alone (each cell "
+                         f"run to its own target or cap: map)", f"leave {key} out, or put it "
+                         f"in a study without a plane")
     if entry["noise"] not in config["noises"]:
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
                      ", ".join(sorted(config["noises"])))
@@ -681,6 +700,8 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         problems.add(f"{where}.map.min_time", spec["min_time"], "transient + min_time is "
                      f"beyond the record (tau <= {tau:.6g})",
                      f"0 < min_time <= {tau - transient:.6g}")
+    _check_batches(where, entry, float(spec["min_time"]), dt, problems,
+                   record="a map cell's shortest, map.min_time", longer="a map.min_time")
     for key in plane:
         if grids[key].size < 2:
             problems.add(f"{where}.{key}", entry[key], f"fig15 draws contours over the "
@@ -758,9 +779,10 @@ def _check_plane_attractors(where, entry, plane, grids, problems):
 MIN_BATCH_TIME = 2 * math.pi
 
 
-def _check_batches(where, entry, length, dt, problems):
-    """Record a statistics record (transient to t_end, ``length``) too short for its
-    ``n_batches`` batches, each at least `MIN_BATCH_TIME` and 2 samples long."""
+def _check_batches(where, entry, length, dt, problems, record="transient to t_end",
+                   longer="a record (t_end - transient)"):
+    """Record a statistics record (``record``, ``length``) too short for its ``n_batches``
+    batches, each at least `MIN_BATCH_TIME` and 2 samples long."""
     if length <= 0.0:
         return          # reported as the transient's
     shortest = max(MIN_BATCH_TIME, 2 * dt)
@@ -769,11 +791,10 @@ def _check_batches(where, entry, length, dt, problems):
         return
     fits = int(length // shortest)
     allowed_ = (f"n_batches <= {fits}, or " if fits >= 2 else "") + (
-        f"a record (t_end - transient) of at least n_batches x {shortest:.4g} = "
-        f"{n_batches * shortest:.4g}")
+        f"{longer} of at least n_batches x {shortest:.4g} = {n_batches * shortest:.4g}")
     problems.add(f"{where}.n_batches", n_batches, f"batches of {length / n_batches:.3g} time "
                  f"units ({length / dt / n_batches:.3g} samples) over the statistics record of "
-                 f"{length:.3g} (transient to t_end), shorter than a natural period 2 pi or 2 "
+                 f"{length:.3g} ({record}), shorter than a natural period 2 pi or 2 "
                  f"samples", allowed_)
 
 
