@@ -387,6 +387,54 @@ CASES = [
             report_with: [motion_map]
         """, "limits.max_jobs", "this build has 25 jobs"),
     # a plane study gets the checks every study gets (issue 44)
+    _own("plane_fixed_inv_beta_the_default_list", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: [1.0]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+        """, "studies.pl.inv_beta", "the default grid of a study without a plane"),
+    _own("plane_axis_inv_beta_one_value", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [inv_beta, delta]
+            eps: 0.5
+            inv_beta: [1.0]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+        """, "studies.pl.inv_beta", "needs a grid"),
     _own("plane_report_with_unknown", """
         paper: false
         studies:

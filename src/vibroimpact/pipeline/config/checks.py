@@ -596,7 +596,13 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
     for key in plane:
         spec = entry.get(key)
         if key == "inv_beta" and spec == unforced:
-            spec = None         # the schema's default: left out (a one-value axis anyway)
+            # the schema's default, or the same one value written: a one-value axis either way
+            problems.add(f"{where}.{key}", spec, f"missing, or the one value {unforced} (the "
+                         f"default): an axis of the plane {plane} needs a grid",
+                         f"a grid of at least 2 values under {key}: a list or "
+                         f"{{start, stop, step}}")
+            ok = False
+            continue
         if spec is None:
             problems.add(f"{where}.{key}", None, f"missing: an axis of the plane {plane}",
                          f"a grid under {key}: a list or {{start, stop, step}}")
@@ -619,9 +625,10 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
             continue
         value = entry[key]
         if key == "inv_beta" and value == unforced:
-            problems.add(f"{where}.inv_beta", None, f"missing: the plane {plane} fixes "
-                         f"1/beta_f", "a number > 0 under inv_beta (a map needs the "
-                         "forcing period)")
+            problems.add(f"{where}.inv_beta", value, f"missing, or the list {unforced} (the "
+                         f"default grid of a study without a plane): the plane {plane} fixes "
+                         f"1/beta_f", "a number > 0 under inv_beta (a map needs the forcing "
+                         "period), e.g. inv_beta: 1.0")
             ok = False
         elif isinstance(value, (list, dict)):
             problems.add(f"{where}.{key}", value, f"a grid, and {key} is fixed in the plane "
