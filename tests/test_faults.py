@@ -504,3 +504,71 @@ def test_the_run_asks_snakemake_what_is_missing_only_when_results_hold_a_file(
     assert [cmd[-1] for cmd in asked] == (["--summary"] if written else [])
     assert ("--forcerun" in handed[0]) == written
     assert cli.has_written(work / "results") == written
+
+
+def test_a_full_disk_is_said_in_one_line_and_keeps_nothing(tmp_path, monkeypatch, capsys):
+    """A write that fails on a full disk (ENOSPC, or the netCDF library's permission error
+    where nothing is free) ends the job with one line on the console naming the mount, what
+    is free and what the write had taken; no temporary is left, the log holds the same."""
+    import errno
+    import shutil
+    from collections import namedtuple
+
+    from vibroimpact import _files
+    from vibroimpact.pipeline import tasks
+
+    ds = xr.Dataset({"x": ("i", np.arange(1000.0))})
+    target = tmp_path / "out" / "d.nc"
+    real_to_netcdf = xr.Dataset.to_netcdf
+
+    def fails_after_writing(self, path, *args, error=None, **kw):
+        real_to_netcdf(self, path, *args, **kw)      # something written, then the failure
+        raise error
+
+    usage = namedtuple("usage", "total used free")
+    for error, free in ((OSError(errno.ENOSPC, "No space left on device"), 10 * 2**20),
+                        (PermissionError(errno.EACCES, "Permission denied"), 2**16)):
+        monkeypatch.setattr(xr.Dataset, "to_netcdf",
+                            lambda self, p, *a, e=error, **k: fails_after_writing(
+                                self, p, *a, error=e, **k))
+        monkeypatch.setattr(shutil, "disk_usage", lambda p, f=free: usage(1, 1, f))
+        log = tmp_path / "job.log"
+        with pytest.raises(SystemExit):
+            with tasks.logged(str(log)):
+                io.write_dataset(ds, target)
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1 and err.startswith("error: no space left on /")
+        assert f"{free / 1e6:.2f} MB free" in err and "d.nc had taken" in err
+        assert "no space left on" in log.read_text()
+        assert list(target.parent.iterdir()) == []
+    # a permission error with room on the disk is what it says
+    monkeypatch.setattr(shutil, "disk_usage", lambda p: usage(1, 1, 10 * 2**30))
+    with pytest.raises(PermissionError):
+        with _files.atomic_path(target) as tmp:
+            raise PermissionError(errno.EACCES, "Permission denied", tmp)
+
+
+def test_the_free_space_check_counts_what_is_left_to_write(tmp_path):
+    """The plan refuses a build whose outputs do not fit the free space, counting what an
+    earlier build left under results/ as written: a finished build missing one dataset is
+    not refused for the whole build's bytes."""
+    from vibroimpact.pipeline import config as configuration
+    from vibroimpact.pipeline.config.messages import ConfigError
+
+    _, plan = configuration.load(root=Path(__file__).resolve().parents[1])
+    plan.results = str(tmp_path / "results")
+    plan.free_bytes = 0.5 * plan.bytes
+    with pytest.raises(ConfigError, match="this build writes"):
+        plan.refuse_beyond_limits()
+    built = tmp_path / "results" / "datasets" / "old.nc"
+    built.parent.mkdir(parents=True)
+    with open(built, "wb") as f:            # an earlier build's outputs: 60 % of the total
+        f.truncate(int(0.6 * plan.bytes))
+    logs = tmp_path / "results" / "logs" / "big.log"
+    logs.parent.mkdir(parents=True)
+    plan.refuse_beyond_limits()
+    built.unlink()
+    with open(logs, "wb") as f:             # logs are not outputs
+        f.truncate(int(0.6 * plan.bytes))
+    with pytest.raises(ConfigError, match=r"in all, 0 B of it already"):
+        plan.refuse_beyond_limits()

@@ -1,15 +1,17 @@
 """The one atomic-write helper: a result appears under its final name complete, or not at all."""
 import contextlib
+import errno
 import os
 from pathlib import Path
 import re
 import secrets
+import shutil
 import signal
 import socket
 import threading
 import time
 
-__all__ = ["atomic_path", "sweep_stale_temporaries", "TEMP_PATTERN"]
+__all__ = ["atomic_path", "sweep_stale_temporaries", "TEMP_PATTERN", "DiskFullError"]
 
 #: Temporary names: ``.<name>.<pid>.<random>@<host>.tmp`` beside the final file, so a later
 #: run can tell whose they are (the writer's process, on which machine).
@@ -17,6 +19,42 @@ TEMP_PATTERN = re.compile(r"^\.(?P<name>.+)\.(?P<pid>[0-9]+)\.[0-9a-f]{12}@(?P<h
 
 #: A temporary file of another machine untouched this long is stale (its writer is gone).
 STALE_ELSEWHERE_S = 2 * 24 * 3600.0
+
+
+#: A write that fails (with any OS error: the netCDF library reports a full disk as a
+#: permission error) where less than this is free is reported as a full disk.
+DISK_FULL_MARGIN = 4 * 2**20
+
+
+class DiskFullError(OSError):
+    """A result could not be written: its file system is full (one line: the mount, what is
+    free, what the writer had written)."""
+
+    def __init__(self, path, written, free, cause):
+        mount = Path(path).resolve().parent
+        while not os.path.ismount(mount) and mount != mount.parent:
+            mount = mount.parent
+        super().__init__(errno.ENOSPC,
+                         f"no space left on {mount}: {free / 1e6:.2f} MB free, and writing "
+                         f"{Path(path).name} had taken {written / 1e6:.2f} MB when it failed "
+                         f"({type(cause).__name__}: {cause}); free some space and run again "
+                         f"(nothing half-written is kept)")
+
+
+def _disk_full(path, tmp, err):
+    """``err`` (raised while writing ``tmp``) as a :class:`DiskFullError` when the disk is full
+    (ENOSPC, EDQUOT, or any OS error with less than `DISK_FULL_MARGIN` free), else None."""
+    try:
+        free = shutil.disk_usage(Path(path).parent).free
+    except OSError:
+        return None
+    if err.errno not in (errno.ENOSPC, errno.EDQUOT) and free >= DISK_FULL_MARGIN:
+        return None
+    try:
+        written = os.path.getsize(tmp)
+    except OSError:
+        written = 0
+    return DiskFullError(path, written, free, err)
 
 
 def _raise_exit(signum, frame):
@@ -47,7 +85,8 @@ def atomic_path(path):
     exception, an interrupt (SIGINT) or a SIGTERM, the temporary file is removed and
     ``path`` is left as it was: a failed or interrupted run never leaves a half-written file
     under a name a later run would trust. A writer killed outright (SIGKILL) leaves its
-    temporary, which :func:`sweep_stale_temporaries` removes at the next start.
+    temporary, which :func:`sweep_stale_temporaries` removes at the next start. A write
+    that fails on a full disk raises :class:`DiskFullError`, which says so in one line.
 
     Parameters
     ----------
@@ -60,8 +99,14 @@ def atomic_path(path):
                          f"@{socket.gethostname()}.tmp")
     with _terminate_as_exit():
         try:
-            yield str(tmp)
-            os.replace(tmp, path)
+            try:
+                yield str(tmp)
+                os.replace(tmp, path)
+            except OSError as err:
+                full = _disk_full(path, tmp, err)
+                if full is None:
+                    raise
+                raise full from err
         finally:
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(tmp)

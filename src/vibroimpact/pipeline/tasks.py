@@ -14,6 +14,7 @@ import sys
 import numpy as np
 
 from vibroimpact import stats
+from vibroimpact._files import DiskFullError
 from vibroimpact.pipeline import datasets, io
 from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
@@ -41,6 +42,13 @@ def logged(path):
     except io.CorruptFileError as err:
         log.exception("job failed")
         print(f"error: {err}", file=sys.stderr)
+        raise SystemExit(1) from None
+    except DiskFullError as err:
+        # the console first: the log's own file system is likely the full one, and its
+        # handler's failure is not reported over this message
+        print(f"error: {err.strerror}", file=sys.stderr)
+        logging.raiseExceptions = False
+        log.error("job failed: %s", err.strerror)
         raise SystemExit(1) from None
     except BaseException:
         log.exception("job failed")

@@ -144,11 +144,30 @@ class Plan:
                             f"writes ~{_bytes(self.bytes)}; raise limits.max_disk_gb to build "
                             f"it, or shorten the records\n  ({self.summary()})")
         elif self.free_bytes is not None and self.bytes > self.free_bytes:
-            problems.append(f"disk: this build writes ~{_bytes(self.bytes)}, only "
-                            f"{_bytes(self.free_bytes)} free under {self.results}; free "
-                            f"some space or shorten the records")
+            # what a finished or partial earlier build holds is not written again
+            built = _built_bytes(self.results)
+            if self.bytes - built > self.free_bytes:
+                problems.append(f"disk: this build writes ~{_bytes(self.bytes - built)} "
+                                f"(~{_bytes(self.bytes)} in all, {_bytes(built)} of it already "
+                                f"under {self.results}), only {_bytes(self.free_bytes)} free "
+                                f"there; free some space or shorten the records")
         if problems:
             raise ConfigError(problems)
+
+
+def _built_bytes(results):
+    """Bytes of the files under ``results`` (an earlier build's outputs, logs and benchmarks
+    aside: they are small and written anew), 0 when there is none."""
+    total = 0
+    for path in Path(results).rglob("*"):
+        if path.parts[len(Path(results).parts):][:1] in (("logs",), ("benchmarks",)):
+            continue
+        try:
+            if path.is_file():
+                total += path.stat().st_size
+        except OSError:
+            continue
+    return total
 
 
 def _n(count, word):
