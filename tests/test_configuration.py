@@ -279,3 +279,28 @@ def test_every_study_key_reaches_the_jobs_that_read_it():
     by_reports = {"figures", "report_with"}
     assert keys == by_jobs | by_figures | before_jobs | by_reports
     assert not by_jobs & by_figures         # a figure option reruns no simulation
+
+
+def test_an_orbits_entry_writing_the_default_eps_lower_is_the_same_system(tmp_path):
+    """The clearance example's orbits entry with ``eps_lower`` written as the default it
+    takes (its eps) still draws the study's fig15_vs_fig16; a different one is refused."""
+    from vibroimpact.pipeline.config.messages import ConfigError
+
+    text = yaml.safe_load((ROOT / "config/examples/clearance.yaml").read_text())
+    for value, refused in ((0.5, False), (0.6, True)):
+        text["orbits"]["clearance"]["eps_lower"] = value
+        path = tmp_path / "c.yaml"
+        path.write_text(yaml.safe_dump(text))
+        if refused:
+            with pytest.raises(ConfigError, match=r"has eps_lower = 0\.6, the study "
+                                                  r"eps_lower = 0\.5"):
+                configuration.load(root=ROOT, user_files=[path])
+        else:
+            configuration.load(root=ROOT, user_files=[path])
+
+
+def test_values_that_differ_past_six_digits_are_printed_apart():
+    from vibroimpact.pipeline.config.checks import _told_apart
+
+    assert _told_apart(1 / 1.1, 0.90909090909091) == ("0.909090909090909", "0.90909090909091")
+    assert _told_apart(0.5, None) == ("0.5", "none")

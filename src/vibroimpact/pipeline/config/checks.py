@@ -292,23 +292,39 @@ def _check_orbits_item_plane(name, entry, at, orbits, other, problems):
         if (a is None) != (b is None) or (a is not None and (
                 isinstance(a, (list, dict)) or isinstance(b, (list, dict))
                 or float(a) != float(b))):
-            def text(v):
-                return _num(v) if isinstance(v, (int, float)) else "none" if v is None else v
-            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = {text(b)}, the "
-                         f"study {key} = {text(a)}",
+            b_text, a_text = _told_apart(b, a)
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = {b_text}, the "
+                         f"study {key} = {a_text}",
                          f"an `orbits` entry over {plane} with the study's fixed values")
 
 
 def _check_orbits_item_system(entry, at, orbits, other, problems):
     for key in ("zeta", "eps", "gap", "eps_lower"):
-        if other.get(key) != entry.get(key) and (
-                other.get(key) is None or entry.get(key) is None
-                or float(other[key]) != float(entry[key])):
-            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = "
-                         f"{_num(other[key]) if other.get(key) is not None else 'none'}, the "
-                         f"study {key} = "
-                         f"{_num(entry[key]) if entry.get(key) is not None else 'none'}",
+        a, b = entry.get(key), other.get(key)
+        if key == "eps_lower" and entry.get("gap") is not None:
+            a = entry["eps"] if a is None else a        # absent with a gap: the entry's eps
+            b = other["eps"] if b is None else b
+        if a != b and (b is None or a is None or float(b) != float(a)):
+            b_text, a_text = _told_apart(b, a)
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} has {key} = {b_text}, the "
+                         f"study {key} = {a_text}",
                          "an `orbits` entry of the same zeta and eps (and walls)")
+
+
+def _told_apart(a, b):
+    """Two values as text, numbers with as many digits as it takes to tell them apart (up
+    to 17: "0.9090909090909091" and "0.90909090909091"), "none" for None."""
+    def text(v, digits):
+        if v is None:
+            return "none"
+        if isinstance(v, (int, float)):
+            return f"{float(v):.{digits}g}" if isinstance(v, float) else str(v)
+        return str(v)
+    for digits in range(6, 18):
+        ta, tb = text(a, digits), text(b, digits)
+        if ta != tb:
+            return ta, tb
+    return ta, tb
 
 
 def _check_walls(where, entry, problems):
