@@ -25,6 +25,7 @@ import pytest
 import yaml
 
 from vibroimpact.pipeline import config as configuration
+from vibroimpact.pipeline.config.messages import ConfigError
 
 from helpers import ROOT, SNAKEMAKE, make_workdir
 
@@ -1063,3 +1064,29 @@ def test_plastic_and_tiny_studies_build(tmp_path):
         for name, factor in (("v_after_mean", 2e-12), ("interval_mean", 1.0)):
             ratio = tiny[name].values / (factor * scaled[name].values)
             assert abs(ratio - 1.0).max() < 1e-12, (name, ratio)
+
+
+def test_a_long_schema_description_is_cut_in_the_message(tmp_path):
+    """A value refused under a key whose description is a paragraph (plane's: ~1 100
+    characters) gets a message of one readable line that says where the rest is."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(textwrap.dedent("""
+        paper: false
+        studies:
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: "eps, delta"
+            eps: 0.5
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig15]
+        """))
+    with pytest.raises(ConfigError) as info:
+        configuration.load(root=ROOT, user_files=[path])
+    line = next(m for m in str(info.value).splitlines() if "studies.pl.plane" in m)
+    assert len(line) < 400, line
+    assert line.endswith("(the whole description: workflow/schemas/config.schema.yaml, "
+                         "studies.pl.plane)")

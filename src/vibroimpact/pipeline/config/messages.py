@@ -55,6 +55,22 @@ def _num(x):
     return f"{x:g}" if isinstance(x, float) else str(x)
 
 
+#: Characters of an "allowed" text beyond which a message keeps only its start (and names
+#: where the rest is): a message stays one readable line.
+ALLOWED_MAX = 240
+
+
+def brief(text, parts=()):
+    """``text`` as it is when short, else its words within `ALLOWED_MAX` and where the whole
+    is: the schema's entry for ``parts``."""
+    if len(text) <= ALLOWED_MAX:
+        return text
+    head = text[:text.rfind(" ", 0, ALLOWED_MAX)].rstrip(",;(") + " ..."
+    where = ".".join(str(p) for p in parts if not isinstance(p, int))
+    return (f"{head} (the whole description: workflow/schemas/config.schema.yaml"
+            + (f", {where})" if where else ")"))
+
+
 def _short(value):
     """``value`` as YAML on one line, cut to 60 characters."""
     if isinstance(value, str) and _invisible(value):
@@ -217,13 +233,14 @@ class _Words:
         return self.resolve(node)
 
     def describe(self, parts, node=None):
-        """What the node at ``parts`` (or ``node``) allows, with its description."""
+        """What the node at ``parts`` (or ``node``) allows, with its description (its start
+        where it is long: `brief`)."""
         node = node if node is not None else self.at(parts)
         text = self.allowed(node) if node else "see workflow/schemas/config.schema.yaml"
         desc = node.get("description", "").strip() if node else ""
         if desc and desc != text and "oneOf" not in node:
             text += f" ({desc})"
-        return text
+        return brief(text, parts)
 
     def not_allowed(self, parts, value, node=None):
         """``<key path> = <value>: not allowed; allowed: ...`` (``node``: the schema node
