@@ -436,6 +436,32 @@ CASES = [
             map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
             figures: [fig15]
         """, "studies.pl.inv_beta", "needs a grid"),
+    _own("plane_escape_default_cells", """
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [gap, delta]
+            eps: 0.5
+            gap: [2.0, 3.0]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+            escape: {rms: [0.2, 0.25, 0.3]}
+        """, "studies.pl.escape.cells", "names its escape cells in its own coordinates"),
     _own("plane_report_with_unknown", """
         paper: false
         studies:

@@ -304,3 +304,11 @@ def test_values_that_differ_past_six_digits_are_printed_apart():
 
     assert _told_apart(1 / 1.1, 0.90909090909091) == ("0.909090909090909", "0.90909090909091")
     assert _told_apart(0.5, None) == ("0.5", "none")
+
+
+def test_the_checks_know_the_schemas_default_escape_cells():
+    from vibroimpact.pipeline.config.checks import DEFAULT_ESCAPE_CELLS
+
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    escape = schema["$defs"]["study"]["properties"]["escape"]["properties"]
+    assert escape["cells"]["default"] == DEFAULT_ESCAPE_CELLS

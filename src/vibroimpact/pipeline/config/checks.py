@@ -825,6 +825,10 @@ def _check_batches(where, entry, length, dt, problems, record="transient to t_en
 ESCAPE_MAX_SAMPLES = 50_000_000
 
 
+#: The schema's default escape cells (``studies.<name>.escape.cells``): [inv_beta, delta].
+DEFAULT_ESCAPE_CELLS = [[1.1, 1.0], [1.1, 0.1], [1.2, 2.5]]
+
+
 def _check_escape(where, entry, grids, harmonic, dt, problems, axes=("inv_beta", "delta")):
     """The escape block: cells inside the study's plane (``axes``: the paper's (1/beta_f,
     delta), or the plane a study names, each cell ``[x, y]`` in its coordinates), distinct
@@ -838,6 +842,13 @@ def _check_escape(where, entry, grids, harmonic, dt, problems, axes=("inv_beta",
         problems.add(where, None, "the escape cells lie in the (1/beta_f, delta) plane of the "
                      "harmonic force, and this study has none (amplitude = 0)",
                      "leave it out, or give the study an amplitude != 0")
+        return
+    if tuple(axes) != ("inv_beta", "delta") and block["cells"] == DEFAULT_ESCAPE_CELLS:
+        # the schema's default cells are [inv_beta, delta] pairs: no cells of this plane
+        problems.add(f"{where}.cells", block["cells"], "missing, or the default cells "
+                     "(pairs [inv_beta, delta]): a study with a plane names its escape cells "
+                     "in its own coordinates", f"cells: a list of {pair} pairs inside the "
+                     f"study's {plane_words} plane")
         return
     box = {k: (float(g.min()), float(g.max())) for k, g in grids.items() if g is not None}
     for i, cell in enumerate(block["cells"]):
