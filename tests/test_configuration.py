@@ -111,7 +111,8 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
     twins |= {p[:-5] + ext for p in current if p.endswith(".html")
               for ext in (".ipynb", ".summary.html")}
     old = ["results/figures/harmonic/fig13-9.png", "results/figures/harmonic/fig13-9.pdf",
-           "results/datasets/harmonic_map.nc", "results/reports/random/harmonic_random.html"]
+           "results/datasets/harmonic_map.nc", "results/reports/random/harmonic_random.html",
+           "results/datasets/harmonic_basins.nc", "results/datasets/random_predictors.nc"]
     other = ["results/datasets/harmonic_two_events.nc", "results/figures/elsewhere/fig09.png"]
     for rel in [*current, *twins, *old, *other]:
         (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
@@ -119,6 +120,9 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
     assert stale.stale_files(config, plan.drawn, tmp_path) == sorted(old)
     mine, mine_plan = configuration.load(MINE, root=ROOT)
     assert stale.stale_files(mine, mine_plan.drawn, tmp_path) == []    # the paper's: not its
+    line = stale.summary(stale.stale_files(config, plan.drawn, tmp_path))
+    assert line.startswith(f"vibroimpact: {len(old)} file(s) beside this config's outputs")
+    assert "and 3 more" in line and "vibroimpact stale --delete" in line
     assert stale.main(["--directory", str(tmp_path), "--delete"]) == 0
     assert not any((tmp_path / rel).exists() for rel in old)
     assert all((tmp_path / rel).exists() for rel in [*current, *twins, *other])

@@ -26,6 +26,20 @@ __all__ = ["stale_files", "main"]
 _TWINS = {".pdf": ".png", ".ipynb": ".html", ".summary.html": ".html"}
 
 
+#: The datasets a study may own (``results/datasets/<study>_<kind>.nc``,
+#: `vibroimpact.pipeline.targets.DATASETS`): its statistics, map, spectra, escape, the
+#: predictors of its map and, over a plane, its basins and Lyapunov exponents.
+STUDY_DATASETS = ("events", "map", "spectra", "escape", "predictors", "basins", "lyapunov")
+
+
+def summary(files):
+    """One line on the files :func:`stale_files` found (a build's end says it)."""
+    shown = ", ".join(files[:3]) + (f" and {len(files) - 3} more" if files[3:] else "")
+    return (f"vibroimpact: {len(files)} file(s) beside this config's outputs are not built by "
+            f"it (an earlier config's): {shown}; `vibroimpact stale` lists them, "
+            f"`vibroimpact stale --delete` (make clean-stale) removes them")
+
+
 def stale_files(config, drawn, root="."):
     """Files under ``root``/results of the entries in ``drawn`` that the config does not
     build (sorted paths relative to ``root``)."""
@@ -35,8 +49,7 @@ def stale_files(config, drawn, root="."):
     for name in drawn["studies"]:
         places += [(f"results/figures/{name}", "*"), (f"results/reports/{name}", "*"),
                    ("results/traces", f"{name}.nc")]
-        places += [("results/datasets", f"{name}_{kind}.nc")
-                   for kind in ("events", "map", "spectra", "escape")]
+        places += [("results/datasets", f"{name}_{kind}.nc") for kind in STUDY_DATASETS]
     for name in drawn["orbits"]:
         places += [(f"results/figures/orbits/{name}", "*"),
                    (f"results/reports/orbits/{name}", "*"), ("results/orbits", f"{name}.nc")]
