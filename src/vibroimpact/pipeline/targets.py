@@ -116,13 +116,17 @@ def attractor_datasets(config, name):
 def predictors_inputs(config, name):
     """``{map, orbits, basins, lyapunov: path}`` the predictors of study ``name``'s map are
     computed from (rule ``map_predictors``): its map and, when it draws Fig. 15 over an
-    orbits entry (``fig15_vs_fig16``), that entry's orbit map and its
-    :func:`attractor_datasets`; the datasets it has not are left out."""
+    orbits entry (``fig15_vs_fig16``), that entry's orbit map; the basins and Lyapunov
+    exponents of the study's own ``attractors`` block (simulated over its map's cells), else
+    the orbits entry's (:func:`attractor_datasets`); the datasets it has not are left out."""
     entry = config["studies"][name]
     inputs = {"map": DATASETS["map"].format(name=name)}
     if "fig15_vs_fig16" in figure_names(entry):
         orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
         inputs["orbits"] = DATASETS["orbits"].format(name=orbits)
+    if entry.get("attractors"):
+        return {**inputs, **{kind: DATASETS[f"plane_{kind}"].format(name=name)
+                             for kind in ("basins", "lyapunov")}}
     return {**inputs, **attractor_datasets(config, name)}
 
 

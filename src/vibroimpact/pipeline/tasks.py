@@ -722,17 +722,22 @@ def aggregate_plane_attractors(entry, tiles, out_basins, out_lyapunov):
 def map_predictors(map_path, out, orbits_path=None, basins_path=None, lyapunov_path=None):
     """Rule ``map_predictors``: the rank correlations of each candidate predictor with each
     motion's P over a study's map (`vibroimpact.reports.predictors`), computed once for the
-    reports that show the map (the study's, a ``report_with`` study's, the orbits entry's).
-    An empty or None path: that dataset is not provided (its rows say why)."""
+    reports that show the map (the study's, a ``report_with`` study's, the orbits entry's),
+    with the orbit map's orbits solved at the map's own cells
+    (:func:`vibroimpact.reports.predictors.orbits_at_cells`), stored beside them. An empty or
+    None path: that dataset is not provided (its rows say why)."""
     from vibroimpact.reports import predictors
 
     def read(path):
         return io.load_dataset(path) if path else None
 
     motion_map = read(map_path)
-    found = predictors.predictor_correlations(motion_map, read(orbits_path),
+    orbits = read(orbits_path)
+    # the orbits at the map's own cells (finding 8 reads them back from this dataset)
+    at_cells = None if orbits is None else predictors.orbits_at_cells(motion_map, orbits)
+    found = predictors.predictor_correlations(motion_map, at_cells,
                                               read(basins_path), read(lyapunov_path))
-    ds = predictors.correlations_dataset(found)
+    ds = predictors.correlations_dataset(found, at_cells)
     block = {"seed": predictors.SEED, "n_resamples": predictors.N_RESAMPLES,
              "inputs": {"map": str(map_path), "orbits": str(orbits_path or ""),
                         "basins": str(basins_path or ""), "lyapunov": str(lyapunov_path or "")}}
