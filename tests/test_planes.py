@@ -400,3 +400,17 @@ def test_the_planes_example_draws_fig16_over_its_restitution_plane():
         config["studies"]["restitution"]["figures"])
     row = next(r for r in plan.rows if r.key == "orbits.restitution")
     assert row.orbit_cells == 41 * 201 and row.jobs == 2 + 1 + 1 + 1
+
+
+def test_the_restitution_study_s_predictors_read_its_own_basins_and_exponents():
+    """config/examples/planes.yaml: the restitution study simulates its basins and exponents
+    over its own (eps, delta) cells (its `attractors` block): the predictors of its P read
+    them, with its map and the orbits entry its fig15_vs_fig16 names."""
+    from vibroimpact.pipeline import targets
+
+    config, _ = configuration.load(root=ROOT, user_files=[ROOT / "config/examples/planes.yaml"])
+    assert targets.predictors_inputs(config, "restitution") == {
+        "map": "results/datasets/restitution_map.nc",
+        "orbits": "results/orbits/restitution.nc",
+        "basins": "results/datasets/restitution_basins.nc",
+        "lyapunov": "results/datasets/restitution_lyapunov.nc"}
