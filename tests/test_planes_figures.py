@@ -236,8 +236,8 @@ def test_the_predictors_read_a_plane_by_its_axes(tmp_path):
     finer grid): S is solved at each map cell by the axes' names (the map stored (y, x)), as
     `orbit_plane` gives it at the map's own cells."""
     from vibroimpact.orbits.plane import orbit_plane
-    from vibroimpact.reports.predictors import (_stable_domain, orbits_at_cells,
-                                                predictor_correlations)
+    from vibroimpact.orbits.cells import orbits_at_cells
+    from vibroimpact.reports.predictors import _stable_domain, predictor_correlations
 
     motion_map = _plane_map(tmp_path)
     fixed = {"zeta": 0.05, "inv_beta": 1.1}

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
+from vibroimpact.orbits.cells import orbits_at_cells
 from vibroimpact.reports import findings, predictors, switching
 
 INV_BETA = np.linspace(0.5, 2.5, 6)
@@ -240,21 +241,15 @@ def test_the_predictors_job_writes_what_the_reports_read_back_value_for_value(tm
 
     x = _plane(7)
     paths = {}
-    for name, ds in (("map", motion_map(x)), ("orbits", fig16(INV_BETA[:2], DELTA[:2])),
+    for name, ds in (("map", motion_map(x)), ("orbits", orbit_map(np.where(x > 0.3, x, 0))),
                      ("basins", basins(x[::2], inv_beta=INV_BETA[::2]))):   # refused grid
         paths[name] = tmp_path / f"{name}.nc"
         ds.to_netcdf(paths[name])
     out = tmp_path / "predictors.nc"
     tasks.map_predictors(paths["map"], out, paths["orbits"], paths["basins"], None)
-    at_cells = predictors.orbits_at_cells(motion_map(x), fig16(INV_BETA[:2], DELTA[:2]))
     expected = predictors.predictor_correlations(
-        motion_map(x), at_cells, basins(x[::2], INV_BETA[::2]))
+        motion_map(x), orbit_map(np.where(x > 0.3, x, 0)), basins(x[::2], INV_BETA[::2]))
     got = notebook.predictors(str(out))
-    # the orbits finding 8 reads are those the correlations used, value for value
-    stored = notebook.orbits_at_cells(str(out))
-    for name in ("n_stable", "S", "complex"):
-        np.testing.assert_array_equal(stored[name].values, at_cells[name].values)
-    assert notebook.orbits_at_cells("") is None
     _same(got, expected)
     assert any(np.isnan(c.rho) and "not used: the basin grid" in c.note for c in got)
     assert any(np.isfinite(c.rho) for c in got)
@@ -304,7 +299,7 @@ def test_the_orbits_of_a_map_cell_are_those_of_its_own_centre():
     grid = probability_map(TIE_ROWS, TIE_PLAYS)
     fine = fig16(np.round(np.arange(0.94, 2.07, 0.02), 10),
                  np.round(np.arange(-1.5, 3.01, 0.02), 10))
-    at = predictors.orbits_at_cells(grid, fine)
+    at = orbits_at_cells(grid, fine)
     assert list(at["type"].values) == MOTIONS
     differs, flagged = 0, {0: 0, 1: 0}
     for t in MOTIONS:
@@ -334,21 +329,24 @@ def test_the_orbits_of_a_map_cell_are_those_of_its_own_centre():
 
 
 def test_finding8_and_the_predictors_table_count_the_same_cells(tmp_path):
-    """The predictors job stores the orbits at the map's cells it correlated with; finding 8
-    reads them back: each motion's stable domain has as many cells in the agreement (Fig.
-    15 against Fig. 16) as in the predictors table's S row, and the complex share is that
-    of the stored flags."""
+    """Rule solve_map_orbits writes the orbits at the map's cells (`tasks.map_orbits`); the
+    predictors job correlates with them and finding 8 reads them: each motion's stable
+    domain has as many cells in the agreement (Fig. 15 against Fig. 16) as in the
+    predictors table's S row, and the complex share is that of the stored flags."""
     from vibroimpact.pipeline import tasks
     from vibroimpact.reports import notebook
 
     grid = probability_map(TIE_ROWS, TIE_PLAYS, seed=3)
-    paths = {"map": tmp_path / "map.nc", "orbits": tmp_path / "orbits.nc"}
+    paths = {"map": tmp_path / "map.nc", "orbits": tmp_path / "orbits.nc",
+             "cells": tmp_path / "map_orbits.nc"}
     grid.to_netcdf(paths["map"])
     fig16(np.round(np.arange(0.94, 2.07, 0.02), 10),
           np.round(np.arange(-1.5, 3.01, 0.02), 10)).to_netcdf(paths["orbits"])
+    tasks.map_orbits(paths["map"], paths["orbits"], paths["cells"])
     out = tmp_path / "predictors.nc"
-    tasks.map_predictors(paths["map"], out, paths["orbits"], None, None)
-    stored = notebook.orbits_at_cells(str(out))
+    tasks.map_predictors(paths["map"], out, paths["cells"], None, None)
+    stored = notebook.open_dataset(str(paths["cells"]))
+    assert "git_commit" in stored.attrs
     agreement = notebook.map_agreement(grid, stored)
     found = notebook.predictors(str(out))
     for t in MOTIONS:
@@ -384,13 +382,14 @@ def test_a_two_wall_orbit_map_is_read_at_the_map_s_cells_or_refused():
                                    eps_lower=0.5))
     grid = xr.Dataset(dict(probability=(("motion", *PLANE), rng.random((2, 2, 3)))),
                       coords=dict(motion=types, inv_beta=ib[1:], delta=d[1:]))
-    at = predictors.orbits_at_cells(grid, orbits)
+    at = orbits_at_cells(grid, orbits)
     np.testing.assert_array_equal(at["n_stable"].values, n_stable[:, 1:, 1:])
     np.testing.assert_array_equal(at["S"].values, np.where(n_stable > 0, S, np.nan)[:, 1:, 1:])
     assert (at["complex"].values == -1).all()
     off = grid.assign_coords(delta=d[1:] + 0.1)
-    with pytest.raises(ValueError, match=r"two-wall orbit map .* is not the map's"):
-        predictors.orbits_at_cells(off, orbits)
+    with pytest.raises(ValueError,
+                       match=r"two-wall orbit map.s cells nearest .* are not the map.s"):
+        orbits_at_cells(off, orbits)
 
 
 def test_a_named_plane_s_orbits_and_attractors_on_its_own_axes():
@@ -407,7 +406,7 @@ def test_a_named_plane_s_orbits_and_attractors_on_its_own_axes():
     orbits = orbit_plane("eps", np.arange(0.1, 0.91, 0.02), "delta",
                          np.arange(-1.0, 3.01, 0.02), fixed)
     grid = probability_map(eps, delta, attrs=dict(axes='["eps", "delta"]'), axes=axes)
-    at = predictors.orbits_at_cells(grid, orbits)
+    at = orbits_at_cells(grid, orbits)
     for i, e in enumerate(eps):
         for j, d in enumerate(delta):
             stable = [o for o in periodic_orbits(1, 1, 1 / 1.1, d, 0.05, e) if o.stable]

@@ -513,12 +513,8 @@ def _agreement_text(a):
 
 
 def _cells_of(at_cells, motion_map):
-    """``(type, x, y)`` ``n_stable`` and ``S`` of the orbits at the map's cells: a map's
-    predictors dataset (``orbit_n_stable``, ``orbit_S`` over ``orbit_type``) or such a
-    dataset itself; its axes must hold the map's values (to 1e-9)."""
-    if "orbit_S" in at_cells:
-        at_cells = at_cells[["orbit_n_stable", "orbit_S"]].rename(
-            orbit_n_stable="n_stable", orbit_S="S", orbit_type="type")
+    """The orbits at the map's cells (``n_stable``, ``S`` over ``(type, x, y)``) with the
+    map's coordinates; their axes must hold the map's values (to 1e-9)."""
     for name in plane_axes(motion_map):
         if (name not in at_cells.dims or at_cells.sizes[name] != motion_map.sizes[name]
                 or not np.allclose(at_cells[name].values, motion_map[name].values,
@@ -540,10 +536,9 @@ def fig15_vs_fig16(motion_map, orbits, at_cells=None, levels=COMPARISON_LEVELS):
         Orbit map of the same system (``results/orbits/{name}.nc``); its zeta and eps must
         equal the map's.
     at_cells : xarray.Dataset, optional
-        The orbits solved at the map's own cells, as the map's predictors dataset stores
-        them (``results/datasets/{study}_predictors.nc``: ``orbit_n_stable``, ``orbit_S``;
-        `vibroimpact.reports.predictors.orbits_at_cells`): the agreement numbers are read
-        there, as finding 8 reads them. Without: at the orbit map's cell nearest to each
+        The orbits solved at the map's own cells (``results/datasets/{study}_map_orbits.nc``,
+        rule ``solve_map_orbits``): the agreement numbers are read there, as finding 8
+        reads them. Without: at the orbit map's cell nearest to each
         map cell (a tie where a map cell lies halfway between two).
     levels : sequence of float
         Probability contours drawn (%).

@@ -182,7 +182,8 @@ def study_settings(ds, name=""):
 def map_agreement(motion_map, orbits):
     """Fig. 15 against Fig. 16 per motion (:func:`vibroimpact.plotting.maps.map_agreement`),
     or None when either map is missing. ``orbits``: the orbits at the map's own cells
-    (:func:`orbits_at_cells`), so that no cell is read at a neighbour; with their
+    (``results/datasets/{study}_map_orbits.nc``, `vibroimpact.orbits.cells.orbits_at_cells`),
+    so that no cell is read at a neighbour (another grid is refused); with their
     ``complex`` flags, each motion's dict also gives ``complex_share``, the share of its
     stable cells whose multipliers are a complex pair (NaN when not known)."""
     if motion_map is None or orbits is None:
@@ -200,17 +201,6 @@ def map_agreement(motion_map, orbits):
             if flags.size and (flags >= 0).all():
                 a["complex_share"] = float((flags == 1).mean())
     return out
-
-
-def orbits_at_cells(path):
-    """The periodic orbits at the map's own cells that the map's predictors dataset stores
-    (:func:`vibroimpact.reports.predictors.orbits_at_cells`, rule ``map_predictors``), or
-    None for an empty path or a dataset without them."""
-    if not path:
-        return None
-    from vibroimpact.reports.predictors import read_orbits_at_cells
-
-    return read_orbits_at_cells(open_dataset(path))
 
 
 def _plane(motion_map):

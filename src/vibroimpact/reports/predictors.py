@@ -5,13 +5,13 @@ The paper's conclusion 5 (finding 8) names one predictor: the degree of stabilit
 periodic motion under the harmonic force alone (Fig. 16). The datasets offer three more:
 
 - ``S``: Fig. 16's degree of stability (%) at each map cell's own centre: the orbits solved
-  there by the orbits entry's own solver (:func:`orbits_at_cells`), never read at a nearby
-  cell of Fig. 16's finer grid (the map's cells may sit halfway between two of its cells,
-  where "nearest" is a tie broken by rounding); 0 outside the stable domain
-  (S = 100 (1 - |lambda|) is 0 at its edge). Where the motion's two multipliers are a
-  complex pair, |lambda| is the square root of the Jacobian's determinant,
-  eps exp(-zeta z / m) with z = 2 pi n / beta_f: S depends on 1/beta_f alone there, not on
-  delta (:func:`orbits_at_cells` flags those cells);
+  there by the orbits entry's own solver (`vibroimpact.orbits.cells.orbits_at_cells`, rule
+  ``solve_map_orbits``), never read at a nearby cell of Fig. 16's finer grid (the map's
+  cells may sit halfway between two of its cells, where "nearest" is a tie broken by
+  rounding); 0 outside the stable domain (S = 100 (1 - |lambda|) is 0 at its edge). Where
+  the motion's two multipliers are a complex pair, |lambda| is the square root of the
+  Jacobian's determinant, eps exp(-zeta z / m) with z = 2 pi n / beta_f: S depends on
+  1/beta_f alone there, not on delta (`orbits_at_cells` flags those cells);
 - ``basin``: the share of starting states that settle on a stable orbit of the type without
   noise (``results/orbits/{orbits}_basins.nc``, `fraction`);
 - ``lyapunov``: the largest Lyapunov exponent of the cell's starts without noise
@@ -45,9 +45,8 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["PREDICTORS", "SEED", "N_RESAMPLES", "MIN_CELLS", "Correlation", "on_map_grid",
-           "orbits_at_cells", "rank_correlation", "predictor_correlations",
-           "correlations_dataset", "read_correlations", "read_orbits_at_cells",
-           "predictors_table"]
+           "rank_correlation", "predictor_correlations", "correlations_dataset",
+           "read_correlations", "predictors_table"]
 
 #: The candidates, in the table's order, with what each is.
 PREDICTORS = {
@@ -95,8 +94,8 @@ def _grid_text(values):
 
 
 def on_map_grid(ds, motion_map, name):
-    """``ds`` (a basins, Lyapunov or :func:`orbits_at_cells` dataset) with the map's plane
-    coordinates (``(inv_beta, delta)``, or its ``attrs["axes"]``).
+    """``ds`` (a basins, Lyapunov or `vibroimpact.orbits.cells.orbits_at_cells` dataset) with
+    the map's plane coordinates (``(inv_beta, delta)``, or its ``attrs["axes"]``).
 
     Raises
     ------
@@ -252,128 +251,10 @@ def _map_axes(motion_map):
     return tuple(str(a) for a in np.atleast_1d(axes))
 
 
-#: Codes of :func:`orbits_at_cells`' ``complex`` (int8; netCDF has no bool).
-COMPLEX_CODES = ("1 complex pair of multipliers, 0 real, -1 not known (no stable orbit or "
-                 "two walls)")
-
-
-def _orbit_system(orbits, axes):
-    """``(fixed, two_walls)`` of an orbit map: what its solver held fixed (``attrs["fixed"]``
-    of a plane, else the paper's ``zeta``, ``eps``, ``amplitude``), and whether it has a
-    second wall."""
-    fixed = orbits.attrs.get("fixed")
-    if fixed is not None:
-        fixed = json.loads(fixed.decode() if isinstance(fixed, bytes) else fixed)
-    else:
-        fixed = {k: float(orbits.attrs[k]) for k in ("zeta", "eps", "amplitude", "gap",
-                                                     "eps_lower") if k in orbits.attrs}
-    fixed = {k: float(v) for k, v in fixed.items() if k not in axes}
-    missing = [k for k in ("zeta", "eps") if k not in fixed and k not in axes]
-    if missing:
-        raise ValueError(f"the orbit map gives no {', '.join(missing)} (attrs): its orbits "
-                         "cannot be solved at the map's cells")
-    two_walls = ("gap" in fixed or "gap" in axes
-                 or int(np.asarray(orbits.attrs.get("n_walls", 1))) == 2)
-    return fixed, two_walls
-
-
-def _complex_pairs(x_name, xs, y_name, ys, fixed, types, n_stable, S):
-    """1 where the stable orbit :func:`orbits_at_cells` reports (the smallest lambda of
-    `vibroimpact.orbits.periodic_orbits` at the cell, the one whose S is the map's to 1e-6)
-    has a complex pair of multipliers, 0 where they are real, -1 where it is not found."""
-    from vibroimpact.orbits import periodic_orbits
-
-    out = np.full(n_stable.shape, -1, dtype=np.int8)
-    for k, label in enumerate(types):
-        m, n = (int(v) for v in label.split("/"))
-        for i, j in zip(*np.nonzero(n_stable[k] > 0)):
-            p = dict(fixed, **{x_name: float(xs[i]), y_name: float(ys[j])})
-            amplitude = p.get("amplitude", 1.0)
-            stable = [o for o in periodic_orbits(m, n, 1.0 / p["inv_beta"],
-                                                 p["delta"] / amplitude, p["zeta"], p["eps"])
-                      if o.stable]
-            if not stable:
-                continue
-            best = min(stable, key=lambda o: o.lam)
-            if abs(best.S - S[k, i, j]) <= 1e-6:
-                out[k, i, j] = int(abs(best.multipliers[0].imag) > 0.0)
-    return out
-
-
-def orbits_at_cells(motion_map, orbits):
-    """The periodic orbits of ``orbits``' system at the centre of every cell of the map, for
-    the motions both name: what finding 8 and the predictors compare P with, cell for cell.
-
-    One wall: solved at the map's own cells by the solver of the orbit map itself
-    (`vibroimpact.orbits.plane.orbit_plane`: Fig. 16's `orbit_map` over ``(1/beta_f,
-    delta)``), with the orbit map's fixed parameters; never read at a nearby cell of its grid.
-    Two walls (the shooting solver, seeded by the simulator): read from the orbit map,
-    whose grid must then hold every map cell (to 1e-9).
-
-    Parameters
-    ----------
-    motion_map : xarray.Dataset
-        ``results/datasets/{study}_map.nc``: its plane and motions.
-    orbits : xarray.Dataset
-        ``results/orbits/{name}.nc`` of the same system.
-
-    Returns
-    -------
-    xarray.Dataset or None
-        Over ``(type, x, y)`` (the map's axes and values): ``n_stable``, ``S`` (NaN where no
-        stable orbit), and ``complex`` (int8, `COMPLEX_CODES`: whether the stable orbit's
-        multipliers are a complex pair, so that S depends on 1/beta_f alone; one wall only).
-        None when no motion of the map is in the orbit map.
-
-    Raises
-    ------
-    ValueError
-        Two walls and a map cell that is not an orbit-map cell (both grids named).
-    """
-    import xarray as xr
-
-    axes = _map_axes(motion_map)
-    x_name, y_name = axes
-    xs, ys = (np.asarray(motion_map[d].values, dtype=float) for d in axes)
-    types = [str(m) for m in motion_map["motion"].values if str(m) in orbits["type"].values]
-    if not types:
-        return None
-    fixed, two_walls = _orbit_system(orbits, axes)
-    if two_walls:
-        # the orbit-map cells nearest to the map's: refused unless they are the map's own
-        o = on_map_grid(orbits.sel({x_name: xs, y_name: ys}, method="nearest"), motion_map,
-                        "two-wall orbit map (read, not solved, at the map's cells)")
-        o = o.sel(type=types).transpose("type", x_name, y_name)
-        n_stable, S = o["n_stable"].values, o["S"].values
-        complex_ = np.full(n_stable.shape, -1, dtype=np.int8)
-        solver = "read from the orbit map (two walls)"
-    else:
-        from vibroimpact.orbits.plane import orbit_plane
-
-        solved = orbit_plane(x_name, xs, y_name, ys, dict(fixed),
-                             types=[tuple(int(v) for v in t.split("/")) for t in types])
-        solved = solved.transpose("type", x_name, y_name)
-        n_stable, S = solved["n_stable"].values, solved["S"].values
-        complex_ = _complex_pairs(x_name, xs, y_name, ys, fixed, types, n_stable, S)
-        solver = str(solved.attrs.get("solver", "orbit_plane"))
-    S = np.where(n_stable > 0, S, np.nan)
-    dims = ("type", x_name, y_name)
-    ds = xr.Dataset({"n_stable": (dims, np.asarray(n_stable, dtype=np.int64)),
-                     "S": (dims, S), "complex": (dims, complex_)},
-                    coords={"type": types, x_name: motion_map[x_name].values,
-                            y_name: motion_map[y_name].values})
-    ds["n_stable"].attrs["long_name"] = "stable orbits at the cell's centre"
-    ds["S"].attrs.update(long_name="degree of stability at the cell's centre", units="%")
-    ds["complex"].attrs.update(long_name="multipliers a complex pair", codes=COMPLEX_CODES)
-    ds.attrs.update(solver=solver, fixed=json.dumps(fixed, sort_keys=True))
-    if "axes" in motion_map.attrs:
-        ds.attrs["axes"] = json.dumps(list(axes))
-    return ds
-
-
 def _stable_domain(motion_map, orbits, basins, motion):
-    """(stable, S) on the map's grid: the orbits at the cells' centres (:func:`orbits_at_cells`,
-    on the map's grid), or the basins' n_stable."""
+    """(stable, S) on the map's grid: the orbits at the cells' centres
+    (`vibroimpact.orbits.cells.orbits_at_cells`, on the map's grid), or the basins'
+    n_stable."""
     if orbits is not None and motion in orbits["type"].values:
         o = orbits.sel(type=motion).transpose(*_map_axes(motion_map))
         stable = o["n_stable"].values > 0
@@ -420,8 +301,9 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
     motion_map : xarray.Dataset
         ``results/datasets/{study}_map.nc``.
     orbits : xarray.Dataset or None
-        The periodic orbits at the map's cells (:func:`orbits_at_cells` of Fig. 16's orbit
-        map), on the map's grid; None: not provided (its rows say so).
+        The periodic orbits at the map's cells (`vibroimpact.orbits.cells.orbits_at_cells` of
+        Fig. 16's orbit map, ``results/datasets/{study}_map_orbits.nc``), on the map's grid;
+        None: not provided (its rows say so).
     basins, lyapunov : xarray.Dataset or None
         The basins and the Lyapunov datasets of the same system (None: not provided; its rows
         say so). An orbits, basins or Lyapunov dataset on another grid than the map's is not
@@ -480,20 +362,12 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
 _FIELDS = ("rho", "low", "high", "n_cells", "note")
 
 
-#: The variables of :func:`orbits_at_cells` in a predictors dataset: ``orbit_`` + name, over
-#: ``(orbit_type, x, y)``.
-_ORBIT_VARIABLES = ("n_stable", "S", "complex")
-
-
-def correlations_dataset(correlations, orbits=None):
+def correlations_dataset(correlations):
     """The correlations of :func:`predictor_correlations` as an ``xarray.Dataset`` of dims
     (predictor, motion, where): ``rho``, ``low``, ``high`` (float64, NaN when not computed),
     ``n_cells`` and ``note`` (:class:`Correlation`'s fields). What the map's predictors job
     writes (``results/datasets/{study}_predictors.nc``) and :func:`read_correlations` reads
-    back, value for value. ``orbits``: the :func:`orbits_at_cells` they were computed with,
-    stored beside them (``orbit_n_stable``, ``orbit_S``, ``orbit_complex`` over
-    ``(orbit_type, x, y)``) so that finding 8 reads the same cells
-    (:func:`read_orbits_at_cells`)."""
+    back, value for value."""
     import xarray as xr
 
     correlations = list(correlations)
@@ -525,23 +399,7 @@ def correlations_dataset(correlations, orbits=None):
     ds["predictor"].attrs["long_name"] = "; ".join(f"{k}: {v}" for k, v in PREDICTORS.items())
     ds["where"].attrs["long_name"] = "domain: the motion's stable domain; plane: every cell"
     ds.attrs.update(seed=SEED, n_resamples=N_RESAMPLES)
-    if orbits is not None:
-        stored = orbits[list(_ORBIT_VARIABLES)].rename(
-            {name: f"orbit_{name}" for name in _ORBIT_VARIABLES}).rename(type="orbit_type")
-        ds = ds.merge(stored)
-        ds.attrs.update({f"orbits_{k}": v for k, v in orbits.attrs.items()})
     return ds
-
-
-def read_orbits_at_cells(ds):
-    """The :func:`orbits_at_cells` dataset a predictors dataset stores (None without one)."""
-    names = [f"orbit_{name}" for name in _ORBIT_VARIABLES]
-    if any(name not in ds for name in names):
-        return None
-    out = ds[names].rename({f"orbit_{name}": name for name in _ORBIT_VARIABLES})
-    out = out.rename(orbit_type="type")
-    out.attrs = {k[len("orbits_"):]: v for k, v in ds.attrs.items() if k.startswith("orbits_")}
-    return out
 
 
 def read_correlations(ds):
