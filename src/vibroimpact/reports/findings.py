@@ -530,8 +530,8 @@ def _best_text(free):
                 f"({direction}), has an interval reaching |rho| < {WEAK_RHO:g}")
     alike = [n for n in free if n != best and _overlap(free[n], c)]
     if alike:
-        return (f"{best} ({direction}) and {', '.join(alike)} rank P alike (their 95 % "
-                "intervals overlap)")
+        return (f"{best} ranks P most strongly ({direction}), not clearly more than "
+                f"{' or '.join(alike)} (their 95 % intervals overlap)")
     return f"{best} ranks P best among the noise-free predictors ({direction})"
 
 
