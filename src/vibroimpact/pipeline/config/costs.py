@@ -106,8 +106,9 @@ PREDICTORS_CELL_S = 7.5e-5
 #: The orbits of Fig. 16's types solved at a map's cells (rule ``solve_map_orbits``:
 #: `orbits.cells.orbits_at_cells`, `orbit_map` along each row and `periodic_orbits` at each
 #: stable cell for its multipliers), per map cell and motion, besides the job's start-up:
-#: PLACEHOLDER.
-MAP_ORBITS_CELL_S = 1.0e-4
+#: 2.4 CPU-s on the default map (5,187 cells, 3 motions; its benchmark file's cpu_time in a
+#: build, load ~4), 1.4 of it besides `JOB_START_S`.
+MAP_ORBITS_CELL_S = 9.0e-5
 #: The rule writing each validation dataset (``results/validation/<name>.nc``).
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
