@@ -182,7 +182,8 @@ def test_finding8_names_no_best_predictor_where_its_interval_reaches_weak_or_mee
     assert ("no noise-free predictor ranks P clearly: the strongest, S (P falls as S grows, "
             "against the expected direction), has an interval reaching |rho| < 0.3") in text
     assert ("multipliers a complex pair in 25 % of the domain's cells, where S = 100 "
-            "(1 - eps exp(-zeta z/m)) depends on 1/beta_f alone") in text
+            "(1 - eps exp(-zeta z/m)), z = 2 pi n/beta_f, does not depend on delta: "
+            "rho(P, S) cannot rank P along delta there") in text
     alike = [C("S", "2/1", "domain", 0.70, 0.55, 0.82, 80),
              C("basin", "2/1", "domain", 0.60, 0.45, 0.72, 80)]
     text = findings.finding8(agreement, predictors=alike).measured

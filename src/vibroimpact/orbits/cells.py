@@ -120,7 +120,7 @@ def orbits_at_cells(motion_map, orbits):
     xarray.Dataset or None
         Over ``(type, x, y)`` (the map's axes and values): ``n_stable``, ``S`` (NaN where no
         stable orbit), and ``complex`` (int8, `COMPLEX_CODES`: whether the stable orbit's
-        multipliers are a complex pair, so that S depends on 1/beta_f alone; one wall only).
+        multipliers are a complex pair, so that S does not depend on delta; one wall only).
         None when no motion of the map is in the orbit map.
 
     Raises

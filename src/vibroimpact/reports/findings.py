@@ -555,14 +555,15 @@ def _predictors_text(predictors, motion):
 
 
 def _complex_text(a):
-    """Where the multipliers are complex, S does not depend on delta: say in how much of the
-    domain (``complex_share`` of :func:`vibroimpact.reports.notebook.map_agreement`)."""
+    """Where the multipliers are complex, S does not depend on delta (over the paper's plane
+    it depends on 1/beta_f alone): say in how much of the domain (``complex_share`` of
+    :func:`vibroimpact.reports.notebook.map_agreement`, given where delta is an axis)."""
     share = a.get("complex_share", np.nan)
     if not np.isfinite(share) or share == 0:
         return ""
     return (f"; multipliers a complex pair in {100 * share:.0f} % of the domain's cells, where "
-            "S = 100 (1 - eps exp(-zeta z/m)) depends on 1/beta_f alone: rho(P, S) cannot "
-            "rank P along delta there")
+            "S = 100 (1 - eps exp(-zeta z/m)), z = 2 pi n/beta_f, does not depend on delta: "
+            "rho(P, S) cannot rank P along delta there")
 
 
 def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5, predictors=None):
@@ -578,7 +579,7 @@ def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5, predictors=No
     time) and the noise-free one that ranks P best, where the intervals allow naming one
     (:func:`_best_text`): the claim names S, the data may favour another. With
     ``complex_share`` in a motion's agreement (the share of its stable cells whose
-    multipliers are a complex pair), it says that S depends on 1/beta_f alone there.
+    multipliers are a complex pair), it says that S does not depend on delta there.
     """
     judged = {m: a for m, a in agreement.items() if a["n_dominant"] >= min_cells}
     if not judged:

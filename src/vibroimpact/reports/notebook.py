@@ -185,7 +185,8 @@ def map_agreement(motion_map, orbits):
     (``results/datasets/{study}_map_orbits.nc``, `vibroimpact.orbits.cells.orbits_at_cells`),
     so that no cell is read at a neighbour (another grid is refused); with their
     ``complex`` flags, each motion's dict also gives ``complex_share``, the share of its
-    stable cells whose multipliers are a complex pair (NaN when not known)."""
+    stable cells whose multipliers are a complex pair, where S does not depend on delta (NaN
+    when not known, or when delta is not an axis of the map)."""
     if motion_map is None or orbits is None:
         return None
     from vibroimpact.plotting.maps import map_agreement as agreement
@@ -193,9 +194,10 @@ def map_agreement(motion_map, orbits):
 
     orbits = on_map_grid(orbits, motion_map, "orbits")
     out = agreement(motion_map, orbits)
+    along_delta = "delta" in _plane(motion_map)
     for name, a in out.items():
         a["complex_share"] = np.nan
-        if "complex" in orbits:
+        if "complex" in orbits and along_delta:
             o = orbits.sel(type=name)
             flags = o["complex"].values[o["n_stable"].values > 0]
             if flags.size and (flags >= 0).all():

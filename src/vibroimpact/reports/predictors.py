@@ -10,8 +10,9 @@ periodic motion under the harmonic force alone (Fig. 16). The datasets offer thr
   cells may sit halfway between two of its cells, where "nearest" is a tie broken by
   rounding); 0 outside the stable domain (S = 100 (1 - |lambda|) is 0 at its edge). Where
   the motion's two multipliers are a complex pair, |lambda| is the square root of the
-  Jacobian's determinant, eps exp(-zeta z / m) with z = 2 pi n / beta_f: S depends on
-  1/beta_f alone there, not on delta (`orbits_at_cells` flags those cells);
+  Jacobian's determinant, eps exp(-zeta z / m) with z = 2 pi n / beta_f: S does not depend
+  on delta there (over the paper's plane it depends on 1/beta_f alone; `orbits_at_cells`
+  flags those cells);
 - ``basin``: the share of starting states that settle on a stable orbit of the type without
   noise (``results/orbits/{orbits}_basins.nc``, `fraction`);
 - ``lyapunov``: the largest Lyapunov exponent of the cell's starts without noise
