@@ -423,3 +423,21 @@ def test_an_amplitude_plane_is_planned_with_its_report_and_captions(tmp_path, gr
     got = arguments.notebook_parameters("harmonic_random", {}, study="plane", entry=entry,
                                         inv_beta=[1.1])
     assert got["amplitude"] == "nan"
+
+
+def test_the_restitution_study_s_predictors_read_its_own_basins_and_exponents():
+    """config/examples/planes.yaml: the restitution study simulates its basins and exponents
+    over its own (eps, delta) cells (its `attractors` block): the predictors of its P read
+    them, with its map and the orbits of the entry its fig15_vs_fig16 names at its cells
+    (rule solve_map_orbits, from the map and that orbit map)."""
+    from vibroimpact.pipeline import targets
+
+    config, _ = configuration.load(root=ROOT, user_files=[ROOT / "config/examples/planes.yaml"])
+    assert targets.predictors_inputs(config, "restitution") == {
+        "map": "results/datasets/restitution_map.nc",
+        "orbits": "results/datasets/restitution_map_orbits.nc",
+        "basins": "results/datasets/restitution_basins.nc",
+        "lyapunov": "results/datasets/restitution_lyapunov.nc"}
+    assert targets.map_orbits_inputs(config, "restitution") == {
+        "map": "results/datasets/restitution_map.nc",
+        "orbits": "results/orbits/restitution.nc"}

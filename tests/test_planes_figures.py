@@ -232,16 +232,21 @@ def test_residence_over_another_plane(tmp_path):
 
 
 def test_the_predictors_read_a_plane_by_its_axes(tmp_path):
-    """The report's predictors over an (eps, delta) map and its Fig. 16 (`orbit_plane`): S is
-    read at each map cell's nearest orbit cell by the axes' names (the map stored (y, x))."""
+    """The report's predictors over an (eps, delta) map and its Fig. 16 (`orbit_plane`, on a
+    finer grid): S is solved at each map cell by the axes' names (the map stored (y, x)), as
+    `orbit_plane` gives it at the map's own cells."""
     from vibroimpact.orbits.plane import orbit_plane
+    from vibroimpact.orbits.cells import orbits_at_cells
     from vibroimpact.reports.predictors import _stable_domain, predictor_correlations
 
     motion_map = _plane_map(tmp_path)
-    orbits = orbit_plane("eps", EPS, "delta", DELTA, {"zeta": 0.05, "inv_beta": 1.1},
-                         types=((1, 1), (2, 1)))
+    fixed = {"zeta": 0.05, "inv_beta": 1.1}
+    fine = orbit_plane("eps", np.round(np.arange(0.1, 0.951, 0.02), 10), "delta",
+                       np.round(np.arange(-1.0, 2.001, 0.02), 10), fixed, types=((1, 1), (2, 1)))
+    orbits = orbits_at_cells(motion_map, fine)
     stable, S = _stable_domain(motion_map.transpose(..., "eps", "delta"), orbits, None, "1/1")
-    expected = orbits["n_stable"].sel(type="1/1").transpose("eps", "delta").values > 0
+    own = orbit_plane("eps", EPS, "delta", DELTA, fixed, types=((1, 1), (2, 1)))
+    expected = own["n_stable"].sel(type="1/1").transpose("eps", "delta").values > 0
     np.testing.assert_array_equal(stable, expected)
     rows = predictor_correlations(motion_map, orbits, n_resamples=20)
     assert any(r.predictor == "S" and np.isfinite(r.rho) for r in rows)

@@ -685,6 +685,26 @@ def test_fig15_vs_fig16_prints_the_agreement_and_refuses_another_system():
         plotting.fig15_vs_fig16(ds, orbits.assign_attrs(zeta=0.06))
 
 
+def test_fig15_vs_fig16_reads_its_agreement_at_the_map_s_own_cells():
+    """Given the orbits at the map's cells (rule solve_map_orbits), the boxes print the
+    agreement read there: (1/1) stable on every cell there, with P 0.9 inside the
+    disc and 0 outside, gives a rank correlation where the orbit map's domain (the disc,
+    P constant) gives none; orbits off the map's grid are refused."""
+    ds, orbits = _synthetic_map()
+    ib, d = np.meshgrid(ds.inv_beta, ds.delta, indexing="ij")
+    at = orbits.copy(deep=True)
+    at["n_stable"].loc[{"type": "1/1"}] = 1
+    at["S"].loc[{"type": "1/1"}] = 40.0 - 10 * np.hypot(ib - 1.5, d)
+    expected = plotting.map_agreement(ds, at)["1/1"]["rank_correlation"]
+    assert np.isnan(plotting.map_agreement(ds, orbits)["1/1"]["rank_correlation"])
+    assert expected > 0.5
+    fig = plotting.fig15_vs_fig16(ds, orbits, at)
+    texts = [t.get_text() for ax in fig.axes for t in ax.texts]
+    assert any(t.endswith(f"rank corr. $(P, S)$ inside: {expected:.2f}") for t in texts)
+    with pytest.raises(ValueError, match="not lie on the map's delta grid"):
+        plotting.fig15_vs_fig16(ds, orbits, at.isel(delta=slice(1, None)))
+
+
 # ------------------------------------------------------------------------- sparse-bin rule
 
 def test_merge_sparse_bins_keeps_full_bins_and_merges_sparse_runs():

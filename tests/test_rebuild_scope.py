@@ -36,7 +36,9 @@ ORBIT_RULES = {"solve_orbit_tile", "aggregate_orbits", "trace_boundaries"}
 ATTRACTOR_RULES = {"solve_attractor_tile", "aggregate_attractors"}
 # the predictors of the map's P (rule map_predictors) read the map, Fig. 16 and the attractors
 PREDICTOR_RULES = {"map_predictors"}
-MAP_RULES = {"simulate_map", "aggregate_map"} | PREDICTOR_RULES
+# Fig. 16's orbits solved at the map's cells read the map and the orbit map
+MAP_ORBIT_RULES = {"solve_map_orbits"}
+MAP_RULES = {"simulate_map", "aggregate_map"} | PREDICTOR_RULES | MAP_ORBIT_RULES
 ESCAPE_RULES = {"simulate_escape", "aggregate_escape"}
 
 
@@ -233,7 +235,8 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
     edit("config/test.yaml", _set(("orbits", "harmonic", "delta"),
                                   {"start": -1.5, "stop": 3.0, "step": 0.5}))
     jobs = scheduled(repo)
-    assert set(jobs) == ORBIT_RULES | PREDICTOR_RULES | FIGURE_RULES | {"orbits_report"}
+    assert set(jobs) == (ORBIT_RULES | MAP_ORBIT_RULES | PREDICTOR_RULES | FIGURE_RULES
+                         | {"orbits_report"})
     # the basins figure draws the map's stable domains; the attractors do not read its grid
     assert {Path(p).name for p in jobs["draw_figure"] if p.endswith(".png")} == {
         "fig16.png", "fig15_vs_fig16.png", "basins.png"}
@@ -248,7 +251,8 @@ def test_orbit_entry_or_solver_edit_reruns_only_the_orbit_figures(repo, edit):
         "basins.png", "lyapunov.png"}
     (repo / "config/test.yaml").write_text((ROOT / "config/test.yaml").read_text())
     edit("src/vibroimpact/orbits/kernels.py", _append_code)     # the stress sample too
-    assert set(scheduled(repo)) == (ORBIT_RULES | ATTRACTOR_RULES | PREDICTOR_RULES
+    assert set(scheduled(repo)) == (ORBIT_RULES | MAP_ORBIT_RULES | ATTRACTOR_RULES
+                                    | PREDICTOR_RULES
                                     | FIGURE_RULES | {"orbits_report"} | STRESS_RULES)
 
 

@@ -33,7 +33,8 @@ def test_arguments_are_quoted_for_the_shell():
 def test_an_orbits_report_is_named_by_its_entry():
     got = arguments.notebook_parameters("periodic_motions", {"orbits": "o.nc"}, orbits="h")
     assert got == {"name": "h", "orbits": "o.nc", "boundaries": "", "basins": "",
-                   "lyapunov": "", "map": "", "predictors": "", "figures": ""}
+                   "lyapunov": "", "map": "", "map_orbits": "", "predictors": "",
+                   "figures": ""}
 
 
 def test_the_readme_quotes_the_campaign_table_of_docs():

@@ -98,10 +98,12 @@ def test_the_harmonic_reports_show_what_predicts_p_and_whether_it_is_markov(buil
     from vibroimpact.reports import predictors
 
     root = built / "results"
+    motion_map, basins, exponents = (xr.load_dataset(root / p) for p in (
+        "datasets/motion_map_map.nc", "orbits/harmonic_basins.nc",
+        "orbits/harmonic_lyapunov.nc"))
     expected = predictors.predictor_correlations(
-        *(xr.load_dataset(root / p) for p in (
-            "datasets/motion_map_map.nc", "orbits/harmonic.nc", "orbits/harmonic_basins.nc",
-            "orbits/harmonic_lyapunov.nc")))
+        motion_map, xr.load_dataset(root / "datasets" / "motion_map_map_orbits.nc"), basins,
+        exponents)
     table = predictors.predictors_table(expected)
     # computed once (rule map_predictors), read back by the reports value for value
     stored = predictors.read_correlations(

@@ -63,7 +63,7 @@ def test_fig15_runs_no_orbit_computation(workdir):
 def test_fig15_vs_fig16_runs_the_map_and_the_orbits(workdir):
     assert scheduled_rules(workdir, "results/figures/fig15_vs_fig16.png") == {
         "generate_noise", "simulate_map", "aggregate_map", "solve_orbit_tile",
-        "aggregate_orbits", "draw_figure", "copy_paper_figure"}
+        "aggregate_orbits", "solve_map_orbits", "draw_figure", "copy_paper_figure"}
 
 
 #: The user's files of the suite that build (each dry-run on a fresh copy, against the plan):
@@ -140,7 +140,7 @@ def test_the_harmonic_reports_read_the_basins_and_exponents_of_the_map_s_orbits(
     assert not any("orbits" in p or "predictors" in p for p in reports["random"])
     (predicting,) = [j for j in jobs if j["rule"] == "map_predictors"]
     assert predicting["input"] == {"results/datasets/motion_map_map.nc",
-                                   "results/orbits/harmonic.nc",
+                                   "results/datasets/motion_map_map_orbits.nc",
                                    "results/orbits/harmonic_basins.nc",
                                    "results/orbits/harmonic_lyapunov.nc"}
 

@@ -304,6 +304,12 @@ def predictors_inputs(wildcards):
     return targets.predictors_inputs(config, wildcards.study)
 
 
+def map_orbits_inputs(wildcards):
+    """The map of study ``{study}`` and the orbit map its ``fig15_vs_fig16`` names: the
+    orbits rule ``solve_map_orbits`` solves at the map's own cells."""
+    return targets.map_orbits_inputs(config, wildcards.study)
+
+
 def study_report_inputs(wildcards):
     """The notebook, the datasets and the figures of a study and of its ``report_with``, and
     the study's noise record (its provenance row, whether or not a figure draws it); with a

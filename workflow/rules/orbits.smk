@@ -71,6 +71,29 @@ rule aggregate_orbits:
         "../scripts/aggregate_orbits.py"
 
 
+rule solve_map_orbits:
+    """The orbits of the entry study {study}'s fig15_vs_fig16 names, at its map's cells."""
+    input:
+        unpack(map_orbits_inputs),
+    output:
+        "results/datasets/{study}_map_orbits.nc",
+    conda:
+        "../envs/vibroimpact.yaml"
+    log:
+        "results/logs/solve_map_orbits/{study}.log",
+    benchmark:
+        "results/benchmarks/solve_map_orbits/{study}.tsv"
+    threads: 1
+    priority: 1  # a long chain's head (common.smk, "Priorities")
+    resources:
+        mem_mb=BASE_MEM_MB + 200,
+        runtime=10,
+    params:
+        code=script_code("solve_map_orbits"),
+    script:
+        "../scripts/solve_map_orbits.py"
+
+
 rule trace_boundaries:
     """The exact edges of the stable domains of orbits entry {orbits}, seeded from its map."""
     input:

@@ -86,8 +86,10 @@ FIGURES = {
                   owner="study", reads=("map",), harmonic=True,
                   shows="maps over the (1/beta_f, delta) plane of the probability (%) of the "
                         "(1/1), (2/1) and (1/2) impact motions under sin(beta_f tau) + r(tau)"),
+    # map_orbits: the orbits at the map's own cells its agreement numbers read
     "fig15_vs_fig16": dict(draw="maps:fig15_vs_fig16",
-                           owner="study", reads=("map", "orbits"), sources=("orbits",),
+                           owner="study", reads=("map", "orbits", "map_orbits"),
+                           sources=("orbits",),
                            harmonic=True,
                            shows="the probability contours of Fig. 15 over the stable domains "
                                  "of Fig. 16, with the agreement measures of each motion"),

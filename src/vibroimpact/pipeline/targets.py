@@ -16,7 +16,8 @@ from vibroimpact.reports.arguments import study_report_kind
 
 __all__ = ["DATASETS", "WORKFLOW_INPUTS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
            "paper_figure_source", "study_datasets", "attractor_datasets",
-           "predictors_inputs", "study_report_inputs", "maps_over", "orbits_report_inputs",
+           "predictors_inputs", "map_orbits_inputs",
+           "study_report_inputs", "maps_over", "orbits_report_inputs",
            "validation_report_inputs", "sweep_inputs", "sweep_targets", "validation_targets",
            "report_targets", "all_targets", "needed_files", "rule_inputs"]
 
@@ -30,6 +31,8 @@ DATASETS = {
     "escape": "results/datasets/{name}_escape.nc",
     # the rank correlations of the predictors with a map's P (the reports that show the map)
     "predictors": "results/datasets/{name}_predictors.nc",
+    # the orbits of the fig15_vs_fig16 entry solved at the map's own cells (finding 8)
+    "map_orbits": "results/datasets/{name}_map_orbits.nc",
     "orbits": "results/orbits/{name}.nc",
     "boundaries": "results/orbits/{name}_boundaries.nc",
     "basins": "results/orbits/{name}_basins.nc",
@@ -113,16 +116,30 @@ def attractor_datasets(config, name):
     return {kind: DATASETS[kind].format(name=orbits) for kind in ("basins", "lyapunov")}
 
 
+def map_orbits_inputs(config, name):
+    """``{map, orbits: path}`` of rule ``solve_map_orbits``: study ``name``'s map and the
+    orbit map of the entry its ``fig15_vs_fig16`` names, whose orbits it solves at the map's
+    own cells."""
+    entry = config["studies"][name]
+    orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
+    return {"map": DATASETS["map"].format(name=name),
+            "orbits": DATASETS["orbits"].format(name=orbits)}
+
+
 def predictors_inputs(config, name):
     """``{map, orbits, basins, lyapunov: path}`` the predictors of study ``name``'s map are
     computed from (rule ``map_predictors``): its map and, when it draws Fig. 15 over an
-    orbits entry (``fig15_vs_fig16``), that entry's orbit map and its
-    :func:`attractor_datasets`; the datasets it has not are left out."""
+    orbits entry (``fig15_vs_fig16``), that entry's orbits solved at the map's own cells
+    (``map_orbits``, rule ``solve_map_orbits``); the basins and Lyapunov exponents of the
+    study's own ``attractors`` block (simulated over its map's cells), else the orbits
+    entry's (:func:`attractor_datasets`); the datasets it has not are left out."""
     entry = config["studies"][name]
     inputs = {"map": DATASETS["map"].format(name=name)}
     if "fig15_vs_fig16" in figure_names(entry):
-        orbits = figures.figure_sources(entry, "fig15_vs_fig16")["orbits"]
-        inputs["orbits"] = DATASETS["orbits"].format(name=orbits)
+        inputs["orbits"] = DATASETS["map_orbits"].format(name=name)
+    if entry.get("attractors"):
+        return {**inputs, **{kind: DATASETS[f"plane_{kind}"].format(name=name)
+                             for kind in ("basins", "lyapunov")}}
     return {**inputs, **attractor_datasets(config, name)}
 
 
@@ -178,6 +195,7 @@ def orbits_report_inputs(config, drawn, name):
     for path in maps_over(config, drawn, name):
         inputs["map"] = path
         inputs["predictors"] = _predictors_of(path)
+        inputs["map_orbits"] = _predictors_of(path).replace("_predictors.nc", "_map_orbits.nc")
     if "fig16" in figures.figure_targets(entry):
         inputs["boundaries"] = DATASETS["boundaries"].format(name=name)
     if entry.get("attractors"):

@@ -731,11 +731,27 @@ def aggregate_plane_attractors(entry, tiles, out_basins, out_lyapunov):
     aggregate_attractors(entry, tiles, out_basins, out_lyapunov, two_walls or None)
 
 
+def map_orbits(map_path, orbits_path, out):
+    """Rule ``solve_map_orbits``: the periodic orbits of an orbits entry solved at the cells
+    of a study's map (`vibroimpact.orbits.cells.orbits_at_cells`): what finding 8, the
+    predictors of P and Fig. 15 against Fig. 16 compare P with, cell for cell."""
+    from vibroimpact.orbits.cells import orbits_at_cells
+
+    motion_map = io.load_dataset(map_path)
+    ds = orbits_at_cells(motion_map, io.load_dataset(orbits_path))
+    if ds is None:
+        raise ValueError(f"no motion of the map {map_path} is a type of the orbit map "
+                         f"{orbits_path}")
+    ds.attrs.update(provenance({"inputs": {"map": str(map_path), "orbits": str(orbits_path)}}))
+    io.write_dataset(ds, out)
+
+
 def map_predictors(map_path, out, orbits_path=None, basins_path=None, lyapunov_path=None):
     """Rule ``map_predictors``: the rank correlations of each candidate predictor with each
     motion's P over a study's map (`vibroimpact.reports.predictors`), computed once for the
     reports that show the map (the study's, a ``report_with`` study's, the orbits entry's).
-    An empty or None path: that dataset is not provided (its rows say why)."""
+    ``orbits_path``: the orbits at the map's own cells (rule ``solve_map_orbits``). An empty
+    or None path: that dataset is not provided (its rows say why)."""
     from vibroimpact.reports import predictors
 
     def read(path):

@@ -512,8 +512,20 @@ def _agreement_text(a):
             rf"rank corr. $(P, S)$ inside: {rho}")
 
 
+def _cells_of(at_cells, motion_map):
+    """The orbits at the map's cells (``n_stable``, ``S`` over ``(type, x, y)``) with the
+    map's coordinates; their axes must hold the map's values (to 1e-9)."""
+    for name in plane_axes(motion_map):
+        if (name not in at_cells.dims or at_cells.sizes[name] != motion_map.sizes[name]
+                or not np.allclose(at_cells[name].values, motion_map[name].values,
+                                   rtol=0.0, atol=1e-9)):
+            raise ValueError(f"the orbits at the map's cells do not lie on the map's {name} "
+                             "grid")
+    return at_cells.assign_coords({n: motion_map[n].values for n in plane_axes(motion_map)})
+
+
 @_styled
-def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
+def fig15_vs_fig16(motion_map, orbits, at_cells=None, levels=COMPARISON_LEVELS):
     """The probability contours of Fig. 15 over the stable domains and S contours of Fig. 16.
 
     Parameters
@@ -523,6 +535,11 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
     orbits : xarray.Dataset
         Orbit map of the same system (``results/orbits/{name}.nc``); its zeta and eps must
         equal the map's.
+    at_cells : xarray.Dataset, optional
+        The orbits solved at the map's own cells (``results/datasets/{study}_map_orbits.nc``,
+        rule ``solve_map_orbits``): the agreement numbers are read there, as finding 8
+        reads them. Without: at the orbit map's cell nearest to each
+        map cell (a tie where a map cell lies halfway between two).
     levels : sequence of float
         Probability contours drawn (%).
 
@@ -536,7 +553,8 @@ def fig15_vs_fig16(motion_map, orbits, levels=COMPARISON_LEVELS):
         the motion dominates; Spearman's rank correlation of probability and S there).
     """
     _same_plane(motion_map, orbits)
-    agreement = map_agreement(motion_map, orbits)
+    agreement = map_agreement(motion_map, orbits if at_cells is None else
+                              _cells_of(at_cells, motion_map))
     if not agreement:
         raise ValueError(f"no motion of the map {list(motion_map['motion'].values)} is in the "
                          f"orbit map {list(orbits['type'].values)}")

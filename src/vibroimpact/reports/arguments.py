@@ -14,10 +14,10 @@ __all__ = ["DENSITY_INV_BETA", "REPORT_PARAMETERS", "nearest", "notebook_paramet
 REPORT_PARAMETERS = {
     "random_force": ("study", "events", "spectra", "noise", "trace", "figures"),
     "harmonic_random": ("study", "events", "spectra", "noise", "trace", "map", "orbits",
-                        "basins", "lyapunov", "predictors", "figures", "amplitude", "inv_beta",
-                        "density_delta"),
+                        "map_orbits", "basins", "lyapunov", "predictors", "figures",
+                        "amplitude", "inv_beta", "density_delta"),
     "periodic_motions": ("name", "orbits", "boundaries", "basins", "lyapunov", "map",
-                         "predictors", "figures"),
+                         "map_orbits", "predictors", "figures"),
     "performance": ("work_precision", "figures"),
     "stability": ("stress", "campaign", "figures"),
 }

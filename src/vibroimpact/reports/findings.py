@@ -497,9 +497,47 @@ def _resolved(c):
     return c is not None and np.isfinite(c.rho) and (c.low > 0 or c.high < 0)
 
 
+#: A rank correlation whose 95 % interval reaches below this |rho| may be weak: no noise-free
+#: predictor is called the best on such evidence (the usual reading: |rho| < 0.3 weak).
+WEAK_RHO = 0.3
+
+#: The sign of rho with P each noise-free predictor is expected to have where it predicts P
+#: (a more stable orbit, a larger basin, a more negative exponent: a likelier motion).
+EXPECTED_SIGN = {"S": 1, "basin": 1, "lyapunov": -1}
+
+
+def _overlap(a, b):
+    """Whether the 95 % intervals of two correlations overlap in |rho|."""
+    def span(c):
+        return sorted((abs(c.low), abs(c.high))) if c.low * c.high > 0 else (0.0, max(
+            abs(c.low), abs(c.high)))
+    (a0, a1), (b0, b1) = span(a), span(b)
+    return a0 <= b1 and b0 <= a1
+
+
+def _best_text(free):
+    """Which resolved noise-free predictor ranks P best, in words the numbers allow: none
+    when the strongest's interval reaches a weak |rho| (`WEAK_RHO`); several when their
+    intervals overlap; and the direction, with a note where it is not the expected one
+    (`EXPECTED_SIGN`)."""
+    best = max(free, key=lambda n: abs(free[n].rho))
+    c = free[best]
+    direction = f"P {'rises' if c.rho > 0 else 'falls'} as {best} grows"
+    if np.sign(c.rho) != EXPECTED_SIGN.get(best, np.sign(c.rho)):
+        direction += ", against the expected direction"
+    if min(abs(c.low), abs(c.high)) < WEAK_RHO:
+        return (f"no noise-free predictor ranks P clearly: the strongest, {best} "
+                f"({direction}), has an interval reaching |rho| < {WEAK_RHO:g}")
+    alike = [n for n in free if n != best and _overlap(free[n], c)]
+    if alike:
+        return (f"{best} ranks P most strongly ({direction}), not clearly more than "
+                f"{' or '.join(alike)} (their 95 % intervals overlap)")
+    return f"{best} ranks P best among the noise-free predictors ({direction})"
+
+
 def _predictors_text(predictors, motion):
     """The noise-free predictors of ``motion``'s P in its stable domain, and which ranks P
-    best (:mod:`vibroimpact.reports.predictors`)."""
+    best, if the numbers say so (:func:`_best_text`; :mod:`vibroimpact.reports.predictors`)."""
     found = {name: _predictor(predictors, name, motion)
              for name in ("S", "basin", "lyapunov", "residence")}
     shown = {n: c for n, c in found.items() if c is not None and np.isfinite(c.rho)}
@@ -512,9 +550,20 @@ def _predictors_text(predictors, motion):
     text = f"; inside the domain ({cells} cells) rho with " + ", ".join(parts)
     free = {n: c for n, c in shown.items() if n != "residence" and _resolved(c)}
     if free:
-        best = max(free, key=lambda n: abs(free[n].rho))
-        text += f"; best noise-free predictor {best}"
+        text += "; " + _best_text(free)
     return text
+
+
+def _complex_text(a):
+    """Where the multipliers are complex, S does not depend on delta (over the paper's plane
+    it depends on 1/beta_f alone): say in how much of the domain (``complex_share`` of
+    :func:`vibroimpact.reports.notebook.map_agreement`, given where delta is an axis)."""
+    share = a.get("complex_share", np.nan)
+    if not np.isfinite(share) or share == 0:
+        return ""
+    return (f"; multipliers a complex pair in {100 * share:.0f} % of the domain's cells, where "
+            "S = 100 (1 - eps exp(-zeta z/m)), z = 2 pi n/beta_f, does not depend on delta: "
+            "rho(P, S) cannot rank P along delta there")
 
 
 def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5, predictors=None):
@@ -527,15 +576,17 @@ def finding8(agreement, inside=0.75, correlation=0.5, min_cells=5, predictors=No
     ``correlation`` and, with ``predictors``, its 95 % bootstrap interval clear of 0. Both:
     ``yes``; where only: ``partly``; not where: ``no``. ``measured`` also gives the other
     predictors' correlations inside the domain (basin fraction, Lyapunov exponent, residence
-    time) and the noise-free one that ranks P best: the claim names S, the data may favour
-    another.
+    time) and the noise-free one that ranks P best, where the intervals allow naming one
+    (:func:`_best_text`): the claim names S, the data may favour another. With
+    ``complex_share`` in a motion's agreement (the share of its stable cells whose
+    multipliers are a complex pair), it says that S does not depend on delta there.
     """
     judged = {m: a for m, a in agreement.items() if a["n_dominant"] >= min_cells}
     if not judged:
         return not_available(8, f"no motion has {min_cells} cells with probability >= 50 %")
     parts = [f"({m}) {a['n_dominant']} cells >= 50 %: {100 * a['dominant_inside']:.0f} % inside, "
              f"domain covered {100 * a['domain_covered']:.0f} %, rank correlation with S "
-             f"{a['rank_correlation']:.2f}" + _predictors_text(predictors, m)
+             f"{a['rank_correlation']:.2f}" + _complex_text(a) + _predictors_text(predictors, m)
              for m, a in judged.items()]
     where = all(a["dominant_inside"] >= inside for a in judged.values())
 

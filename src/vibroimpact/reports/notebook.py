@@ -181,12 +181,28 @@ def study_settings(ds, name=""):
 
 def map_agreement(motion_map, orbits):
     """Fig. 15 against Fig. 16 per motion (:func:`vibroimpact.plotting.maps.map_agreement`),
-    or None when either map is missing."""
+    or None when either map is missing. ``orbits``: the orbits at the map's own cells
+    (``results/datasets/{study}_map_orbits.nc``, `vibroimpact.orbits.cells.orbits_at_cells`),
+    so that no cell is read at a neighbour (another grid is refused); with their
+    ``complex`` flags, each motion's dict also gives ``complex_share``, the share of its
+    stable cells whose multipliers are a complex pair, where S does not depend on delta (NaN
+    when not known, or when delta is not an axis of the map)."""
     if motion_map is None or orbits is None:
         return None
     from vibroimpact.plotting.maps import map_agreement as agreement
+    from vibroimpact.reports.predictors import on_map_grid
 
-    return agreement(motion_map, orbits)
+    orbits = on_map_grid(orbits, motion_map, "orbits")
+    out = agreement(motion_map, orbits)
+    along_delta = "delta" in _plane(motion_map)
+    for name, a in out.items():
+        a["complex_share"] = np.nan
+        if "complex" in orbits and along_delta:
+            o = orbits.sel(type=name)
+            flags = o["complex"].values[o["n_stable"].values > 0]
+            if flags.size and (flags >= 0).all():
+                a["complex_share"] = float((flags == 1).mean())
+    return out
 
 
 def _plane(motion_map):

@@ -4,9 +4,15 @@ with the candidates, cell by cell over the map's (1/beta_f, delta) plane.
 The paper's conclusion 5 (finding 8) names one predictor: the degree of stability S of the
 periodic motion under the harmonic force alone (Fig. 16). The datasets offer three more:
 
-- ``S``: Fig. 16's degree of stability (%), read at the orbit map's cell nearest to each map
-  cell (its grid is finer; as `plotting.maps.map_agreement`); 0 outside the stable domain
-  (S = 100 (1 - |lambda|) is 0 at its edge);
+- ``S``: Fig. 16's degree of stability (%) at each map cell's own centre: the orbits solved
+  there by the orbits entry's own solver (`vibroimpact.orbits.cells.orbits_at_cells`, rule
+  ``solve_map_orbits``), never read at a nearby cell of Fig. 16's finer grid (the map's
+  cells may sit halfway between two of its cells, where "nearest" is a tie broken by
+  rounding); 0 outside the stable domain (S = 100 (1 - |lambda|) is 0 at its edge). Where
+  the motion's two multipliers are a complex pair, |lambda| is the square root of the
+  Jacobian's determinant, eps exp(-zeta z / m) with z = 2 pi n / beta_f: S does not depend
+  on delta there (over the paper's plane it depends on 1/beta_f alone; `orbits_at_cells`
+  flags those cells);
 - ``basin``: the share of starting states that settle on a stable orbit of the type without
   noise (``results/orbits/{orbits}_basins.nc``, `fraction`);
 - ``lyapunov``: the largest Lyapunov exponent of the cell's starts without noise
@@ -20,8 +26,8 @@ periodic motion under the harmonic force alone (Fig. 16). The datasets offer thr
   much the noise-free dynamics foretell.
 
 Each is correlated with P (the map's ``probability``: the motion with free flights, as Figs. 15
-and 16 compare) inside the motion's stable domain (Fig. 16's ``n_stable > 0``; without an
-orbit map, the basins dataset's ``n_stable``) and over the whole plane. The basins and
+and 16 compare) inside the motion's stable domain (``n_stable > 0`` at the cell's centre;
+without an orbit map, the basins dataset's ``n_stable``) and over the whole plane. The basins and
 exponents are simulated on the orbits entry's ``attractors`` grid, which the config sets to
 the map's grid so that they compare cell for cell; a different grid is refused
 (:func:`on_map_grid`), never interpolated (a share of starts or an exponent between two
@@ -78,6 +84,9 @@ class Correlation:
     note: str = ""
 
 
+_AXIS_TEXT = {"inv_beta": "1/beta_f"}
+
+
 def _grid_text(values):
     values = np.asarray(values, dtype=float)
     if values.size < 2:
@@ -86,25 +95,28 @@ def _grid_text(values):
 
 
 def on_map_grid(ds, motion_map, name):
-    """``ds`` (a basins or Lyapunov dataset) with the map's (inv_beta, delta) coordinates.
+    """``ds`` (a basins, Lyapunov or `vibroimpact.orbits.cells.orbits_at_cells` dataset) with
+    the map's plane coordinates (``(inv_beta, delta)``, or its ``attrs["axes"]``).
 
     Raises
     ------
     ValueError
         When its grid is not the map's (both must list the same values, to 1e-9): the
-        message gives both grids and the config key that sets them.
+        message gives both grids and how to make them one.
     """
-    same = all(ds.sizes[d] == motion_map.sizes[d]
+    axes = _map_axes(motion_map)
+    same = all(d in ds.dims and ds.sizes[d] == motion_map.sizes[d]
                and np.allclose(ds[d].values, motion_map[d].values, rtol=0.0, atol=1e-9)
-               for d in ("inv_beta", "delta"))
+               for d in axes)
     if not same:
-        raise ValueError(
-            f"the {name} grid (1/beta_f {_grid_text(ds.inv_beta)}, delta "
-            f"{_grid_text(ds.delta)}) is not the map's (1/beta_f "
-            f"{_grid_text(motion_map.inv_beta)}, delta {_grid_text(motion_map.delta)}): set "
-            f"the orbits entry's attractors grid to the study's to compare them cell for cell")
-    return ds.assign_coords(inv_beta=motion_map.inv_beta.values,
-                            delta=motion_map.delta.values)
+        def grid(data):
+            return ", ".join(f"{_AXIS_TEXT.get(d, d)} {_grid_text(data[d])}" if d in data.dims
+                             else f"no {d} axis" for d in axes)
+        hint = ("solve the orbits at the map's cells (orbits_at_cells)" if "orbit" in name
+                else "set the attractors grid to the study's")
+        raise ValueError(f"the {name} grid ({grid(ds)}) is not the map's ({grid(motion_map)}): "
+                         f"{hint} to compare them cell for cell")
+    return ds.assign_coords({d: motion_map[d].values for d in axes})
 
 
 def _ranks(a):
@@ -241,21 +253,13 @@ def _map_axes(motion_map):
 
 
 def _stable_domain(motion_map, orbits, basins, motion):
-    """(stable, S) on the map's grid: Fig. 16's nearest cell, or the basins' n_stable."""
+    """(stable, S) on the map's grid: the orbits at the cells' centres
+    (`vibroimpact.orbits.cells.orbits_at_cells`, on the map's grid), or the basins'
+    n_stable."""
     if orbits is not None and motion in orbits["type"].values:
-        x_name, y_name = _map_axes(motion_map)
-        o = orbits.sel(type=motion)
-        near = o.sel({x_name: motion_map[x_name], y_name: motion_map[y_name]},
-                     method="nearest").transpose(x_name, y_name)
-        # map cells beyond the orbit map's plane (more than half a step out) are unknown
-        inside = np.ones((motion_map.sizes[x_name], motion_map.sizes[y_name]), bool)
-        for axis, d in enumerate((x_name, y_name)):
-            grid = o[d].values
-            half = 0.5 * (np.diff(grid).max() if grid.size > 1 else 0.0) + 1e-9
-            out = np.abs(near[d].values - motion_map[d].values) > half
-            inside &= ~np.expand_dims(out, 1 - axis)
-        stable = (near["n_stable"].values > 0) & inside
-        S = np.where(stable, near["S"].values, np.where(inside, 0.0, np.nan))
+        o = orbits.sel(type=motion).transpose(*_map_axes(motion_map))
+        stable = o["n_stable"].values > 0
+        S = np.where(stable, o["S"].values, 0.0)
         return stable, S
     if basins is not None and motion in basins["motion"].values:
         return basins["n_stable"].sel(motion=motion).values > 0, None
@@ -265,15 +269,15 @@ def _stable_domain(motion_map, orbits, basins, motion):
 def _fields(motion_map, motion, orbits, basins, lyapunov, errors):
     """``{predictor: array on the map's grid or a reason string}`` for one motion."""
     stable, S = _stable_domain(motion_map, orbits, basins, motion)
-    out = {"S": S if S is not None else
+    out = {"S": S if S is not None else errors["S"] if "S" in errors else
            "no orbit map (the study draws no fig15_vs_fig16)" if orbits is None else
            f"the orbit map has no type {motion}"}
     for name, ds in (("basin", basins), ("lyapunov", lyapunov)):
         if name in errors:
             out[name] = errors[name]
         elif ds is None:
-            out[name] = ("no attractors dataset (the orbits entry fig15_vs_fig16 names has no "
-                         "attractors block)")
+            out[name] = ("no attractors dataset (neither the study nor the orbits entry "
+                         "fig15_vs_fig16 names has an attractors block)")
         elif name == "basin":
             out[name] = (ds["fraction"].sel(motion=motion).values
                          if motion in ds["motion"].values else f"no basin of {motion}")
@@ -297,10 +301,14 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
     ----------
     motion_map : xarray.Dataset
         ``results/datasets/{study}_map.nc``.
-    orbits, basins, lyapunov : xarray.Dataset or None
-        Fig. 16's orbit map, the basins and the Lyapunov datasets of the same system (None:
-        not provided; its rows say so). A basins or Lyapunov dataset on another grid than the
-        map's is not used (its rows give :func:`on_map_grid`'s reason).
+    orbits : xarray.Dataset or None
+        The periodic orbits at the map's cells (`vibroimpact.orbits.cells.orbits_at_cells` of
+        Fig. 16's orbit map, ``results/datasets/{study}_map_orbits.nc``), on the map's grid;
+        None: not provided (its rows say so).
+    basins, lyapunov : xarray.Dataset or None
+        The basins and the Lyapunov datasets of the same system (None: not provided; its rows
+        say so). An orbits, basins or Lyapunov dataset on another grid than the map's is not
+        used (its rows give :func:`on_map_grid`'s reason): never read at a nearby cell.
     seed, n_resamples : int
         Of the bootstrap (:func:`rank_correlation`).
 
@@ -312,13 +320,15 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
     motion_map = motion_map.transpose(..., *_map_axes(motion_map))   # every field (x, y)
     errors = {}
     aligned = {}
-    for name, ds in (("basin", basins), ("lyapunov", lyapunov)):
+    for name, ds in (("S", orbits), ("basin", basins), ("lyapunov", lyapunov)):
         try:
-            aligned[name] = None if ds is None else on_map_grid(ds, motion_map, name)
+            aligned[name] = None if ds is None else on_map_grid(
+                ds, motion_map, "orbits" if name == "S" else name)
         except ValueError as error:
             errors[name], aligned[name] = f"not used: {error}", None
     motions = [str(m) for m in motion_map["motion"].values]
-    fields = {m: _fields(motion_map, m, orbits, aligned["basin"], aligned["lyapunov"], errors)
+    fields = {m: _fields(motion_map, m, aligned["S"], aligned["basin"], aligned["lyapunov"],
+                         errors)
               for m in motions}
     # computed motion by motion (P's resampled ranks shared by the four predictors), listed
     # predictor by predictor
@@ -399,8 +409,8 @@ def read_correlations(ds):
     missing = [name for name in _FIELDS if name not in ds]
     if missing:
         raise ValueError(f"not a predictors dataset: no variable {', '.join(missing)}")
-    ds = ds.transpose("predictor", "motion", "where")
-    arrays = {name: ds[name].values for name in _FIELDS}
+    arrays = {name: ds[name].transpose("predictor", "motion", "where").values
+              for name in _FIELDS}
     out = []
     for i, predictor in enumerate(ds["predictor"].values):
         for j, motion in enumerate(ds["motion"].values):

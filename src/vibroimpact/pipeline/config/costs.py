@@ -12,7 +12,7 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
            "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "orbit_plane_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
-           "work_precision_cpu_s", "stress_cpu_s", "predictors_cpu_s"]
+           "work_precision_cpu_s", "stress_cpu_s", "predictors_cpu_s", "map_orbits_cpu_s"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 #: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
@@ -103,6 +103,12 @@ MAP_REPORT_S = 1.6
 #: 3 times by `benchmarks/job_costs.py --jobs --only map_predictors`, load ~4), 1.2 of it
 #: besides `JOB_START_S`.
 PREDICTORS_CELL_S = 7.5e-5
+#: The orbits of Fig. 16's types solved at a map's cells (rule ``solve_map_orbits``:
+#: `orbits.cells.orbits_at_cells`, `orbit_map` along each row and `periodic_orbits` at each
+#: stable cell for its multipliers), per map cell and motion, besides the job's start-up:
+#: 2.4 CPU-s on the default map (5,187 cells, 3 motions; its benchmark file's cpu_time in a
+#: build, load ~4), 1.4 of it besides `JOB_START_S`.
+MAP_ORBITS_CELL_S = 9.0e-5
 #: The rule writing each validation dataset (``results/validation/<name>.nc``).
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
@@ -281,6 +287,12 @@ def orbit_plane_cpu_s(entry, cells):
 def attractor_cpu_s(cells, n_starts):
     """CPU seconds of the attractor map's ``n_starts`` starts in each of ``cells`` cells."""
     return cells * n_starts * US_PER_START * 1e-6
+
+
+def map_orbits_cpu_s(cells, motions):
+    """CPU seconds of solving an orbit map's types at a map's cells (rule
+    ``solve_map_orbits``) besides its start-up: ``cells`` of the map, ``motions`` of it."""
+    return MAP_ORBITS_CELL_S * cells * motions
 
 
 def predictors_cpu_s(cells, motions):

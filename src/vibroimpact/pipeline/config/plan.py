@@ -192,7 +192,8 @@ def _time(s):
     return f"{s:.2g} s"
 
 
-_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace", "plane_basins", "predictors")
+_STUDY_KINDS = ("events", "map", "spectra", "escape", "trace", "plane_basins", "predictors",
+                "map_orbits")
 _ORBIT_KINDS = ("orbits", "boundaries", "basins", "lyapunov")
 
 
@@ -216,8 +217,8 @@ def built_entries(config, own=None):
         kinds = {k for k in _STUDY_KINDS if targets.DATASETS[k].format(name=name) in needed}
         if kinds:
             build["studies"][name] = kinds
-            # escape, attractors, predictors: no record file
-            if kinds - {"escape", "plane_basins", "predictors"}:
+            # escape, attractors, predictors, orbits at the map's cells: no record file
+            if kinds - {"escape", "plane_basins", "predictors", "map_orbits"}:
                 build["noises"].add(config["studies"][name]["noise"])
     for name in config.get("orbits", {}):
         kinds = {k for k in _ORBIT_KINDS if targets.DATASETS[k].format(name=name) in needed}
@@ -347,6 +348,12 @@ def make_plan(config, own=None, *, results="results", studies=None):
             _charge(row, "map_predictors", 1,
                     costs.predictors_cpu_s(cells, motions) + JOB_START_S)
             parts.append("predictors of P")
+        if "map_orbits" in needs:          # rule solve_map_orbits: Fig. 16 at the map's cells
+            cells, motions = len(study.cells("events")), len(entry["motions"])
+            row.bytes += FILE_OVERHEAD + cells * motions * 17
+            _charge(row, "solve_map_orbits", 1,
+                    costs.map_orbits_cpu_s(cells, motions) + JOB_START_S)
+            parts.append("orbits at the map's cells")
         if "trace" in needs:
             steps = float(entry["trace"]["t_end"]) / float(noise["dt"])
             _add(row, 0, 0, 40 * steps + FILE_OVERHEAD, 0.0)
