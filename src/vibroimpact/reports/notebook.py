@@ -938,22 +938,26 @@ def finding5_readings(spectra):
         "the paper's Fig. 12 shows moving. *With the lines*: the centroid of the whole "
         "response. *Broadband*: the lines taken out over "
         f"$\\pm${LINE_BINS} bins of the Welch grid (the Hann window's main lobe is $\\pm$2 "
-        "bins; a line between two bins leaves 3.5e-6 of its power beyond $\\pm$5), their bins "
+        "bins; a line half a bin off leaves 6.1e-6 of its power beyond $\\pm$5), their bins "
         "bridged by a straight line between the neighbouring clean bins, each line's power "
         "what it adds over that bridge (`line k beta_f`). The 95 % intervals come from the "
         "spectra of the record's consecutive batches (`S_a_batch`): delete-one jackknife "
         "for the centroid, the batches' own smoothed peaks for the peak."))
     numbers = findings.finding5_readings(spectra)
     display(_styled(numbers, {"data": "f5_value", "row_heading": "f5_row",
-                              "col_heading": "f5_column"}).format(precision=3))
+                              "col_heading": "f5_column"}).format(precision=3, na_rep="")
+            .hide(axis="index"))
     display(Markdown(
         "The broadband centroid at the smallest play less that at the largest, under each "
-        "choice of the lines' half-width and of the band's upper end: finding 5 calls the "
+        "choice of the lines' half-width, of the band's upper end and of what stands in the "
+        "lines' bins (bridged, or dropped: which drops the broadband under them too, and "
+        "lowers the centroid where the lines sit near the resonance): finding 5 calls the "
         "move only when every choice of a 1/$\\beta_f$ reads the same way (the interval "
         "below or above 0), and prints a contradiction of the paper only then."))
     display(_styled(findings.finding5_choices(spectra),
                     {"data": "f5c_value", "row_heading": "f5c_row",
-                     "col_heading": "f5c_column"}).format(precision=3))
+                     "col_heading": "f5c_column"}).format(precision=3)
+            .format("{:g}", subset=["beta <="]).hide(axis="index"))
 
 
 def two_wall_checks(events=None, spectra=None, motion_map=None):
@@ -983,7 +987,8 @@ def two_wall_checks(events=None, spectra=None, motion_map=None):
         display(Markdown("### Per wall"))
         display(_styled(two_walls.per_wall(events),
                         {"data": "wall_value", "row_heading": "wall_row",
-                         "col_heading": "wall_column"}).format(precision=3))
+                         "col_heading": "wall_column"}).format(precision=3)
+                .hide(axis="index"))
     shifts = None
     if spectra is not None:
         from vibroimpact.reports.findings import spectra_shifts
@@ -998,8 +1003,11 @@ def two_wall_checks(events=None, spectra=None, motion_map=None):
         [two_walls.mirror_table(events, shifts) if events is not None else None,
          two_walls.map_mirror_table(motion_map) if motion_map is not None else None])
     if not table.empty:
+        numbers = {"1/beta_f": "{:.3g}", "delta": "{:g}", "mirror delta": "{:g}",
+                   "value": "{:.4g}", "mirror value": "{:.4g}"}
         display(_styled(table, {"data": "mirror_value", "row_heading": "mirror_row",
-                                "col_heading": "mirror_column"}).format(precision=4))
+                                "col_heading": "mirror_column"})
+                .format({k: v for k, v in numbers.items() if k in table}).hide(axis="index"))
     display(Markdown("### Against the two-wall stable domains"))
     if motion_map is not None:
         display(Markdown(

@@ -222,5 +222,6 @@ def mirror_check(events=None, spectra_shift=None, motion_map=None):
     summary = "" if holds == "yes" else _sentence(
         f"{n_agree} of {n} mirror comparisons agree within their 95 % intervals"
         if holds == "partly" else None,
-        f"{n - n_agree} do not (their intervals do not overlap)")
+        f"{n - n_agree} {'is' if n - n_agree == 1 else 'are'} apart (the intervals do not "
+        f"overlap)")
     return Finding("mirror", MIRROR_CLAIM, measured, holds, summary)
