@@ -990,7 +990,7 @@ def two_wall_checks(events=None, spectra=None, motion_map=None):
                          "col_heading": "wall_column"}).format(precision=3)
                 .hide(axis="index"))
     shifts = None
-    if spectra is not None:
+    if spectra is not None and float(spectra.attrs.get("amplitude", 0.0)) != 0.0:
         from vibroimpact.reports.findings import spectra_shifts
 
         shifts = spectra_shifts(spectra)
