@@ -504,11 +504,11 @@ def test_fig12_gives_both_readings_and_which_way_the_broadband_moves(data, plays
     spectra.attrs = dict(data["spectra_h"].attrs)
     title = _title(plotting.fig12(spectra, inv_beta=1.1)).replace("\n", " ")
     sh = shift(row, 1 / 1.1)
-    assert (f"with the lines {sh.centroid_lines[-1]:.2f} $\\to$ {sh.centroid_lines[0]:.2f};  "
-            f"broadband (lines at $k\\beta_f$ out, $\\pm$5 bins) {sh.centroid[-1]:.2f} "
-            f"[{sh.centroid_low[-1]:.2f}, {sh.centroid_high[-1]:.2f}] $\\to$ "
-            f"{sh.centroid[0]:.2f} [") in title, title
-    assert way in title and "95 % intervals from 10 batches" in title
+    assert (f"with the lines at $k\\beta_f$ {sh.centroid_lines[-1]:.2f} $\\to$ "
+            f"{sh.centroid_lines[0]:.2f} broadband (lines' $\\pm$5 bins out): "
+            f"{sh.centroid[-1]:.2f} [{sh.centroid_low[-1]:.2f}, {sh.centroid_high[-1]:.2f}] "
+            f"$\\to$ {sh.centroid[0]:.2f} [") in title, title
+    assert way in title and "(95 %, 10 batches)" in title
     assert "opposite" not in title
 
 

@@ -9,8 +9,7 @@ from vibroimpact.plotting._common import (
     axis_label)
 from vibroimpact.plotting._common import two_wall_dataset
 from vibroimpact.plotting.walls import two_walls, wall_density_figure
-from vibroimpact.stats.centroid import (BAND_CHOICES, CENTROID_BAND, LINE_BINS,
-                                        LINE_BINS_CHOICES, shift)
+from vibroimpact.stats.centroid import CENTROID_BAND, LINE_BINS, shift
 
 
 def fig10(trace):
@@ -100,7 +99,7 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
         As :func:`fig06`; S_lin (random part only) dashed, the forcing frequency dotted;
         each delta's legend entry gives the power of the response's line at beta_f
         (`vibroimpact.stats.line_power`), comparable with Fig. 11's A^2/2 where the Welch
-        peak heights are not, and the legend's title the resolution. The header's last two
+        peak heights are not, and the legend's title the resolution. The header's last
         lines give the response's centroid (`vibroimpact.stats.centroid`, the reports'
         finding 5) at the largest delta and the smallest in both readings: with the lines at
         k beta_f (whose strength follows delta) and of the broadband response (the lines
@@ -116,7 +115,7 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
 
 
 def _centroid_note(spectra, i_beta):
-    """Two header lines: the response's centroid at the largest and the smallest delta with
+    """Header lines: the response's centroid at the largest and the smallest delta with
     the lines and of the broadband response (`vibroimpact.stats.centroid.shift`), and, one
     wall only, which way the broadband centroid moves against the paper (empty with fewer
     than two deltas)."""
@@ -133,21 +132,19 @@ def _centroid_note(spectra, i_beta):
         return (f"{sh.centroid[k]:.2f}" if not np.isfinite(low) else
                 f"{sh.centroid[k]:.2f} [{low:.2f}, {high:.2f}]")
 
-    text = (f"\ncentroid of the response ($\\beta \\leq$ {CENTROID_BAND:g}) from "
-            f"$\\delta$ = {d_hi} to {d_lo}: with the lines {sh.centroid_lines[-1]:.2f} $\\to$ "
-            f"{sh.centroid_lines[0]:.2f};  broadband (lines at $k\\beta_f$ out, $\\pm${LINE_BINS} "
-            f"bins) {between(-1)} $\\to$ {between(0)}")
+    text = (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}), $\\delta$ = {d_hi} "
+            f"$\\to$ {d_lo}: with the lines at $k\\beta_f$ {sh.centroid_lines[-1]:.2f} $\\to$ "
+            f"{sh.centroid_lines[0]:.2f}\nbroadband (lines' $\\pm${LINE_BINS} bins out): "
+            f"{between(-1)} $\\to$ {between(0)}"
+            + (f" (95 %, {sh.n_batches} batches)" if sh.n_batches else ""))
     if two_wall_dataset(spectra):   # two walls: the paper's finding (one wall) is no reference
         return text
-    choices = (f"half-width {', '.join(map(str, LINE_BINS_CHOICES))} bins, $\\beta \\leq$ "
-               f"{', '.join(format(b, 'g') for b in BAND_CHOICES)}, lines' bins bridged or "
-               f"dropped")
     way = {"falls": "falls as $\\delta$ decreases, as in the paper",
            "rises": "rises as $\\delta$ decreases, against the paper",
            "unresolved": "shows no resolved move as $\\delta$ decreases"}[sh.reading()]
-    scope = (f"under every choice of {choices}; 95 % intervals from {sh.n_batches} batches"
-             if sh.n_batches else "no batch spectra: no interval, no verdict")
-    return text + f"\nthe broadband centroid {way} ({scope})"
+    scope = (f"under all {len(sh.change)} choices of the measure" if sh.reading() != "unresolved"
+             else "no batch spectra" if not sh.n_batches else "not under every choice")
+    return text + f"\nit {way}, {scope}"
 
 
 @_styled
