@@ -278,11 +278,11 @@ def shift(spectra_row, beta_f, band=CENTROID_BAND, halfwidth=LINE_BINS, level=0.
             c = _centroids(beta, broadband(beta, loo, beta_f, top, h, fill)[0], top)
             low, high = _jackknife(c[0] - c[-1], diff, level)
             change[key] = (diff, float(low), float(high))
-            if key == (halfwidth, float(band), "bridge"):
-                cl, ch = _jackknife(c, whole, level)
         else:
             change[key] = (diff, float("nan"), float("nan"))
     if has_batches:
+        c = _centroids(beta, broadband(beta, loo, beta_f, band, halfwidth)[0], band)
+        cl, ch = _jackknife(c, _centroids(beta, broad, band), level)
         # a maximum is no smooth statistic (the jackknife's leave-one-out peaks mostly share
         # one bin): the batch means' error instead, from the peaks of the batches' own
         # broadband spectra, each smoothed over +-halfwidth bins
