@@ -167,6 +167,10 @@ def test_finding5_reads_the_broadband_not_the_lines():
     assert "opposite" not in found.measured + found.summary
     choices = findings.finding5_choices(spectra)
     assert len(choices) == 18 and set(choices.reads) == {"falls"}
+    main = choices[(choices["half-width (bins)"] == 5) & (choices["beta <="] == 3.0)
+                   & (choices["lines' bins"] == "bridged")].iloc[0]
+    assert main["centroid at delta = 2"] == pytest.approx(table["broadband centroid"][2.0])
+    assert main["change"] == pytest.approx(main["at delta = -0.5"] - main["centroid at delta = 2"])
 
 
 def test_finding5_prints_a_contradiction_only_under_every_choice():

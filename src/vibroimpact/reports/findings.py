@@ -481,16 +481,20 @@ def finding5_readings(spectra, line_bins=LINE_BINS, band=CENTROID_BAND):
 def finding5_choices(spectra):
     """The broadband centroid's change from the largest play to the smallest under each
     choice of the lines' half-width, the band and what stands in the lines' bins (a pandas
-    DataFrame: the change, its 95 % interval, and which way it reads), per 1/beta_f: finding
+    DataFrame: the two centroids, the change, its 95 % interval, and which way it reads),
+    per 1/beta_f: finding
     5 calls a move only when every row of a 1/beta_f reads the same."""
     import pandas as pd
 
     rows = []
     for inv_beta, sh in spectra_shifts(spectra).items():
         for (h, top, fill), (diff, low, high) in sh.change.items():
+            large, small = sh.ends[(h, top, fill)]
             rows.append({"1/beta_f": inv_beta, "half-width (bins)": h, "beta <=": top,
                          "lines' bins": "bridged" if fill == "bridge" else "dropped",
-                         "change": diff, "95 %": f"[{low:+.3f}, {high:+.3f}]",
+                         f"centroid at delta = {sh.delta[-1]:g}": large,
+                         f"at delta = {sh.delta[0]:g}": small, "change": diff,
+                         "95 %": f"[{low:+.3f}, {high:+.3f}]",
                          "reads": ("falls" if high < 0 else "rises" if low > 0 else
                                    "unresolved")})
     return pd.DataFrame(rows)

@@ -215,6 +215,9 @@ class Shift:
         the smallest play less that at the largest, with its jackknife interval (the same
         batches at both plays: one record), for every choice in `LINE_BINS_CHOICES` x
         `BAND_CHOICES` x `FILL_CHOICES`; NaN bounds without batches.
+    ends : dict
+        ``{(halfwidth, band, fill): (at the largest play, at the smallest)}``: the broadband
+        centroids whose difference ``change`` gives.
     halfwidth, band, level, n_batches : int, float, float, int
         The main choice, the interval's level and the batches (0: none).
     """
@@ -229,6 +232,7 @@ class Shift:
     peak_high: np.ndarray
     lines: np.ndarray
     change: dict
+    ends: dict
     halfwidth: int
     band: float
     level: float
@@ -264,7 +268,7 @@ def shift(spectra_row, beta_f, band=CENTROID_BAND, halfwidth=LINE_BINS, level=0.
     n_delta = S.shape[0]
     nan = np.full(n_delta, np.nan)
     cl, ch, pl, ph = nan.copy(), nan.copy(), nan.copy(), nan.copy()
-    change = {}
+    change, ends = {}, {}
     has_batches = "S_a_batch" in row and row.sizes.get("batch", 0) >= 2
     if has_batches:
         n_batches = row.sizes["batch"]
@@ -274,6 +278,7 @@ def shift(spectra_row, beta_f, band=CENTROID_BAND, halfwidth=LINE_BINS, level=0.
         whole = _centroids(beta, broadband(beta, S, beta_f, top, h, fill)[0], top)
         diff = float(whole[0] - whole[-1])
         key = (h, float(top), fill)
+        ends[key] = (float(whole[-1]), float(whole[0]))
         if has_batches:
             c = _centroids(beta, broadband(beta, loo, beta_f, top, h, fill)[0], top)
             low, high = _jackknife(c[0] - c[-1], diff, level)
@@ -298,6 +303,6 @@ def shift(spectra_row, beta_f, band=CENTROID_BAND, halfwidth=LINE_BINS, level=0.
     return Shift(delta=np.asarray(row.delta, dtype=float),
                  centroid_lines=_centroids(beta, S, band),
                  centroid=_centroids(beta, broad, band), centroid_low=cl, centroid_high=ch,
-                 peak=peak, peak_low=pl, peak_high=ph, lines=lines, change=change,
+                 peak=peak, peak_low=pl, peak_high=ph, lines=lines, change=change, ends=ends,
                  halfwidth=int(halfwidth), band=float(band), level=float(level),
                  n_batches=int(row.sizes["batch"]) if has_batches else 0)
