@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from vibroimpact.reports import findings
+from vibroimpact.reports import findings, sensitivity, two_walls
 
 DELTA = np.array([-1.0, -0.5, 0.0, 0.5, 1.0, 2.0, 3.0])
 
@@ -138,23 +138,57 @@ def test_every_partly_verdict_opens_with_what_holds_and_what_not():
     assert table.loc[8, "measured"].startswith(found.summary + " (1/1) 40 cells")
 
 
-def test_finding5_says_which_part_fails():
-    """A response whose centroid rises as delta falls: the summary names the 1/beta_f and the
-    centroids (from the spectra), and the verdict is partly."""
-    beta = np.linspace(0.0, 4.0, 401)
-    deltas = np.array([-0.5, 2.0])
-    S_a = np.array([0.01 + np.exp(-((beta - 1.1) / 0.3) ** 2),          # wide, higher
-                    0.01 + 5 * np.exp(-((beta - 1 / 1.1) / 0.02) ** 2)])  # narrow line at beta_f
-    spectra = xr.Dataset(
-        {"S_a": (("inv_beta", "delta", "beta"), S_a[None]),
-         "S_f": (("inv_beta", "beta"), np.full((1, beta.size), 1e-4))},
-        coords=dict(inv_beta=[1.1], delta=deltas, beta=beta))
+def harmonic_spectra(plays, inv_beta=1.1):
+    """One 1/beta_f row of a harmonic spectra dataset from Welch estimates with batches
+    (tests/test_centroid.py's records: ``{delta: (resonance, line amplitude)}``), its input
+    a line of power 0.5 over a weak random part."""
+    from test_centroid import spectra_row
+
+    row = spectra_row(plays)
+    spectra = xr.concat([row], dim="inv_beta").assign_coords(inv_beta=[inv_beta])
+    spectra["S_f"] = (("inv_beta", "beta"), np.full((1, row.beta.size), 1e-4))
+    return spectra
+
+
+def test_finding5_reads_the_broadband_not_the_lines():
+    """The study's case: the broadband resonance moves down (1.3 -> 1.0) as delta falls,
+    while the line at beta_f, strong at the large play and weak at the small one, makes the
+    centroid with the lines rise. Finding 5 reads the broadband (it holds), and gives both
+    readings. Counting the lines (the earlier measure) would print the contradiction."""
+    spectra = harmonic_spectra({2.0: (1.3, 1.7), 1.0: (1.2, 0.8), -0.5: (1.0, 0.2)})
     found = findings.finding5(spectra)
-    assert found.holds == "partly", found.measured
-    assert found.summary.startswith("Holds: the input's power is concentrated at beta_f")
-    assert ("does not: as delta falls from 2 to -0.5 the response moves to higher frequency, "
-            "opposite to the paper (its centroid (beta <= 3) 1.00 -> 1.12" in found.summary)
-    assert "at 1/beta_f = 1.1)." in found.summary
+    assert found.holds == "yes", found.measured
+    table = findings.finding5_readings(spectra).set_index("delta")
+    with_lines = table["centroid with the lines (beta <= 3)"]
+    assert with_lines[-0.5] > with_lines[2.0]                # the lines' reading rises
+    assert table["broadband centroid"][-0.5] < table["broadband centroid"][2.0] - 0.1
+    assert (f"with the lines {with_lines[2.0]:.2f} -> {with_lines[-0.5]:.2f}; broadband "
+            f"{table['broadband centroid'][2.0]:.2f} [" in found.measured)
+    assert "opposite" not in found.measured + found.summary
+    choices = findings.finding5_choices(spectra)
+    assert len(choices) == 18 and set(choices.reads) == {"falls"}
+    main = choices[(choices["half-width (bins)"] == 5) & (choices["beta <="] == 3.0)
+                   & (choices["lines' bins"] == "bridged")].iloc[0]
+    assert main["centroid at delta = 2"] == pytest.approx(table["broadband centroid"][2.0])
+    assert main["change"] == pytest.approx(main["at delta = -0.5"] - main["centroid at delta = 2"])
+
+
+def test_finding5_prints_a_contradiction_only_under_every_choice():
+    """A broadband that rises under every choice: "partly", against the paper, named with its
+    centroids. One that does not move (the same resonance on other noise): not resolved, and
+    no contradiction printed."""
+    rises = findings.finding5(harmonic_spectra({2.0: (1.0, 1.7), -0.5: (1.3, 0.2)}))
+    assert rises.holds == "partly", rises.measured
+    assert ("the broadband response moves to higher frequency, opposite to the paper"
+            in rises.summary)
+    assert "under every choice of half-width 3, 5, 8 bins x beta <= 2, 3, 4" in rises.summary
+    still = findings.finding5(harmonic_spectra({2.0: (1.2, 1.7), -0.5: (1.2, 0.2)}))
+    assert still.holds == "partly" and "opposite" not in still.summary + still.measured
+    assert "the broadband centroid's move is not resolved" in still.summary
+    # without batch spectra: no interval, so no verdict on the move either way
+    bare = harmonic_spectra({2.0: (1.0, 1.7), -0.5: (1.3, 0.2)}).drop_vars("S_a_batch")
+    found = findings.finding5(bare)
+    assert "opposite" not in found.summary and "no batch spectra" in found.measured
 
 
 def test_the_table_has_one_row_per_finding_with_claim_measure_and_verdict():
@@ -195,3 +229,97 @@ def test_finding2_with_plastic_impact_is_not_available():
     # monotonicity still decides
     v = np.array([0.0, 0.03, 0.12, 0.3, 0.45, 0.6, 0.7])
     assert findings.finding2(random_events(v=v)).holds == "yes"
+
+
+# --- a two-wall study: its own checks in place of findings 1-7 ---------------------------------
+
+WALL_DELTA = np.array([0.0, 0.5, 1.0, 1.5, 2.0, 2.5])
+
+
+def two_wall_events(eps_lower=0.5):
+    """A two-wall events dataset (gap 2, restitution 0.5 above, ``eps_lower`` below), mirror
+    symmetric: the upper wall at delta behaves as the lower wall at 2 - delta; intervals
+    +-2 %."""
+    rate_upper = np.array([0.30, 0.18, 0.17, 0.06, 0.003, 0.0])
+    v_upper = np.array([0.65, 0.90, 0.56, 0.35, 0.29, np.nan])
+    # the lower wall at delta is the upper at 2 - delta (2.5 has no mirror in the grid)
+    mirror = {0.0: 4, 0.5: 3, 1.0: 2, 1.5: 1, 2.0: 0}
+    rate_lower = np.array([rate_upper[mirror[d]] if d in mirror else 0.34 for d in WALL_DELTA])
+    v_lower = np.array([v_upper[mirror[d]] if d in mirror else 0.4 for d in WALL_DELTA])
+    rate = np.stack([rate_upper, rate_lower], axis=-1)[None]
+    v = np.stack([v_upper, v_lower], axis=-1)[None]
+    n = np.rint(rate * 20000).astype(int)
+    dims = ("inv_beta", "delta", "wall")
+    data = {"wall_collision_rate": rate, "wall_collision_rate_lo": 0.98 * rate,
+            "wall_collision_rate_hi": 1.02 * rate, "wall_v_after_mean": v,
+            "wall_v_after_mean_lo": 0.98 * v, "wall_v_after_mean_hi": 1.02 * v,
+            "wall_n_collisions": n,
+            "wall_interval_mean": np.divide(1.0, rate, where=rate > 0,
+                                            out=np.full_like(rate, np.inf)),
+            "wall_stuck_fraction": 0 * rate}
+    ds = xr.Dataset({k: (dims, x) for k, x in data.items()},
+                    coords=dict(inv_beta=[1.1], delta=WALL_DELTA, wall=["upper", "lower"]),
+                    attrs=dict(n_walls=2, gap=2.0, eps=0.5, eps_lower=eps_lower))
+    ds["n_collisions"] = ds.wall_n_collisions.sum("wall")
+    return ds
+
+
+def test_two_wall_study_gets_no_verdict_on_the_papers_play():
+    """Findings 1-7 compare plays of the paper's one wall: on a two-wall dataset each is n/a
+    and says why; the collision-rule table does not re-read findings 2 and 3 there."""
+    events = two_wall_events().assign(v_after_mean=lambda d: d.wall_v_after_mean.mean("wall"))
+    spectra = harmonic_spectra({2.0: (1.3, 1.7), -0.5: (1.0, 0.2)}).assign_attrs(
+        n_walls=2, gap=2.0)
+    found = (findings.random_force(events=events, spectra=spectra)
+             + findings.harmonic_random(events=events, spectra=spectra)[:3])
+    assert [f.number for f in found] == [1, 2, 3, 4, 5, 6, 7]
+    assert all(f.holds == "n/a" and "two-wall study" in f.measured
+               and "mirror images" in f.measured for f in found), found
+    assert sensitivity.finding_sensitivity(events.assign_coords(rule=["physical"])).empty
+
+
+def test_mirror_check_names_the_pairs_and_what_disagrees():
+    events = two_wall_events()
+    assert two_walls.mirror_pairs(events) == [(0.0, 2.0), (0.5, 1.5), (1.0, 1.0)]
+    agree = two_walls.mirror_check(events)
+    assert agree.holds == "yes", agree.measured
+    assert "mirror pairs delta = 0 and 2, delta = 0.5 and 1.5, delta = 1 (its two walls)" \
+        in agree.measured
+    # rows: (0, 2) and (0.5, 1.5) each wall both ways; delta = 2 lower-rate 0.003 x 20000 =
+    # 60 collisions < 1000 leaves (0, upper)-(2, lower) in, (0, lower)-(2, upper) out
+    table = two_walls.mirror_table(events)
+    assert len(table) == 2 * (1 + 2 + 1) and table.agree.all()
+    # the upper wall at 0.5 faster by 10 %: its mirror (the lower wall at 1.5) disagrees
+    broken = two_wall_events().copy(deep=True)
+    broken["wall_v_after_mean"].loc[dict(delta=0.5, wall="upper")] = 0.99
+    for bound, factor in (("wall_v_after_mean_lo", 0.98), ("wall_v_after_mean_hi", 1.02)):
+        broken[bound].loc[dict(delta=0.5, wall="upper")] = 0.99 * factor
+    found = two_walls.mirror_check(broken)
+    assert found.holds == "partly" and "7 of 8 mirror comparisons agree" in found.summary
+    assert ("mean velocity after impact at delta = 0.5 (upper): 0.99 [0.97, 1.01] against "
+            "0.9 [0.882, 0.918] at delta = 1.5 (lower)") in found.measured
+    # no mirror image without one restitution
+    assert two_walls.mirror_check(two_wall_events(eps_lower=0.8)).holds == "n/a"
+    assert "restitutions differ" in two_walls.mirror_check(two_wall_events(eps_lower=0.8)).measured
+    rows = two_walls.per_wall(events)
+    assert len(rows) == 2 * WALL_DELTA.size and set(rows.wall) == {"upper", "lower"}
+
+
+def test_mirror_check_on_a_map_swaps_the_motions_walls():
+    """On a map, P((1,0)/1) at delta is compared with P((0,1)/1) at gap - delta; a
+    probability with no error (never seen) is not compared."""
+    motions = ["(1,1)/1", "(1,0)/1", "(0,1)/1"]
+    delta = np.array([0.0, 1.0, 2.0])
+    p = np.array([[0.2, 0.9, 0.2], [0.7, 0.05, 0.0], [0.0, 0.05, 0.7]])[:, None, :]
+    se = np.where(p > 0, 0.01, 0.0)
+    ds = xr.Dataset({"probability": (("motion", "inv_beta", "delta"), p),
+                     "probability_stderr": (("motion", "inv_beta", "delta"), se)},
+                    coords=dict(motion=motions, inv_beta=[1.0], delta=delta),
+                    attrs=dict(n_walls=2, gap=2.0, eps=0.5, eps_lower=0.5))
+    table = two_walls.map_mirror_table(ds)
+    assert set(table.statistic) == {"P((1,1)/1)", "P((1,0)/1) against P((0,1)/1)"}
+    assert table.agree.all() and len(table) == 3     # (1,1)/1 at 0-2; (1,0)/(0,1) at 0-2, 1-1
+    ds["probability"].loc[dict(motion="(0,1)/1", delta=2.0)] = 0.5
+    found = two_walls.mirror_check(motion_map=ds)
+    assert found.holds == "no"                       # 2 of 3 agree (< 3 in 4)
+    assert "P((1,0)/1) against P((0,1)/1) at delta = 0: 0.7" in found.measured

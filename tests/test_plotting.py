@@ -485,26 +485,31 @@ def test_fig12_states_the_resolution_and_each_line_power(data):
                    for t in texts), (d, power, texts)
 
 
-@pytest.mark.parametrize("centres, way", [((1.2, 0.9), "rises as $\\delta$ decreases: the "
-                                                       "frequency shift runs opposite"),
-                                          ((0.9, 1.2), "falls as $\\delta$ decreases, as in "
-                                                       "the paper")])
-def test_fig12_says_which_way_the_response_moves(data, centres, way):
-    """One peak per play (at centres[0] for the smallest delta, centres[1] for the others):
-    the header's centroid is the peak's centre (a symmetric peak, far wider than the grid's
-    step, on a floor 1e-6 of its height: within 0.005) and its direction the one the paper's
-    finding 5 reads."""
-    spectra = data["spectra_h"].copy(deep=True)
-    beta = spectra["beta"]
-    smallest = spectra["delta"] == spectra["delta"].min()
-    centre = xr.where(smallest, centres[0], centres[1])
-    peak = 1e-6 + np.exp(-((beta - centre) / 0.15) ** 2)
-    spectra["S_a"] = peak.broadcast_like(spectra["S_a"]).transpose(*spectra["S_a"].dims)
-    title = _title(plotting.fig12(spectra, inv_beta=1.1))
-    deltas = np.sort(spectra["delta"].values)
-    assert (f"{centres[1]:.2f} at $\\delta$ = {deltas[-1]:g}, {centres[0]:.2f} at $\\delta$ = "
-            f"{deltas[0]:g};") in title.replace("\n", " "), title
-    assert way in title.replace("\n", " ")
+@pytest.mark.parametrize("plays, way", [
+    ({2.0: (1.0, 1.7), -0.5: (1.3, 0.2)}, "rises as $\\delta$ decreases, against the paper"),
+    ({2.0: (1.3, 1.7), -0.5: (1.0, 0.2)}, "falls as $\\delta$ decreases, as in the paper"),
+    ({2.0: (1.2, 1.7), -0.5: (1.2, 0.2)}, "shows no resolved move")])
+def test_fig12_gives_both_readings_and_which_way_the_broadband_moves(data, plays, way):
+    """Welch spectra with batches of a broadband resonance (at the plays' resonances) under a
+    line at beta_f strong at the large play and weak at the small (tests/test_centroid.py):
+    the header gives the centroid with the lines and the broadband one with its interval,
+    both as `vibroimpact.stats.centroid.shift` computes them, and the broadband's way."""
+    from test_centroid import spectra_row
+
+    from vibroimpact.stats.centroid import shift
+
+    row = spectra_row(plays)
+    spectra = xr.concat([row], dim="inv_beta").assign_coords(inv_beta=[1.1])
+    spectra["S_lin"] = ("beta", np.full(row.beta.size, 1e-3))
+    spectra.attrs = dict(data["spectra_h"].attrs)
+    title = _title(plotting.fig12(spectra, inv_beta=1.1)).replace("\n", " ")
+    sh = shift(row, 1 / 1.1)
+    assert (f"with the lines at $k\\beta_f$ {sh.centroid_lines[-1]:.2f} $\\to$ "
+            f"{sh.centroid_lines[0]:.2f} broadband (lines' $\\pm$5 bins out): "
+            f"{sh.centroid[-1]:.2f} [{sh.centroid_low[-1]:.2f}, {sh.centroid_high[-1]:.2f}] "
+            f"$\\to$ {sh.centroid[0]:.2f} [") in title, title
+    assert way in title and "(95 %, 10 batches)" in title
+    assert "opposite" not in title
 
 
 def _nearest_index(coord, value):

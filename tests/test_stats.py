@@ -49,6 +49,43 @@ def test_streaming_welch_equals_scipy_on_concatenation(cuts, nperseg, detrend):
     assert acc.n_samples == x.size
 
 
+@pytest.mark.parametrize("detrend", ["mean", "constant"])
+def test_welch_batches_are_welch_of_their_stretches_and_average_to_the_whole(detrend):
+    # Each batch is scipy's Welch estimate of its own consecutive segments (for "mean", of the
+    # record less its whole mean); the batches weighted by their segment counts give the
+    # whole estimate, which batches leave bit for bit unchanged. Tolerances: round-off only.
+    x = 1.5 + _ar1(np.random.default_rng(1), 0.8, 10_000)
+    nperseg, step, n_batches = 256, 128, 7
+    n_seg = (x.size - nperseg) // step + 1
+    plain = WelchAccumulator(0.3, nperseg, detrend=detrend)
+    acc = WelchAccumulator(0.3, nperseg, detrend=detrend, batches=(n_batches, n_seg))
+    for chunk in np.split(x, [1000, 1001, 5555]):
+        plain.feed(chunk)
+        acc.feed(chunk)
+    beta, S = acc.result()
+    assert np.array_equal(S, plain.result()[1])
+    S_b = acc.result_batches()
+    batch = np.arange(n_seg) * n_batches // n_seg
+    counts = np.bincount(batch)
+    assert S_b.shape == (n_batches, beta.size) and counts.min() >= counts.max() - 1
+    np.testing.assert_allclose((counts[:, None] * S_b).sum(0) / n_seg, S, rtol=1e-12,
+                               atol=1e-12 * S.max())
+    y = x - x.mean() if detrend == "mean" else x
+    for b in (0, n_batches - 1):
+        first, last = np.flatnonzero(batch == b)[[0, -1]]
+        stretch = y[first * step:last * step + nperseg]
+        _, P = signal.welch(stretch, fs=1 / 0.3, nperseg=nperseg,
+                            detrend=False if detrend == "mean" else detrend)
+        np.testing.assert_allclose(S_b[b, 1:-1], P[1:-1] / 2, rtol=1e-10,
+                                   atol=1e-12 * P.max())
+    with pytest.raises(ValueError, match="segments fed"):
+        WelchAccumulator(0.3, nperseg, batches=(2, n_seg + 1)).feed(x).result_batches()
+    with pytest.raises(ValueError, match="more segments"):
+        WelchAccumulator(0.3, nperseg, batches=(2, n_seg - 1)).feed(x)
+    with pytest.raises(ValueError, match="n_batches"):
+        WelchAccumulator(0.3, nperseg, batches=(n_seg + 1, n_seg))
+
+
 def test_welch_rejects_bad_input_and_empty_result():
     with pytest.raises(ValueError, match="dt"):
         WelchAccumulator(0.0, 64)

@@ -15,6 +15,7 @@ from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
+from vibroimpact.impact.simulate import _split_steps
 from vibroimpact.model import Model
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
@@ -559,7 +560,7 @@ def _clipped_contact(start, end, transient):
 
 def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                        transient=0.0, t_end=None, nperseg=4096, chunk_size=2**20, gap=None,
-                       eps_lower=None):
+                       eps_lower=None, n_batches=None):
     """Welch PSDs of a(tau) and of the random input r(tau) for one cell (Figs. 6, 11, 12).
 
     a(tau) is recorded at every sample and fed segment by segment to a
@@ -569,7 +570,11 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     -------
     dict
         ``beta`` (>= 0), ``S_a`` and ``S_f`` (paper's two-sided angular convention, eq. 9),
-        ``n_segments``. ``S_f`` is the random part r(tau) of the input only: the harmonic
+        ``n_segments``; with ``n_batches``, also ``S_a_batch`` (n_batches, beta): the
+        estimate of a(tau) over each of ``n_batches`` consecutive stretches of the record
+        (fewer when the record holds fewer Welch segments: one each)
+        (`WelchAccumulator`'s ``batches``; their spread is the estimate's sampling error).
+        ``S_f`` is the random part r(tau) of the input only: the harmonic
         part ``amplitude sin(beta_f tau)`` is a spectral line of power ``amplitude**2 / 2``,
         which a Welch estimate would smear over its window's main lobe (Fig. 11 draws it as
         the line it is). ``gap, eps_lower``: a second wall (`event_statistics`); a(tau) is
@@ -577,7 +582,15 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     """
     t_end = _record_end(noise, dt, t_end)
     skip = int(math.ceil(transient / dt - 1e-9))
-    acc_a = stats.WelchAccumulator(dt, nperseg)
+    batches = None
+    if n_batches is not None:
+        # the samples fed: the grid's k = skip .. n_steps (a(tau) at every step from 0)
+        n_samples = _split_steps(t_end, dt)[0] + 1 - skip
+        step = nperseg - nperseg // 2
+        n_segments = max((n_samples - nperseg) // step + 1, 0)
+        if n_segments:      # none: `result` says so; a batch holds at least one segment
+            batches = (min(int(n_batches), n_segments), n_segments)
+    acc_a = stats.WelchAccumulator(dt, nperseg, batches=batches)
     acc_f = stats.WelchAccumulator(dt, nperseg)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=t_end, record_every=1, chunk_size=chunk_size,
@@ -591,7 +604,10 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
         acc_f.feed(np.asarray(noise[k[0] : k[-1] + 1], dtype=float))
     beta, S_a = acc_a.result()
     _, S_f = acc_f.result()
-    return dict(beta=beta, S_a=S_a, S_f=S_f, n_segments=acc_a.n_segments)
+    out = dict(beta=beta, S_a=S_a, S_f=S_f, n_segments=acc_a.n_segments)
+    if batches is not None:
+        out["S_a_batch"] = acc_a.result_batches()
+    return out
 
 
 def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=None,

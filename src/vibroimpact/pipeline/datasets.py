@@ -137,6 +137,8 @@ META = {
     "n_checks": ("precision checks made while extending the record", "1"),
     "cpu_time": ("CPU time of the cell (s)", "s"),
     "S_a": ("power spectral density of a(tau) (two-sided, eq. 9)", "1"),
+    "S_a_batch": ("power spectral density of a(tau) over one batch (consecutive stretch) of "
+                  "the record (two-sided, eq. 9)", "1"),
     "S_f": ("power spectral density of the random input r(tau) (estimate, two-sided)", "1"),
     "S_r_target": ("power spectral density of the random input r(tau) (target, two-sided)", "1"),
     "S_lin": ("linear response |H|^2 S_f (no wall)", "1"),
@@ -379,6 +381,9 @@ def spectra_tile(cells, results, attrs):
     data = dict(S_a=(("cell", "beta"), np.stack([r["S_a"] for r in results])),
                 S_f=(("cell", "beta"), np.stack([r["S_f"] for r in results])),
                 n_segments=("cell", np.array([r["n_segments"] for r in results])))
+    if "S_a_batch" in results[0]:
+        data["S_a_batch"] = (("cell", "batch", "beta"),
+                             np.stack([r["S_a_batch"] for r in results]))
     coords = dict(_cell_coords(cells), beta=results[0]["beta"])
     return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 

@@ -45,7 +45,7 @@ JOB_KEYS = {
     # a plane's axes (``plane``) and, with the rms an axis, its grid (``rms``): a study without
     # a plane has neither key, so its map jobs' params are those they always were
     "map": _PHYSICS + ("delta", "n_batches", "motion_window", "motions", "map", "plane", "rms"),
-    "spectra": _PHYSICS + ("spectra",),
+    "spectra": _PHYSICS + ("spectra", "n_batches"),
     "trace": _PHYSICS + ("trace",),
     # its own records (no noise file, no grid): the noise entry's spectrum and seed reach the
     # job as a param of their own (common.smk, ``escape_noise``)

@@ -279,7 +279,8 @@ def spectra_tile(name, block, tile, noise_path, out):
     def run_cell(cell):
         return cells.spectra_statistics(
             samples, dt, **_physics(study, cell), transient=float(block["transient"]),
-            t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"]))
+            t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"]),
+            n_batches=None if block.get("n_batches") is None else int(block["n_batches"]))
 
     def to_dataset(tile_cells, results):
         attrs = dict(_study_attrs(study, block, noise_attrs),

@@ -11,7 +11,7 @@ from vibroimpact.plotting._common import (
     axis_label)
 from vibroimpact.plotting._common import two_wall_dataset
 from vibroimpact.plotting.walls import two_walls, wall_density_figure
-from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
+from vibroimpact.stats.centroid import CENTROID_BAND, LINE_BINS, shift
 from vibroimpact.stats.motions import DEFAULT_MOTIONS, motion_key
 
 
@@ -102,10 +102,13 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
         As :func:`fig06`; S_lin (random part only) dashed, the forcing frequency dotted;
         each delta's legend entry gives the power of the response's line at beta_f
         (`vibroimpact.stats.line_power`), comparable with Fig. 11's A^2/2 where the Welch
-        peak heights are not, and the legend's title the resolution. The header's last line
-        says which way the response's centroid (`vibroimpact.stats.centroid`, the
-        reports' finding 5) moves from the largest delta to the smallest, against the paper's
-        "to lower frequency".
+        peak heights are not, and the legend's title the resolution. The header's last
+        lines give the response's centroid (`vibroimpact.stats.centroid`, the reports'
+        finding 5) at the largest delta and the smallest in both readings: with the lines at
+        k beta_f (whose strength follows delta) and of the broadband response (the lines
+        taken out), with its 95 % interval from the batch spectra; and, one wall only, which
+        way the broadband centroid moves against the paper's "to lower frequency" when every
+        choice of the measure reads the same way (not resolved otherwise).
     """
     i = _nearest(spectra["inv_beta"], inv_beta)
     return _response_spectra(
@@ -115,25 +118,36 @@ def fig12(spectra, inv_beta, beta_max=SPECTRUM_BETA_MAX):
 
 
 def _centroid_note(spectra, i_beta):
-    """A header line: the response's centroid at the largest and the smallest delta, and
-    whether it falls as the paper says or rises (empty with fewer than two deltas)."""
+    """Header lines: the response's centroid at the largest and the smallest delta with
+    the lines and of the broadband response (`vibroimpact.stats.centroid.shift`), and, one
+    wall only, which way the broadband centroid moves against the paper (empty with fewer
+    than two deltas)."""
     row = spectra.isel(inv_beta=i_beta).sortby("delta")
     if row.sizes["delta"] < 2:
         return ""
-    beta = np.asarray(row["beta"], dtype=float)
-    at_small, at_large = (spectral_centroid(beta, np.asarray(row["S_a"].isel(delta=k)))
-                 for k in (0, -1))
-    if not (np.isfinite(at_small) and np.isfinite(at_large)):
+    sh = shift(row, 1.0 / float(row.inv_beta))
+    if not np.all(np.isfinite(sh.centroid[[0, -1]])):
         return ""
+    d_hi, d_lo = _num(float(sh.delta[-1])), _num(float(sh.delta[0]))
+
+    def between(k):
+        low, high = sh.centroid_low[k], sh.centroid_high[k]
+        return (f"{sh.centroid[k]:.2f}" if not np.isfinite(low) else
+                f"{sh.centroid[k]:.2f} [{low:.2f}, {high:.2f}]")
+
+    text = (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}), $\\delta$ = {d_hi} "
+            f"$\\to$ {d_lo}: with the lines at $k\\beta_f$ {sh.centroid_lines[-1]:.2f} $\\to$ "
+            f"{sh.centroid_lines[0]:.2f}\nbroadband (lines' $\\pm${LINE_BINS} bins out): "
+            f"{between(-1)} $\\to$ {between(0)}"
+            + (f" (95 %, {sh.n_batches} batches)" if sh.n_batches else ""))
     if two_wall_dataset(spectra):   # two walls: the paper's finding (one wall) is no reference
-        return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
-                f"$\\delta$ = {_num(float(row.delta[-1]))}, {at_small:.2f} at $\\delta$ = "
-                f"{_num(float(row.delta[0]))}")
-    way = ("falls as $\\delta$ decreases, as in the paper" if at_small < at_large else
-           "rises as $\\delta$ decreases: the frequency shift runs opposite to the paper's")
-    return (f"\nresponse's centroid ($\\beta \\leq$ {CENTROID_BAND:g}): {at_large:.2f} at "
-            f"$\\delta$ = {_num(float(row.delta[-1]))}, {at_small:.2f} at $\\delta$ = "
-            f"{_num(float(row.delta[0]))};  it {way}")
+        return text
+    way = {"falls": "falls as $\\delta$ decreases, as in the paper",
+           "rises": "rises as $\\delta$ decreases, against the paper",
+           "unresolved": "shows no resolved move as $\\delta$ decreases"}[sh.reading()]
+    scope = (f"under all {len(sh.change)} choices of the measure" if sh.reading() != "unresolved"
+             else "no batch spectra" if not sh.n_batches else "not under every choice")
+    return text + f"\nit {way}, {scope}"
 
 
 @_styled

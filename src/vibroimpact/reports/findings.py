@@ -10,6 +10,12 @@ what does not, which the table puts first. The report notebooks show them as a t
 (:func:`findings_table`); the workflow tests assert them on the test config.
 Nothing here is typed in from a previous run: change a dataset and the verdict changes with it.
 
+Findings 1-7 read trends along delta, the play of the paper's one wall. On a two-wall study
+(attribute ``n_walls`` 2) delta places a clearance between two stops, and the settings at
+delta and gap - delta are mirror images: those findings are ``n/a`` there, and the study's
+own checks are in :mod:`vibroimpact.reports.two_walls`. Finding 8 (stable domains against
+the probability map) names no play and is read on either.
+
 The thresholds are the ones stated with each claim below; "within the resolution" means one
 bin of the density or the frequency grid.
 """
@@ -17,7 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vibroimpact.stats.centroid import CENTROID_BAND, spectral_centroid
+from vibroimpact.stats.centroid import (BAND_CHOICES, CENTROID_BAND, FILL_CHOICES, LINE_BINS,
+                                        LINE_BINS_CHOICES, shift)
 from vibroimpact.stats.theory import upcrossing_rate
 
 #: Fewest impacts a play needs before its means and densities take part in a finding
@@ -98,6 +105,16 @@ def _fmt(values, spec=".3g"):
     return ", ".join(format(float(v), spec) for v in values)
 
 
+def _two_walls(ds, number):
+    """Finding ``number`` ``n/a`` on a two-wall study's dataset ``ds`` (None on one wall)."""
+    if ds is None or int(ds.attrs.get("n_walls", 1)) != 2:
+        return None
+    return not_available(number, f"a two-wall study (the second wall at delta - "
+                                 f"{float(ds.attrs['gap']):g}): delta places a clearance, "
+                                 f"not the paper's play, and the settings at delta and gap - "
+                                 f"delta are mirror images; the two-wall checks replace it")
+
+
 def _without_collision(events):
     """Why ``events`` (one 1/beta row or all) cannot decide a finding on collisions: the
     record has none at any play (and, with no force at all, that the mass stays at rest);
@@ -141,6 +158,8 @@ def finding1(spectra, band=(0.2, 3.0), flat=3.0):
     reference ``S_lin`` zero) or fewer than two frequencies in ``band`` leave nothing to
     judge: ``n/a``.
     """
+    if (two := _two_walls(spectra, 1)) is not None:
+        return two
     s = _row(spectra).sel(beta=slice(*band))
     if s.sizes["beta"] < 2:
         step = float(spectra.beta[1] - spectra.beta[0])
@@ -171,6 +190,8 @@ def finding2(events):
     impacts, and "markedly so for negative delta": it falls faster, relative to its value,
     over the negative plays than over as wide a range of positive ones (the mean slope of
     ln v against delta on [delta_min, 0] exceeds that on [0, -delta_min])."""
+    if (two := _two_walls(events, 2)) is not None:
+        return two
     if (why := _without_collision(_row(events))) is not None:
         return not_available(2, why)
     ev = _impacting(_row(events))
@@ -201,6 +222,8 @@ def finding3(events):
     interval may grow again at the lowest plays: ``yes`` when it increases over every play,
     ``partly`` when it increases from some play <= 0 upwards (the table says where it turns
     and the contact fraction below), ``no`` otherwise."""
+    if (two := _two_walls(events, 3)) is not None:
+        return two
     if (why := _without_collision(_row(events))) is not None:
         return not_available(3, why)
     ev = _impacting(_row(events))
@@ -239,6 +262,8 @@ def finding4(events, orders=2.0):
     system ("partly": the rate falls, it does not vanish). Without those attributes only the
     fall is read ("yes").
     """
+    if (two := _two_walls(events, 4)) is not None:
+        return two
     ev = _row(events).sortby("delta")
     if (why := _without_collision(ev)) is not None:
         return not_available(4, why)
@@ -297,17 +322,56 @@ def random_force(events=None, spectra=None):
 
 # --- harmonic plus random force (Figs. 11-15) --------------------------------------------------
 
-def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=CENTROID_BAND, events=None):
+def spectra_shifts(spectra, line_bins=LINE_BINS, band=CENTROID_BAND):
+    """``{inv_beta: vibroimpact.stats.centroid.Shift}`` of every 1/beta_f row of a spectra
+    dataset."""
+    return {float(ib): shift(spectra.sel(inv_beta=ib), 1.0 / float(ib), band, line_bins)
+            for ib in np.atleast_1d(spectra.inv_beta.values)}
+
+
+def _choices_text():
+    """The choices a verdict on the broadband shift must hold under, in words."""
+    return (f"half-width {', '.join(map(str, LINE_BINS_CHOICES))} bins x beta <= "
+            f"{', '.join(format(b, 'g') for b in BAND_CHOICES)} x the lines' bins "
+            f"{' or '.join(('bridged' if f == 'bridge' else 'dropped') for f in FILL_CHOICES)}")
+
+
+def _between(value, low, high, spec=".2f"):
+    """``"0.98 [0.96, 1.00]"``, or the value alone when its interval is not known."""
+    if not (np.isfinite(low) and np.isfinite(high)):
+        return format(float(value), spec)
+    value, low, high = (format(float(x), spec) for x in (value, low, high))
+    return f"{value} [{low}, {high}]"
+
+
+def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=CENTROID_BAND, events=None,
+             line_bins=LINE_BINS):
     """Input and response spectra under ``amplitude sin(beta_f tau) + r(tau)`` (Figs. 11, 12).
 
     The input: the line carries ``amplitude^2/2`` against the random part's power (the
     integral of its one-sided PSD); concentrated means > 80 %. The response, per 1/beta_f:
     its share of power within ``halfwidth`` of beta_f must fall as delta decreases (spreads
-    wider), and its centroid over ``0 < beta <= band`` fall (moves to lower frequency).
-    Fewer than two frequencies in that band (a Welch segment too short) leave it ``n/a``, and
+    wider), and its power must move to lower frequency. The paper's Fig. 12 shows the
+    broadband response moving; its lines at k beta_f carry the periodic part of the motion,
+    whose strength follows the play (at delta = 2 the line at beta_f holds ~40 times the power
+    it holds at -0.5), so a centroid with the lines in mostly follows the line. The move is
+    therefore read on the broadband response (`vibroimpact.stats.centroid.shift`: the lines
+    taken out over ``line_bins`` bins either side, their powers reported apart), its centroid
+    over ``0 < beta <= band`` at the smallest play against the largest, with a 95 % interval
+    from the spread of the dataset's batch spectra (``S_a_batch``). It moves to lower
+    frequency when that change is below 0 under every choice of the half-width, the band and
+    what stands in the lines' bins (`LINE_BINS_CHOICES` x `BAND_CHOICES` x `FILL_CHOICES`),
+    to higher frequency (against the paper) when above 0 under every choice; otherwise it is
+    not resolved, and no contradiction is printed.
+    ``measured`` gives both readings (the centroid with the lines and the broadband one).
+
+    Fewer than two frequencies in the band (a Welch segment too short) leave it ``n/a``, and
     so do ``events`` (the study's impact statistics) without a collision at the spectra's
-    plays: a response that never meets the wall cannot show what impacts do to it.
+    plays: a response that never meets the wall cannot show what impacts do to it; and a
+    two-wall study (delta is no play there).
     """
+    if (two := _two_walls(spectra, 5)) is not None:
+        return two
     if events is not None:
         at = events.sel(delta=spectra.delta.values, method="nearest")
         if "inv_beta" in at.dims and "inv_beta" in spectra.dims:
@@ -320,57 +384,120 @@ def finding5(spectra, amplitude=1.0, halfwidth=0.1, band=CENTROID_BAND, events=N
         return not_available(5, f"the spectrum's resolution (beta step {beta[1] - beta[0]:.3g}) "
                                 f"leaves fewer than two frequencies in 0 < beta <= {band:g}; a "
                                 f"finer one needs a longer spectra.nperseg")
+    if spectra.sizes["delta"] < 2:
+        return not_available(5, "needs spectra of a(tau) at two plays")
     lines, shares, centroids = [], [], []
-    spread_all, lower_all = True, True
-    wider, narrower, lower, higher = [], [], [], []
-    for inv_beta in np.atleast_1d(spectra.inv_beta.values):
+    spread_all = True
+    wider, narrower, lower, higher, unresolved = [], [], [], [], []
+    shifts = spectra_shifts(spectra, line_bins, band)
+    for inv_beta, sh in shifts.items():
         s = spectra.sel(inv_beta=inv_beta).sortby("delta")
         beta = s.beta.values
         step = beta[1] - beta[0]
         random_power = 2 * float(s.S_f.sum()) * step / (2 * np.pi)
         line = 0.5 * amplitude ** 2
         lines.append(line / (line + random_power))
-        if s.sizes["delta"] < 2:
-            return not_available(5, "needs spectra of a(tau) at two plays")
         near = np.abs(beta - 1 / inv_beta) < halfwidth
         share = s.S_a.isel(beta=near).sum("beta") / s.S_a.sum("beta")
-        centroid = np.array([spectral_centroid(beta, s.S_a.isel(delta=k).values, band)
-                             for k in range(s.sizes["delta"])])
-        shares.append(f"1/beta_f = {inv_beta:.3g}: {float(share[-1]):.2f} at delta = "
-                      f"{float(s.delta[-1]):.3g} -> {float(share[0]):.2f} at delta = "
-                      f"{float(s.delta[0]):.3g}")
-        centroids.append(f"{float(centroid[-1]):.2f} -> {float(centroid[0]):.2f}")
+        d_hi, d_lo = float(s.delta[-1]), float(s.delta[0])
+        at = f"1/beta_f = {inv_beta:.3g}"
+        shares.append(f"{at}: {float(share[-1]):.2f} at delta = {d_hi:.3g} -> "
+                      f"{float(share[0]):.2f} at delta = {d_lo:.3g}")
+        diff, low, high = sh.change[(int(line_bins), float(band), "bridge")]
+        centroids.append(
+            f"{at}: with the lines {sh.centroid_lines[-1]:.2f} -> {sh.centroid_lines[0]:.2f}; "
+            f"broadband {_between(sh.centroid[-1], sh.centroid_low[-1], sh.centroid_high[-1])}"
+            f" -> {_between(sh.centroid[0], sh.centroid_low[0], sh.centroid_high[0])} "
+            f"(change {_between(diff, low, high, '+.2f')}), broadband peak "
+            f"{_between(sh.peak[-1], sh.peak_low[-1], sh.peak_high[-1])} -> "
+            f"{_between(sh.peak[0], sh.peak_low[0], sh.peak_high[0])}, power of the line at "
+            f"beta_f {sh.lines[-1, 0]:.3g} -> {sh.lines[0, 0]:.3g}")
         spread_all &= float(share[0]) < float(share[-1])
-        lower_all &= float(centroid[0]) < float(centroid[-1])
         (wider if float(share[0]) < float(share[-1]) else narrower).append(
-            f"{float(share[-1]):.2f} -> {float(share[0]):.2f} at 1/beta_f = {inv_beta:.3g}")
-        (lower if float(centroid[0]) < float(centroid[-1]) else higher).append(
-            f"{float(centroid[-1]):.2f} -> {float(centroid[0]):.2f} at 1/beta_f = "
-            f"{inv_beta:.3g}")
+            f"{float(share[-1]):.2f} -> {float(share[0]):.2f} at {at}")
+        moved = f"{sh.centroid[-1]:.2f} -> {sh.centroid[0]:.2f} at {at}"
+        {"falls": lower, "rises": higher, "unresolved": unresolved}[sh.reading()].append(moved)
+    lower_all = not higher and not unresolved
     concentrated = min(lines) > 0.8
+    n_batches = min(sh.n_batches for sh in shifts.values())
+    errors = (f"95 % intervals from {n_batches} batches (delete-one jackknife; the peak's from "
+              f"the batches' own peaks)" if n_batches else
+              "no batch spectra in this dataset (S_a_batch): no intervals, no verdict on the "
+              "shift")
     measured = (f"line share of the input power {_fmt(lines, '.2f')}; response power within "
                 f"+-{halfwidth:g} of beta_f, " + "; ".join(shares)
-                + f"; centroid (beta <= {band:g}) " + ", ".join(centroids))
+                + f"; centroid (beta <= {band:g}) from the largest play to the smallest, "
+                f"broadband = the lines at k beta_f taken out (+-{line_bins} bins): "
+                + "; ".join(centroids) + f"; {errors}; the broadband change read under "
+                f"{_choices_text()}")
     holds = "yes" if concentrated and spread_all and lower_all else (
         "partly" if concentrated and spread_all else "no")
     deltas = np.sort(spectra.delta.values)
     falling = f"as delta falls from {deltas[-1]:.3g} to {deltas[0]:.3g}"
     near = f"its share within +-{halfwidth:g} of beta_f"
-    centre = f"its centroid (beta <= {band:g})"
+    centre = (f"its broadband centroid (beta <= {band:g}, the lines out), under every choice "
+              f"of {_choices_text()}")
     held = [f"the input's power is concentrated at beta_f (line share {_fmt(lines, '.2f')})"
             if concentrated else None,
             f"{falling} the response's power spreads wider ({near} " + ", ".join(wider) + ")"
             if wider else None,
-            f"moves to lower frequency ({centre} " + ", ".join(lower) + ")" if lower else None]
+            f"moves to lower frequency ({centre}: " + ", ".join(lower) + ")" if lower else None]
     failed = [None if concentrated else f"the input's line carries only {_fmt(lines, '.2f')} "
                                         f"of its power (<= 0.8)",
               f"{falling} the response's power does not spread wider ({near} "
               + ", ".join(narrower) + ")" if narrower else None,
-              f"{'' if narrower else falling + ' '}the response moves to higher frequency, "
-              f"opposite to the paper ({centre} " + ", ".join(higher) + ")" if higher else None]
+              f"{'' if narrower else falling + ' '}the broadband response moves to higher "
+              f"frequency, opposite to the paper ({centre}: " + ", ".join(higher) + ")"
+              if higher else None,
+              "the broadband centroid's move is not resolved (its 95 % interval holds 0 or "
+              "the choices disagree: " + ", ".join(unresolved) + ")" if unresolved else None]
     summary = "" if holds == "yes" else _sentence(
         " and ".join(h for h in held if h) or None, " and ".join(f for f in failed if f) or None)
     return _finding(5, measured, holds, summary)
+
+
+def finding5_readings(spectra, line_bins=LINE_BINS, band=CENTROID_BAND):
+    """Finding 5's two readings per 1/beta_f and play (a pandas DataFrame): the centroid of
+    the whole response (lines included), the broadband centroid and peak with their 95 %
+    intervals, and the power of each line at k beta_f taken out (``line k``)."""
+    import pandas as pd
+
+    rows = []
+    for inv_beta, sh in spectra_shifts(spectra, line_bins, band).items():
+        for k, d in enumerate(sh.delta):
+            rows.append({"1/beta_f": inv_beta, "delta": float(d),
+                         f"centroid with the lines (beta <= {band:g})": sh.centroid_lines[k],
+                         "broadband centroid": sh.centroid[k],
+                         "centroid 95 %": _between(sh.centroid[k], sh.centroid_low[k],
+                                                   sh.centroid_high[k], ".3f").partition(" ")[2],
+                         "broadband peak": sh.peak[k],
+                         "peak 95 %": _between(sh.peak[k], sh.peak_low[k],
+                                               sh.peak_high[k], ".3f").partition(" ")[2],
+                         **{f"line {j + 1} beta_f": sh.lines[k, j]
+                            for j in range(sh.lines.shape[1])}})
+    return pd.DataFrame(rows)
+
+
+def finding5_choices(spectra):
+    """The broadband centroid's change from the largest play to the smallest under each
+    choice of the lines' half-width, the band and what stands in the lines' bins (a pandas
+    DataFrame: the two centroids, the change, its 95 % interval, and which way it reads),
+    per 1/beta_f: finding
+    5 calls a move only when every row of a 1/beta_f reads the same."""
+    import pandas as pd
+
+    rows = []
+    for inv_beta, sh in spectra_shifts(spectra).items():
+        for (h, top, fill), (diff, low, high) in sh.change.items():
+            large, small = sh.ends[(h, top, fill)]
+            rows.append({"1/beta_f": inv_beta, "half-width (bins)": h, "beta <=": top,
+                         "lines' bins": "bridged" if fill == "bridge" else "dropped",
+                         f"centroid at delta = {sh.delta[-1]:g}": large,
+                         f"at delta = {sh.delta[0]:g}": small, "change": diff,
+                         "95 %": f"[{low:+.3f}, {high:+.3f}]",
+                         "reads": ("falls" if high < 0 else "rises" if low > 0 else
+                                   "unresolved")})
+    return pd.DataFrame(rows)
 
 
 def _peaks_below_one(ratio, density):
@@ -392,6 +519,8 @@ def finding6(events, inv_beta=1.1, symmetric=0.1):
     of 1 and P(1/1) > 0.5. Small play: at the smaller play where (2/1) is most
     probable, the two peaks below 1 add up to 1 within ``symmetric`` and P(2/1) > 0.5.
     """
+    if (two := _two_walls(events, 6)) is not None:
+        return two
     if (why := _without_collision(_row(events, inv_beta))) is not None:
         return not_available(6, why)
     ev = _impacting(_row(events, inv_beta))
@@ -444,6 +573,8 @@ def finding7(events, inv_beta=1.1, correlation=-0.7, deltas=None):
     """
     from vibroimpact.stats.ranks import spearman
 
+    if (two := _two_walls(events, 7)) is not None:
+        return two
     if (why := _without_collision(_row(events, inv_beta))) is not None:
         return not_available(7, why)
     ev = _impacting(_row(events, inv_beta))

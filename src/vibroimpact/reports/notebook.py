@@ -930,3 +930,112 @@ def map_audit(motion_map):
                  for ib, d in bad.cell.values[bad.values][:AUDIT_WORST]]
         text += " Failing cells: " + ", ".join(where) + "."
     return Markdown(text)
+
+
+# --- finding 5 read twice, and a two-wall study's own checks (the harmonic report) ----------
+
+def finding5_readings(spectra):
+    """Finding 5's numbers (one-wall harmonic studies with spectra): per 1/beta_f and play,
+    the response's centroid with its lines at k beta_f and of the broadband response (lines
+    taken out) with the broadband peak, their 95 % intervals from the batch spectra and the
+    lines' powers; then the broadband centroid's change under each choice of the measure.
+    Nothing for a two-wall study or without spectra (the findings table says why)."""
+    from IPython.display import Markdown, display
+
+    from vibroimpact.reports import findings
+    from vibroimpact.stats.centroid import LINE_BINS
+
+    if spectra is None or int(spectra.attrs.get("n_walls", 1)) == 2:
+        return
+    display(Markdown(
+        "### Finding 5 read twice: with the lines and broadband\n\n"
+        "The response's PSD holds lines at $k\\beta_f$ (the periodic part of the motion, "
+        "whose power follows $\\delta$) over the broadband response to $r(\\tau)$, the part "
+        "the paper's Fig. 12 shows moving. *With the lines*: the centroid of the whole "
+        "response. *Broadband*: the lines taken out over "
+        f"$\\pm${LINE_BINS} bins of the Welch grid (the Hann window's main lobe is $\\pm$2 "
+        "bins; a line half a bin off leaves 6.1e-6 of its power beyond $\\pm$5), their bins "
+        "bridged by a straight line between the neighbouring clean bins, each line's power "
+        "what it adds over that bridge (`line k beta_f`). The 95 % intervals come from the "
+        "spectra of the record's consecutive batches (`S_a_batch`): delete-one jackknife "
+        "for the centroid, the batches' own smoothed peaks for the peak."))
+    numbers = findings.finding5_readings(spectra)
+    display(_styled(numbers, {"data": "f5_value", "row_heading": "f5_row",
+                              "col_heading": "f5_column"}).format(precision=3, na_rep="")
+            .hide(axis="index"))
+    display(Markdown(
+        "The broadband centroid at the smallest play less that at the largest, under each "
+        "choice of the lines' half-width, of the band's upper end and of what stands in the "
+        "lines' bins (bridged, or dropped: which drops the broadband under them too, and "
+        "lowers the centroid where the lines sit near the resonance): finding 5 calls the "
+        "move only when every choice of a 1/$\\beta_f$ reads the same way (the interval "
+        "below or above 0), and prints a contradiction of the paper only then."))
+    display(_styled(findings.finding5_choices(spectra),
+                    {"data": "f5c_value", "row_heading": "f5c_row",
+                     "col_heading": "f5c_column"}).format(precision=3)
+            .format("{:g}", subset=["beta <="]).hide(axis="index"))
+
+
+def two_wall_checks(events=None, spectra=None, motion_map=None):
+    """A two-wall study's own checks in place of the paper's findings 1-7 (nothing for a
+    one-wall study): per wall, the collision rate and velocity after impact; the symmetry
+    check of mirror settings (:mod:`vibroimpact.reports.two_walls`); and where the motions
+    sit against the two-wall stable domains, or what data that needs."""
+    from IPython.display import Markdown, display
+
+    from vibroimpact.reports import two_walls
+
+    ds = first(events, motion_map, spectra)
+    if not two_walls.is_two_wall(ds):
+        return
+    gap = float(ds.attrs["gap"])
+    display(Markdown(
+        f"## A two-wall study: per wall, mirror images, stable domains\n\n"
+        f"The second wall stands at $\\delta$ - {gap:g}, so $\\delta$ places a clearance, not "
+        f"the paper's play: findings 1-7, which read trends along the play, are not applicable "
+        f"(the table above says so). What is measured instead: each wall's collisions, and "
+        f"the mirror symmetry x $\\to$ -x, which swaps the walls: with one restitution the "
+        f"setting at $\\delta$ is the mirror image of that at {gap:g} - $\\delta$, so the upper "
+        f"wall's statistics at one must agree with the lower wall's at the other, within "
+        f"their 95 % intervals. Mirror cells run on one record r($\\tau$) while a mirror image "
+        f"is driven by -r($\\tau$): two realisations of one law."))
+    if events is not None:
+        display(Markdown("### Per wall"))
+        display(_styled(two_walls.per_wall(events),
+                        {"data": "wall_value", "row_heading": "wall_row",
+                         "col_heading": "wall_column"}).format(precision=3)
+                .hide(axis="index"))
+    shifts = None
+    if spectra is not None and float(spectra.attrs.get("amplitude", 0.0)) != 0.0:
+        from vibroimpact.reports.findings import spectra_shifts
+
+        shifts = spectra_shifts(spectra)
+    check = two_walls.mirror_check(events, shifts, motion_map)
+    display(Markdown("### Mirror images"))
+    show_table([check])
+    import pandas as pd
+
+    table = pd.concat(
+        [two_walls.mirror_table(events, shifts) if events is not None else None,
+         two_walls.map_mirror_table(motion_map) if motion_map is not None else None])
+    if not table.empty:
+        numbers = {"1/beta_f": "{:.3g}", "delta": "{:g}", "mirror delta": "{:g}",
+                   "value": "{:.4g}", "mirror value": "{:.4g}"}
+        display(_styled(table, {"data": "mirror_value", "row_heading": "mirror_row",
+                                "col_heading": "mirror_column"})
+                .format({k: v for k, v in numbers.items() if k in table}).hide(axis="index"))
+    display(Markdown("### Against the two-wall stable domains"))
+    if motion_map is not None:
+        display(Markdown(
+            "Finding 8 in the table above sets this map's probabilities against the stable "
+            "domains of the two-wall periodic motions (Fig. 16 of the orbits entry that "
+            "`fig15_vs_fig16` names), motion by motion: its claim names no play, so it reads "
+            "a clearance as it reads the paper's wall."))
+    else:
+        display(Markdown(
+            "*Not computed here:* this study has no probability map over a plane of "
+            "$(1/\\beta_f, \\delta)$, and its plays and forcing frequencies need not lie on an "
+            "orbits grid, so where its motions sit against the two-wall stable domains is "
+            "not measured in this report. A map study over the same walls with "
+            "`fig15_vs_fig16` (as `clearance_map` in config/examples/clearance.yaml) reads it "
+            "as finding 8 of its own report."))

@@ -130,9 +130,10 @@ def finding_sensitivity(events, findings=(2, 3)):
         One row per finding (and per 1/beta_f of a harmonic study): its verdict under each
         rule, and the largest difference between
         the rules over the negative plays with collisions (the statistic, the play, its value
-        under each rule). Empty when ``events`` carries no rules.
+        under each rule). Empty when ``events`` carries no rules, and for a two-wall study
+        (findings 2 and 3 read the paper's play, which delta is not there).
     """
-    if not _has_rules(events):
+    if not _has_rules(events) or int(events.attrs.get("n_walls", 1)) == 2:
         return pd.DataFrame()
     rules = [str(r) for r in events.rule.values]
     rows = []

@@ -60,6 +60,13 @@ class WelchAccumulator:
         (the estimate equals scipy's with ``detrend=False`` on ``x - mean(x)``). The others
         are per-segment, as in ``scipy.signal.welch``: ``'constant'`` removes
         each segment's mean, so the PSD is that of the fluctuation about the mean.
+    batches : (int, int), optional
+        ``(n_batches, n_segments)``: the signal will hold ``n_segments`` complete segments,
+        and segment ``s`` (counted from 0) is also averaged into batch
+        ``s * n_batches // n_segments`` (consecutive stretches of the record, their sizes
+        differing by at most one segment). `result_batches` then gives one estimate per
+        batch, whose spread is the estimate's sampling error (batch means). ``result`` is
+        the same with or without batches, bit for bit.
 
     Notes
     -----
@@ -72,7 +79,8 @@ class WelchAccumulator:
     deviation of each bin (0 < beta < Nyquist) is about ``1 / sqrt(n_effective)``.
     """
 
-    def __init__(self, dt: float, nperseg: int, detrend: str | bool = PSD_DETREND):
+    def __init__(self, dt: float, nperseg: int, detrend: str | bool = PSD_DETREND,
+                 batches: tuple[int, int] | None = None):
         from scipy import signal   # here, not at import: a figure job never estimates a PSD
 
         dt = _checks.real("dt", dt, low=0.0, low_open=True)
@@ -94,6 +102,14 @@ class WelchAccumulator:
         self._leftover = np.empty(0)
         self._n_segments = 0
         self._n_samples = 0
+        self._batches = None
+        if batches is not None:
+            n_segments = _checks.integer("batches[1] (n_segments)", batches[1], low=1)
+            n_batches = _checks.integer("batches[0] (n_batches)", batches[0], low=1,
+                                        high=n_segments)
+            self._batches = (n_batches, n_segments)
+            self._batch_power = np.zeros((n_batches, self.nperseg // 2 + 1))
+            self._batch_spectrum = np.zeros((n_batches, self.nperseg // 2 + 1), dtype=complex)
 
     @property
     def n_segments(self) -> int:
@@ -149,13 +165,19 @@ class WelchAccumulator:
             return self
         n_seg = (buf.size - self.nperseg) // self.step + 1
         segments = sliding_window_view(buf, self.nperseg)[::self.step][:n_seg]
+        if self._batches is not None and self._n_segments + n_seg > self._batches[1]:
+            raise ValueError(f"more segments than the {self._batches[1]} the batches were "
+                             f"set for: {self._n_segments + n_seg}")
         for start in range(0, n_seg, _BATCH):
-            self._sum_power += self._periodogram_sum(segments[start:start + _BATCH])
+            self._sum_power += self._periodogram_sum(segments[start:start + _BATCH],
+                                                     self._n_segments + start)
         self._n_segments += n_seg
         self._leftover = buf[n_seg * self.step:].copy()
         return self
 
-    def _periodogram_sum(self, segments: np.ndarray) -> np.ndarray:
+    def _periodogram_sum(self, segments: np.ndarray, first: int) -> np.ndarray:
+        """The summed periodograms of ``segments``, the first of which is segment ``first``
+        of the record (its batches, when asked for, take theirs)."""
         if self.detrend in ("constant", "linear"):
             from scipy import signal
 
@@ -163,17 +185,28 @@ class WelchAccumulator:
         spectrum = np.fft.rfft(segments * self.window, axis=-1)
         if self.detrend == "mean":
             self._sum_spectrum += spectrum.sum(axis=0)
-        return np.sum(spectrum.real**2 + spectrum.imag**2, axis=0)
+        power = spectrum.real**2 + spectrum.imag**2
+        if self._batches is not None:
+            n_batches, n_segments = self._batches
+            batch = (first + np.arange(len(segments))) * n_batches // n_segments
+            np.add.at(self._batch_power, batch, power)
+            if self.detrend == "mean":
+                np.add.at(self._batch_spectrum, batch, spectrum)
+        return np.sum(power, axis=0)
 
-    def _power(self) -> np.ndarray:
-        """Summed periodograms; for "mean", those of ``x - mean(x)`` (mean of all samples fed):
+    def _power(self, sum_power=None, sum_spectrum=None, n_segments=None) -> np.ndarray:
+        """Summed periodograms (of every segment, or those given); for "mean", those of
+        ``x - mean(x)`` (mean of all samples fed):
         ``sum_s |X_s - m W|^2 = sum_s |X_s|^2 - 2 m Re(conj(W) sum_s X_s) + K m^2 |W|^2``."""
+        if sum_power is None:
+            sum_power, sum_spectrum = self._sum_power, self._sum_spectrum
+            n_segments = self._n_segments
         if self.detrend != "mean":
-            return self._sum_power
+            return sum_power
         m = self._sum_x / self._n_samples
         w = np.fft.rfft(self.window)
-        cross = np.real(np.conj(w) * self._sum_spectrum)
-        power = self._sum_power - 2.0 * m * cross + self._n_segments * m * m * np.abs(w) ** 2
+        cross = np.real(np.conj(w) * sum_spectrum)
+        power = sum_power - 2.0 * m * cross + n_segments * m * m * np.abs(w) ** 2
         return np.maximum(power, 0.0)
 
     def _check_ready(self):
@@ -196,6 +229,28 @@ class WelchAccumulator:
         beta = 2.0 * np.pi * np.fft.rfftfreq(self.nperseg, d=self.dt)
         S = self._power() / self._n_segments * (self.dt / self._win_energy)
         return beta, S
+
+    def result_batches(self) -> np.ndarray:
+        """The estimate of each batch (``batches``), as `result`'s S: shape
+        ``(n_batches, nperseg // 2 + 1)``. With detrend "mean" every batch has the mean of
+        the whole record removed, so the batches' average weighted by their segment counts
+        is `result`'s S (to round-off).
+
+        Raises
+        ------
+        ValueError
+            Without ``batches``, or when fewer segments were fed than they were set for.
+        """
+        if self._batches is None:
+            raise ValueError("no batches: give batches=(n_batches, n_segments)")
+        n_batches, n_segments = self._batches
+        if self._n_segments != n_segments:
+            raise ValueError(f"{self._n_segments} segments fed, the batches were set for "
+                             f"{n_segments}")
+        counts = np.bincount(np.arange(n_segments) * n_batches // n_segments,
+                             minlength=n_batches)
+        return np.stack([self._power(self._batch_power[b], self._batch_spectrum[b], counts[b])
+                         / counts[b] for b in range(n_batches)]) * (self.dt / self._win_energy)
 
     def onesided_density(self) -> tuple[np.ndarray, np.ndarray]:
         """scipy's convention: frequency f (cycles per unit tau) and one-sided density P(f).
