@@ -28,8 +28,10 @@ _TWINS = {".pdf": ".png", ".ipynb": ".html", ".summary.html": ".html"}
 
 #: The datasets a study may own (``results/datasets/<study>_<kind>.nc``,
 #: `vibroimpact.pipeline.targets.DATASETS`): its statistics, map, spectra, escape, the
-#: predictors of its map and, over a plane, its basins and Lyapunov exponents.
-STUDY_DATASETS = ("events", "map", "spectra", "escape", "predictors", "basins", "lyapunov")
+#: predictors of its map, the orbits at its cells and, over a plane, its basins and Lyapunov
+#: exponents.
+STUDY_DATASETS = ("events", "map", "spectra", "escape", "predictors", "map_orbits", "basins",
+                  "lyapunov")
 
 
 def summary(files):
