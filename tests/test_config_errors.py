@@ -82,6 +82,45 @@ def _own(id, text, key, fragment, snakemake=True):
                 snakemake=snakemake)
 
 
+#: A plane study beside a plain one: the plane cases of `CASES` edit it (issue 44: every check
+#: a study gets, a plane study gets, with the same message).
+PLANE_STUDY = textwrap.dedent("""
+        paper: false
+        studies:
+          flat:
+            noise: harmonic_input
+            zeta: 0.05
+            eps: 0.5
+            amplitude: 1.0
+            inv_beta: [1.1]
+            delta: [0.0, 1.0]
+            transient: 100.0
+            figures: [fig13]
+          pl:
+            noise: harmonic_input
+            zeta: 0.05
+            amplitude: 1.0
+            plane: [eps, delta]
+            eps: [0.3, 0.5]
+            inv_beta: 1.1
+            delta: [0.0, 1.0]
+            transient: 100.0
+            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
+            figures: [fig15]
+""")
+
+
+def _plane(id, key, fragment, edits=(), add=""):
+    """A case of `PLANE_STUDY` with ``edits`` (old, new) of its text and ``add``, lines of
+    the plane study ``pl``."""
+    text = PLANE_STUDY
+    for old, new in edits:
+        assert old in text, old
+        text = text.replace(old, new)
+    return Case(id=id, key=key, fragment=fragment,
+                text=text + textwrap.indent(add, "    "), snakemake=True)
+
+
 def _aliases(levels, width):
     """A YAML file whose `delta` list nests ``levels`` aliases ``width`` wide: a "billion
     laughs" of ``width ** levels`` values, a few lines of text."""
@@ -388,205 +427,27 @@ CASES = [
             report_with: [motion_map]
         """, "limits.max_jobs", "this build has 25 jobs"),
     # a plane study gets the checks every study gets (issue 44)
-    _own("plane_fixed_inv_beta_the_default_list", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [eps, delta]
-            eps: [0.3, 0.5]
-            inv_beta: [1.0]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-        """, "studies.pl.inv_beta", "the default grid of a study without a plane"),
-    _own("plane_axis_inv_beta_one_value", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [inv_beta, delta]
-            eps: 0.5
-            inv_beta: [1.0]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-        """, "studies.pl.inv_beta", "needs a grid"),
-    _own("plane_escape_default_cells", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [gap, delta]
-            eps: 0.5
-            gap: [2.0, 3.0]
-            inv_beta: 1.1
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-            escape: {rms: [0.2, 0.25, 0.3]}
-        """, "studies.pl.escape.cells", "names its escape cells in its own coordinates"),
-    _own("plane_report_with_unknown", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [eps, delta]
-            eps: [0.3, 0.5]
-            inv_beta: 1.1
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-            report_with: [no_such_study]
-        """, "studies.pl.report_with", "no other study of this name"),
-    _own("plane_report_with_itself", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [eps, delta]
-            eps: [0.3, 0.5]
-            inv_beta: 1.1
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-            report_with: [pl]
-        """, "studies.pl.report_with", "allowed: flat"),
-    _own("plane_t_end_ignored", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [eps, delta]
-            eps: [0.3, 0.5]
-            inv_beta: 1.1
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-            t_end: 1.0e+9
-        """, "studies.pl.t_end", "draws its map alone"),
-    _own("plane_density_delta_ignored", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [eps, delta]
-            eps: [0.3, 0.5]
-            inv_beta: 1.1
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-            density_delta: [7.0]
-        """, "studies.pl.density_delta", "draws its map alone"),
-    _own("plane_n_batches_beyond_min_time", """
-        paper: false
-        studies:
-          flat:
-            noise: harmonic_input
-            zeta: 0.05
-            eps: 0.5
-            amplitude: 1.0
-            inv_beta: [1.1]
-            delta: [0.0, 1.0]
-            transient: 100.0
-            figures: [fig13]
-          pl:
-            noise: harmonic_input
-            zeta: 0.05
-            amplitude: 1.0
-            plane: [eps, delta]
-            eps: [0.3, 0.5]
-            inv_beta: 1.1
-            delta: [0.0, 1.0]
-            transient: 100.0
-            map: {target_stderr: 0.05, min_time: 200.0, max_periods: 100, min_switches: 5}
-            figures: [fig15]
-            n_batches: 1000
-        """, "studies.pl.n_batches", "map.min_time"),
+    _plane("plane_fixed_inv_beta_the_default_list", "studies.pl.inv_beta",
+           "the default grid of a study without a plane",
+           edits=[("    inv_beta: 1.1", "    inv_beta: [1.0]")]),
+    _plane("plane_axis_inv_beta_one_value", "studies.pl.inv_beta", "needs a grid",
+           edits=[("plane: [eps, delta]", "plane: [inv_beta, delta]"),
+                  ("eps: [0.3, 0.5]", "eps: 0.5"), ("    inv_beta: 1.1", "    inv_beta: [1.0]")]),
+    _plane("plane_escape_default_cells", "studies.pl.escape.cells",
+           "names its escape cells in its own coordinates",
+           edits=[("plane: [eps, delta]", "plane: [gap, delta]"),
+                  ("eps: [0.3, 0.5]", "eps: 0.5\n    gap: [2.0, 3.0]")],
+           add="escape: {rms: [0.2, 0.25, 0.3]}\n"),
+    _plane("plane_report_with_unknown", "studies.pl.report_with", "no other study of this name",
+           add="report_with: [no_such_study]\n"),
+    _plane("plane_report_with_itself", "studies.pl.report_with", "allowed: flat",
+           add="report_with: [pl]\n"),
+    _plane("plane_t_end_ignored", "studies.pl.t_end", "draws its map alone",
+           add="t_end: 1.0e+9\n"),
+    _plane("plane_density_delta_ignored", "studies.pl.density_delta", "draws its map alone",
+           add="density_delta: [7.0]\n"),
+    _plane("plane_n_batches_beyond_min_time", "studies.pl.n_batches", "map.min_time",
+           add="n_batches: 1000\n"),
     _own("replace_names_no_entry", """
         paper: false
         replace: [studies.random]
@@ -1116,3 +977,10 @@ def test_a_long_schema_description_is_cut_in_the_message(tmp_path):
     assert len(line) < 400, line
     assert line.endswith("(the whole description: workflow/schemas/config.schema.yaml, "
                          "studies.pl.plane)")
+
+
+def test_the_plane_cases_edit_an_accepted_study(tmp_path):
+    """Each plane case is refused for its one edit: the study they edit is accepted."""
+    path = tmp_path / "plane.yaml"
+    path.write_text(PLANE_STUDY)
+    configuration.load(root=ROOT, user_files=[path])
