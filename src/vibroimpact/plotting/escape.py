@@ -3,7 +3,8 @@
 One panel per cell of the (1/beta_f, delta) plane: the mean residence time of each state
 (the motions and "none") on a log axis against 1/rms^2, with the straight line of
 ln(residence time) against 1/rms^2 fitted over the weak-noise levels (`stats.escape_fit`,
-stored in the dataset by the aggregation: the figure draws, it does not fit).
+stored in the dataset by the aggregation: the figure draws, it does not fit), and the levels
+where a motion was never left drawn as lower bounds.
 """
 from __future__ import annotations
 
@@ -139,11 +140,13 @@ def escape_vs_noise(escape):
         (+-t standard errors of the mean of the n complete stretches, t of n - 1 dof, as
         Delta's interval), filled where the level is in the fit (gid ``"fitted_points"``),
         open where it is not (``"excluded_points"``: fewer than ``min_stretches`` complete
-        stretches, or rms above ``fit_max_rms``, whose levels lie in a grey band); the fitted
-        lines
-        (``"fit"``) with Delta, its 95 % interval and chi^2 per degree of freedom in the
-        legend. A state with fewer than ``min_stretches`` complete stretches at every level
-        is not drawn.
+        stretches, or rms above ``fit_max_rms``, whose levels lie in a grey band, or no fit:
+        fewer than three such levels); where a motion holding most of the record was never
+        left (no complete stretch), an arrow up from the mean length of its cut stretches
+        (``"censored_bound"``, `stats.censored_bound`: a lower bound, not in the fit); the
+        fitted lines (``"fit"``) with Delta, its 95 % interval and chi^2 per degree of
+        freedom in the legend, or why there is no fit. A state with fewer than
+        ``min_stretches`` complete stretches at every level and no bound is not drawn.
     """
     states = [str(s) for s in escape["state"].values]
     n_cells = escape.sizes["cell"]
