@@ -77,14 +77,14 @@ def test_an_overdispersed_fit_scales_its_covariance_by_chi2_per_dof():
     assert fit.slope_hi - fit.slope == pytest.approx(4.302653 * fit.slope_stderr, rel=1e-6)
 
 
-@pytest.mark.parametrize("spread, low, high", [(1.0, 0.95, 1.0), (3.0, 0.91, 1.0)])
-def test_fit_covers_the_slope_of_noisy_data_at_least_at_its_confidence(spread, low, high):
-    """500 synthetic data sets of 5 levels, each ln T off by ``spread`` times its stated error.
-    As stated (spread 1): the t interval on 3 degrees of freedom, scaled only when chi2_red >
-    1, is conservative: it holds the true slope in at least 95 % of the sets, binomial 3 sigma
-    (+-3 %) below that allowed... measured 99 %; chi2_red ~ 1. Errors understated three times
-    (overdispersion): the scale keeps the coverage near 95 % (measured ~94 %), where the
-    errors' own interval would cover about half."""
+@pytest.mark.parametrize("spread", [1.0, 3.0])
+def test_fit_covers_the_slope_of_noisy_data_at_least_at_its_confidence(spread):
+    """500 synthetic data sets of 5 levels, each ln T off by ``spread`` times its stated
+    error. The interval holds the true slope in at least 95 % of them (binomial 3 sigma,
+    -3 %, allowed): as stated (spread 1) the t interval on 3 degrees of freedom, scaled only
+    when chi2_red > 1, is conservative (measured 500 of 500; the errors' own normal interval
+    94.8 %); with the errors understated three times (overdispersion) the scale keeps it at
+    96.4 %, where the errors' own normal interval covers 50.4 %. chi2_red ~ spread^2."""
     rng = np.random.default_rng(7)
     x = 1.0 / np.array([0.15, 0.18, 0.22, 0.26, 0.29]) ** 2
     rel = np.array([0.2, 0.08, 0.04, 0.02, 0.015])     # few stretches where T is long
@@ -94,7 +94,7 @@ def test_fit_covers_the_slope_of_noisy_data_at_least_at_its_confidence(spread, l
         fit = stats.escape_fit(x, t, rel * t, np.full(5, 50))
         hits += fit.slope_lo <= 0.07 <= fit.slope_hi
         chi2.append(fit.chi2_red)
-    assert low - 0.03 <= hits / 500 <= high
+    assert hits / 500 >= 0.95 - 0.03
     assert np.mean(chi2) == pytest.approx(spread ** 2, rel=0.15)
 
 
