@@ -746,8 +746,9 @@ ESCAPE_META = {
                  "linear in 1 / rms^2 within the errors; NaN: no fit)", "1"),
     "n_fit": ("noise levels in the fit (0: no fit, fewer than 3 usable levels)", "1"),
     "censored_time": ("total length of the state's stretches cut by the record's start or "
-                      "end (forcing periods); where n_stretches = 0 their mean, "
-                      "censored_time / n_censored, is a lower bound of residence_time", "1"),
+                      "end (forcing periods); where a state holding at least half the record "
+                      "has n_stretches = 0 (never left), censored_time / n_censored is a lower "
+                      "bound of residence_time", "1"),
     "fit_used": ("1: the level enters the fit (enough complete stretches, rms <= "
                  "fit_max_rms)", "1"),
 }
