@@ -55,7 +55,7 @@ EPS_DELTA = NOISE + f"""studies:
     inv_beta: 1.1
     delta: [-0.5, 0.25, 1.0, 2.5]
 {MAP}    attractors: {ATTRACTORS}
-    escape: {{cells: [[0.5, 1.0], [0.3, 0.25]], rms: [0.2, 0.29], record_length: 2000.0}}
+    escape: {{cells: [[0.5, 1.0], [0.3, 0.25]], rms: [0.2, 0.29, 0.4], record_length: 2000.0}}
     figures: [fig15, basins, lyapunov, escape_vs_noise]
 """
 PAPER_ESCAPE = NOISE + f"""studies:
@@ -64,7 +64,7 @@ PAPER_ESCAPE = NOISE + f"""studies:
     eps: 0.5
     inv_beta: [1.0, 1.1]
     delta: [0.25, 1.0]
-{MAP}    escape: {{cells: [[1.1, 1.0], [1.1, 0.25]], rms: [0.2, 0.29], record_length: 2000.0}}
+{MAP}    escape: {{cells: [[1.1, 1.0], [1.1, 0.25]], rms: [0.2, 0.29, 0.4], record_length: 2000.0}}
     figures: [fig15, escape_vs_noise]
 """
 
@@ -204,15 +204,15 @@ def test_the_targets_and_the_plan(tmp_path):
     ("attractors: {gap: [0.0, 4.0], n_starts: 6}\n    gap: 2.0", "attractors.gap",
      "smallest clearance of the plane is gap = 2"),
     ("attractors: {max_time: 100.0}", "attractors.max_time", "too short for a start"),
-    ("escape: {cells: [[0.5, 9.0]], rms: [0.2, 0.3]}", "escape.cells[0]",
+    ("escape: {cells: [[0.5, 9.0]], rms: [0.2, 0.3, 0.4]}", "escape.cells[0]",
      "outside the study's (eps, delta) plane"),
-    ("escape: {cells: [[1.5, 1.0]], rms: [0.2, 0.3]}", "escape.cells[0]",
+    ("escape: {cells: [[1.5, 1.0]], rms: [0.2, 0.3, 0.4]}", "escape.cells[0]",
      "eps = 1.5 is out of its range"),
     ("spectra: {delta: [1.0]}", "spectra", "has no spectra: they run at plays"),
 ])
 def test_a_plane_block_is_refused_naming_its_key(tmp_path, change, key, fragment):
-    text = EPS_DELTA.replace("    escape: {cells: [[0.5, 1.0], [0.3, 0.25]], rms: [0.2, 0.29], "
-                             "record_length: 2000.0}\n", "")
+    text = EPS_DELTA.replace("    escape: {cells: [[0.5, 1.0], [0.3, 0.25]], "
+                             "rms: [0.2, 0.29, 0.4], record_length: 2000.0}\n", "")
     text = text.replace("figures: [fig15, basins, lyapunov, escape_vs_noise]",
                         "figures: [fig15, basins, lyapunov]")
     if change.startswith("plane:"):

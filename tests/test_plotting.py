@@ -678,6 +678,39 @@ def test_fig15_three_maps_in_percent_with_untrusted_cells_marked():
     assert any("percent" in ax.get_ylabel() or "%" in ax.get_ylabel() for ax in fig.axes)
 
 
+def test_fig15_draws_a_cell_short_of_its_target_whole_at_the_planes_edge():
+    """Issue 43: the dots of the cells where the cap stopped the record sat on the axes' edge
+    (the grid runs from centre to centre) and were cut in half; they are not clipped."""
+    ds, _ = _synthetic_map()
+    fig = plotting.fig15(ds)
+    for ax in [ax for ax in fig.axes if ax.get_title()]:
+        (dots,) = [line for line in ax.get_lines() if line.get_gid() == "not_reached"]
+        assert not dots.get_clip_on()
+        assert (dots.get_xdata()[0], dots.get_ydata()[0]) == (ax.get_xlim()[0],
+                                                              ax.get_ylim()[0])
+
+
+def test_fig16_legend_of_three_types_hides_no_domain():
+    """Issue 43: over the (eps, delta) plane panel (a)'s legend covered the (1/1) grazing and
+    (2/1) fold edges; with an empty panel in the grid the legend goes there, off the data."""
+    inv_beta = np.round(np.arange(0.6, 1.61, 0.1), 10)
+    deltas = np.round(np.arange(-0.5, 2.51, 0.25), 10)
+    types = [(1, 1), (2, 1), (1, 2)]
+    orbits = datasets.orbit_map_dataset(orbit_map(inv_beta, deltas, types=types, zeta=0.05,
+                                                  eps=0.5),
+                                        dict(zeta=0.05, eps=0.5, amplitude=1.0))
+    fig = plotting.fig16(orbits)
+    fig.canvas.draw()
+    overview = fig.axes[0]
+    assert overview.get_legend() is None
+    (holder,) = [ax for ax in fig.axes if ax.get_legend() is not None]
+    assert [t.get_text() for t in holder.get_legend().get_texts()] == ["(1/1)", "(2/1)",
+                                                                       "(1/2)"]
+    box = holder.get_legend().get_window_extent()
+    for ax in fig.axes[:len(types) + 1]:          # (a) and the type panels
+        assert not box.overlaps(ax.get_window_extent()), ax.get_title()
+
+
 def test_fig15_vs_fig16_prints_the_agreement_and_refuses_another_system():
     ds, orbits = _synthetic_map()
     fig = plotting.fig15_vs_fig16(ds, orbits)

@@ -33,8 +33,9 @@ Method
   determinant is ``eps^(2m) exp(-2 zeta z)``.
 - Map (``orbit_map``): rows of constant 1/beta run in parallel; along a row the solutions of
   the previous delta seed Newton (branch following). m = 2 also runs the global scan at every
-  point; m = 3 runs it every ``kernels.MAP_SCAN_EVERY`` points, wherever a branch ends,
-  and follows every branch a scan finds back to the previous scan.
+  point; m = 3 runs it every ``kernels.MAP_SCAN_EVERY`` points, wherever a branch ends (and
+  then at the points since the previous scan too, where the partner of a fold may have lived
+  and died), and follows every branch a scan finds back to the previous scan.
 
 Limits: for m = 3 the scan nodes keep a third of a step (~0.04 / max(beta, 1) in time) off the
 edges of the interval triangle, so a (3/n) solution with a flight shorter than that (an orbit

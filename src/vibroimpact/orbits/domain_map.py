@@ -51,7 +51,9 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
     m = 3 it runs every ``MAP_SCAN_EVERY`` points of delta (and at the last, and wherever a
     branch ends); in between, the solutions of the previous point seed Newton (branch following
     upward in delta), and every solution found by a scan is followed back down to the previous
-    scan, so a branch born between two scans is filled in as well.
+    scan, so a branch born between two scans is filled in as well. Where a branch ends between
+    two scans, the points since the last scan are scanned too: the partner of a fold that was
+    born and died between two scans (next to a zero impact velocity) is found there.
     """
     nd = deltas.shape[0]
     stack = np.empty((FLIGHT_STACK, 2))
@@ -62,6 +64,7 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
         nn = 2 * m
         z = 2.0 * pi * n / beta
         sols = np.empty((nd, MAX_SOLUTIONS, nn + 1))   # rows (tau.., u.., uncertainty)
+        seeds = np.empty((MAX_SOLUTIONS, nn + 1))
         counts = np.zeros(nd, dtype=np.int64)
         work = np.empty((N_WORK, nn))
         jac = np.empty((nn, nn))
@@ -71,13 +74,33 @@ def _map_row(ib, beta, deltas, types, zeta, eps, exists, n_sol, n_stab, lam_best
             prev = d - 1 if d > 0 else 0
             nseed = counts[prev] if d > 0 else 0
             scan = m == 2 or d % MAP_SCAN_EVERY == 0 or d == nd - 1
-            counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
-                                   scan_step if scan else 0.0, sols[d])
-            if m > 1 and not scan and counts[d] < nseed:
-                # a branch ended (fold or an impact velocity reaching zero): others may start
+            if m == 2:
+                counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
+                                       scan_step, sols[d])
+            else:
+                counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
+                                       0.0, sols[d])
+            # m = 3: a branch of the previous point not continued (a fold or an impact
+            # velocity reaching zero) ends here, whether or not another starts
+            ended = m > 2 and counts[d] < nseed
+            if m > 2 and (scan or ended):
                 scan = True
                 counts[d] = solve_type(m, n, beta, deltas[d], zeta, eps, sols[prev], nseed,
                                        scan_step, sols[d])
+            if ended:
+                # at a fold its partner ended with it: born between the last scan and d (at
+                # a zero impact velocity, say) it was never seen. Scan the points in between,
+                # each seeded with what it holds, and follow what they find back.
+                for dd in range(d - 1, last_scan, -1):
+                    held = counts[dd]
+                    for s in range(held):
+                        for c in range(nn + 1):
+                            seeds[s, c] = sols[dd, s, c]
+                    counts[dd] = solve_type(m, n, beta, deltas[dd], zeta, eps, seeds, held,
+                                            scan_step, sols[dd])
+                    for s in range(counts[dd]):
+                        _follow_back(sols[dd, s], m, n, beta, deltas, dd, last_scan + 1,
+                                     zeta, eps, sols, counts, work, jac)
             if scan and m > 1 and d > 0:
                 d_stop = max(0, last_scan)
                 last_scan = d

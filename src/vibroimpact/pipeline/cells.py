@@ -771,8 +771,10 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
 
     edges, states = stats.label_pieces(impact_time, labels, t_start, t_stop, n_motions)
     r = tally.residence_statistics(edges, states, n_motions + 1)
+    complete = np.where(r.n_stretches > 0, r.mean * r.n_stretches, 0.0)
     return dict(residence_time=r.mean / period, residence_time_stderr=r.stderr / period,
                 n_stretches=r.n_stretches, n_censored=r.n_censored,
+                censored_time=np.maximum(r.time - complete, 0.0) / period,
                 switch_rate=r.rate * period, switch_count=r.count)
 
 
@@ -803,8 +805,10 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
     dict
         Over the states (the motions, then "none"): ``residence_time,
         residence_time_stderr`` (forcing periods), ``n_stretches, n_censored`` as
-        `motion_map_cell`'s, and ``probability`` (fraction of the record after the
-        transient: a motion's free and impact-stick variants together, "none" the rest);
+        `motion_map_cell`'s, ``censored_time`` (forcing periods: the total length of the
+        cut stretches, ``stats.censored_bound``), and ``probability`` (fraction of the
+        record after the transient: a motion's free and impact-stick variants together,
+        "none" the rest);
         ``n_collisions``, ``simulated_time``, ``record_end``.
 
     Notes
@@ -836,7 +840,8 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
                 n_collisions=int(col.time.size), simulated_time=k * dt - transient,
                 record_end=k * dt, residence_time=stays["residence_time"],
                 residence_time_stderr=stays["residence_time_stderr"],
-                n_stretches=stays["n_stretches"], n_censored=stays["n_censored"])
+                n_stretches=stays["n_stretches"], n_censored=stays["n_censored"],
+                censored_time=stays["censored_time"])
 
 
 def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None):

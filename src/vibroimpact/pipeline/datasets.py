@@ -792,18 +792,24 @@ ESCAPE_META = {
     "slope": ("Delta: slope of ln(residence_time) against 1 / rms^2 (weighted least squares "
               "over the levels with fit_used = 1)", "1"),
     "slope_stderr": ("standard error of the slope (scaled by sqrt(chi2_red) when > 1)", "1"),
-    "slope_lo": ("lower end of the slope's 95 % interval", "1"),
-    "slope_hi": ("upper end of the slope's 95 % interval", "1"),
+    "slope_lo": ("lower end of the slope's 95 % interval (Student's t at n_fit - 2 degrees "
+                 "of freedom)", "1"),
+    "slope_hi": ("upper end of the slope's 95 % interval (Student's t at n_fit - 2 degrees "
+                 "of freedom)", "1"),
     "intercept": ("ln C of the fit ln(residence_time) = ln C + slope / rms^2 (C in forcing "
                   "periods)", "1"),
     "chi2_red": ("chi^2 per degree of freedom of the fit (about 1: ln(residence_time) is "
-                 "linear in 1 / rms^2 within the errors; NaN with two levels)", "1"),
-    "n_fit": ("noise levels in the fit", "1"),
+                 "linear in 1 / rms^2 within the errors; NaN: no fit)", "1"),
+    "n_fit": ("noise levels in the fit (0: no fit, fewer than 3 usable levels)", "1"),
+    "censored_time": ("total length of the state's stretches cut by the record's start or "
+                      "end (forcing periods); where a state holding at least half the record "
+                      "has n_stretches = 0 (never left), censored_time / n_censored is a lower "
+                      "bound of residence_time", "1"),
     "fit_used": ("1: the level enters the fit (enough complete stretches, rms <= "
                  "fit_max_rms)", "1"),
 }
 _ESCAPE_STATES = ("residence_time", "residence_time_stderr", "n_stretches", "n_censored",
-                  "probability")
+                  "censored_time", "probability")
 
 
 def escape_part(index, rms, cells, results, motions, attrs, axes=("inv_beta", "delta")):

@@ -3,7 +3,8 @@
 One panel per cell of the (1/beta_f, delta) plane: the mean residence time of each state
 (the motions and "none") on a log axis against 1/rms^2, with the straight line of
 ln(residence time) against 1/rms^2 fitted over the weak-noise levels (`stats.escape_fit`,
-stored in the dataset by the aggregation: the figure draws, it does not fit).
+stored in the dataset by the aggregation: the figure draws, it does not fit), and the levels
+where a motion was never left drawn as lower bounds.
 """
 from __future__ import annotations
 
@@ -19,6 +20,7 @@ from vibroimpact.plotting._common import (CONFIDENCE, _attr, _decoded, _header, 
                                           _spectrum_parts, _styled, _system_text, motion_title,
                                           note_on_axes)
 from vibroimpact.plotting.maps import TYPE_COLORS
+from vibroimpact.stats.escape import MIN_FIT_LEVELS, censored_bound
 from vibroimpact.stats.events import t_quantile
 
 __all__ = ["escape_vs_noise"]
@@ -56,9 +58,18 @@ def _fit_text(cell, k):
     return text + (rf", $\chi^2/\nu$ = {chi2:.2g}" if np.isfinite(chi2) else "")
 
 
-def _panel(ax, cell, states, min_stretches, x_line, home):
-    """One cell: points with error bars (filled: in the fit), the fitted lines (solid for the
-    cell's ``home`` state, thin dashed for the others); returns whether it holds a point."""
+def _no_fit_text(cell, k, min_stretches, allowed):
+    """``no fit: 2 levels with >= 20 complete stretches (3 needed)``."""
+    n = cell["n_stretches"].values[:, k]
+    usable = int(np.count_nonzero((n >= min_stretches) & allowed))
+    return (f"no fit: {usable} level{'s' if usable != 1 else ''} with "
+            rf"$\geq$ {min_stretches} complete stretches ({MIN_FIT_LEVELS} needed)")
+
+
+def _panel(ax, cell, states, min_stretches, x_line, home, allowed):
+    """One cell: points with error bars (filled: in the fit), the levels where a motion was
+    never left drawn as lower bounds, the fitted lines (solid for the cell's ``home`` state,
+    thin dashed for the others); returns whether it holds a point."""
     x = cell["inv_rms2"].values
     drawn = False
     for k, name in enumerate(states):
@@ -67,7 +78,13 @@ def _panel(ax, cell, states, min_stretches, x_line, home):
         n = cell["n_stretches"].values[:, k]
         used = cell["fit_used"].values[:, k].astype(bool)
         shown = np.isfinite(t) & (t > 0) & (n >= min(min_stretches, 2))
-        if not shown.any() or (n < min_stretches).all():
+        bound = (censored_bound(n, cell["n_censored"].values[:, k],
+                                cell["censored_time"].values[:, k],
+                                cell["probability"].values[:, k])
+                 if "censored_time" in cell else np.full(x.shape, np.nan))
+        bounded = np.isfinite(bound)
+        if not (shown.any() or bounded.any()) or ((n < min_stretches).all()
+                                                  and not bounded.any()):
             continue            # a state never held long enough to say anything
         drawn = True
         color = NONE_COLOR if name == "none" else TYPE_COLORS[k % len(TYPE_COLORS)]
@@ -78,15 +95,24 @@ def _panel(ax, cell, states, min_stretches, x_line, home):
         err = np.vstack([np.minimum(half, 0.999 * np.nan_to_num(t)), half])
         label = _state_label(name)
         fitted = np.isfinite(cell["slope"].values[k])
-        if fitted:
-            label += ": " + _fit_text(cell, k)
+        label += ": " + (_fit_text(cell, k) if fitted
+                         else _no_fit_text(cell, k, min_stretches, allowed))
+        labelled = False
         for mask, face, gid in ((shown & used, color, "fitted_points"),
                                 (shown & ~used, "white", "excluded_points")):
             if mask.any():
                 ax.errorbar(x[mask], t[mask], yerr=err[:, mask], fmt=marker, color=color,
                             markerfacecolor=face, markersize=5, capsize=2, linestyle="none",
-                            gid=gid, label=label if gid == "fitted_points" or not fitted
-                            and not (shown & used).any() else None)
+                            gid=gid, label=None if labelled else label)
+                labelled = True
+        if bounded.any():
+            # never left: the mean is longer than the cut stretches' mean length, an arrow
+            # up from it (to twice the bound on the log axis)
+            ax.errorbar(x[bounded], bound[bounded], yerr=[np.zeros(bounded.sum()),
+                                                          bound[bounded]],
+                        lolims=True, fmt="_", markersize=9, color=color, capsize=3,
+                        linestyle="none", gid="censored_bound",
+                        label=None if labelled else label)
         if fitted:
             line = np.exp(cell["intercept"].values[k] + cell["slope"].values[k] * x_line)
             ax.plot(x_line, line, color=color, gid="fit",
@@ -114,11 +140,13 @@ def escape_vs_noise(escape):
         (+-t standard errors of the mean of the n complete stretches, t of n - 1 dof, as
         Delta's interval), filled where the level is in the fit (gid ``"fitted_points"``),
         open where it is not (``"excluded_points"``: fewer than ``min_stretches`` complete
-        stretches, or rms above ``fit_max_rms``, whose levels lie in a grey band); the fitted
-        lines
-        (``"fit"``) with Delta, its 95 % interval and chi^2 per degree of freedom in the
-        legend. A state with fewer than ``min_stretches`` complete stretches at every level
-        is not drawn.
+        stretches, or rms above ``fit_max_rms``, whose levels lie in a grey band, or no fit:
+        fewer than three such levels); where a motion holding most of the record was never
+        left (no complete stretch), an arrow up from the mean length of its cut stretches
+        (``"censored_bound"``, `stats.censored_bound`: a lower bound, not in the fit); the
+        fitted lines (``"fit"``) with Delta, its 95 % interval and chi^2 per degree of
+        freedom in the legend, or why there is no fit. A state with fewer than
+        ``min_stretches`` complete stretches at every level and no bound is not drawn.
     """
     states = [str(s) for s in escape["state"].values]
     n_cells = escape.sizes["cell"]
@@ -140,7 +168,9 @@ def escape_vs_noise(escape):
             ax.axvspan(x_line[0], 1.0 / top ** 2, gid="outside_fit", **OUTSIDE_FIT_STYLE)
         share = cell["probability"].values[weakest]
         home = int(np.argmax(share))
-        if not _panel(ax, cell, states, min_stretches, x_line, home):
+        allowed = (escape["rms"].values <= top * (1 + 1e-12) if np.isfinite(top)
+                   else np.ones(escape.sizes["rms"], dtype=bool))
+        if not _panel(ax, cell, states, min_stretches, x_line, home, allowed):
             note_on_axes(ax, f"no state with {min_stretches} complete stretches\n"
                              "at any noise level")
         else:
@@ -166,8 +196,14 @@ def escape_vs_noise(escape):
                             "mean of n stretches, t of n - 1 d.o.f.)"),
                Line2D([], [], marker="o", color="0.3", markerfacecolor="white",
                       linestyle="none",
-                      label=f"not in the fit (fewer than {min_stretches} complete stretches"
-                            + (f", or rms > {_num(top)}" if np.isfinite(top) else "") + ")")]
+                      label=f"not in a fit (fewer than {min_stretches} complete stretches"
+                            + (f", or rms > {_num(top)}" if np.isfinite(top) else "")
+                            + f"; no fit from fewer than {MIN_FIT_LEVELS} levels)")]
+    if "censored_time" in escape and _has_bound(escape, states):
+        handles.append(Line2D([], [], marker="$\\uparrow$", color="0.3", linestyle="none",
+                              markersize=8,
+                              label="never left: T above the mean length of its stretches "
+                                    "cut by the record (lower bound, not in the fit)"))
     if np.isfinite(top):
         handles.append(Patch(label=f"rms > {_num(top)}: outside the fits",
                              **{k: v for k, v in OUTSIDE_FIT_STYLE.items() if k == "color"}))
@@ -188,6 +224,13 @@ def escape_vs_noise(escape):
             rf"impact-stick together), $w$ = {_num(_attr(escape, 'motion_window'))};  "
             r"$\Delta$: slope of $\ln T$ against $1/\mathrm{rms}_r^2$ (weighted)")
     return fig
+
+
+def _has_bound(escape, states):
+    """Whether any (level, cell, state) is drawn as a lower bound."""
+    return bool(np.isfinite(censored_bound(
+        escape["n_stretches"].values, escape["n_censored"].values,
+        escape["censored_time"].values, escape["probability"].values)).any())
 
 
 def _cell_axes(escape):

@@ -438,7 +438,10 @@ def fig15(motion_map, levels=PROBABILITY_LEVELS):
         mark_few_switches(ax, x, y, few)
         if short.any():
             i, j = np.nonzero(short)
-            ax.plot(x[i], y[j], ls="none", marker=".", ms=1.5, color="C3")
+            # whole at the plane's edge too: a cell centre on the axis limit is not clipped,
+            # and drawn over the spine
+            ax.plot(x[i], y[j], ls="none", marker=".", ms=1.5, color="C3", clip_on=False,
+                    zorder=3, gid="not_reached")
         ax.set_title(title, fontsize=9 if len(title) > 12 else None)
     _finish_axes(axes, motion_map)
     for ax in grid[len(panels) - ncols:len(panels)]:

@@ -454,11 +454,19 @@ def fig16(orbits, boundaries=None):
     kinds, marked = ([], False) if boundaries is None else _draw_boundaries(overview, panels,
                                                                             boundaries)
     overview.set_title("(a) stable domains")
-    overview.legend(loc="lower right")
+    spare = axes[len(types) + 1:]
+    if spare.size:
+        # in the first empty panel's place: inside (a) it hid edges of the domains
+        spare[0].axis("off")
+        spare[0].legend(*overview.get_legend_handles_labels(), loc="upper left",
+                        title="(a): stable domain of", title_fontsize=8, frameon=False)
+        spare = spare[1:]
+    else:
+        overview.legend(loc="lower right")
     for ax in axes:
         ax.set_xlim(xe[0], xe[-1])
         ax.set_ylim(ye[0], ye[-1])
-    for ax in axes[len(types) + 1:]:
+    for ax in spare:
         ax.set_visible(False)
     for ax in axes:
         ax.set_xlabel(axis_label(orbits[x_name]))

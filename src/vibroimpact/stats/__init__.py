@@ -49,7 +49,7 @@ _WHERE = {
     "ResidenceStatistics": "residence", "label_pieces": "residence",
     "residence_statistics": "residence", "by_state": "residence",
     "stationary_distribution": "residence",
-    "EscapeFit": "escape", "escape_fit": "escape",
+    "EscapeFit": "escape", "escape_fit": "escape", "censored_bound": "escape",
     "MarkovCheck": "residence", "markov_residence_check": "residence",
     "jump_chain_independence": "residence",
     "linear_response_std": "theory", "elastic_impact_rate": "theory",

@@ -20,6 +20,7 @@ from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
 from vibroimpact.pipeline.study import (NOISE_PARAMETERS, PLANE_PARAMETERS, escape_samples,
                                         grid_decimals, grid_size, grid_values, map_cap_steps,
                                         noise_record)
+from vibroimpact.stats.escape import MIN_FIT_LEVELS
 
 __all__ = ["GRID_RTOL", "check"]
 
@@ -881,9 +882,9 @@ def _check_escape(where, entry, grids, harmonic, dt, problems, axes=("inv_beta",
                      f"{n:,} samples at dt = {_num(dt)}, held in memory by each job",
                      f"transient + record_length <= {_num(ESCAPE_MAX_SAMPLES * dt)}")
     top = block.get("fit_max_rms")
-    if top is not None and sum(float(r) <= float(top) for r in block["rms"]) < 2:
-        problems.add(f"{where}.fit_max_rms", top, "leaves fewer than 2 noise levels for the "
-                     "fits", "null, or at least the second smallest of escape.rms")
+    if top is not None and sum(float(r) <= float(top) for r in block["rms"]) < MIN_FIT_LEVELS:
+        problems.add(f"{where}.fit_max_rms", top, f"leaves fewer than {MIN_FIT_LEVELS} noise "
+                     "levels for the fits", "null, or at least the third smallest of escape.rms")
 
 
 def _plane(problems, where, grids, fig):
