@@ -73,3 +73,9 @@ def cutoff(kind, beta_c, dt):
                 f"{FIR_MAX_TAPS}): beta_c*dt = {beta_c * dt!r} must be neither "
                 f"tiny nor this close to pi; use a larger dt, or beta_c = pi/dt (white)")
     return beta_c
+
+
+#: Fewest noise levels an escape fit is made from (`vibroimpact.stats.escape_fit`; the config
+#: checks ask for them): a line through two points has no residual degree of freedom, so
+#: neither its scatter nor a t interval can be estimated.
+MIN_FIT_LEVELS = 3

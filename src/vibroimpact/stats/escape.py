@@ -14,15 +14,13 @@ from typing import NamedTuple
 
 import numpy as np
 
+from vibroimpact._limits import MIN_FIT_LEVELS
 from vibroimpact.stats.events import t_quantile
 
 __all__ = ["EscapeFit", "escape_fit", "censored_bound", "FIT_CONFIDENCE", "MIN_FIT_LEVELS"]
 
 #: Confidence of the slope's interval (see `escape_fit`).
 FIT_CONFIDENCE = 0.95
-#: Fewest noise levels a fit is made from: a line through two points has no residual degree
-#: of freedom, so neither its scatter nor a t interval can be estimated.
-MIN_FIT_LEVELS = 3
 
 
 class EscapeFit(NamedTuple):

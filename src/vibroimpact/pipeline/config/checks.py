@@ -14,13 +14,13 @@ import math
 
 import numpy as np
 
-from vibroimpact._limits import ATTRACTOR_MATCH_TOL, MAX_M, attractor_min_time, cutoff
+from vibroimpact._limits import (ATTRACTOR_MATCH_TOL, MAX_M, MIN_FIT_LEVELS, attractor_min_time,
+                                 cutoff)
 from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
 from vibroimpact.pipeline.study import (NOISE_PARAMETERS, PLANE_PARAMETERS, escape_samples,
                                         grid_decimals, grid_size, grid_values, map_cap_steps,
                                         noise_record)
-from vibroimpact.stats.escape import MIN_FIT_LEVELS
 
 __all__ = ["GRID_RTOL", "check"]
 
