@@ -425,7 +425,7 @@ CASES = [
             transient: 100.0
             figures: [fig13]
             report_with: [motion_map]
-        """, "limits.max_jobs", "this build has 25 jobs"),
+        """, "limits.max_jobs", "this build has 26 jobs"),
     # a plane study gets the checks every study gets (issue 44)
     _plane("plane_fixed_inv_beta_the_default_list", "studies.pl.inv_beta",
            "the default grid of a study without a plane",
