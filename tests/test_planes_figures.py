@@ -250,3 +250,17 @@ def test_the_predictors_read_a_plane_by_its_axes(tmp_path):
     np.testing.assert_array_equal(stable, expected)
     rows = predictor_correlations(motion_map, orbits, n_resamples=20)
     assert any(r.predictor == "S" and np.isfinite(r.rho) for r in rows)
+
+
+def test_a_seed_swept_over_maps_is_read_from_the_sweeps_attributes(tmp_path):
+    """The noise's seed is no parameter of the map (its fixed values agree, the rms too when
+    it is an axis): the sweep's own attribute names it; with none, or two, nothing is swept."""
+    maps = [_plane_map(tmp_path, rms=0.29, name=f"s{k}") for k in range(2)]
+    with pytest.raises(ValueError, match="nothing is swept"):
+        swept_parameter(maps)
+    for k, ds in enumerate(maps):
+        ds.attrs.update(sweep_seed=k + 7, sweep_index=k)
+    assert swept_parameter(maps) == ("seed", [7, 8])
+    maps[1].attrs["sweep_zeta"], maps[0].attrs["sweep_zeta"] = 0.1, 0.05
+    with pytest.raises(ValueError, match=r"2 sweep attributes \(\['seed', 'zeta'\]\)"):
+        swept_parameter(maps)

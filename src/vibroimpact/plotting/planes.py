@@ -59,8 +59,17 @@ def swept_parameter(maps):
     differ = [k for k in keys
               if len({format_value(f.get(k, "unset")) for f in fixed}) > 1]
     if not differ:
-        raise ValueError(f"the maps differ in no fixed parameter (fixed: {keys}): nothing is "
-                         f"swept")
+        # a parameter of the record, not of the map (the noise's seed; the rms when it is an
+        # axis): the sweep's own attribute, sweep_<name>, says which
+        swept = [{k[len("sweep_"):]: v for k, v in ds.attrs.items()
+                  if k.startswith("sweep_") and k != "sweep_index"} for ds in maps]
+        names = sorted(set().union(*swept))
+        differ = [k for k in names if all(k in s for s in swept)
+                  and len({format_value(s[k]) for s in swept}) > 1]
+        if len(differ) == 1:
+            return differ[0], [s[differ[0]] for s in swept]
+        raise ValueError(f"the maps differ in no fixed parameter (fixed: {keys}) and in "
+                         f"{len(differ)} sweep attributes ({differ}): nothing is swept")
     if len(differ) > 1:
         raise ValueError(f"the maps differ in {differ}: a stack sweeps one parameter")
     name = differ[0]
