@@ -427,6 +427,9 @@ CASES = [
             report_with: [motion_map]
         """, "limits.max_jobs", "this build has 26 jobs"),
     # a plane study gets the checks every study gets (issue 44)
+    _plane("two_wall_attractors_without_a_plane", "studies.flat.attractors",
+           "with the second wall: e.g. plane: [inv_beta, delta] and gap fixed",
+           edits=[("  flat:\n", "  flat:\n    gap: 3.0\n    attractors: {n_starts: 8}\n")]),
     _plane("plane_fixed_inv_beta_the_default_list", "studies.pl.inv_beta",
            "the default grid of a study without a plane",
            edits=[("    inv_beta: 1.1", "    inv_beta: [1.0]")]),

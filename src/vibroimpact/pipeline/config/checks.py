@@ -370,10 +370,13 @@ def _check_study(config, name, entry, problems, limits, unforced):
     if entry.get("plane") is not None:
         return _check_plane_study(config, name, entry, problems, limits, unforced)
     if entry.get("attractors"):
+        # an orbits entry's attractors block is one-wall only: with a gap, a plane is the way
+        other = ("a `plane: [x, y]` in the study (with the second wall: e.g. plane: "
+                 "[inv_beta, delta] and gap fixed)" if entry.get("gap") is not None else
+                 "a `plane: [x, y]` in the study, or the attractors block of an orbits entry "
+                 "(the paper's (1/beta_f, delta) plane)")
         problems.add(f"{where}.attractors", "...", "basins and Lyapunov exponents of a study "
-                     "run over its plane, and this study has none", "a `plane: [x, y]` in the "
-                     "study, or the attractors block of an orbits entry (the paper's (1/beta_f, "
-                     "delta) plane)")
+                     "run over its plane, and this study has none", other)
     shapes_ok = True
     for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
         if key in ("inv_beta", "delta"):
