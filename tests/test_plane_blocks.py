@@ -286,6 +286,9 @@ def test_a_plane_trace_at_its_cell(tmp_path):
     ref = _trace(tmp_path / "at", TRACE_RMS_PAPER, "flat")   # the record at rms 0.29
     np.testing.assert_allclose(rms["x"].values, ref["x"].values, rtol=0, atol=1e-12)
     assert rms.sizes["impact"] == ref.sizes["impact"]
+    # the trace's record is the scaled one: its rms is the cell's, as the reference's
+    assert rms.attrs["noise_rms"] == pytest.approx(ref.attrs["noise_rms"], rel=1e-12)
+    assert rms.attrs["noise_unit_rms"] == 1.0
     from vibroimpact import plotting
     from vibroimpact.plotting.harmonic import fig10
 

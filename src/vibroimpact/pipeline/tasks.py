@@ -316,8 +316,13 @@ def _plane_trace(name, block, noise_path, out, cells):
     spec = block["trace"]
     plane = list(block["plane"])
     p = dict(_plane_fixed(block), **{k: float(v) for k, v in zip(plane, spec["cell"])})
+    scaled = {}
     if "rms" in p:
-        samples = samples * p.pop("rms")
+        # the record this trace ran on: the unit-rms record times the cell's rms
+        rms = p.pop("rms")
+        samples = samples * rms
+        scaled = dict(noise_rms=float(noise_attrs["noise_rms"]) * rms,
+                      noise_unit_rms=float(noise_attrs["noise_rms"]))
     if "gap" in p and p.get("eps_lower") is None:
         p["eps_lower"] = p["eps"]
     beta_f = 1.0 / p.pop("inv_beta")
@@ -325,7 +330,7 @@ def _plane_trace(name, block, noise_path, out, cells):
     fixed = _plane_fixed(block)
     if "rms" not in plane and noise_attrs.get("noise_rms") is not None:
         fixed["rms"] = float(noise_attrs["noise_rms"])
-    noise = {k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}
+    noise = dict({k: noise_attrs[k] for k in noise_attrs if k.startswith("noise_")}, **scaled)
     attrs = dict(provenance(block, int(noise_attrs["seed"])), study=name, noise=block["noise"],
                  dt=float(noise_attrs["dt"]), **noise, **p, beta_f=beta_f,
                  t_end=float(spec["t_end"]), axes=plane, cell=[float(v) for v in spec["cell"]],
