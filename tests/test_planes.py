@@ -441,3 +441,19 @@ def test_the_restitution_study_s_predictors_read_its_own_basins_and_exponents():
     assert targets.map_orbits_inputs(config, "restitution") == {
         "map": "results/datasets/restitution_map.nc",
         "orbits": "results/orbits/restitution.nc"}
+
+
+def test_two_rms_planes_on_one_noise_entry_share_its_unit_rms_record(tmp_path):
+    """Two (rms, delta) studies of one noise entry read the same unit-rms record: one copy
+    of the entry, one file; a third on another seed gets its own."""
+    second = RMS_DELTA.split("studies:\n")[1].replace("  noisy:", "  noisy_too:").replace(
+        "    eps: 0.5\n", "    eps: 0.7\n")
+    third = second.replace("  noisy_too:", "  reseeded:").replace(
+        "    noise: tiny\n", "    noise: tiny\n    seed: 99\n")
+    config, _ = _load(tmp_path, RMS_DELTA + second + third)
+    noises = {name: config["studies"][name]["noise"]
+              for name in ("noisy", "noisy_too", "reseeded")}
+    assert noises["noisy"] == noises["noisy_too"] != noises["reseeded"]
+    unit = config["noises"][noises["noisy"]]
+    assert unit["rms"] == 1.0 and unit["seed"] == config["noises"]["tiny"]["seed"]
+    assert config["noises"][noises["reseeded"]]["seed"] == 99

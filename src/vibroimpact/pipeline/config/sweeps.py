@@ -170,9 +170,11 @@ def expand_sweeps(config, own=None, *, max_studies=None):
     {name, index, values}`` (``values``: the listed keys' values of this combination).
     ``rms`` and ``seed`` override the study's ``noises`` entry: each distinct (rms, seed)
     pair that differs from the entry gets a copy of it, ``<name>_noise<j>`` (j in order of
-    first use), shared by the combinations that use it; the pair equal to the entry uses the
-    entry itself (a list of rms alone keeps the entry's seed: the records differ only in
-    scale, common random numbers). A study that only overrides rms or seed keeps its name.
+    first use), shared by the combinations that use it and by any later study that needs
+    the same copy of the same entry (two rms planes' unit-rms record: one file); the pair
+    equal to the entry uses the entry itself (a list of rms alone keeps the entry's seed:
+    the records differ only in scale, common random numbers). A study that only overrides
+    rms or seed keeps its name.
     A parameter the study's ``plane`` names is an axis, not a sweep: its list (or
     ``{start, stop, step}``) stays in the study as the axis's grid; the rms as an axis gives
     the study its noise entry at unit rms (`UNIT_RMS`, a copy unless the entry has it).
@@ -206,7 +208,7 @@ def expand_sweeps(config, own=None, *, max_studies=None):
         return sweeps                           # the schema check names the problem
     noises = config["noises"] if isinstance(config.get("noises"), dict) else {}
     taken = {"studies": set(studies), "noises": set(noises)}
-    problems, expanded, derived_noises = _Problems(), {}, {}
+    problems, expanded, derived_noises, shared = _Problems(), {}, {}, {}
     for name, entry in studies.items():
         if isinstance(entry, dict) and "sweep" in entry:
             problems.add(f"studies.{name}.sweep", None, "set by the expansion of a sweep, "
@@ -221,7 +223,8 @@ def expand_sweeps(config, own=None, *, max_studies=None):
             continue
         noise = entry.get("noise")
         copies = _NoiseCopies(name, noises.get(noise) if isinstance(noise, str) else None,
-                              taken["noises"], problems)
+                              taken["noises"], problems, shared,
+                              noise if isinstance(noise, str) else None)
         made = _expand(name, entry, axes, copies, taken["studies"], problems, sweeps)
         expanded.update(made)
         derived_noises.update(copies.entries)
@@ -284,8 +287,12 @@ class _NoiseCopies:
     call for: one per distinct (rms, seed) pair that differs from the entry, named
     ``<study>_noise<j>`` in order of first use and shared by the combinations that use it."""
 
-    def __init__(self, study, base, taken, problems):
+    def __init__(self, study, base, taken, problems, shared=None, base_name=None):
         self.study, self.base, self.taken, self.problems = study, base, taken, problems
+        # copies made for earlier studies, ``{(base_name, pair): noise name}``: a study that
+        # needs the same record (e.g. two rms planes' unit-rms record) shares it
+        self.shared = {} if shared is None else shared
+        self.base_name = base_name
         self.names = {}         # (rms, seed) pair -> noise name
         self.entries = {}       # noise name -> its entry
         self.overrides = {}     # noise name -> {rms, seed} of its entry
@@ -297,6 +304,10 @@ class _NoiseCopies:
                                                   for key, value in override.items()):
             return None
         pair = tuple(override.items())
+        earlier = self.shared.get((self.base_name, pair))
+        if pair not in self.names and earlier is not None:
+            self.names[pair] = earlier          # another study's copy: the same record
+            self.overrides[earlier] = override
         if pair not in self.names:
             name = f"{self.study}_noise{len(self.names)}"
             if name in self.taken:
@@ -308,6 +319,7 @@ class _NoiseCopies:
             self.names[pair] = name
             self.entries[name] = dict(copy.deepcopy(self.base), **override)
             self.overrides[name] = override
+            self.shared[(self.base_name, pair)] = name
         self.users.setdefault(self.names[pair], []).append(k)
         return self.names[pair]
 
