@@ -18,7 +18,8 @@ nothing else:
 - ``report``: the size of that build's ``results/report.html``.
 - ``figures``: which entry lists each figure, the config blocks it needs and its options,
   from the figure table `vibroimpact.pipeline.figures.FIGURES` that the checks read.
-- ``plan_clearance``, ``plan_planes``: ``make plan`` on the shipped examples.
+- ``plan_clearance``, ``plan_planes``: ``make plan`` on the shipped examples;
+  ``plan_finer``: on the README's own ``finer.yaml``.
 
 ``--docs docs/figures.md`` rewrites that file's blocks the same way, from the finished
 build's datasets: ``fig08_tail`` (the quantiles of the interval at the lowest play) and
@@ -68,6 +69,24 @@ def example_plan_text(name, root=ROOT):
     """A ``plan_*`` block: the plan of a shipped example (:data:`EXAMPLES`)."""
     _, plan = configuration.load(root=root, user_files=[Path(root) / EXAMPLES[name]])
     return f"`make plan CONFIG={EXAMPLES[name]}` (generated): {plan.summary(2)}"
+
+
+def finer_plan_text(root=ROOT):
+    """The ``plan_finer`` block: the plan of the README's own example file ``finer.yaml``
+    (its first ``yaml`` block after "A new study, and a sweep"), written to a temporary file
+    and planned as `make plan CONFIG=finer.yaml` would."""
+    import tempfile
+
+    readme = (Path(root) / "README.md").read_text()
+    start = readme.index("```yaml\n", readme.index("### A new study, and a sweep")) + 8
+    text = readme[start:readme.index("```", start)]
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "finer.yaml"
+        path.write_text(text)
+        _, plan = configuration.load(root=root, user_files=[path])
+    maps = [r for r in plan.rows if r.key == "studies.finer_map"]
+    cells = f"{maps[0].cells:,} cells; " if maps and getattr(maps[0], "cells", None) else ""
+    return f"{cells}`make plan CONFIG=finer.yaml` (generated): {plan.summary(2)}"
 
 
 def _fmt(x, digits=2):
@@ -190,8 +209,12 @@ def figures_text():
     (the rules `vibroimpact.pipeline.config.checks` applies to the table FIGURES)."""
     rows = ["", "| figure | listed by | needs in that entry | options of its item |",
             "|---|---|---|---|"]
+    from vibroimpact.pipeline.config.checks import PLANE_FIGURES
+
     for fig, spec in figures.FIGURES.items():
         owner = "a study" if spec["owner"] == "study" else "an `orbits` entry"
+        if spec["owner"] != "study" and fig in PLANE_FIGURES:
+            owner += ", or a study with a `plane` (over it)"
         needs = [f"`{b}:`" for b in ("trace", "spectra", "escape") if b in spec["reads"]]
         if "map" in spec["reads"]:
             needs.append("the map grid (`inv_beta`, `delta`; `map:` defaults)")
@@ -201,7 +224,8 @@ def figures_text():
             needs.append(f"`{spec['needs']}:`")
         if spec.get("harmonic"):
             needs.append("`amplitude` != 0")
-        needs += [f"an `{src}` entry of the same zeta and eps, named in its item"
+        needs += [f"an `{src}` entry of the same zeta, eps and walls (over a plane: the same "
+                  f"plane and every fixed value), named in its item"
                   for src in spec.get("sources", ())]
         options = [f"`{o}`" for o in spec.get("options", ())]
         if spec.get("per"):
@@ -237,7 +261,8 @@ def main(argv=None):
                         help="rewrite the blocks of this file (docs/figures.md)")
     args = parser.parse_args(argv)
     blocks = {"plan": plan_text(), "figures": figures_text()}
-    blocks.update({name: example_plan_text(name) for name in EXAMPLES})
+    blocks.update({name: example_plan_text(name) for name in EXAMPLES},
+                  plan_finer=finer_plan_text())
     docs = {}
     if not args.plan_only:
         numbers = build_numbers(args.results)

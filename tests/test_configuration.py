@@ -152,6 +152,7 @@ def test_the_readme_quotes_the_current_plan_and_figure_table():
     assert block("figures") == module.figures_text()
     for name in module.EXAMPLES:        # the shipped examples' plans, e.g. their job counts
         assert block(name) == module.example_plan_text(name)
+    assert block("plan_finer") == module.finer_plan_text()
     for fig in figures.FIGURES:
         assert f"| `{fig}` |" in block("figures")
 
