@@ -11,19 +11,9 @@ import json
 
 import numpy as np
 
+from vibroimpact._plane import dataset_axes
+
 __all__ = ["COMPLEX_CODES", "orbits_at_cells"]
-
-
-def _axes(ds):
-    """A map's plane ``(x, y)``: ``attrs["axes"]`` (JSON list or space-separated), else the
-    paper's ``(inv_beta, delta)``."""
-    axes = ds.attrs.get("axes")
-    if axes is None:
-        return ("inv_beta", "delta")
-    if isinstance(axes, (bytes, str)):
-        text = axes.decode() if isinstance(axes, bytes) else axes
-        axes = json.loads(text) if text.lstrip().startswith("[") else text.split()
-    return tuple(str(a) for a in np.atleast_1d(axes))
 
 
 def _grid_text(values):
@@ -130,7 +120,7 @@ def orbits_at_cells(motion_map, orbits):
     """
     import xarray as xr
 
-    axes = _axes(motion_map)
+    axes = dataset_axes(motion_map)
     x_name, y_name = axes
     xs, ys = (np.asarray(motion_map[d].values, dtype=float) for d in axes)
     types = [str(m) for m in motion_map["motion"].values if str(m) in orbits["type"].values]

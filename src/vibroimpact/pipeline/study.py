@@ -13,6 +13,8 @@ import math
 
 import numpy as np
 
+from vibroimpact._plane import DEFAULT_PLANE
+
 #: Significant decimals kept when a grid is given as start/stop/step (so 0.1 * 3 is 0.3, not
 #: 0.30000000000000004), relative to the grid's scale: 10 decimals for a grid of scale >= 1,
 #: more for a smaller one (1e-12 ... 5e-12 keeps 22), so no two values merge (`grid_decimals`).
@@ -121,8 +123,6 @@ def grid_values(spec):
 #: the two walls' restitutions, the play, the clearance, the forcing's amplitude and period
 #: ratio) and the noise's rms.
 PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta", "rms")
-#: The plane of a study that names none: Fig. 15's (1/beta_f, delta).
-DEFAULT_PLANE = ("inv_beta", "delta")
 #: Of `PLANE_PARAMETERS`, those of the noise (no harmonic-force problem has them: no Fig. 16).
 NOISE_PARAMETERS = ("rms",)
 

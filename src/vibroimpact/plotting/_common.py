@@ -19,6 +19,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from vibroimpact._files import atomic_path
+from vibroimpact._plane import dataset_axes
 from vibroimpact._symbols import PARAMETERS, fixed_caption, parameter_symbol
 from vibroimpact.stats.events import poisson_interval, t_quantile
 from vibroimpact.stats.spectra import line_power
@@ -328,8 +329,6 @@ def _system_text(ds):
 # The plane of a map (issue 36): its two axes and what it holds fixed
 # --------------------------------------------------------------------------------------------
 
-#: The paper's plane: a map dataset without ``attrs["axes"]`` runs over it.
-DEFAULT_PLANE = ("inv_beta", "delta")
 #: Global attributes a map dataset of the paper's plane carries for its fixed parameters
 #: (the fixed caption of a dataset without ``attrs["fixed"]``), by parameter name.
 FIXED_ATTRS = {"zeta": "zeta", "eps": "eps", "eps_lower": "eps_lower", "delta": "delta",
@@ -348,17 +347,9 @@ def _decoded(value, what):
 
 
 def plane_axes(ds):
-    """The names ``(x, y)`` of a map's two axes: ``ds.attrs["axes"]`` (x first), else the
-    paper's ``("inv_beta", "delta")``; each must be a dimension of `ds`."""
-    axes = ds.attrs.get("axes")
-    if axes is None:
-        return DEFAULT_PLANE
-    if isinstance(axes, (bytes, str)):
-        text = axes.decode() if isinstance(axes, bytes) else axes
-        axes = _decoded(text, "axes") if text.lstrip().startswith("[") else text.split()
-    axes = tuple(str(a) for a in np.atleast_1d(axes))
-    if len(axes) != 2 or axes[0] == axes[1]:
-        raise ValueError(f"attrs['axes'] must name two different parameters, got {axes!r}")
+    """The names ``(x, y)`` of a map's two axes (`vibroimpact._plane.dataset_axes`: its
+    ``axes`` attribute, x first, else the paper's); each must be a dimension of `ds`."""
+    axes = dataset_axes(ds)
     missing = [a for a in axes if a not in ds.dims]
     if missing:
         raise ValueError(f"the plane's axes {list(axes)} must be dimensions of the dataset; "

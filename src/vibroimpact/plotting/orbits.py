@@ -11,6 +11,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from vibroimpact._plane import dataset_axes
 from vibroimpact.plotting._common import (_attr, _header, _nearest, _same_system, _styled,
                                           _system_text, axis_label, custom_plane,
                                           motion_title, on_plane, plane_axes, plane_caption,
@@ -241,18 +242,9 @@ def _fits(allowed, bw, bh):
 
 
 def boundary_axes(boundaries):
-    """The plane ``(x, y)`` of a boundaries dataset: ``attrs["axes"]``, else ``(inv_beta,
-    delta)`` (its points are variables over ``point``, not dimensions)."""
-    axes = boundaries.attrs.get("axes")
-    if axes is None:
-        return ("inv_beta", "delta")
-    if isinstance(axes, (bytes, str)):
-        text = axes.decode() if isinstance(axes, bytes) else axes
-        axes = json.loads(text) if text.lstrip().startswith("[") else text.split()
-    axes = tuple(str(a) for a in np.atleast_1d(axes))
-    if len(axes) != 2 or axes[0] == axes[1]:
-        raise ValueError(f"attrs['axes'] must name two different parameters, got {axes!r}")
-    return axes
+    """The plane ``(x, y)`` of a boundaries dataset (`vibroimpact._plane.dataset_axes`; its
+    points are variables over ``point``, not dimensions)."""
+    return dataset_axes(boundaries)
 
 
 def _fixed_of(boundaries):

@@ -40,10 +40,11 @@ resamples without spread in either variable are dropped. Neighbouring cells are 
 pieces of evidence than their number and the interval is narrower than it should be: read
 it as a lower bound on the uncertainty.
 """
-import json
 from dataclasses import dataclass
 
 import numpy as np
+
+from vibroimpact._plane import dataset_axes
 
 __all__ = ["PREDICTORS", "SEED", "N_RESAMPLES", "MIN_CELLS", "Correlation", "on_map_grid",
            "rank_correlation", "predictor_correlations", "correlations_dataset",
@@ -104,7 +105,7 @@ def on_map_grid(ds, motion_map, name):
         When its grid is not the map's (both must list the same values, to 1e-9): the
         message gives both grids and how to make them one.
     """
-    axes = _map_axes(motion_map)
+    axes = dataset_axes(motion_map)
     same = all(d in ds.dims and ds.sizes[d] == motion_map.sizes[d]
                and np.allclose(ds[d].values, motion_map[d].values, rtol=0.0, atol=1e-9)
                for d in axes)
@@ -240,24 +241,12 @@ def rank_correlation(x, p, seed=SEED, n_resamples=N_RESAMPLES, level=0.95, *, _s
     return rho, float(min(low, rho)), float(max(high, rho)), n
 
 
-def _map_axes(motion_map):
-    """The map's plane ``(x, y)``: ``attrs["axes"]`` (a map over another plane), else the
-    paper's ``(inv_beta, delta)``."""
-    axes = motion_map.attrs.get("axes")
-    if axes is None:
-        return ("inv_beta", "delta")
-    if isinstance(axes, (bytes, str)):
-        text = axes.decode() if isinstance(axes, bytes) else axes
-        axes = json.loads(text) if text.lstrip().startswith("[") else text.split()
-    return tuple(str(a) for a in np.atleast_1d(axes))
-
-
 def _stable_domain(motion_map, orbits, basins, motion):
     """(stable, S) on the map's grid: the orbits at the cells' centres
     (`vibroimpact.orbits.cells.orbits_at_cells`, on the map's grid), or the basins'
     n_stable."""
     if orbits is not None and motion in orbits["type"].values:
-        o = orbits.sel(type=motion).transpose(*_map_axes(motion_map))
+        o = orbits.sel(type=motion).transpose(*dataset_axes(motion_map))
         stable = o["n_stable"].values > 0
         S = np.where(stable, o["S"].values, 0.0)
         return stable, S
@@ -317,7 +306,7 @@ def predictor_correlations(motion_map, orbits=None, basins=None, lyapunov=None, 
     list of Correlation
         Per predictor (the order of `PREDICTORS`), per motion of the map, domain then plane.
     """
-    motion_map = motion_map.transpose(..., *_map_axes(motion_map))   # every field (x, y)
+    motion_map = motion_map.transpose(..., *dataset_axes(motion_map))   # every field (x, y)
     errors = {}
     aligned = {}
     for name, ds in (("S", orbits), ("basin", basins), ("lyapunov", lyapunov)):
