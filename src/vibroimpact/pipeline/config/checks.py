@@ -347,9 +347,12 @@ def _check_motions(where, entry, two_walls, problems):
         problems.add(f"{where}.motions", walled, "two-wall motions [m_upper, m_lower, n], "
                      "and this study has one wall (no gap)", "[m, n] pairs, or give "
                      f"{where}.gap > 0")
-    for m in walled:
-        if m[0] + m[1] < 1:
-            problems.add(f"{where}.motions", m, "a motion without a collision",
+    for j, m in enumerate(motions):
+        if len(m) == 3 and m[2] < 1:
+            problems.add(f"{where}.motions[{j}][2]", m[2], "a motion over no forcing period",
+                         "n >= 1 in [m_upper, m_lower, n]")
+        if len(m) == 3 and m[0] + m[1] < 1:
+            problems.add(f"{where}.motions[{j}]", list(m), "a motion without a collision",
                          "[m_upper, m_lower, n] with m_upper + m_lower >= 1")
     if len(set(motions)) != len(motions):
         problems.add(f"{where}.motions", entry["motions"], "a motion is listed twice",
@@ -1039,7 +1042,7 @@ def _check_two_wall_orbits(where, entry, problems):
     """A two-wall ``orbits`` entry: triples of at most `MAX_SHOOTING_N` periods with an
     impact, fig16 only (no attractors block: its kernels' workflow job knows one wall)."""
     for j, t in enumerate(entry["types"]):
-        if len(t) == 3 and (t[2] > MAX_SHOOTING_N or t[0] + t[1] < 1):
+        if len(t) == 3 and not (1 <= t[2] <= MAX_SHOOTING_N and t[0] + t[1] >= 1):
             problems.add(f"{where}.types[{j}]", t, "a two-wall type the shooting map does not "
                          "solve for", f"[m_upper, m_lower, n] with m_upper + m_lower >= 1 and "
                          f"1 <= n <= {MAX_SHOOTING_N}")

@@ -13,6 +13,7 @@ import math
 import re
 
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems, _short
+from vibroimpact.pipeline.study import PLANE_PARAMETERS
 
 __all__ = ["SWEEP_KEYS", "NOISE_KEYS", "Sweeps", "expand_sweeps", "sweep_label", "sweep_labels",
            "drawn_sweeps", "sweep_figures", "Member", "sweep_members"]
@@ -100,11 +101,14 @@ class Sweeps:
 
 
 def _plane(entry):
-    """The parameters a study's ``plane`` names (its axes: grids, not sweeps), or ()."""
+    """The parameters a study's ``plane`` names that can be axes (grids, not sweeps), or ().
+    A name no plane takes (``seed``) stays a sweep key: the schema names the plane's
+    mistake, and nothing reads the key as an axis meanwhile (a seed list was given the
+    unit-rms value of an rms axis, and refused as "seed = 1.0")."""
     plane = entry.get("plane")
     if not isinstance(plane, list):
         return ()
-    return tuple(p for p in plane if isinstance(p, str))
+    return tuple(p for p in plane if p in PLANE_PARAMETERS)
 
 
 def _swept(entry):
@@ -129,8 +133,10 @@ def _axes(name, entry, problems, max_studies):
             problems.add(f"studies.{name}.{key}", value, "an empty list sweeps nothing", allowed_)
             ok = False
         elif any(isinstance(v, (list, dict)) for v in items):
-            problems.add(f"studies.{name}.{key}", value, "not a number or a list of numbers",
-                         allowed_)
+            named = isinstance(entry.get("plane"), list) and key in entry["plane"]
+            problems.add(f"studies.{name}.{key}", value, "not a number or a list of numbers"
+                         + (f" (plane names {key}, but {key} can be no axis: a plane is two "
+                            f"of {', '.join(PLANE_PARAMETERS)})" if named else ""), allowed_)
             ok = False
         elif isinstance(value, list):
             repeated = sorted({_short(v) for i, v in enumerate(value) if v in value[:i]})
