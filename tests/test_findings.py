@@ -323,3 +323,36 @@ def test_mirror_check_on_a_map_swaps_the_motions_walls():
     found = two_walls.mirror_check(motion_map=ds)
     assert found.holds == "no"                       # 2 of 3 agree (< 3 in 4)
     assert "P((1,0)/1) against P((0,1)/1) at delta = 0: 0.7" in found.measured
+
+
+def test_mirror_check_on_a_map_over_another_plane_says_why_not():
+    """A two-wall map over (zeta, eps_lower) has no plays to pair (eps_lower an axis, not an
+    attribute): n/a, naming its plane (it raised KeyError in the report)."""
+    ds = xr.Dataset({"probability": (("motion", "zeta", "eps_lower"), np.full((1, 2, 2), 0.5)),
+                     "probability_stderr": (("motion", "zeta", "eps_lower"),
+                                            np.full((1, 2, 2), 0.01))},
+                    coords=dict(motion=["(1,1)/1"], zeta=[0.03, 0.05], eps_lower=[0.3, 0.5]),
+                    attrs=dict(n_walls=2, gap=4.0, eps=0.5, delta=1.0, inv_beta=1.1,
+                               axes=["zeta", "eps_lower"]))
+    found = two_walls.mirror_check(motion_map=ds)
+    assert found.holds == "n/a" and "over (zeta, eps_lower)" in found.measured
+    assert two_walls.mirror_pairs(ds) == [] and two_walls.map_mirror_table(ds).empty
+
+
+def test_a_two_wall_report_over_a_gap_axis(monkeypatch):
+    """The report's two-wall section on a map over (delta, gap): the gap is an axis, not an
+    attribute; the section says so and the mirror check is n/a (it raised KeyError 'gap')."""
+    from vibroimpact.reports import notebook as nb
+
+    shape = (1, 2, 2)
+    ds = xr.Dataset({"probability": (("motion", "delta", "gap"), np.full(shape, 0.5)),
+                     "probability_stderr": (("motion", "delta", "gap"), np.full(shape, 0.01))},
+                    coords=dict(motion=["(1/1)"], delta=[0.0, 1.0], gap=[4.0, 5.0]),
+                    attrs=dict(n_walls=2, eps=0.5, eps_lower=0.5, inv_beta=1.1,
+                               axes=["delta", "gap"]))
+    shown = []
+    monkeypatch.setattr("IPython.display.display", lambda *objs: shown.extend(objs))
+    nb.two_wall_checks(motion_map=ds)
+    out = " ".join(o.data.to_csv() if hasattr(o.data, "to_csv") else str(o.data)
+                   for o in shown)          # Markdown's text, a table's frame
+    assert "gap (an axis of the map, 4 to 5)" in out and "runs over (delta, gap)" in out

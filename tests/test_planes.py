@@ -457,3 +457,33 @@ def test_two_rms_planes_on_one_noise_entry_share_its_unit_rms_record(tmp_path):
     unit = config["noises"][noises["noisy"]]
     assert unit["rms"] == 1.0 and unit["seed"] == config["noises"]["tiny"]["seed"]
     assert config["noises"][noises["reseeded"]]["seed"] == 99
+
+
+def test_every_pair_of_axes_is_a_plane(tmp_path):
+    """One file with a study over each of the 28 pairs of `PLANE_PARAMETERS` plans (an
+    amplitude axis raised TypeError for every pair that named it; the issue's trial file). A
+    plane naming eps_lower gets the second wall (gap 4) it needs."""
+    import itertools
+
+    import yaml
+
+    from vibroimpact.pipeline.study import PLANE_PARAMETERS
+
+    grid = {"zeta": [0.03, 0.05], "eps": [0.3, 0.5], "eps_lower": [0.3, 0.5],
+            "delta": [0.0, 1.0], "gap": [4.0, 5.0], "amplitude": [0.8, 1.0],
+            "inv_beta": [1.0, 1.1], "rms": [0.2, 0.29]}
+    fixed = {"zeta": 0.05, "eps": 0.5, "delta": 1.0, "amplitude": 1.0, "inv_beta": 1.1}
+    studies = {}
+    for x, y in itertools.combinations(PLANE_PARAMETERS, 2):
+        entry = dict(fixed, noise="tiny", plane=[x, y], transient=100.0, figures=["fig15"],
+                     map=dict(target_stderr=0.1, min_time=300.0, max_periods=200))
+        if "eps_lower" in (x, y):
+            entry["gap"] = 4.0
+        entry.update({x: grid[x], y: grid[y]})
+        studies[f"p_{x}_{y}"] = entry
+    text = TINY_NOISE + yaml.safe_dump({"studies": studies}, sort_keys=False)
+    config, plan = _load(tmp_path, text)
+    assert len(studies) == 28
+    for name, entry in studies.items():
+        assert config["studies"][name]["plane"] == entry["plane"]
+    assert plan.cells == 28 * 4

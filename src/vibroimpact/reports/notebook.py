@@ -988,14 +988,15 @@ def two_wall_checks(events=None, spectra=None, motion_map=None):
     ds = first(events, motion_map, spectra)
     if not two_walls.is_two_wall(ds):
         return
-    gap = float(ds.attrs["gap"])
+    gaps = (f"{float(ds.attrs['gap']):g}" if "gap" in ds.attrs else
+            f"gap (an axis of the map, {float(ds.gap.min()):g} to {float(ds.gap.max()):g})")
     display(Markdown(
         f"## A two-wall study: per wall, mirror images, stable domains\n\n"
-        f"The second wall stands at $\\delta$ - {gap:g}, so $\\delta$ places a clearance, not "
+        f"The second wall stands at $\\delta$ - {gaps}, so $\\delta$ places a clearance, not "
         f"the paper's play: findings 1-7, which read trends along the play, are not applicable "
         f"(the table above says so). What is measured instead: each wall's collisions, and "
         f"the mirror symmetry x $\\to$ -x, which swaps the walls: with one restitution the "
-        f"setting at $\\delta$ is the mirror image of that at {gap:g} - $\\delta$, so the upper "
+        f"setting at $\\delta$ is the mirror image of that at gap - $\\delta$, so the upper "
         f"wall's statistics at one must agree with the lower wall's at the other, within "
         f"their 95 % intervals. Mirror cells run on one record r($\\tau$) while a mirror image "
         f"is driven by -r($\\tau$): two realisations of one law."))

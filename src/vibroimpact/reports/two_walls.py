@@ -18,6 +18,7 @@ are two realisations of one law, compared as independent estimates.
 """
 import numpy as np
 
+from vibroimpact._plane import DEFAULT_PLANE, dataset_axes
 from vibroimpact.reports.findings import MIN_IMPACTS, Finding, _sentence
 
 __all__ = ["MIRROR_CLAIM", "is_two_wall", "mirror_check", "mirror_pairs", "per_wall"]
@@ -43,7 +44,10 @@ def is_two_wall(ds):
 def mirror_pairs(ds):
     """The plays of ``ds`` whose mirror image is also in it: ``[(d, gap - d), ...]`` with
     ``d <= gap - d`` (a play at gap / 2 is its own mirror image: its two walls are compared).
-    Empty when the walls' restitutions differ (then no setting is a mirror image)."""
+    Empty when the walls' restitutions differ (then no setting is a mirror image), and for a
+    map over another plane than (1/beta_f, delta) (its gap or restitutions may be axes)."""
+    if dataset_axes(ds) != DEFAULT_PLANE:
+        return []
     gap = float(ds.attrs["gap"])
     if not np.isclose(float(ds.attrs["eps"]), float(ds.attrs["eps_lower"]), rtol=0, atol=1e-12):
         return []
@@ -149,6 +153,8 @@ def map_mirror_table(motion_map, z=1.959963984540054):
 
     rows = []
     pairs = mirror_pairs(motion_map)
+    if not pairs:
+        return pd.DataFrame(rows)
     motions = [str(m) for m in motion_map.motion.values]
     for ib in np.atleast_1d(motion_map.inv_beta.values):
         where = {"1/beta_f": float(ib)}
@@ -190,6 +196,11 @@ def mirror_check(events=None, spectra_shift=None, motion_map=None):
     ds = events if events is not None else motion_map
     if not is_two_wall(ds):
         return Finding("mirror", MIRROR_CLAIM, "a one-wall study: no mirror image", "n/a")
+    axes = dataset_axes(ds)
+    if axes != DEFAULT_PLANE:
+        return Finding("mirror", MIRROR_CLAIM, f"the map runs over ({axes[0]}, {axes[1]}): "
+                       f"the check pairs the plays delta and gap - delta at each 1/beta_f, "
+                       f"one gap and one restitution (a map over (1/beta_f, delta))", "n/a")
     gap = float(ds.attrs["gap"])
     if not mirror_pairs(ds):
         eps, eps_l = float(ds.attrs["eps"]), float(ds.attrs["eps_lower"])
