@@ -346,6 +346,31 @@ def test_a_tiny_rms_delta_map_builds(tmp_path):
     assert (work / "results/noise/noisy_noise0.nc").exists()
 
 
+GAP_DELTA = NOISE + """  walls:
+    noise: tiny
+    plane: [gap, delta]
+    eps: 0.5
+    gap: [3.0, 4.0]
+    inv_beta: 1.1
+    delta: [0.5, 1.0]
+""" + MAP
+
+
+@pytest.mark.workflow
+def test_a_two_wall_plane_builds_its_report(tmp_path):
+    """A (gap, delta) map of two walls, through its executed report: the gap is an axis, so
+    the report's two-wall section has no one gap to print and no mirror pairs (its mirror
+    check raised KeyError 'gap' on such a map)."""
+    from helpers import make_workdir, snakemake
+
+    work = make_workdir(tmp_path / "wf")
+    (work / "walls.yaml").write_text(GAP_DELTA)
+    target = "results/reports/walls/harmonic_random.html"
+    snakemake(work, target, config="walls.yaml")
+    text = (work / target).read_text()
+    assert "an axis of the map, 3 to 4" in text and "the map runs over (gap, delta)" in text
+
+
 def test_an_orbits_plane_built_by_its_tasks_is_orbit_plane_bit_for_bit(tmp_path):
     """The orbits entry's tiles (eps columns strided over 2 jobs) joined by the aggregate are
     `orbit_plane` over the whole plane, bit for bit; the boundaries job writes the plane's
