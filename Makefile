@@ -37,7 +37,7 @@ LOCK := requirements.lock
 CONFIG ?=
 CONFIG_ARGS := $(if $(CONFIG),--configfile $(CONFIG))
 
-.PHONY: all plan report stale clean-stale test test-fast test-slow bench lint lock clean
+.PHONY: all plan report stale clean-stale test test-fast test-slow docs bench lint lock clean
 # checks the config, prints the plan, recovers from a killed run, then runs Snakemake; then
 # writes Snakemake's report of the build, whole or not at all
 all: $(STAMP)
@@ -72,7 +72,7 @@ $(STAMP): $(LOCK) pyproject.toml
 
 # the seconds-long checks first: a lint failure stops the build before the half-hour suites
 test: $(STAMP)
-	$(BIN)/ruff check src tests benchmarks tools workflow/scripts
+	$(BIN)/ruff check src tests benchmarks tools workflow/scripts docs
 	$(BIN)/snakefmt --check workflow/
 	$(BIN)/lint-imports
 	$(BIN)/python -m pytest -q $(FAST_WORKERS)
@@ -88,12 +88,19 @@ lock: $(STAMP)
 	  --custom-compile-command "make lock" -o $(LOCK)
 	$(BIN)/python tools/environment.py conda
 
+# the documentation site, docs/_build/html/index.html: the pages, the config reference from the
+# schema, the API reference from the docstrings and the tutorials, executed as it builds
+# (offline; any warning fails it)
+docs: $(STAMP)
+	$(BIN)/sphinx-build -W --keep-going -q -b html docs docs/_build/html
+	@echo "the site: docs/_build/html/index.html"
+
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_simulate.py
 
 lint: $(STAMP)
 	$(BIN)/snakemake --lint
-	$(BIN)/ruff check src tests benchmarks tools workflow/scripts
+	$(BIN)/ruff check src tests benchmarks tools workflow/scripts docs
 	$(BIN)/snakefmt --check workflow/
 
 clean:

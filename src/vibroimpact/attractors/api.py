@@ -299,6 +299,18 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     (walls swapped, starts mirrored) settle alike. A motion that meets both walls settles as
     "periodic_other", with its exponents from its own last period. An impact at the other
     wall always starts a new collision.
+
+    Examples
+    --------
+    One cell of Fig. 16's plane, 8 starts: all of them settle on the (1/1) motion, whose
+    largest Lyapunov exponent is negative:
+
+    >>> from vibroimpact import attractor_map
+    >>> result = attractor_map([1.1], [0.5], 0.05, 0.5, n_starts=8)
+    >>> result["motions"][0], float(result["fraction"][0, 0, 0])
+    ('1/1', 1.0)
+    >>> bool(result["lyapunov"][0, 0] < 0)
+    True
     """
     (inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time, match_tol,
      seed) = _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,

@@ -767,6 +767,17 @@ def periodic_motions(model, n, seeds=None, *, starts=None, settle_periods=SETTLE
     -----
     docs/model.md, section 8.8: the flow, the saltation matrix, the Newton section and the
     determinant ``prod eps_w^2 exp(-2 zeta z)`` of the monodromy.
+
+    Examples
+    --------
+    A clearance: the paper's oscillator with a second wall 2 below the first, under
+    sin(tau / 1.1); the motions of one forcing period reached from the settled seeds:
+
+    >>> from vibroimpact import periodic_motions
+    >>> from vibroimpact.model import Model
+    >>> found = periodic_motions(Model.paper(0.05, 0.5, 1.0, 1.0, 1 / 1.1, gap=2.0), n=1)
+    >>> [(motion.name, motion.stable) for motion in found]
+    [('(1,1)/1', True)]
     """
     if not isinstance(model, Model):
         raise ValueError(f"model must be a vibroimpact.model.Model, got {type(model).__name__}")

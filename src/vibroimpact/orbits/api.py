@@ -258,6 +258,19 @@ def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False)
     -----
     Eqs. (10)-(11) with positive intervals and velocities, filtered by eq. (13); stability by
     eqs. (14)-(24). See the module docstring for the method and for eps = 0.
+
+    Examples
+    --------
+    The (1/1) motion at 1/beta = 1.1, delta = 0.5 (Fig. 16's point), and the determinant of
+    its one-period Jacobian against eps^(2m) exp(-2 zeta z):
+
+    >>> import numpy as np
+    >>> from vibroimpact import periodic_orbits
+    >>> (orbit,) = periodic_orbits(1, 1, 1 / 1.1, 0.5, 0.05, 0.5)
+    >>> orbit.stable, round(orbit.lam, 4), round(float(orbit.velocities[0]), 4)
+    (True, 0.3539, 2.1048)
+    >>> bool(np.isclose(np.linalg.det(orbit.jacobian), 0.5**2 * np.exp(-2 * 0.05 * orbit.period)))
+    True
     """
     m, n, beta, delta, zeta, eps = _validate(m, n, beta, delta, zeta, eps)
     orbits = [_make_orbit(y, m, n, beta, delta, zeta, eps)
@@ -295,6 +308,15 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
     Each row of constant ``1/beta`` is one parallel task; along it the solutions of the previous
     ``delta`` seed Newton (branch following) in addition to the global interval scan, so a
     branch lost by the scan near a fold is still followed.
+
+    Examples
+    --------
+    Stable (1/1) motions on a 2 x 3 grid (rows 1/beta, columns delta):
+
+    >>> from vibroimpact import orbit_map
+    >>> result = orbit_map([0.9, 1.1], [0.0, 0.5, 1.0], types=((1, 1),))
+    >>> result["n_stable"][0].tolist()
+    [[1, 1, 1], [0, 1, 1]]
     """
     inv_beta = np.ascontiguousarray(inv_beta, dtype=float).ravel()
     deltas = np.ascontiguousarray(delta, dtype=float).ravel()

@@ -628,6 +628,16 @@ def domain_boundaries(m, n, zeta, eps, inv_beta=(0.2, 3.0), delta=(-1.5, 3.0), *
     See the module docstring for the method, the ends of a curve and the accuracy. Points are
     at most 1/250 of the box's diagonal apart and the direction turns by at most 0.1 rad
     between them (except across a cusp of the curve's projection).
+
+    Examples
+    --------
+    The edges of the stable (1/1) domain over a small window of Fig. 16:
+
+    >>> from vibroimpact import domain_boundaries
+    >>> curves = domain_boundaries(1, 1, 0.05, 0.5, inv_beta=(0.8, 1.4), delta=(-0.5, 1.5),
+    ...                            resolution=(13, 21))
+    >>> sorted({curve.kind for curve in curves})
+    ['grazing']
     """
     m = _checks.integer("m", m, low=1)
     n = _checks.integer("n", n, low=1)
