@@ -16,7 +16,7 @@ import functools
 import os
 from pathlib import Path
 
-__all__ = ["ENV", "version", "source_version", "checkout", "export"]
+__all__ = ["ENV", "SOFTWARE", "version", "source_version", "checkout", "export", "software"]
 
 PACKAGE_DIR = Path(__file__).resolve().parent
 #: ``<package folder>=<version>``, set by :func:`export` for the processes a build starts.
@@ -82,3 +82,41 @@ def export():
     found = version()
     os.environ[ENV] = f"{PACKAGE_DIR}={found}"
     return found
+
+
+#: The distributions whose version can change a number of a dataset or a figure: the arrays,
+#: the special functions and filters, the kernels' compiler, the files, the drawing, the
+#: workflow that decides what runs.
+SOFTWARE = ("numpy", "scipy", "numba", "llvmlite", "xarray", "netCDF4", "matplotlib",
+            "snakemake")
+
+
+@functools.lru_cache(maxsize=1)
+def software():
+    """``{name: version}`` of `SOFTWARE` as installed (importlib.metadata: nothing is
+    imported), ``Python``, and ``CPU``: the processor's model (numba compiles its kernels for
+    it), ``"unknown"`` where the system does not say."""
+    import platform
+    from importlib import metadata
+
+    found = {}
+    for name in SOFTWARE:
+        try:
+            found[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            found[name] = "not installed"
+    found["Python"] = platform.python_version()
+    found["CPU"] = _cpu_model()
+    return found
+
+
+def _cpu_model():
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return " ".join(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    import platform
+
+    return platform.processor() or platform.machine() or "unknown"

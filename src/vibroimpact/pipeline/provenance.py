@@ -73,7 +73,9 @@ def provenance(config_block, seed=None):
 
     ``config`` (the block as YAML text: the same block the rule's params carry, so the
     dataset says what it was computed from), ``config_digest``, ``created`` (UTC, ISO
-    8601), ``package_version``, ``git_commit`` and ``git_dirty``, ``paper_reference``; and
+    8601), ``package_version``, ``git_commit`` and ``git_dirty``, ``software`` (JSON: the
+    versions that can change a number and the CPU, `vibroimpact._release.software`),
+    ``paper_reference``; and
     :func:`sweep_attrs` for a study of a sweep.
 
     Parameters
@@ -88,9 +90,11 @@ def provenance(config_block, seed=None):
     # the function, not the lazy ``__version__``: a code digest follows a named function,
     # while a name that only the package's ``__getattr__`` knows reaches all of it
     from vibroimpact import PAPER_REFERENCE, _version
+    from vibroimpact._release import software
 
     commit, dirty = git_state()
     attrs = dict(package_version=_version(), git_commit=commit, git_dirty=dirty,
+                 software=json.dumps(software()),
                  config=config_text(config_block), config_digest=config_digest(config_block),
                  created=datetime.now(timezone.utc).isoformat(timespec="seconds"),
                  paper_reference=PAPER_REFERENCE)

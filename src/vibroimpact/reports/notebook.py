@@ -1040,3 +1040,48 @@ def two_wall_checks(events=None, spectra=None, motion_map=None):
             "not measured in this report. A map study over the same walls with "
             "`fig15_vs_fig16` (as `clearance_map` in config/examples/clearance.yaml) reads it "
             "as finding 8 of its own report."))
+
+
+def run_section(owners, benchmarks, **datasets):
+    """The report's "Run" section: the versions that computed its numbers
+    (:func:`vibroimpact.reports.run.versions`) and the CPU time, wall time and peak memory
+    of the jobs behind its datasets and figures (:func:`vibroimpact.reports.run.job_costs`
+    of ``owners`` under the folder ``benchmarks``)."""
+    from IPython.display import Markdown, display
+
+    from vibroimpact.reports import run
+
+    display(Markdown("The tool's version and commit and the versions that can change a "
+                     "number, as each dataset recorded them when its job wrote it, beside "
+                     "the environment executing this report:"))
+    display(run.versions(**datasets).style.set_table_attributes(
+        'style="width: 100%; table-layout: fixed"'))
+    costs = run.job_costs(owners, benchmarks)
+    if costs.empty:
+        display(Markdown(f"*No benchmark of the jobs behind this report under "
+                         f"`{benchmarks}` (a build that kept none, or datasets copied from "
+                         f"elsewhere).*"))
+        return
+    display(Markdown(
+        f"The {len(costs)} jobs behind its datasets and figures, as Snakemake's benchmarks "
+        f"measured them: {costs['CPU s'].sum():.1f} CPU-s and {costs['wall s'].sum():.1f} s "
+        f"of wall time in all (jobs run side by side, so the build took less), the largest "
+        f"peak memory {costs['peak memory MB'].max():.0f} MB "
+        f"({costs.loc[costs['peak memory MB'].idxmax(), 'rule']})."))
+    display(costs.style.format({"CPU s": "{:.2f}", "wall s": "{:.2f}",
+                                "peak memory MB": "{:.0f}"}).hide(axis="index"))
+
+
+def entry_name(path):
+    """The entry a dataset's file is named after (``results/orbits/harmonic.nc``:
+    ``harmonic``; a noise record's file: its ``noises`` entry), "" for none."""
+    return Path(path).stem if path else ""
+
+
+noise_name = entry_name
+
+
+def benchmarks_of(path):
+    """The benchmarks folder of the build that wrote the file ``path``
+    (``results/<kind>/<file>``: ``results/benchmarks``)."""
+    return Path(path).parent.parent / "benchmarks"
