@@ -12,6 +12,7 @@ import json
 import numpy as np
 
 from vibroimpact._plane import dataset_axes
+from vibroimpact._symbols import PARAMETERS
 
 __all__ = ["COMPLEX_CODES", "orbits_at_cells"]
 
@@ -149,9 +150,15 @@ def orbits_at_cells(motion_map, orbits):
                      "S": (dims, S), "complex": (dims, complex_)},
                     coords={"type": types, x_name: motion_map[x_name].values,
                             y_name: motion_map[y_name].values})
-    ds["n_stable"].attrs["long_name"] = "stable orbits at the cell's centre"
+    ds["n_stable"].attrs.update(long_name="stable orbits at the cell's centre", units="1")
     ds["S"].attrs.update(long_name="degree of stability at the cell's centre", units="%")
-    ds["complex"].attrs.update(long_name="multipliers a complex pair", codes=COMPLEX_CODES)
+    ds["complex"].attrs.update(long_name="multipliers a complex pair", units="1",
+                               codes=COMPLEX_CODES)
+    ds["type"].attrs.update(long_name="impact motion (m/n)", units="1")
+    for name in axes:      # the map's words for its axes, else orbit_plane's (dimensionless)
+        words = motion_map[name].attrs
+        ds[name].attrs.update(long_name=words.get("long_name") or PARAMETERS[name][2],
+                              units=words.get("units") or "1")
     ds.attrs.update(solver=solver, fixed=json.dumps(fixed, sort_keys=True))
     if "axes" in motion_map.attrs:
         ds.attrs["axes"] = json.dumps(list(axes))

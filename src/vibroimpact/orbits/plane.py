@@ -247,6 +247,7 @@ def plane_dataset(x_name, xs, y_name, ys, fixed, parsed, result, solver, n_walls
         ds[name].attrs.update(long_name=long_name, units=units)
     for name in (x_name, y_name):
         ds[name].attrs.update(long_name=PARAMETERS[name][2], units="1")
+    ds["type"].attrs.update(long_name="impact motion (m/n)", units="1")
     ds.attrs.update({k: float(v) for k, v in fixed.items()})
     ds.attrs.update(axes=[x_name, y_name], fixed=json.dumps(fixed, sort_keys=True),
                     n_walls=n_walls, solver=solver)
