@@ -250,7 +250,9 @@ def _stable_domain(motion_map, orbits, basins, motion):
         stable = o["n_stable"].values > 0
         S = np.where(stable, o["S"].values, 0.0)
         return stable, S
-    if basins is not None and motion in basins["motion"].values:
+    # a one-wall basins dataset counts the closed-form orbits' stable solutions per cell; a
+    # two-wall one classifies the study's motions and solves none (no n_stable)
+    if basins is not None and "n_stable" in basins and motion in basins["motion"].values:
         return basins["n_stable"].sel(motion=motion).values > 0, None
     return None, None
 
