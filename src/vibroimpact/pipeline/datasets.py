@@ -687,7 +687,8 @@ def attractor_tile_dataset(result, attrs):
     for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
         data[name] = (("start", *plane), result[name])
     data["class_start"] = (("start", *plane), result["class_start"].astype(np.int8))
-    if "gap" in plane or "gap" in result.get("fixed", {}):
+    two_walls = "gap" in plane or "gap" in result.get("fixed", {})
+    if two_walls:
         # two walls: what each settled start's motion is in the study's own names
         data["period_impacts_start"] = (("start", *plane), result["period_start"][0])
         data["period_periods_start"] = (("start", *plane), result["period_start"][1])
@@ -696,6 +697,8 @@ def attractor_tile_dataset(result, attrs):
     if "axes" in result:        # a named plane (attractors.plane.attractor_plane)
         ds.attrs.update(axes=list(plane), fixed=json.dumps(result["fixed"], sort_keys=True),
                         **{k: float(v) for k, v in result["fixed"].items()})
+    if two_walls:       # `gap` is the clearance (a fixed value or an axis), as every dataset's
+        ds.attrs["n_walls"] = 2             # of a two-wall study; the starts' box: start_gap
         for name in plane:
             ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
     return ds

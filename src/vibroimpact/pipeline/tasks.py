@@ -665,7 +665,7 @@ def _attractor_attrs(entry):
     gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
     return dict(zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                 n_starts=int(block["n_starts"]), max_time=float(block["max_time"]),
-                seed=int(block["seed"]), gap=list(gap), velocity=list(vel),
+                seed=int(block["seed"]), start_gap=list(gap), velocity=list(vel),
                 box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
                     f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
 
@@ -685,7 +685,7 @@ def attractor_tile(entry, tile, out, threads=None):
     result = attractor_map(rows[tile::n_tiles], grid_values(block["delta"]),
                            float(entry["zeta"]), float(entry["eps"]),
                            types=[tuple(int(k) for k in t) for t in entry["types"]],
-                           n_starts=attrs["n_starts"], gap=tuple(attrs["gap"]),
+                           n_starts=attrs["n_starts"], gap=tuple(attrs["start_gap"]),
                            velocity=tuple(attrs["velocity"]), max_time=attrs["max_time"],
                            seed=attrs["seed"])
     attrs = dict(provenance(entry), **attrs)
@@ -717,8 +717,8 @@ def plane_attractor_tile(name, entry, tile, out, threads=None):
     block = entry["attractors"]
     gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
     attrs = dict(study=name, n_starts=int(block["n_starts"]),
-                 max_time=float(block["max_time"]), seed=int(block["seed"]), gap=list(gap),
-                 velocity=list(vel),
+                 max_time=float(block["max_time"]), seed=int(block["seed"]),
+                 start_gap=list(gap), velocity=list(vel),
                  box=f"forcing phase in [0, 2 pi), x0 = delta - s (s: distance below the "
                      f"wall at delta) with s in [{gap[0]:g}, {gap[1]:g}], v0 in "
                      f"[{vel[0]:g}, {vel[1]:g}]")
