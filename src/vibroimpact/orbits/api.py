@@ -66,6 +66,12 @@ from vibroimpact.orbits import kernels as ok
 
 __all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
 
+#: Rows per thread in one call of `orbit_map`'s kernel, between two reports of its progress:
+#: ~0.2 s a row of Fig. 16's 226 deltas, so a block is ~1 s, under the progress log's
+#: cadence; a block ends when its slowest thread does, and rows that cost alike (neighbours
+#: in 1/beta) keep that wait to a few per cent of a row per block (benchmarks/progress_ab.py).
+MAP_BLOCK_ROWS = 4
+
 
 class Reason(enum.IntEnum):
     """Why a map point has no stable motion of a type (``orbit_map``'s ``reason``; Fig. 16).
@@ -268,7 +274,7 @@ def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False)
 
 
 def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), zeta=0.05,
-              eps=0.5):
+              eps=0.5, *, progress=None):
     """Existence and stability of (m/n) motions over a ``(1/beta, delta)`` grid (Fig. 16).
 
     Parameters
@@ -281,6 +287,9 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
         Motion types (m <= 3).
     zeta, eps : float
         Damping ratio and restitution coefficient.
+    progress : callable, optional
+        ``progress(k)`` after every block of rows solved (`MAP_BLOCK_ROWS` per thread), ``k``
+        its cells: a job's progress log (`vibroimpact.pipeline.tasks.Progress.advance`).
 
     Returns
     -------
@@ -319,9 +328,17 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
     lam = np.full(shape, np.nan)
     reason = np.zeros(shape, dtype=np.int8)
     threads = numba.get_num_threads()
-    row_order = np.argsort(np.arange(inv_beta.size) % threads, kind="stable")
-    ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), row_order, exists, n_sol,
-                  n_stab, lam, reason)
+    # rows interleaved over the threads (block lo.. runs row lo + t + k threads on thread t,
+    # as one call over every row would): a block's rows are independent of the others, so
+    # the blocks give the one call's numbers bit for bit, and each thread the same rows
+    step = MAP_BLOCK_ROWS * threads
+    for lo in range(0, inv_beta.size, step):
+        block = np.arange(lo, min(lo + step, inv_beta.size))
+        row_order = block[np.argsort((block - lo) % threads, kind="stable")]
+        ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), row_order, exists,
+                      n_sol, n_stab, lam, reason)
+        if progress is not None:
+            progress(block.size * deltas.size)
     return {
         "exists": exists, "n_solutions": n_sol, "n_stable": n_stab, "lam": lam,
         "S": 100.0 * (1.0 - lam), "reason": reason,
