@@ -37,10 +37,11 @@ DEFAULT_MATCH_TOL = ATTRACTOR_MATCH_TOL
 #: Two-sided level of the Clopper-Pearson interval of ``fraction``.
 CONFIDENCE = 0.95
 #: Starts (whole cells of them) in one call of the starts' kernel, between two reports of
-#: `attractor_map`'s progress: ~30 us a start (Fig. 15's plane, 64 starts a cell), so ~1 s
-#: of one thread's work a block, under the progress log's cadence, in 32 blocks a thread
-#: whose last one to finish leaves the others idle for ~1 % of it, as one call over every
-#: start does (benchmarks/progress_ab.py).
+#: `attractor_map`'s progress: ~55 CPU-us a start on Fig. 15's plane (64 starts a cell), so
+#: a block is ~1 s on 2 threads, under the progress log's cadence, and holds 32 blocks a
+#: thread whose last one to finish leaves the others idle ~1/64 of it, as one call over
+#: every start does. Measured (5 pairs, whole process, benchmarks/progress_ab.py):
+#: main/blocks CPU 0.98 (0.90-1.22), wall 1.05 (0.66-1.28) on a machine loaded by other builds.
 BLOCK_STARTS = 2 ** 15
 
 

@@ -67,9 +67,12 @@ from vibroimpact.orbits import kernels as ok
 __all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
 
 #: Rows per thread in one call of `orbit_map`'s kernel, between two reports of its progress:
-#: ~0.2 s a row of Fig. 16's 226 deltas, so a block is ~1 s, under the progress log's
-#: cadence; a block ends when its slowest thread does, and rows that cost alike (neighbours
-#: in 1/beta) keep that wait to a few per cent of a row per block (benchmarks/progress_ab.py).
+#: Fig. 16's 141 x 226 map takes ~11 CPU-s, ~0.08 s a row, so a block is ~0.3 s on 2 idle
+#: threads (~3 s under a load of 9 on 2 cores), well under the progress log's cadence. Each
+#: block ends when its slower thread does; the rows are those the thread had in one call, so
+#: that wait is the one call's imbalance spread over the blocks: measured (5 pairs, whole
+#: process, benchmarks/progress_ab.py) main/blocks CPU 0.966 (0.94-0.99), wall 0.94
+#: (0.65-1.30) on a machine loaded by other builds.
 MAP_BLOCK_ROWS = 4
 
 
