@@ -89,7 +89,7 @@ def _complex_pairs(x_name, xs, y_name, ys, fixed, types, n_stable, S):
     return out
 
 
-def orbits_at_cells(motion_map, orbits):
+def orbits_at_cells(motion_map, orbits, progress=None):
     """The periodic orbits of ``orbits``' system at the centre of every cell of the map, for
     the motions both name: what finding 8 and the predictors compare P with, cell for cell.
 
@@ -105,6 +105,8 @@ def orbits_at_cells(motion_map, orbits):
         ``results/datasets/{study}_map.nc``: its plane and motions.
     orbits : xarray.Dataset
         ``results/orbits/{name}.nc`` of the same system.
+    progress : callable, optional
+        ``progress(k)`` as ``k`` more cells are solved (`orbit_plane`'s) or read.
 
     Returns
     -------
@@ -135,11 +137,14 @@ def orbits_at_cells(motion_map, orbits):
         n_stable, S = o["n_stable"].values, o["S"].values
         complex_ = np.full(n_stable.shape, -1, dtype=np.int8)
         solver = "read from the orbit map (two walls)"
+        if progress is not None:
+            progress(xs.size * ys.size)
     else:
         from vibroimpact.orbits.plane import orbit_plane
 
         solved = orbit_plane(x_name, xs, y_name, ys, dict(fixed),
-                             types=[tuple(int(v) for v in t.split("/")) for t in types])
+                             types=[tuple(int(v) for v in t.split("/")) for t in types],
+                             progress=progress)
         solved = solved.transpose("type", x_name, y_name)
         n_stable, S = solved["n_stable"].values, solved["S"].values
         complex_ = _complex_pairs(x_name, xs, y_name, ys, fixed, types, n_stable, S)
