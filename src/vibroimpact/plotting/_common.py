@@ -229,17 +229,39 @@ def symbols(text):
     return "$".join(parts)
 
 
+#: Characters of a header line an inch of figure holds (the title size, 10 pt; 6.5 in, the
+#: default width, holds `HEADER_WIDTH`): a narrower figure breaks its lines shorter.
+HEADER_CHARS_PER_INCH = 14.0
+
+
 def _header(fig, title, params):
     """The figure's title and its parameter lines (plain names as symbols, `symbols`),
-    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`)."""
+    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`); on a figure too narrow
+    for that many characters, at the width it holds, and at ``", "`` where a part between
+    separators is longer than that."""
+    width = min(HEADER_WIDTH, int(fig.get_figwidth() * HEADER_CHARS_PER_INCH))
     lines = []
     for line in symbols(params).split("\n"):
-        while len(line) > HEADER_WIDTH and ";  " in line[:HEADER_WIDTH + 10]:
-            cut = line.rfind(";  ", 0, HEADER_WIDTH + 10)
+        while len(line) > width and ";  " in line[:width + 10]:
+            cut = line.rfind(";  ", 0, width + 10)
             lines.append(line[:cut + 1])
             line = line[cut + 3:]
+        while width < HEADER_WIDTH and len(line) > width:
+            cut = _comma_outside_math(line, width)
+            if cut < 0:
+                break
+            lines.append(line[:cut + 1])
+            line = line[cut + 2:]
         lines.append(line)
     fig.suptitle("\n".join([title, *lines]))
+
+
+def _comma_outside_math(line, width):
+    """The last ``", "`` of ``line`` before ``width`` outside ``$...$``, or -1."""
+    cut = line.rfind(", ", 0, width)
+    while cut >= 0 and line.count("$", 0, cut) % 2:
+        cut = line.rfind(", ", 0, cut)
+    return cut
 
 
 def _panel_tag(ax, tag):
@@ -377,8 +399,14 @@ def plane_fixed(ds):
 
 
 def plane_caption(ds, math=True):
-    """``"fixed: ζ = 0.05, A = 1, 1/β_f = 1.1, σ_r = 0.29"`` of a map dataset (`plane_fixed`)."""
-    text = fixed_caption(plane_fixed(ds), math=math)
+    """``"fixed: ζ = 0.05, A = 1, 1/β_f = 1.1, σ_r = 0.29"`` of a map dataset (`plane_fixed`);
+    with a second wall whose restitution is given nowhere, ``ε_l = ε`` (its default)."""
+    fixed = plane_fixed(ds)
+    text = fixed_caption(fixed, math=math)
+    axes = plane_axes(ds)
+    if ("gap" in axes or "gap" in fixed) and "eps_lower" not in axes and "eps_lower" not in fixed:
+        text += (", " if text else "") + (r"$\varepsilon_l = \varepsilon$" if math
+                                          else "ε_l = ε")
     return f"fixed: {text}" if text else "nothing fixed"
 
 
