@@ -237,8 +237,8 @@ HEADER_CHARS_PER_INCH = 14.0
 def _header(fig, title, params):
     """The figure's title and its parameter lines (plain names as symbols, `symbols`),
     long lines broken at their ``";  "`` separators (`HEADER_WIDTH`); on a figure too narrow
-    for that many characters, at the width it holds, and at ``", "`` where a part between
-    separators is longer than that."""
+    for that many characters, at the width it holds, and at ``", "`` (else a space) outside
+    maths where a part between separators is longer than that."""
     width = min(HEADER_WIDTH, int(fig.get_figwidth() * HEADER_CHARS_PER_INCH))
     lines = []
     for line in symbols(params).split("\n"):
@@ -247,21 +247,26 @@ def _header(fig, title, params):
             lines.append(line[:cut + 1])
             line = line[cut + 3:]
         while width < HEADER_WIDTH and len(line) > width:
-            cut = _comma_outside_math(line, width)
+            cut, skip = _break_outside_math(line, width)
             if cut < 0:
                 break
-            lines.append(line[:cut + 1])
-            line = line[cut + 2:]
+            lines.append(line[:cut])
+            line = line[cut + skip:]
         lines.append(line)
     fig.suptitle("\n".join([title, *lines]))
 
 
-def _comma_outside_math(line, width):
-    """The last ``", "`` of ``line`` before ``width`` outside ``$...$``, or -1."""
-    cut = line.rfind(", ", 0, width)
-    while cut >= 0 and line.count("$", 0, cut) % 2:
-        cut = line.rfind(", ", 0, cut)
-    return cut
+def _break_outside_math(line, width):
+    """``(end, skip)`` of a break of ``line`` before ``width`` outside ``$...$``: after its
+    last ``", "`` there (the comma kept), else at its last space; the line goes on ``skip``
+    characters later. ``(-1, 0)`` if there is neither."""
+    for sep, keep in ((", ", 1), (" ", 0)):
+        cut = line.rfind(sep, 0, width)
+        while cut >= 0 and line.count("$", 0, cut) % 2:
+            cut = line.rfind(sep, 0, cut)
+        if cut > 0:
+            return cut + keep, len(sep) - keep
+    return -1, 0
 
 
 def _panel_tag(ax, tag):

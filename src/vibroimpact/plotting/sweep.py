@@ -33,6 +33,7 @@ def _shared_text(datasets):
                 parts.append(f"{symbol} = {_num(value)}")
         else:
             varied.append(symbol)
+    walls_text = ""
     if any(two_wall_dataset(ds) for ds in datasets):
         # two walls: where the lower one stands and its restitution; the means pool the
         # collisions at both walls (the members' own Fig. 9 draws them per wall)
@@ -43,15 +44,16 @@ def _shared_text(datasets):
                 walls.append(f"{symbol} = {_num(values.pop())}")
             elif values:
                 varied.append(symbol)
-        parts.append(r"two walls, the lower at $\delta$ - g"
-                     + (f" ({', '.join(walls)})" if walls else "")
-                     + ": collisions at both walls pooled")
+        walls_text = (r"two walls, the lower at $\delta$ - g"
+                      + (f" ({', '.join(walls)})" if walls else "")
+                      + ": collisions at both walls pooled")
     seeds = {int(ds.attrs.get("seed", -1)) for ds in datasets}
     if len(seeds) > 1:
         varied.append("seed")
     first = datasets[0].attrs
     noise = ", ".join([str(first.get("noise_kind", "")), *_filter_parts(first)]).strip(", ")
-    line = ", ".join(parts) + (f";  input {noise}" if noise else "")
+    line = ", ".join(parts) + (f";  {walls_text}" if walls_text else "") + (
+        f";  input {noise}" if noise else "")
     inv_beta = {float(ds["inv_beta"][0]) for ds in datasets}
     if any(float(_attr(ds, "amplitude")) != 0.0 for ds in datasets) and len(inv_beta) == 1:
         line += rf",  $\sin(\tau/{_num(inv_beta.pop())})$"
