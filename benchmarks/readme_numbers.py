@@ -168,7 +168,7 @@ def datasets_text(results):
 
     rows = [""]
     for path in dataset_files(results):
-        rows += [f"#### `results/{path.relative_to(results).as_posix()}`", "",
+        rows += [f"### `results/{path.relative_to(results).as_posix()}`", "",
                  "| variable | dimensions | units | long_name |", "|---|---|---|---|"]
         with netCDF4.Dataset(path) as nc:
             for name, var in nc.variables.items():
