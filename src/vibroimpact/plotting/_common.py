@@ -15,6 +15,7 @@ from pathlib import Path
 import matplotlib
 import matplotlib.style
 import numpy as np
+from matplotlib.textpath import text_to_path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -236,18 +237,21 @@ HEADER_CHARS_PER_INCH = 14.0
 
 def _header(fig, title, params):
     """The figure's title and its parameter lines (plain names as symbols, `symbols`),
-    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`); on a figure too narrow
-    for that many characters, at the width it holds, and at ``", "`` (else a space) outside
-    maths where a part between separators is longer than that."""
+    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`, or the characters a
+    narrower figure holds); a line still wider than the figure, as its title's font draws it
+    (`_points`), breaks again: at the last ``";  "``, else ``", "``, else space outside maths
+    where what comes before fits."""
     width = min(HEADER_WIDTH, int(fig.get_figwidth() * HEADER_CHARS_PER_INCH))
+    prop = fig.suptitle(title).get_fontproperties()
+    room = 72.0 * fig.get_figwidth() - 2 * HEADER_MARGIN_PT
     lines = []
     for line in symbols(params).split("\n"):
         while len(line) > width and ";  " in line[:width + 10]:
             cut = line.rfind(";  ", 0, width + 10)
             lines.append(line[:cut + 1])
             line = line[cut + 3:]
-        while width < HEADER_WIDTH and len(line) > width:
-            cut, skip = _break_outside_math(line, width)
+        while _points(line, prop) > room:
+            cut, skip = _break_outside_math(line, lambda head: _points(head, prop) <= room)
             if cut < 0:
                 break
             lines.append(line[:cut])
@@ -256,16 +260,30 @@ def _header(fig, title, params):
     fig.suptitle("\n".join([title, *lines]))
 
 
-def _break_outside_math(line, width):
-    """``(end, skip)`` of a break of ``line`` before ``width`` outside ``$...$``: after its
-    last ``", "`` there (the comma kept), else at its last space; the line goes on ``skip``
-    characters later. ``(-1, 0)`` if there is neither."""
-    for sep, keep in ((", ", 1), (" ", 0)):
-        cut = line.rfind(sep, 0, width)
-        while cut >= 0 and line.count("$", 0, cut) % 2:
+#: Points a header keeps clear of each side of the figure.
+HEADER_MARGIN_PT = 6.0
+
+
+def _points(text, prop):
+    """The width in points of one line of ``text`` drawn in font ``prop`` (maths as
+    mathtext), measured by Matplotlib's own text layout."""
+    if not text:
+        return 0.0
+    ismath = text.count("$") >= 2 and text.count("$") % 2 == 0
+    return float(text_to_path.get_text_width_height_descent(text, prop, ismath=ismath)[0])
+
+
+def _break_outside_math(line, fits):
+    """``(end, skip)`` of the break of ``line`` outside ``$...$`` after which the head
+    ``line[:end]`` ``fits`` (a predicate): after its last such ``";  "`` (the semicolon kept),
+    else ``", "`` (the comma kept), else space; the line goes on ``skip`` characters later.
+    ``(-1, 0)`` if there is none."""
+    for sep, keep in ((";  ", 1), (", ", 1), (" ", 0)):
+        cut = line.rfind(sep)
+        while cut > 0:
+            if line.count("$", 0, cut) % 2 == 0 and fits(line[:cut + keep]):
+                return cut + keep, len(sep) - keep
             cut = line.rfind(sep, 0, cut)
-        if cut > 0:
-            return cut + keep, len(sep) - keep
     return -1, 0
 
 
