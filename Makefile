@@ -79,11 +79,11 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q -m "$(LONG_MARKERS)" $(LONG_WORKERS)
 
 # requirements.lock again from pyproject.toml's direct requirements (the package's, the slurm
-# extra, the dev group), keeping every pin that still satisfies them; `make lock UPGRADE=1`
+# extra, the dev and docs groups), keeping every pin that still satisfies them; `make lock UPGRADE=1`
 # moves every distribution to its newest allowed version. Then the conda environment of the
 # rules, from the lock. Python 3.11.5: the oldest 3.11 the locked distributions support.
 lock: $(STAMP)
-	$(BIN)/uv pip compile pyproject.toml --extra slurm --group dev --universal \
+	$(BIN)/uv pip compile pyproject.toml --extra slurm --group dev --group docs --universal \
 	  --python-version 3.11.5 --generate-hashes --quiet $(if $(UPGRADE),--upgrade) \
 	  --custom-compile-command "make lock" -o $(LOCK)
 	$(BIN)/python tools/environment.py conda

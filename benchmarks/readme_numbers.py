@@ -26,6 +26,11 @@ build's datasets: ``fig08_tail`` (the quantiles of the interval at the lowest pl
 ``fig09_rice`` (the measured mean interval against Rice's, `results/datasets/
 random_events.nc`).
 
+``--datasets docs/datasets.md`` rewrites that file's block ``variables``: a table of every
+variable and coordinate of each dataset of the finished build (not the per-job tiles), with
+its dimensions, ``units`` and ``long_name`` as the file holds them. The test config builds
+the same files with the same variables, and a workflow test holds the block to its build.
+
 Re-run it after a build that changes what the README quotes (a new job, a new cost): the
 README's numbers then come from one build, named by its commit.
 """
@@ -146,6 +151,36 @@ def docs_blocks(results):
         f"{d[far].max():g}")}
 
 
+def dataset_files(results):
+    """The datasets of a build that docs/datasets.md tabulates: every ``results/<folder>/
+    <name>.nc``, the per-job tiles (further down) left out."""
+    results = Path(results)
+    return sorted(p for p in results.glob("*/*.nc") if not p.name.startswith("."))
+
+
+def datasets_text(results):
+    """The ``variables`` block of docs/datasets.md: per dataset of the build in ``results``,
+    each variable and coordinate with its dimensions, units and long_name, from the file."""
+    import netCDF4
+
+    def cell(text):
+        return " ".join(str(text).split()).replace("|", "\\|")
+
+    rows = [""]
+    for path in dataset_files(results):
+        rows += [f"### `results/{path.relative_to(results).as_posix()}`", "",
+                 "| variable | dimensions | units | long_name |", "|---|---|---|---|"]
+        with netCDF4.Dataset(path) as nc:
+            for name, var in nc.variables.items():
+                kind = " (coordinate)" if var.dimensions == (name,) else ""
+                attrs = {k: var.getncattr(k) for k in var.ncattrs()}
+                rows.append(f"| `{name}`{kind} | {', '.join(var.dimensions) or '-'} | "
+                            f"`{cell(attrs.get('units', ''))}` | "
+                            f"{cell(attrs.get('long_name', ''))} |")
+        rows.append("")
+    return "\n".join(rows)
+
+
 def _minsec(s):
     m, s = divmod(round(s), 60)
     return f"{m} min {s} s" if m else f"{s} s"
@@ -259,6 +294,8 @@ def main(argv=None):
                         help="only the plans (no finished build needed)")
     parser.add_argument("--docs", metavar="FIGURES_MD",
                         help="rewrite the blocks of this file (docs/figures.md)")
+    parser.add_argument("--datasets", metavar="DATASETS_MD",
+                        help="rewrite the variables block of this file (docs/datasets.md)")
     args = parser.parse_args(argv)
     blocks = {"plan": plan_text(), "figures": figures_text()}
     blocks.update({name: example_plan_text(name) for name in EXAMPLES},
@@ -274,6 +311,8 @@ def main(argv=None):
         rewrite(args.write, blocks)
     if args.docs and docs:
         rewrite(args.docs, docs)
+    if args.datasets:
+        rewrite(args.datasets, {"variables": datasets_text(Path(args.results))})
     return 0
 
 

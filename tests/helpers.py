@@ -14,6 +14,8 @@ its path itself.
 - :func:`snakemake`, :func:`scheduled_rules`, :func:`scheduled_jobs`: the real ``snakemake``
   command in a copy.
 - :func:`data_files`, :func:`data`, :func:`assert_same_data`: the datasets of two builds.
+- :func:`cf_problems`, :func:`assert_cf`: the CF attributes of every file of a build, units
+  parsed by UDUNITS (``cf_units``).
 """
 from pathlib import Path
 import re
@@ -178,6 +180,45 @@ def assert_same_data(a, b):
     assert len(files) >= 10
     for name in files:
         xr.testing.assert_identical(data(a / name), data(b / name))
+
+
+#: The global attributes every file carries (`vibroimpact.pipeline.conventions`).
+CF_GLOBALS = ("Conventions", "source", "history", "references")
+
+
+def cf_problems(path):
+    """What a netCDF file lacks of the CF attributes: ``"<var>: no units"``, ``"<var>: no
+    long_name"``, ``"<var>: units '<u>' not UDUNITS"`` (parsed by ``cf_units``, which wraps
+    the UDUNITS-2 library) and ``"no <global attribute>"``."""
+    import cf_units
+    import netCDF4
+
+    out = []
+    with netCDF4.Dataset(path) as nc:
+        for name, var in nc.variables.items():
+            attrs = {k: var.getncattr(k) for k in var.ncattrs()}
+            for key in ("long_name", "units"):
+                if not str(attrs.get(key, "")).strip():
+                    out.append(f"{name}: no {key}")
+            if str(attrs.get("units", "")).strip():
+                try:
+                    cf_units.Unit(str(attrs["units"]))
+                except ValueError:
+                    out.append(f"{name}: units {attrs['units']!r} not UDUNITS")
+        out += [f"no {key}" for key in CF_GLOBALS if not str(
+            nc.getncattr(key) if key in nc.ncattrs() else "").strip()]
+        if "Conventions" in nc.ncattrs() and not nc.getncattr("Conventions").startswith("CF-"):
+            out.append(f"Conventions {nc.getncattr('Conventions')!r}")
+    return out
+
+
+def assert_cf(root):
+    """Every netCDF file under ``root`` (datasets, noise, traces, orbits, validation, the
+    per-job tiles) is CF-clean (:func:`cf_problems`); returns how many were checked."""
+    paths = sorted(p for p in Path(root).rglob("*.nc") if not p.name.startswith("."))
+    problems = {str(p.relative_to(root)): cf_problems(p) for p in paths}
+    assert paths and not any(problems.values()), {k: v for k, v in problems.items() if v}
+    return len(paths)
 
 
 def assert_figure(path):

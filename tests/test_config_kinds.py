@@ -44,7 +44,9 @@ def _form(kind, study):
         entry["motions"] = copy.deepcopy(WALL_MOTIONS)
         if study == "motion_map":                # its fig15_vs_fig16 reads the orbits entry
             orbits = cfg["orbits"]["harmonic"]
-            orbits.update(gap=6.0, types=copy.deepcopy(WALL_MOTIONS), figures=["fig16"])
+            orbits.update(gap=6.0, types=copy.deepcopy(WALL_MOTIONS), figures=["fig16"],
+                          inv_beta=copy.deepcopy(entry["inv_beta"]),   # its motions are read
+                          delta=copy.deepcopy(entry["delta"]))         # at the map's cells
             orbits.pop("attractors")             # one-wall (a plane study has its own)
         return cfg, study
     if kind == "plane":
@@ -209,3 +211,63 @@ def test_each_check_on_each_kind(check, kind):
     assert fragment in text, text
     # one readable message: no line of it runs past a paragraph
     assert max(map(len, text.splitlines())) < 600, text
+
+
+# --- the second newcomer pass (issue 44): refusals that misled, and a build that failed late --
+
+def _refusal(cfg):
+    with pytest.raises(ConfigError) as info:
+        configuration.load(cfg, root=ROOT)
+    return str(info.value)
+
+
+def _two_wall_map_and_orbits():
+    cfg, study = _form("two_walls", M)
+    return cfg, cfg["studies"][study], cfg["orbits"]["harmonic"]
+
+
+def test_a_two_wall_orbit_map_must_hold_the_maps_cells():
+    """Its motions are read at the map's cells, not solved there: a cell off its grid was
+    accepted, then failed in solve_map_orbits with a message naming one grid twice."""
+    cfg, study, orbits = _two_wall_map_and_orbits()
+    orbits["delta"] = {"start": -1.0, "stop": 3.0, "step": 1.0}     # the map's step is 0.5
+    text = _refusal(cfg)
+    assert "orbits.harmonic.delta lacks -0.5, 0.5, 1.5, 2.5 of the study's delta grid" in text
+    assert "inv_beta lacks" not in text
+
+
+def test_walls_that_differ_are_said_once_and_no_eps_lower_is_invented():
+    """A two-wall plane study over (eps, delta) beside a one-wall orbits entry of the same
+    plane: the gap differs; eps_lower (which follows the eps axis) was said to differ from
+    itself, '[0.3, 0.5] against [0.3, 0.5]'."""
+    cfg, _ = _form("plane", M)
+    study = cfg["studies"]["motion_map"]
+    study.update(gap=6.0, motions=copy.deepcopy(WALL_MOTIONS),
+                 figures=["fig15", {"name": "fig15_vs_fig16", "orbits": "pl"}])
+    cfg["orbits"]["pl"] = {"plane": ["eps", "delta"], "zeta": 0.05, "eps": [0.3, 0.5],
+                           "inv_beta": 1.1, "delta": copy.deepcopy(study["delta"]),
+                           "types": [[1, 1], [2, 1], [1, 2]], "figures": ["fig16"]}
+    text = _refusal(cfg)
+    assert "orbits.pl has gap = none, the study gap = 6" in text
+    assert "eps_lower" not in text
+
+
+def test_an_orbits_entry_with_a_gap_and_attractors_is_sent_to_a_plane_study():
+    """The hint named an orbits entry over (inv_beta, delta), which is refused with a gap."""
+    cfg, _ = _form("plain", M)
+    orbits = cfg["orbits"]["harmonic"]
+    orbits.update(plane=["eps", "delta"], eps=[0.3, 0.5], inv_beta=1.1, gap=6.0,
+                  types=copy.deepcopy(WALL_MOTIONS), figures=["fig16"])
+    text = _refusal(cfg)
+    assert "orbits.harmonic.attractors: basins and Lyapunov exponents over the plane" in text
+    assert "a study with plane: ['eps', 'delta'] and this gap has them" in text
+
+
+def test_a_misspelt_axis_is_no_sweep():
+    """plane: [Eps, delta] with eps a grid: one line on the axis, not '(all 2
+    combinations)' as though eps were swept."""
+    cfg, _ = _form("plane", M)
+    cfg["studies"]["motion_map"]["plane"] = ["Eps", "delta"]
+    text = _refusal(cfg)
+    assert "studies.motion_map.plane[0] = Eps: not allowed" in text
+    assert "combination" not in text

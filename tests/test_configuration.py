@@ -242,21 +242,38 @@ def test_a_signal_while_writing_removes_the_temporary(tmp_path, sig):
 
 # --- progress of a job ------------------------------------------------------------------------
 
-def test_progress_is_logged_at_a_bounded_rate_and_at_the_end(caplog):
+def test_progress_is_logged_at_its_start_at_a_bounded_rate_and_at_the_end(caplog):
     from vibroimpact.pipeline.tasks import Progress
 
     now = [0.0]
-    progress = Progress("tile 0", 1000, every=20.0, clock=lambda: now[0])
     with caplog.at_level("INFO", logger="vibroimpact"):
+        progress = Progress("tile 0", 1000, every=20.0, clock=lambda: now[0], events=True)
         for _ in range(1000):
             now[0] += 0.1                    # 100 s of cells, one every 0.1 s
             progress.cell_done({"n_collisions": 3, "simulated_time": 2.0})
     lines = [r.getMessage() for r in caplog.records]
-    assert len(lines) == 5                   # every 20 s of 100 s; the 5th is the last cell
-    assert lines[0].startswith("progress tile 0: 200 of 1000 cells, 600 collisions, 400 time")
-    assert "~80 s left" in lines[0]
+    assert len(lines) == 6                   # the start; every 20 s of 100 s; the last cell
+    assert lines[0] == "progress tile 0: 0 of 1000 cells, started"
+    assert lines[1].startswith("progress tile 0: 200 of 1000 cells, 600 collisions, 400 time")
+    assert "~80 s left" in lines[1]
     assert lines[-1].startswith("progress tile 0: 1000 of 1000 cells, 3000 collisions")
     assert "~0 s left" in lines[-1]
+
+
+def test_progress_of_other_units_has_no_simulation_counts(caplog):
+    """A job that simulates nothing (orbits, boundaries) counts its units alone."""
+    from vibroimpact.pipeline.tasks import Progress
+
+    now = [0.0]
+    with caplog.at_level("INFO", logger="vibroimpact"):
+        progress = Progress("boundaries", 5, unit="types", every=1.0, clock=lambda: now[0])
+        for _ in range(5):
+            now[0] += 2.0
+            progress.advance()
+    lines = [r.getMessage() for r in caplog.records]
+    assert lines[0] == "progress boundaries: 0 of 5 types, started"
+    assert lines[1] == "progress boundaries: 1 of 5 types, 0.5 types/s, ~8 s left"
+    assert len(lines) == 6 and lines[-1].endswith("5 of 5 types, 0.5 types/s, ~0 s left")
 
 
 def test_a_per_figure_listed_by_name_alone_is_drawn_at_every_grid_value():

@@ -265,7 +265,8 @@ def test_a_file_written_before_the_checksums_is_accepted_and_listed(tmp_path, mo
     """The rule for a build from before the checksums: read through, accepted, listed (its
     writer's code digest changed, so the build rewrites it)."""
     monkeypatch.chdir(tmp_path)
-    ds = xr.Dataset({"x": ("i", np.arange(10.0)), "s": ((), 1.0)})
+    words = {"long_name": "a value", "units": "1"}
+    ds = xr.Dataset({"x": ("i", np.arange(10.0), words), "s": ((), 1.0, words)})
     ds.to_netcdf(tmp_path / "old.nc", engine="netcdf4")
     io.write_dataset(ds, tmp_path / "new.nc")
     assert io.check_readable(tmp_path) == ["old.nc"]
@@ -517,7 +518,7 @@ def test_a_full_disk_is_said_in_one_line_and_keeps_nothing(tmp_path, monkeypatch
     from vibroimpact import _files
     from vibroimpact.pipeline import tasks
 
-    ds = xr.Dataset({"x": ("i", np.arange(1000.0))})
+    ds = xr.Dataset({"x": ("i", np.arange(1000.0), {"long_name": "a value", "units": "1"})})
     target = tmp_path / "out" / "d.nc"
     real_to_netcdf = xr.Dataset.to_netcdf
 

@@ -332,12 +332,13 @@ def test_the_tiles_name_their_coordinates_after_the_plane(tmp_path):
 
 @pytest.mark.workflow
 def test_a_tiny_rms_delta_map_builds(tmp_path):
-    from helpers import make_workdir, snakemake
+    from helpers import assert_cf, make_workdir, snakemake
 
     work = make_workdir(tmp_path / "wf")
     (work / "tiny.yaml").write_text(RMS_DELTA)
     target = "results/datasets/noisy_map.nc"
     snakemake(work, target, config="tiny.yaml")
+    assert_cf(work / "results")        # a plane study's files (the planes example's)
     ds = xr.load_dataset(work / target)
     assert ds.attrs["axes"] == ["rms", "delta"]
     fixed = json.loads(ds.attrs["fixed"])

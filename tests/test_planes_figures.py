@@ -16,7 +16,7 @@ import xarray as xr
 from vibroimpact import plotting
 from vibroimpact._symbols import (PARAMETERS, fixed_caption, parameter_label,
                                   parameter_symbol)
-from vibroimpact.pipeline import io
+from vibroimpact.pipeline import datasets, io
 from vibroimpact.plotting._common import plane_axes, plane_caption, plane_fixed
 from vibroimpact.plotting.planes import map_stack, swept_parameter
 
@@ -48,7 +48,7 @@ def _plane_map(tmp_path, rms=0.29, x=("eps", EPS), y=("delta", DELTA), name="map
                                min_switches=10))
     ds = ds.transpose("motion", yn, xn)
     path = tmp_path / f"{name}.nc"
-    io.write_dataset(ds, path)
+    io.write_dataset(datasets.annotate(ds), path)
     return io.load_dataset(path)
 
 

@@ -810,3 +810,27 @@ def test_a_single_bin_spans_zero_to_max():
                       coords={"interval": [500.0]})
     edges, counts, n = plotting.bin_counts(cell, "interval_density")
     assert edges.tolist() == [0.0, 1000.0] and counts.tolist() == [368] and n == 368
+
+
+@pytest.mark.parametrize("inches", [3.0, 4.0, 6.5, 9.0])
+def test_a_long_header_stays_inside_its_figure_whatever_its_width(inches):
+    """Every line of a header, as the renderer lays it out, lies inside the figure, broken at
+    ';  ', ', ' or a space but never inside maths: one part alone (the two-wall line, the
+    escape figure's definition) is wider than a narrow figure."""
+    from vibroimpact.plotting._common import _header, symbols
+    params = (r"zeta = 0.05, eps = 0.5;  two walls, the lower at $\delta$ - g (g = 2, "
+              r"$\varepsilon_l$ = 0.5): collisions at both walls pooled;  input band_limited, "
+              r"$\beta_c$ = 4;  varied: rms$_r$ (legend)" "\n"
+              r"residence time T: mean length of the complete stretches of a motion (free and "
+              r"impact-stick together), $w$ = 0.1;  $\Delta$: slope of $\ln T$ against "
+              r"1/rms$_r^2$ (weighted)")
+    fig = Figure(figsize=(inches, 4))
+    _header(fig, "Sweep 's11': mean velocity", params)
+    fig.canvas.draw()
+    box = fig._suptitle.get_window_extent()
+    assert 0 <= box.x0 and box.x1 <= fig.bbox.x1, (box, fig.bbox)
+    lines = fig.get_suptitle().split("\n")
+    assert all(line.count("$") % 2 == 0 for line in lines)
+    assert len(lines) > 3                       # the two lines given broke somewhere
+    # nothing lost or added: the same words, in order
+    assert fig.get_suptitle().split() == f"Sweep 's11': mean velocity {symbols(params)}".split()

@@ -57,7 +57,7 @@ def test_every_pin_is_exact_with_hashes_and_every_direct_requirement_is_locked()
                                             "platform_python_implementation": "CPython"})
     project = PYPROJECT["project"]
     direct = [*project["dependencies"], *project["optional-dependencies"]["slurm"],
-              *PYPROJECT["dependency-groups"]["dev"]]
+              *PYPROJECT["dependency-groups"]["dev"], *PYPROJECT["dependency-groups"]["docs"]]
     for text in direct:        # pyproject.toml changed without `make lock`: fails here
         req = Requirement(text)
         name = environment.canonical(req.name)
@@ -211,17 +211,19 @@ def _same_pixels(a, b):
 
 
 #: The outputs of a report that differ between any two runs of the same data: the styled
-#: tables' random ids, object addresses, and the provenance table (creation times).
+#: tables' random ids, object addresses, the provenance table (creation times) and the Run
+#: section (the jobs' CPU and wall seconds).
 _RUN_ONLY = (re.compile(r"T_[0-9a-f]{5}"), re.compile(r" at 0x[0-9a-f]+"))
 
 
 def _report_outputs(ipynb):
-    """The outputs of a report's cells but for its parameters and provenance, as text."""
+    """The outputs of a report's cells but for its parameters, provenance and Run section, as
+    text."""
     nb = nbformat.read(ipynb, as_version=4)
     out = []
     for cell in nb.cells:
         if cell.cell_type != "code" or "parameters" in cell.metadata.get("tags", []) \
-                or cell.source.startswith(("nb.provenance(", "# Parameters")):
+                or cell.source.startswith(("nb.provenance(", "nb.run_section(", "# Parameters")):
             continue
         for output in cell.get("outputs", []):
             for kind, value in sorted(output.get("data", {}).items()):

@@ -248,13 +248,14 @@ studies:
 def test_a_two_wall_config_builds_its_datasets_and_a_figure(tmp_path):
     import xarray as xr
 
-    from helpers import make_workdir, snakemake
+    from helpers import assert_cf, make_workdir, snakemake
 
     work = make_workdir(tmp_path / "wf")
     (work / "tiny.yaml").write_text(TINY)
     targets = ["results/datasets/clear_events.nc", "results/datasets/clear_map_map.nc",
                "results/figures/clear/fig09.png"]
     snakemake(work, *targets, config="tiny.yaml")
+    assert_cf(work / "results")        # a two-wall study's files (the clearance example's)
     events = xr.load_dataset(work / targets[0])
     assert events.attrs["gap"] == 2.0 and events.attrs["eps_lower"] == 0.3
     assert events["wall"].values.tolist() == ["upper", "lower"]

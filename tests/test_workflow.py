@@ -171,6 +171,41 @@ def test_end_to_end(built):
 
 
 @pytest.mark.workflow
+def test_every_file_of_the_build_is_cf_clean(built):
+    """Every netCDF file the test config's build writes (the default config's studies in
+    small: every dataset, noise record, trace, orbit map, validation run and per-job tile)
+    has long_name and units on every variable and coordinate, each unit parsed by UDUNITS,
+    and the CF global attributes; history names the rule's script."""
+    from helpers import assert_cf
+
+    assert assert_cf(built / "results") >= 18
+    events = xr.open_dataset(built / "results" / "datasets" / "random_events.nc").attrs
+    assert events["Conventions"] == "CF-1.11"
+    assert events["source"].startswith(f"vibroimpact {events['package_version']}")
+    assert events["history"].startswith(events["created"])
+    assert "workflow/scripts/aggregate_events.py" in events["history"]
+    assert "Irie" in events["references"]
+
+
+@pytest.mark.workflow
+def test_the_datasets_page_tabulates_what_the_build_writes(built):
+    """docs/datasets.md's generated tables (benchmarks/readme_numbers.py --datasets, run on
+    a default build) are the test build's files, variable for variable: the test config
+    writes the default build's files with the same variables, dimensions, units and
+    long_names (only the sizes differ, which the tables do not show)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("readme_numbers",
+                                                  ROOT / "benchmarks" / "readme_numbers.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    page = (ROOT / "docs" / "datasets.md").read_text()
+    marker = "<!-- readme_numbers:variables -->"
+    block = page[page.index(marker) + len(marker):page.index("<!-- /readme_numbers:variables")]
+    assert block == module.datasets_text(built / "results")
+
+
+@pytest.mark.workflow
 def test_every_dataset_carries_its_config_block_and_creation_time(built):
     """Provenance: the block the rule's params carry, as YAML, and the statistical settings."""
     from datetime import datetime

@@ -1,9 +1,9 @@
 """The exact environment: what requirements.lock pins, and the files made from it.
 
 ``requirements.lock`` is written by uv (``make lock``) from the direct requirements of
-pyproject.toml (the package's, the ``slurm`` extra and the ``dev`` group): every distribution
-of the development environment, its version, the platforms it applies to (a marker) and the
-hashes of every file PyPI serves for it. ``make`` installs it with ``uv pip sync
+pyproject.toml (the package's, the ``slurm`` extra, the ``dev`` and ``docs`` groups): every
+distribution of the development environment, its version, the platforms it applies to (a
+marker) and the hashes of every file PyPI serves for it. ``make`` installs it with ``uv pip sync
 --require-hashes``. This script reads it with ``packaging`` (what pip and uv implement) for
 what the lock itself cannot do:
 

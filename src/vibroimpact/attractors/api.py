@@ -36,6 +36,13 @@ DEFAULT_MAX_TIME = 1500.0
 DEFAULT_MATCH_TOL = ATTRACTOR_MATCH_TOL
 #: Two-sided level of the Clopper-Pearson interval of ``fraction``.
 CONFIDENCE = 0.95
+#: Starts (whole cells of them) in one call of the starts' kernel, between two reports of
+#: `attractor_map`'s progress: ~55 CPU-us a start on Fig. 15's plane (64 starts a cell), so
+#: a block is ~1 s on 2 threads, under the progress log's cadence, and holds 32 blocks a
+#: thread whose last one to finish leaves the others idle ~1/64 of it, as one call over
+#: every start does. Measured (5 pairs, whole process, benchmarks/progress_ab.py):
+#: main/blocks CPU 0.98 (0.90-1.22), wall 1.05 (0.66-1.28) on a machine loaded by other builds.
+BLOCK_STARTS = 2 ** 15
 
 
 def _interval(name, value, low=None):
@@ -141,7 +148,8 @@ def _validate(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_ti
 
 def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=64,
                   gap=(0.0, 4.0), velocity=(-4.0, 4.0), max_time=DEFAULT_MAX_TIME,
-                  match_tol=DEFAULT_MATCH_TOL, seed=0, clearance=None, eps_lower=None):
+                  match_tol=DEFAULT_MATCH_TOL, seed=0, clearance=None, eps_lower=None,
+                  progress=None):
     """Basins of the stable (m/n) motions and the largest Lyapunov exponent over a grid.
 
     Parameters
@@ -176,6 +184,10 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
         range, which must then lie within it: ``gap[1] <= clearance``). Default: one wall.
     eps_lower : float, optional, keyword-only
         Restitution coefficient of that wall, in [0, 1] (default ``eps``).
+    progress : callable, optional, keyword-only
+        ``progress(k)`` after every block of ``k`` cells whose starts have all run
+        (`BLOCK_STARTS` starts a block): a job's progress log
+        (`vibroimpact.pipeline.tasks.Progress.advance`).
 
     Returns
     -------
@@ -318,7 +330,8 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
     clearance, eps_lower = _validate_walls(clearance, eps_lower, eps, gap)
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
     raw = _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
-                           max_time, match_tol, seed, clearance=clearance, eps_lower=eps_lower)
+                           max_time, match_tol, seed, clearance=clearance, eps_lower=eps_lower,
+                           progress=progress)
     outf, outi = raw["outf"], raw["outi"]
     # per start, (n_starts, nb, nd)
     shape_s = (nb, nd, n_starts)
@@ -390,7 +403,7 @@ def _validate_walls(clearance, eps_lower, eps, gap):
 
 
 def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,
-                     match_tol, seed, *, clearance=math.inf, eps_lower=None):
+                     match_tol, seed, *, clearance=math.inf, eps_lower=None, progress=None):
     """Every start of every cell (validated input); the kernels' raw per-start records
     ``outf (n, N_F)``, ``outi (n, N_I)`` (start ``i`` of cell ``c = ib nd + id`` at row
     ``c n_starts + i``), the starts, the solver orbits and the kernels' times."""
@@ -416,14 +429,23 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
     n = th.size
     outf = np.empty((n, ak.N_F))
     outi = np.empty((n, ak.N_I), np.int64)
-    n_blocks = min(n, 32 * numba.get_num_threads())     # the last block to finish is short
-    with numba.parallel_chunksize(1):       # blocks handed out as threads come free
-        ak.run_starts(cell_beta, cell_delta, cell_of, th, x0, vv, float(zeta), float(eps),
-                      float(clearance), float(eps if eps_lower is None else eps_lower),
-                      float(max_time), float(match_tol), np.tile(types, (n_walls, 1)), nt,
-                      np.ascontiguousarray(orb_n),
-                      oph.reshape(shape), ou.reshape(shape), oz.reshape(shape), n_blocks,
-                      outf, outi)
+    # the starts in blocks of whole cells, one kernel call each, between two reports of
+    # progress: a start's numbers are its own (its buffers are reset, whatever ran before on
+    # them), so the blocks give one call's numbers bit for bit
+    per_block = max(1, BLOCK_STARTS // n_starts) * n_starts
+    args = (float(zeta), float(eps), float(clearance),
+            float(eps if eps_lower is None else eps_lower), float(max_time), float(match_tol),
+            np.tile(types, (n_walls, 1)), nt, np.ascontiguousarray(orb_n),
+            oph.reshape(shape), ou.reshape(shape), oz.reshape(shape))
+    for lo in range(0, n, per_block):
+        part = slice(lo, min(lo + per_block, n))
+        size = part.stop - lo
+        n_blocks = min(size, 32 * numba.get_num_threads())  # the last one to finish is short
+        with numba.parallel_chunksize(1):       # blocks handed out as threads come free
+            ak.run_starts(cell_beta, cell_delta, cell_of[part], th[part], x0[part], vv[part],
+                          *args, n_blocks, outf[part], outi[part])
+        if progress is not None:
+            progress(size // n_starts)
     t_c = time.perf_counter()
     # a type's stable orbits at either wall, pooled
     n_stable = n_stable.reshape(n_walls, nt, nb, nd).sum(axis=0)

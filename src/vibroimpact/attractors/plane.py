@@ -24,7 +24,8 @@ from vibroimpact.orbits.plane import NOISE_PARAMETERS, TWO_WALL_PARAMETERS
 __all__ = ["orbit_plane", "attractor_plane"]
 
 
-def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1), (1, 2))):
+def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1), (1, 2)), *,
+                progress=None):
     """Existence and stability of periodic impact motions over any plane, any wall layout.
 
     The parameters and the result are those of `vibroimpact.orbits.plane.orbit_plane`; with
@@ -32,12 +33,14 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
     ``eps_lower``, default eps) the types are ``(m_upper, m_lower, n)`` triples or names
     ``"(1,1)/1"`` and every cell is solved by `periodic_motions` for the types' n; the
     dataset's ``solver`` is ``"periodic_motions"`` and ``n_walls`` 2. Without a second wall
-    the call is the one-wall closed form's, unchanged.
+    the call is the one-wall closed form's, unchanged. ``progress(k)``: as ``k`` more cells
+    are solved.
     """
     xs, ys, fixed_, parsed, two_walls = one_wall.check_plane(x_name, x_values, y_name,
                                                              y_values, fixed, types)
     if not two_walls:
-        return one_wall.orbit_plane(x_name, x_values, y_name, y_values, fixed, types)
+        return one_wall.orbit_plane(x_name, x_values, y_name, y_values, fixed, types,
+                                    progress=progress)
     shape = (len(parsed), xs.size, ys.size)
     out = one_wall.empty(shape)
     ns = sorted({key[2] for _, key in parsed})
@@ -54,6 +57,8 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
             for t, (label, _) in enumerate(parsed):
                 found = [mo for mo in motions if mo.name == label]
                 one_wall.classify(out, (t, i, j), found, [mo.admissible for mo in found])
+        if progress is not None:
+            progress(ys.size)
     return one_wall.plane_dataset(x_name, xs, y_name, ys, fixed_, parsed,
                                   one_wall.finish(out), "periodic_motions", n_walls=2)
 
@@ -70,7 +75,7 @@ _ARRAYS = ("count", "stick_count", "fraction", "fraction_lo", "fraction_hi", "n_
 
 
 def attractor_plane(x_name, x_values, y_name, y_values, fixed, types=None, *,
-                    gap=(0.0, 4.0), velocity=(-4.0, 4.0), **options):
+                    gap=(0.0, 4.0), velocity=(-4.0, 4.0), progress=None, **options):
     """Basins of attraction and Lyapunov exponents (`vibroimpact.attractor_map`) over any
     plane of the harmonic-force problem.
 
@@ -92,6 +97,8 @@ def attractor_plane(x_name, x_values, y_name, y_values, fixed, types=None, *,
         The starts' box in the oscillator's own units: distance ``g`` from the wall at delta
         (``x0 = delta - g``) and velocity ``v0``; with a second wall ``gap[1]`` must not exceed
         any cell's clearance.
+    progress : callable, optional
+        ``progress(k)`` as ``k`` more cells are solved (`attractor_map`'s).
     **options
         ``n_starts``, ``max_time``, ``match_tol``, ``seed`` of `attractor_map`.
 
@@ -140,7 +147,7 @@ def attractor_plane(x_name, x_values, y_name, y_values, fixed, types=None, *,
         nonlocal coords
         amp = p["amplitude"]
         kw = dict(options, types=types, gap=tuple(float(g) / amp for g in gap),
-                  velocity=tuple(float(v) / amp for v in velocity))
+                  velocity=tuple(float(v) / amp for v in velocity), progress=progress)
         if two_walls:
             kw.update(clearance=p["gap"] / amp,
                       eps_lower=p["eps"] if p.get("eps_lower") is None else p["eps_lower"])

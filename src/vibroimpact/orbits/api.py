@@ -66,6 +66,15 @@ from vibroimpact.orbits import kernels as ok
 
 __all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
 
+#: Rows per thread in one call of `orbit_map`'s kernel, between two reports of its progress:
+#: Fig. 16's 141 x 226 map takes ~11 CPU-s, ~0.08 s a row, so a block is ~0.3 s on 2 idle
+#: threads (~3 s under a load of 9 on 2 cores), well under the progress log's cadence. Each
+#: block ends when its slower thread does; the rows are those the thread had in one call, so
+#: that wait is the one call's imbalance spread over the blocks: measured (5 pairs, whole
+#: process, benchmarks/progress_ab.py) main/blocks CPU 0.966 (0.94-0.99), wall 0.94
+#: (0.65-1.30) on a machine loaded by other builds.
+MAP_BLOCK_ROWS = 4
+
 
 class Reason(enum.IntEnum):
     """Why a map point has no stable motion of a type (``orbit_map``'s ``reason``; Fig. 16).
@@ -281,7 +290,7 @@ def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False)
 
 
 def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), zeta=0.05,
-              eps=0.5):
+              eps=0.5, *, progress=None):
     """Existence and stability of (m/n) motions over a ``(1/beta, delta)`` grid (Fig. 16).
 
     Parameters
@@ -294,6 +303,9 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
         Motion types (m <= 3).
     zeta, eps : float
         Damping ratio and restitution coefficient.
+    progress : callable, optional
+        ``progress(k)`` after every block of rows solved (`MAP_BLOCK_ROWS` per thread), ``k``
+        its cells: a job's progress log (`vibroimpact.pipeline.tasks.Progress.advance`).
 
     Returns
     -------
@@ -341,9 +353,17 @@ def orbit_map(inv_beta, delta, types=((1, 1), (2, 1), (1, 2), (1, 3), (3, 1)), z
     lam = np.full(shape, np.nan)
     reason = np.zeros(shape, dtype=np.int8)
     threads = numba.get_num_threads()
-    row_order = np.argsort(np.arange(inv_beta.size) % threads, kind="stable")
-    ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), row_order, exists, n_sol,
-                  n_stab, lam, reason)
+    # rows interleaved over the threads (block lo.. runs row lo + t + k threads on thread t,
+    # as one call over every row would): a block's rows are independent of the others, so
+    # the blocks give the one call's numbers bit for bit, and each thread the same rows
+    step = MAP_BLOCK_ROWS * threads
+    for lo in range(0, inv_beta.size, step):
+        block = np.arange(lo, min(lo + step, inv_beta.size))
+        row_order = block[np.argsort((block - lo) % threads, kind="stable")]
+        ok.map_kernel(inv_beta, deltas, tarr, float(zeta), float(eps), row_order, exists,
+                      n_sol, n_stab, lam, reason)
+        if progress is not None:
+            progress(block.size * deltas.size)
     return {
         "exists": exists, "n_solutions": n_sol, "n_stable": n_stab, "lam": lam,
         "S": 100.0 * (1.0 - lam), "reason": reason,

@@ -12,6 +12,7 @@ import json
 import numpy as np
 
 from vibroimpact._plane import dataset_axes
+from vibroimpact._symbols import PARAMETERS
 
 __all__ = ["COMPLEX_CODES", "orbits_at_cells"]
 
@@ -88,7 +89,7 @@ def _complex_pairs(x_name, xs, y_name, ys, fixed, types, n_stable, S):
     return out
 
 
-def orbits_at_cells(motion_map, orbits):
+def orbits_at_cells(motion_map, orbits, progress=None):
     """The periodic orbits of ``orbits``' system at the centre of every cell of the map, for
     the motions both name: what finding 8 and the predictors compare P with, cell for cell.
 
@@ -104,6 +105,8 @@ def orbits_at_cells(motion_map, orbits):
         ``results/datasets/{study}_map.nc``: its plane and motions.
     orbits : xarray.Dataset
         ``results/orbits/{name}.nc`` of the same system.
+    progress : callable, optional
+        ``progress(k)`` as ``k`` more cells are solved (`orbit_plane`'s) or read.
 
     Returns
     -------
@@ -134,11 +137,14 @@ def orbits_at_cells(motion_map, orbits):
         n_stable, S = o["n_stable"].values, o["S"].values
         complex_ = np.full(n_stable.shape, -1, dtype=np.int8)
         solver = "read from the orbit map (two walls)"
+        if progress is not None:
+            progress(xs.size * ys.size)
     else:
         from vibroimpact.orbits.plane import orbit_plane
 
         solved = orbit_plane(x_name, xs, y_name, ys, dict(fixed),
-                             types=[tuple(int(v) for v in t.split("/")) for t in types])
+                             types=[tuple(int(v) for v in t.split("/")) for t in types],
+                             progress=progress)
         solved = solved.transpose("type", x_name, y_name)
         n_stable, S = solved["n_stable"].values, solved["S"].values
         complex_ = _complex_pairs(x_name, xs, y_name, ys, fixed, types, n_stable, S)
@@ -149,9 +155,15 @@ def orbits_at_cells(motion_map, orbits):
                      "S": (dims, S), "complex": (dims, complex_)},
                     coords={"type": types, x_name: motion_map[x_name].values,
                             y_name: motion_map[y_name].values})
-    ds["n_stable"].attrs["long_name"] = "stable orbits at the cell's centre"
+    ds["n_stable"].attrs.update(long_name="stable orbits at the cell's centre", units="1")
     ds["S"].attrs.update(long_name="degree of stability at the cell's centre", units="%")
-    ds["complex"].attrs.update(long_name="multipliers a complex pair", codes=COMPLEX_CODES)
+    ds["complex"].attrs.update(long_name="multipliers a complex pair", units="1",
+                               codes=COMPLEX_CODES)
+    ds["type"].attrs.update(long_name="impact motion (m/n)", units="1")
+    for name in axes:      # the map's words for its axes, else orbit_plane's (dimensionless)
+        words = motion_map[name].attrs
+        ds[name].attrs.update(long_name=words.get("long_name") or PARAMETERS[name][2],
+                              units=words.get("units") or "1")
     ds.attrs.update(solver=solver, fixed=json.dumps(fixed, sort_keys=True))
     if "axes" in motion_map.attrs:
         ds.attrs["axes"] = json.dumps(list(axes))

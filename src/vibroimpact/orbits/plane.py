@@ -157,7 +157,8 @@ def _resolve(x_name, y_name, fixed):
     return out
 
 
-def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1), (1, 2))):
+def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1), (1, 2)), *,
+                progress=None):
     """Existence and stability of periodic impact motions over any plane (Fig. 16 analogue).
 
     Parameters
@@ -177,6 +178,8 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
     types : sequence
         One wall: ``(m, n)`` pairs (m <= 3). Two walls: ``(m_upper, m_lower, n)`` triples or
         names ``"(1,1)/1"``.
+    progress : callable, optional
+        ``progress(k)`` as ``k`` more cells are solved (`orbit_map`'s).
 
     Returns
     -------
@@ -205,9 +208,11 @@ def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1)
                          "vibroimpact.attractors.plane.orbit_plane (Newton shooting seeded by "
                          "the simulator); this one is the one-wall closed form")
     if "delta" in (x_name, y_name):
-        result, solver = _columns(x_name, xs, y_name, ys, fixed, parsed), "orbit_map"
+        result = _columns(x_name, xs, y_name, ys, fixed, parsed, progress)
+        solver = "orbit_map"
     else:
-        result, solver = _cells(x_name, xs, y_name, ys, fixed, parsed), "periodic_orbits"
+        result = _cells(x_name, xs, y_name, ys, fixed, parsed, progress)
+        solver = "periodic_orbits"
     return plane_dataset(x_name, xs, y_name, ys, fixed, parsed, result, solver, n_walls=1)
 
 
@@ -247,6 +252,7 @@ def plane_dataset(x_name, xs, y_name, ys, fixed, parsed, result, solver, n_walls
         ds[name].attrs.update(long_name=long_name, units=units)
     for name in (x_name, y_name):
         ds[name].attrs.update(long_name=PARAMETERS[name][2], units="1")
+    ds["type"].attrs.update(long_name="impact motion (m/n)", units="1")
     ds.attrs.update({k: float(v) for k, v in fixed.items()})
     ds.attrs.update(axes=[x_name, y_name], fixed=json.dumps(fixed, sort_keys=True),
                     n_walls=n_walls, solver=solver)
@@ -273,7 +279,7 @@ def value_at(name, k_x, k_y, x_name, xs, y_name, ys, fixed):
     return float(fixed[name])
 
 
-def _columns(x_name, xs, y_name, ys, fixed, parsed):
+def _columns(x_name, xs, y_name, ys, fixed, parsed, progress=None):
     """One wall, delta on an axis: `orbit_map` along delta, one column per other value."""
     types = [key for _, key in parsed]
     swap = x_name == "delta"
@@ -290,21 +296,21 @@ def _columns(x_name, xs, y_name, ys, fixed, parsed):
     if other == "inv_beta":          # the Fig. 16 call itself: rows in parallel
         amp = fixed["amplitude"]
         res = orbit_map(o_values, deltas / amp, types=types, zeta=fixed["zeta"],
-                        eps=fixed["eps"])
+                        eps=fixed["eps"], progress=progress)
         for name in VARIABLES:
             out[name] = res[name]
     else:
         for k, v in enumerate(o_values):
             p = dict(fixed, **{other: float(v)})
             res = orbit_map([p["inv_beta"]], deltas / p["amplitude"], types=types,
-                            zeta=p["zeta"], eps=p["eps"])
+                            zeta=p["zeta"], eps=p["eps"], progress=progress)
             put(k, res)
     if swap:                         # (type, other, delta) -> (type, delta, other)
         out = {k: np.swapaxes(v, 1, 2) for k, v in out.items()}
     return {k: np.ascontiguousarray(v) for k, v in out.items()}
 
 
-def _cells(x_name, xs, y_name, ys, fixed, parsed):
+def _cells(x_name, xs, y_name, ys, fixed, parsed, progress=None):
     """One wall, no delta axis: `periodic_orbits` at every cell."""
     shape = (len(parsed), xs.size, ys.size)
     out = empty(shape)
@@ -316,6 +322,8 @@ def _cells(x_name, xs, y_name, ys, fixed, parsed):
                 orbits = periodic_orbits(m, n, 1.0 / p["inv_beta"], p["delta"] / p["amplitude"],
                                          p["zeta"], p["eps"], include_inadmissible=True)
                 classify(out, (t, i, j), orbits, [o.admissible for o in orbits])
+        if progress is not None:
+            progress(ys.size)
     return finish(out)
 
 

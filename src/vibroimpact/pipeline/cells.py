@@ -844,7 +844,8 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
                 censored_time=stays["censored_time"])
 
 
-def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None):
+def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None,
+                       progress=None):
     """Stable periodic motions of a clearance over the (1/beta_f, delta) plane (the Fig. 16
     analogue), under ``sin(beta_f tau)`` alone, from the shooting solver.
 
@@ -860,6 +861,8 @@ def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None
         The motion types mapped.
     zeta, eps, gap, eps_lower : float
         The oscillator and its walls (``eps_lower`` None: ``eps``).
+    progress : callable, optional
+        ``progress(k)`` after each row, ``k`` its cells (a job's progress log).
 
     Returns
     -------
@@ -903,6 +906,8 @@ def two_wall_orbit_map(inv_beta, delta, types, *, zeta, eps, gap, eps_lower=None
                 out["n_stable"][k, i, j] += 1
                 if not motion.lam >= out["lam"][k, i, j]:      # NaN: the first stable one
                     out["lam"][k, i, j], out["S"][k, i, j] = motion.lam, motion.S
+        if progress is not None:
+            progress(delta.size)
     out["reason"] = np.where(out["n_stable"] > 0, 0, np.where(
         out["exists"], 3, np.where(out["n_solutions"] > 0, 2, 1))).astype(np.int64)
     return dict(out, types=np.array(types, dtype=np.int64), inv_beta=inv_beta, delta=delta)

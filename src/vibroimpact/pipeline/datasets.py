@@ -223,10 +223,18 @@ _HARMONIC_DENSITIES = (("ratio_density", "ratio"), ("ratio_density_stderr", "rat
 RUN_MEASUREMENTS = ("cpu_time",)
 
 
-def _annotate(ds):
+def annotate(ds):
+    """``ds`` with the ``long_name`` and ``units`` of `META` on each variable it names, of
+    `PLANE_META` on a plane's other axes and on a tile's cell coordinates ``<x>_cell``; the
+    run measurements flagged. Returns ``ds`` (changed in place)."""
     for name in list(ds.variables):
         if name in META:
             ds[name].attrs.update(long_name=META[name][0], units=META[name][1])
+        elif name in PLANE_META:
+            ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
+        elif name.endswith("_cell") and name.removesuffix("_cell") in PLANE_META:
+            long_name, units = PLANE_META[name.removesuffix("_cell")]
+            ds[name].attrs.update(long_name=f"{long_name} of the cell", units=units)
         if name in RUN_MEASUREMENTS:
             ds[name].attrs["run_measurement"] = 1
     return ds
@@ -318,7 +326,7 @@ def events_tile(cells, results, edges, attrs, motions=stats.DEFAULT_MOTIONS):
                 data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
     _add_walls(data, coords, results)
-    return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+    return annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
 #: The map's residence statistics: over `motion` for the listed motions, and for "none" (time
@@ -359,7 +367,7 @@ def map_tile(cells, results, motions, attrs):
             data[name] = (("cell", "rule", "motion"), np.stack([r[name] for r in results]))
         coords["rule"] = list(stats.RULES)
     _add_walls(data, coords, results)
-    return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+    return annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
 def aggregate_map(tiles, study, attrs, n_cells=None):
@@ -369,7 +377,7 @@ def aggregate_map(tiles, study, attrs, n_cells=None):
     ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells), names=names).transpose(
         "motion", "from_motion", "to_motion", *names, ..., missing_dims="ignore")
     ds.attrs = dict(attrs)
-    ds = _annotate(ds)
+    ds = annotate(ds)
     if "axes" in attrs:             # a plane's map: its axes named in words
         for name in names:
             ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
@@ -385,7 +393,7 @@ def spectra_tile(cells, results, attrs):
         data["S_a_batch"] = (("cell", "batch", "beta"),
                              np.stack([r["S_a_batch"] for r in results]))
     coords = dict(_cell_coords(cells), beta=results[0]["beta"])
-    return _annotate(xr.Dataset(data, coords=coords, attrs=attrs))
+    return annotate(xr.Dataset(data, coords=coords, attrs=attrs))
 
 
 def tile_axes(tiles, n_cells=None):
@@ -450,7 +458,7 @@ def aggregate_events(tiles, study, attrs, n_cells=None):
     study's, or with ``study=None`` the tiles' own, `tile_axes`)."""
     ds = _to_grid(tiles, *_axes(tiles, study, n_cells=n_cells))
     ds.attrs = dict(attrs)
-    return _annotate(ds)
+    return annotate(ds)
 
 
 def aggregate_spectra(tiles, study, spec, attrs, input_correlation, zeta=None, n_cells=None):
@@ -480,7 +488,7 @@ def aggregate_spectra(tiles, study, spec, attrs, input_correlation, zeta=None, n
     ds["phi_r"] = ("lag", phi)
     ds["phi_r_target"] = ("lag", phi_target)
     ds.attrs = dict(attrs)
-    return _annotate(ds)
+    return annotate(ds)
 
 
 def trace_dataset(tr, attrs):
@@ -493,7 +501,7 @@ def trace_dataset(tr, attrs):
         coords=dict(tau=tr["tau"]), attrs=attrs)
     if "impact_wall" in tr:         # two walls
         ds["impact_wall"] = ("impact", np.asarray(tr["impact_wall"], dtype=np.int8))
-    return _annotate(ds)
+    return annotate(ds)
 
 
 ORBIT_META = {
@@ -627,23 +635,34 @@ ATTRACTOR_META = {
     "class_fraction": ("share of the starts in each class", "1"),
     "other_class_fraction": ("share of the starts in each class that settle on none of the "
                              "motions (counted in other)", "1"),
-    "lyapunov": ("largest Lyapunov exponent over the cell's starts (-inf: every start sticks)",
-                 "1/tau"),
-    "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle",
-                        "1/tau"),
+    "lyapunov": ("largest Lyapunov exponent over the cell's starts, per unit of "
+                 "non-dimensional time tau (-inf: every start sticks)", "1"),
+    "lyapunov_stderr": ("standard error of the exponent of the starts that do not settle, "
+                        "per unit of non-dimensional time tau", "1"),
     "cell_class": ("the most frequent class of the cell's starts", "1"),
     "lyapunov_class": ("class of the start whose exponent is the cell's largest", "1"),
     "class_start": ("class of each start (flag_meanings)", "1"),
-    "impact_rate": ("collisions per unit time, mean over the cell's starts", "1/tau"),
-    "lyapunov_start": ("largest Lyapunov exponent of each start", "1/tau"),
+    "impact_rate": ("collisions per unit of non-dimensional time tau, mean over the cell's "
+                    "starts", "1"),
+    "lyapunov_start": ("largest Lyapunov exponent of each start, per unit of non-dimensional "
+                       "time tau", "1"),
     "motion_start": ("what each start settles on: index into motion", "1"),
-    "lyapunov_second_start": ("second Lyapunov exponent of each start", "1/tau"),
+    "lyapunov_second_start": ("second Lyapunov exponent of each start, per unit of "
+                              "non-dimensional time tau", "1"),
     "settle_time": ("time a start takes to settle on a periodic motion (NaN: not settled)",
                     "1"),
     "period_impacts_start": ("impacts per period of the periodic motion a start settles on "
                              "(collisions of an impact-stick motion; 0: none)", "1"),
     "period_periods_start": ("forcing periods of that period (0: none)", "1"),
     "impacts_lower_start": ("of those impacts, the ones at the wall below", "1"),
+    "stick_count": ("starts that settle on this type's impact-stick variant", "1"),
+    "class_count": ("starts in each class", "1"),
+    "motion": ("what a start settles on: a stable periodic motion of a listed type (m/n), or "
+               "other", "1"),
+    "type": ("impact motion (m/n)", "1"),
+    "class": ("class of what a start settles on: listed, periodic_other, sticking, chaotic, "
+              "undecided, wall_free (codes 0-5)", "1"),
+    "start": ("starting state of the cell (index)", "1"),
 }
 
 
@@ -668,15 +687,18 @@ def attractor_tile_dataset(result, attrs):
     for name in ("lyapunov_start", "lyapunov_second_start", "settle_time", "motion_start"):
         data[name] = (("start", *plane), result[name])
     data["class_start"] = (("start", *plane), result["class_start"].astype(np.int8))
-    if "gap" in plane or "gap" in result.get("fixed", {}):
+    two_walls = "gap" in plane or "gap" in result.get("fixed", {})
+    if two_walls:
         # two walls: what each settled start's motion is in the study's own names
         data["period_impacts_start"] = (("start", *plane), result["period_start"][0])
         data["period_periods_start"] = (("start", *plane), result["period_start"][1])
         data["impacts_lower_start"] = (("start", *plane), result["impacts_lower_start"])
-    ds = xr.Dataset(data, coords=coords, attrs=dict(attrs))
+    ds = _described(xr.Dataset(data, coords=coords, attrs=dict(attrs)))
     if "axes" in result:        # a named plane (attractors.plane.attractor_plane)
         ds.attrs.update(axes=list(plane), fixed=json.dumps(result["fixed"], sort_keys=True),
                         **{k: float(v) for k, v in result["fixed"].items()})
+    if two_walls:       # `gap` is the clearance (a fixed value or an axis), as every dataset's
+        ds.attrs["n_walls"] = 2             # of a two-wall study; the starts' box: start_gap
         for name in plane:
             ds[name].attrs.update(long_name=PLANE_META[name][0], units=PLANE_META[name][1])
     return ds
@@ -691,9 +713,15 @@ def concat_attractor_tiles(tiles):
 
 
 def _described(ds):
+    """An attractor dataset's variables described (`ATTRACTOR_META`), and its plane's axes
+    (`META`, `PLANE_META`) where they have no words yet."""
     for name, (long_name, units) in ATTRACTOR_META.items():
         if name in ds.variables:
             ds[name].attrs.update(long_name=long_name, units=units)
+    for name in ds.dims:
+        words = META.get(name) or PLANE_META.get(name)
+        if name in ds.variables and words and "long_name" not in ds[name].attrs:
+            ds[name].attrs.update(long_name=words[0], units=words[1])
     return ds
 
 
@@ -829,7 +857,7 @@ def escape_part(index, rms, cells, results, motions, attrs, axes=("inv_beta", "d
     coords = {"rms": [float(rms)], "cell": np.arange(len(results)),
               "state": _motion_names(motions) + ["none"], x: ("cell", pairs[:, 0]),
               y: ("cell", pairs[:, 1])}
-    ds = _escape_described(_annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
+    ds = _escape_described(annotate(xr.Dataset(data, coords=coords, attrs=attrs)))
     if tuple(axes) != ("inv_beta", "delta"):      # a plane's cells: named in its words
         for name in axes:
             ds[name].attrs.update(long_name=f"{PLANE_META[name][0]} of the cell",
@@ -866,7 +894,7 @@ def aggregate_escape(parts, attrs, min_stretches, fit_max_rms=None):
     ds["fit_used"] = (("rms", "cell", "state"), used)
     ds.attrs = dict(attrs, min_stretches=int(min_stretches),
                     fit_max_rms=float("nan") if fit_max_rms is None else float(fit_max_rms))
-    return _escape_described(_annotate(ds.transpose("rms", "cell", "state")))
+    return _escape_described(annotate(ds.transpose("rms", "cell", "state")))
 
 
 def _escape_described(ds):

@@ -22,6 +22,7 @@ import netCDF4
 import numpy as np
 
 from vibroimpact._files import atomic_path
+from vibroimpact.pipeline import conventions
 
 __all__ = ["CHECKSUM", "CorruptFileError", "check_readable", "load_dataset", "verify",
            "verify_png", "write_dataset", "write_noise", "noise_spec", "read_noise_attrs",
@@ -161,8 +162,23 @@ def verify_png(path):
 def write_dataset(ds, path):
     """Write an ``xarray.Dataset`` to netCDF4 atomically, every variable with a Fletcher-32
     checksum (:data:`CHECKSUM`); the encodings the variables bring along (from a file they
-    were read from) are kept, but never ``contiguous`` storage, which takes no checksum."""
+    were read from) are kept, but never ``contiguous`` storage, which takes no checksum.
+
+    The file gets the CF global attributes (`conventions.global_attributes`: ``Conventions``,
+    ``source``, ``references``, ``history``) besides the dataset's own.
+
+    Raises
+    ------
+    ValueError
+        A variable or coordinate has no ``long_name`` or no ``units``
+        (`conventions.missing`): every file the pipeline writes describes each of them.
+    """
+    lacking = conventions.missing(ds)
+    if lacking:
+        raise ValueError(f"{path}: every variable needs long_name and units; missing: "
+                         + ", ".join(f"{name}.{key}" for name, key in lacking))
     ds = ds.copy(deep=False)          # new Variable objects: the caller's encodings stay
+    ds.attrs = {**ds.attrs, **conventions.global_attributes(ds.attrs, path)}
     for var in ds.variables.values():
         encoding = {k: v for k, v in var.encoding.items() if k != "contiguous"}
         var.encoding = {**encoding, **CHECKSUM}
@@ -229,7 +245,8 @@ def write_noise(path, spec, n_samples, seed, *, attrs, chunk_size=2**20, n_estim
             _var(nc, "S_target_linear", ("beta",), spec.psd_piecewise_linear(beta),
                  "power spectral density of the piecewise-linear force (target)", "1")
             nc.setncatts({**attrs, **{f"noise_{k}": v for k, v in spec.to_attrs().items()},
-                          "dt": spec.dt, "seed": int(seed), "n_samples": int(n_samples)})
+                          "dt": spec.dt, "seed": int(seed), "n_samples": int(n_samples),
+                          **conventions.global_attributes(attrs, path)})
         finally:
             nc.close()
 

@@ -57,35 +57,51 @@ def logged(path):
         logging.shutdown()
 
 
-class Progress:
-    """A job's progress over its cells, logged at most every ``every`` seconds and at the end.
+#: Seconds between two progress lines of a long job (README, "Progress of a build"): often
+#: enough that ``tail -f`` on its log says where it stands, rare enough not to flood it.
+PROGRESS_EVERY = 5.0
 
-    Each line: cells done of total, collisions, simulated time, the rate and the time left
-    (README, "Progress of a build"): a long tile says where it stands without flooding its log.
+
+class Progress:
+    """A job's progress over its units (cells, rows, types), logged when it starts, at most
+    every ``every`` seconds (default `PROGRESS_EVERY`) and at its end.
+
+    Each line: units done of total, with a simulation's collisions and simulated time
+    (``events``), the rate and the time left (README, "Progress of a build"): a long job says
+    where it stands without flooding its log. `advance` is the callback the numerical
+    modules take as ``progress`` (they know nothing of logging).
     """
 
-    def __init__(self, what, total, every=20.0, clock=None):
+    def __init__(self, what, total, unit="cells", every=None, clock=None, events=False):
         import time
 
-        self.what, self.total, self.every = what, int(total), float(every)
+        self.what, self.total, self.unit = what, int(total), unit
+        self.every = PROGRESS_EVERY if every is None else float(every)
+        self.events = events
         self.clock = clock or time.monotonic
         self.start = self.last = self.clock()
         self.done, self.collisions, self.simulated = 0, 0, 0.0
+        log.info("progress %s: 0 of %d %s, started", what, self.total, unit)
 
     def cell_done(self, result):
-        """Count one cell (its ``n_collisions`` and ``simulated_time`` when it has them)."""
-        self.done += 1
+        """Count one simulated cell (its ``n_collisions`` and ``simulated_time``)."""
         self.collisions += int(result.get("n_collisions", 0))
         self.simulated += float(result.get("simulated_time", 0.0))
+        self.advance(1)
+
+    def advance(self, n=1):
+        """Count ``n`` more units done; log if ``every`` seconds have passed or all are."""
+        self.done += int(n)
         now = self.clock()
         if self.done < self.total and now - self.last < self.every:
             return
         self.last = now
-        elapsed = max(now - self.start, 1e-9)
-        rate = self.done / elapsed
-        log.info("progress %s: %d of %d cells, %d collisions, %.4g time units simulated, "
-                 "%.3g cells/s, ~%.0f s left", self.what, self.done, self.total, self.collisions,
-                 self.simulated, rate, (self.total - self.done) / rate)
+        rate = self.done / max(now - self.start, 1e-9)
+        left = (self.total - self.done) / rate if rate > 0 else float("inf")
+        counts = (f"{self.collisions} collisions, {self.simulated:.4g} time units simulated, "
+                  if self.events else "")
+        log.info("progress %s: %d of %d %s, %s%.3g %s/s, ~%.0f s left", self.what, self.done,
+                 self.total, self.unit, counts, rate, self.unit, left)
 
 
 def noise_spec(entry):
@@ -180,7 +196,8 @@ def _tile_job(study, tile, grid, what, run_cell, to_dataset, out):
     ``to_dataset(cells, results)`` written to ``out`` (its provenance collected then).
     """
     tile_cells = study.tile(tile, grid)
-    progress = Progress(f"studies.{study.name} {what} tile {tile}", len(tile_cells))
+    progress = Progress(f"studies.{study.name} {what} tile {tile}", len(tile_cells),
+                        events=True)
     results = []
     for cell in tile_cells:
         log.debug("cell %d: inv_beta=%g delta=%g", cell.index, cell.inv_beta, cell.delta)
@@ -419,7 +436,8 @@ def escape_level(name, block, noise, index, out):
     log.info("level %d: rms %g, %d samples of %s", index, rms, n, spec)
     samples = generate_array(spec, n, escape_seed(noise["seed"], index))
     motions = [tuple(int(k) for k in m) for m in block["motions"]]
-    progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]))
+    progress = Progress(f"studies.{name} escape level {index}", len(escape["cells"]),
+                        events=True)
     results = []
     for p in escape_cells(block):
         results.append(cells.escape_cell(
@@ -509,9 +527,11 @@ def orbit_tile(entry, tile, out, threads=None):
         io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
         return
     rows, n_tiles = orbit_rows(entry)
-    result = orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
-                       types=[tuple(t) for t in entry["types"]], zeta=float(entry["zeta"]),
-                       eps=float(entry["eps"]))
+    rows, deltas = rows[tile::n_tiles], grid_values(entry["delta"])
+    progress = Progress(f"orbit tile {tile}", rows.size * deltas.size)
+    result = orbit_map(rows, deltas, types=[tuple(t) for t in entry["types"]],
+                       zeta=float(entry["zeta"]), eps=float(entry["eps"]),
+                       progress=progress.advance)
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                  amplitude=1.0)
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
@@ -530,10 +550,12 @@ def clearance_orbit_tile(entry, tile, out):
     from vibroimpact.pipeline.cells import two_wall_orbit_map
 
     rows, n_tiles = orbit_rows(entry)
+    rows, deltas = rows[tile::n_tiles], grid_values(entry["delta"])
     gap, eps_lower = walls(entry, "orbits")
-    result = two_wall_orbit_map(rows[tile::n_tiles], grid_values(entry["delta"]),
-                                entry["types"], zeta=float(entry["zeta"]),
-                                eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower)
+    progress = Progress(f"clearance orbit tile {tile}", rows.size * deltas.size)
+    result = two_wall_orbit_map(rows, deltas, entry["types"], zeta=float(entry["zeta"]),
+                                eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower,
+                                progress=progress.advance)
     attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                  amplitude=1.0, **_wall_attrs(gap, eps_lower))
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
@@ -560,8 +582,10 @@ def _plane_tile(entry, tile, orbit_plane):
     rows, n_tiles = orbit_rows(entry)
     values = {k: grid_values(entry[k]) for k in (x_name, y_name)}
     values[orbit_tiled_axis(entry)] = rows[tile::n_tiles]
+    progress = Progress(f"orbit tile {tile}", values[x_name].size * values[y_name].size)
     ds = orbit_plane(x_name, values[x_name], y_name, values[y_name], orbit_plane_fixed(entry),
-                     types=[tuple(int(k) for k in t) for t in entry["types"]])
+                     types=[tuple(int(k) for k in t) for t in entry["types"]],
+                     progress=progress.advance)
     ds.attrs.update(provenance(entry), reason_codes="0 stable, 1 no solution, 2 inadmissible, "
                                                     "3 unstable")
     return ds
@@ -610,7 +634,9 @@ def boundaries(entry, orbits_path, out, threads=None):
     if threads is not None:
         numba.set_num_threads(int(threads))
     curves = {}
-    for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
+    types = [tuple(int(k) for k in t) for t in entry["types"]]
+    progress = Progress("boundaries", len(types), unit="types")
+    for m, n in types:
         curves[(m, n)] = domain_boundaries(
             m, n, float(entry["zeta"]), float(entry["eps"]), **box,
             resolution=(seeds["inv_beta"].size, seeds["delta"].size), seed_map=seeds,
@@ -620,6 +646,7 @@ def boundaries(entry, orbits_path, out, threads=None):
         if lost:
             log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
                         "there (the dataset's `ends` says which curves)", m, n, lost)
+        progress.advance()
     io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
 
 
@@ -649,7 +676,9 @@ def plane_boundaries(entry, orbits_path, out, threads=None):
     if threads is not None:
         numba.set_num_threads(int(threads))
     curves = {}
-    for m, n in (tuple(int(k) for k in t) for t in entry["types"]):
+    types = [tuple(int(k) for k in t) for t in entry["types"]]
+    progress = Progress("boundaries", len(types), unit="types")
+    for m, n in types:
         curves[(m, n)] = trace_plane(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
                                      seed_map=seeds, tol=BOUNDARY_TOL)
         log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
@@ -657,6 +686,7 @@ def plane_boundaries(entry, orbits_path, out, threads=None):
         if lost:
             log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
                         "there (the dataset's `ends` says which curves)", m, n, lost)
+        progress.advance()
     io.write_dataset(datasets.boundaries_dataset(curves, attrs, axes), out)
 
 
@@ -665,7 +695,7 @@ def _attractor_attrs(entry):
     gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
     return dict(zeta=float(entry["zeta"]), eps=float(entry["eps"]),
                 n_starts=int(block["n_starts"]), max_time=float(block["max_time"]),
-                seed=int(block["seed"]), gap=list(gap), velocity=list(vel),
+                seed=int(block["seed"]), start_gap=list(gap), velocity=list(vel),
                 box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
                     f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
 
@@ -681,13 +711,14 @@ def attractor_tile(entry, tile, out, threads=None):
         numba.set_num_threads(int(threads))
     block = entry["attractors"]
     rows, n_tiles = attractor_rows(entry)
+    rows, deltas = rows[tile::n_tiles], grid_values(block["delta"])
     attrs = _attractor_attrs(entry)
-    result = attractor_map(rows[tile::n_tiles], grid_values(block["delta"]),
-                           float(entry["zeta"]), float(entry["eps"]),
+    progress = Progress(f"attractor tile {tile}", rows.size * deltas.size)
+    result = attractor_map(rows, deltas, float(entry["zeta"]), float(entry["eps"]),
                            types=[tuple(int(k) for k in t) for t in entry["types"]],
-                           n_starts=attrs["n_starts"], gap=tuple(attrs["gap"]),
+                           n_starts=attrs["n_starts"], gap=tuple(attrs["start_gap"]),
                            velocity=tuple(attrs["velocity"]), max_time=attrs["max_time"],
-                           seed=attrs["seed"])
+                           seed=attrs["seed"], progress=progress.advance)
     attrs = dict(provenance(entry), **attrs)
     io.write_dataset(datasets.attractor_tile_dataset(result, attrs), out)
 
@@ -717,15 +748,18 @@ def plane_attractor_tile(name, entry, tile, out, threads=None):
     block = entry["attractors"]
     gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
     attrs = dict(study=name, n_starts=int(block["n_starts"]),
-                 max_time=float(block["max_time"]), seed=int(block["seed"]), gap=list(gap),
-                 velocity=list(vel),
+                 max_time=float(block["max_time"]), seed=int(block["seed"]),
+                 start_gap=list(gap), velocity=list(vel),
                  box=f"forcing phase in [0, 2 pi), x0 = delta - s (s: distance below the "
                      f"wall at delta) with s in [{gap[0]:g}, {gap[1]:g}], v0 in "
                      f"[{vel[0]:g}, {vel[1]:g}]")
-    result = attractor_plane(x, rows[tile::n_tiles], y, study.axes[y], study.fixed(),
+    rows = rows[tile::n_tiles]
+    progress = Progress(f"studies.{name} attractor tile {tile}", rows.size * study.axes[y].size)
+    result = attractor_plane(x, rows, y, study.axes[y], study.fixed(),
                              types=[tuple(int(k) for k in t) for t in block["types"]],
                              n_starts=attrs["n_starts"], gap=gap, velocity=vel,
-                             max_time=attrs["max_time"], seed=attrs["seed"])
+                             max_time=attrs["max_time"], seed=attrs["seed"],
+                             progress=progress.advance)
     io.write_dataset(datasets.attractor_tile_dataset(result, dict(provenance(entry), **attrs)),
                      out)
 
@@ -741,10 +775,14 @@ def map_orbits(map_path, orbits_path, out):
     """Rule ``solve_map_orbits``: the periodic orbits of an orbits entry solved at the cells
     of a study's map (`vibroimpact.orbits.cells.orbits_at_cells`): what finding 8, the
     predictors of P and Fig. 15 against Fig. 16 compare P with, cell for cell."""
+    from vibroimpact._plane import dataset_axes
     from vibroimpact.orbits.cells import orbits_at_cells
 
     motion_map = io.load_dataset(map_path)
-    ds = orbits_at_cells(motion_map, io.load_dataset(orbits_path))
+    axes = dataset_axes(motion_map)
+    progress = Progress("orbits at the map's cells",
+                        motion_map.sizes[axes[0]] * motion_map.sizes[axes[1]])
+    ds = orbits_at_cells(motion_map, io.load_dataset(orbits_path), progress=progress.advance)
     if ds is None:
         raise ValueError(f"no motion of the map {map_path} is a type of the orbit map "
                          f"{orbits_path}")

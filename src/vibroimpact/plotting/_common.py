@@ -15,6 +15,7 @@ from pathlib import Path
 import matplotlib
 import matplotlib.style
 import numpy as np
+from matplotlib.textpath import text_to_path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -229,17 +230,61 @@ def symbols(text):
     return "$".join(parts)
 
 
+#: Characters of a header line an inch of figure holds (the title size, 10 pt; 6.5 in, the
+#: default width, holds `HEADER_WIDTH`): a narrower figure breaks its lines shorter.
+HEADER_CHARS_PER_INCH = 14.0
+
+
 def _header(fig, title, params):
     """The figure's title and its parameter lines (plain names as symbols, `symbols`),
-    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`)."""
+    long lines broken at their ``";  "`` separators (`HEADER_WIDTH`, or the characters a
+    narrower figure holds); a line still wider than the figure, as its title's font draws it
+    (`_points`), breaks again: at the last ``";  "``, else ``", "``, else space outside maths
+    where what comes before fits."""
+    width = min(HEADER_WIDTH, int(fig.get_figwidth() * HEADER_CHARS_PER_INCH))
+    prop = fig.suptitle(title).get_fontproperties()
+    room = 72.0 * fig.get_figwidth() - 2 * HEADER_MARGIN_PT
     lines = []
     for line in symbols(params).split("\n"):
-        while len(line) > HEADER_WIDTH and ";  " in line[:HEADER_WIDTH + 10]:
-            cut = line.rfind(";  ", 0, HEADER_WIDTH + 10)
+        while len(line) > width and ";  " in line[:width + 10]:
+            cut = line.rfind(";  ", 0, width + 10)
             lines.append(line[:cut + 1])
             line = line[cut + 3:]
+        while _points(line, prop) > room:
+            cut, skip = _break_outside_math(line, lambda head: _points(head, prop) <= room)
+            if cut < 0:
+                break
+            lines.append(line[:cut])
+            line = line[cut + skip:]
         lines.append(line)
     fig.suptitle("\n".join([title, *lines]))
+
+
+#: Points a header keeps clear of each side of the figure.
+HEADER_MARGIN_PT = 6.0
+
+
+def _points(text, prop):
+    """The width in points of one line of ``text`` drawn in font ``prop`` (maths as
+    mathtext), measured by Matplotlib's own text layout."""
+    if not text:
+        return 0.0
+    ismath = text.count("$") >= 2 and text.count("$") % 2 == 0
+    return float(text_to_path.get_text_width_height_descent(text, prop, ismath=ismath)[0])
+
+
+def _break_outside_math(line, fits):
+    """``(end, skip)`` of the break of ``line`` outside ``$...$`` after which the head
+    ``line[:end]`` ``fits`` (a predicate): after its last such ``";  "`` (the semicolon kept),
+    else ``", "`` (the comma kept), else space; the line goes on ``skip`` characters later.
+    ``(-1, 0)`` if there is none."""
+    for sep, keep in ((";  ", 1), (", ", 1), (" ", 0)):
+        cut = line.rfind(sep)
+        while cut > 0:
+            if line.count("$", 0, cut) % 2 == 0 and fits(line[:cut + keep]):
+                return cut + keep, len(sep) - keep
+            cut = line.rfind(sep, 0, cut)
+    return -1, 0
 
 
 def _panel_tag(ax, tag):
@@ -377,8 +422,14 @@ def plane_fixed(ds):
 
 
 def plane_caption(ds, math=True):
-    """``"fixed: ζ = 0.05, A = 1, 1/β_f = 1.1, σ_r = 0.29"`` of a map dataset (`plane_fixed`)."""
-    text = fixed_caption(plane_fixed(ds), math=math)
+    """``"fixed: ζ = 0.05, A = 1, 1/β_f = 1.1, σ_r = 0.29"`` of a map dataset (`plane_fixed`);
+    with a second wall whose restitution is given nowhere, ``ε_l = ε`` (its default)."""
+    fixed = plane_fixed(ds)
+    text = fixed_caption(fixed, math=math)
+    axes = plane_axes(ds)
+    if ("gap" in axes or "gap" in fixed) and "eps_lower" not in axes and "eps_lower" not in fixed:
+        text += (", " if text else "") + (r"$\varepsilon_l = \varepsilon$" if math
+                                          else "ε_l = ε")
     return f"fixed: {text}" if text else "nothing fixed"
 
 

@@ -311,14 +311,15 @@ def basins(basins, orbits=None):
 
 
 def _starts_text(basins):
-    """``N = 64 starts per cell (box); 95 % Clopper-Pearson intervals up to +-x pp``."""
+    """``N = 64 starts per cell (box); 95 % Clopper-Pearson intervals up to x pp wide``: the
+    width, not a half-width (an interval of 0 or N of N starts is one-sided: [0, x])."""
     n = int(_attr(basins, "n_starts"))
     text = (f"{n} starts per cell, a scrambled Sobol sample, the same in every cell:\n"
             f"{_attr(basins, 'box')}")
     if "fraction_lo" in basins and "fraction_hi" in basins:
-        half = 0.5 * np.nanmax(np.asarray(basins["fraction_hi"] - basins["fraction_lo"]))
-        text += ("\n" + rf"shares $\pm$ up to {100.0 * half:.0f} pp "
-                 "(95 % Clopper-Pearson interval)")
+        width = np.nanmax(np.asarray(basins["fraction_hi"] - basins["fraction_lo"]))
+        text += ("\n" + f"a share's 95 % Clopper-Pearson interval: up to {100.0 * width:.0f} "
+                 f"pp wide")
     return text
 
 
@@ -502,7 +503,7 @@ def lyapunov(lyapunov):
     ax_c.pcolormesh(xe, ye, code.T, cmap=ListedColormap(colors), vmin=-0.5,
                     vmax=len(names) - 0.5, rasterized=True, gid="cell-class")
     handles_c = [Patch(facecolor=c, edgecolor="0.6",
-                       label=f"{w} ({100.0 * np.mean(code == k):.2g} %)")
+                       label=f"{w} ({_pct(np.mean(code == k))})")
                  for k, (c, w) in enumerate(zip(colors, words)) if (code == k).any()]
     if "class_fraction" in lyapunov:
         cf = np.asarray(lyapunov["class_fraction"].sel({"class": names}).values, dtype=float)

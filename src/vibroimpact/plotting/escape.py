@@ -207,7 +207,9 @@ def escape_vs_noise(escape):
     if np.isfinite(top):
         handles.append(Patch(label=f"rms > {_num(top)}: outside the fits",
                              **{k: v for k, v in OUTSIDE_FIT_STYLE.items() if k == "color"}))
-    fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=7)
+    # side by side under three panels; one above another under fewer (their labels are long)
+    fig.legend(handles=handles, loc="outside lower center",
+               ncols=len(handles) if ncols >= 3 else 1, fontsize=7)
     noise = ", ".join(_spectrum_parts(escape.attrs))
     system, force = ((f"{_system_text(escape)};  ", r"$\sin(\beta_f\tau) + r(\tau)$")
                      if _cell_axes(escape) == ("inv_beta", "delta") else

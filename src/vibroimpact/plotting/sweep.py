@@ -6,7 +6,7 @@ from matplotlib.lines import Line2D
 
 from vibroimpact.plotting._common import (
     CONFIDENCE, FEW_IMPACTS, _attr, _colors, _figure, _filter_parts, _header, _num, _padded,
-    _panel_tag, _require, _styled, axis_label, note_on_axes, t_quantile)
+    _panel_tag, _require, _styled, axis_label, note_on_axes, t_quantile, two_wall_dataset)
 
 #: Height (inches): two panels and the legend below them.
 SWEEP_HEIGHT = 7.0
@@ -33,12 +33,27 @@ def _shared_text(datasets):
                 parts.append(f"{symbol} = {_num(value)}")
         else:
             varied.append(symbol)
+    walls_text = ""
+    if any(two_wall_dataset(ds) for ds in datasets):
+        # two walls: where the lower one stands and its restitution; the means pool the
+        # collisions at both walls (the members' own Fig. 9 draws them per wall)
+        walls = []
+        for key, symbol in (("gap", "g"), ("eps_lower", r"$\varepsilon_l$")):
+            values = {float(ds.attrs[key]) for ds in datasets if key in ds.attrs}
+            if len(values) == 1:
+                walls.append(f"{symbol} = {_num(values.pop())}")
+            elif values:
+                varied.append(symbol)
+        walls_text = (r"two walls, the lower at $\delta$ - g"
+                      + (f" ({', '.join(walls)})" if walls else "")
+                      + ": collisions at both walls pooled")
     seeds = {int(ds.attrs.get("seed", -1)) for ds in datasets}
     if len(seeds) > 1:
         varied.append("seed")
     first = datasets[0].attrs
     noise = ", ".join([str(first.get("noise_kind", "")), *_filter_parts(first)]).strip(", ")
-    line = ", ".join(parts) + (f";  input {noise}" if noise else "")
+    line = ", ".join(parts) + (f";  {walls_text}" if walls_text else "") + (
+        f";  input {noise}" if noise else "")
     inv_beta = {float(ds["inv_beta"][0]) for ds in datasets}
     if any(float(_attr(ds, "amplitude")) != 0.0 for ds in datasets) and len(inv_beta) == 1:
         line += rf",  $\sin(\tau/{_num(inv_beta.pop())})$"

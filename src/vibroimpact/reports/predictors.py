@@ -250,7 +250,9 @@ def _stable_domain(motion_map, orbits, basins, motion):
         stable = o["n_stable"].values > 0
         S = np.where(stable, o["S"].values, 0.0)
         return stable, S
-    if basins is not None and motion in basins["motion"].values:
+    # a one-wall basins dataset counts the closed-form orbits' stable solutions per cell; a
+    # two-wall one classifies the study's motions and solves none (no n_stable)
+    if basins is not None and "n_stable" in basins and motion in basins["motion"].values:
         return basins["n_stable"].sel(motion=motion).values > 0, None
     return None, None
 
@@ -381,13 +383,16 @@ def correlations_dataset(correlations):
     ds = xr.Dataset({name: (dims, array) for name, array in values.items()},
                     coords={"predictor": list(PREDICTORS), "motion": motions,
                             "where": wheres})
-    ds["rho"].attrs["long_name"] = "Spearman's rank correlation of the predictor with P"
-    ds["low"].attrs["long_name"] = "95 % bootstrap interval, lower end"
-    ds["high"].attrs["long_name"] = "95 % bootstrap interval, upper end"
-    ds["n_cells"].attrs["long_name"] = "cells correlated"
-    ds["note"].attrs["long_name"] = "why rho is not computed (empty when it is)"
-    ds["predictor"].attrs["long_name"] = "; ".join(f"{k}: {v}" for k, v in PREDICTORS.items())
-    ds["where"].attrs["long_name"] = "domain: the motion's stable domain; plane: every cell"
+    for name, long_name in (
+            ("rho", "Spearman's rank correlation of the predictor with P"),
+            ("low", "95 % bootstrap interval of rho, lower end"),
+            ("high", "95 % bootstrap interval of rho, upper end"),
+            ("n_cells", "cells correlated"),
+            ("note", "why rho is not computed (empty when it is)"),
+            ("predictor", "; ".join(f"{k}: {v}" for k, v in PREDICTORS.items())),
+            ("motion", "impact motion (m/n) of the map"),
+            ("where", "domain: the motion's stable domain; plane: every cell")):
+        ds[name].attrs.update(long_name=long_name, units="1")
     ds.attrs.update(seed=SEED, n_resamples=N_RESAMPLES)
     return ds
 

@@ -259,12 +259,39 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
         _check_orbits_item_plane(name, entry, at, orbits, other, problems)
     else:
         _check_orbits_item_system(entry, at, orbits, other, problems)
+    if other.get("gap") is not None:
+        _check_orbit_grid_holds(name, entry, at, orbits, other, problems)
     types = {tuple(t) for t in other["types"]}
     missing = [m for m in entry["motions"] if tuple(m) not in types]
     if missing:
         problems.add(f"{at}.orbits", orbits, f"orbits.{orbits} maps no {missing} motion, "
                      f"which studies.{name}.motions lists", "an `orbits` entry whose types "
                      "include every motion of the study")
+
+
+def _check_orbit_grid_holds(name, entry, at, orbits, other, problems):
+    """A two-wall orbits entry's motions are read at the map's cells from its own grid
+    (`vibroimpact.orbits.cells`: shooting is not run again per cell), so its grid must hold
+    every value of the map's axes."""
+    plane = list(entry.get("plane") or ("inv_beta", "delta"))
+    for key in plane:
+        spec, ospec = entry.get(key), other.get(key)
+        if not isinstance(spec, (list, dict)) or not isinstance(ospec, (list, dict)):
+            continue                        # a plane mismatch, said by its own check
+        try:
+            values, held = grid_values(spec), grid_values(ospec)
+        except (ValueError, TypeError):
+            continue                        # a malformed grid, said by its own check
+        scale = max(1.0, float(np.abs(held).max(initial=0.0)))
+        missing = [float(v) for v in values
+                   if not np.any(np.abs(held - v) <= 1e-9 * scale)]
+        if missing:
+            shown = ", ".join(_num(v) for v in missing[:6]) + (", ..." if len(missing) > 6
+                                                                 else "")
+            problems.add(f"{at}.orbits", orbits, f"orbits.{orbits}.{key} lacks {shown} of the "
+                         f"study's {key} grid: a two-wall entry's motions are read at the "
+                         f"map's cells from its own grid, not solved there",
+                         f"orbits.{orbits}.{key} holding every value of studies.{name}.{key}")
 
 
 #: The parameters a map over a plane and its orbits entry must share (each fixed, or an
@@ -287,7 +314,11 @@ def _check_orbits_item_plane(name, entry, at, orbits, other, problems):
             continue
         a = entry.get(key)
         b = other.get(key, 1.0 if key == "amplitude" else None)
-        if key == "eps_lower" and entry.get("gap") is not None:
+        if key == "eps_lower":
+            if entry.get("gap") is None or other.get("gap") is None:
+                continue            # a wall below in one only: the gap's line says so
+            if a is None and b is None:
+                continue            # both follow eps (fixed alike, or the same axis)
             a = entry["eps"] if a is None else a        # absent with a gap: the study's eps
             b = other["eps"] if b is None else b
         if (a is None) != (b is None) or (a is not None and (
@@ -302,7 +333,9 @@ def _check_orbits_item_plane(name, entry, at, orbits, other, problems):
 def _check_orbits_item_system(entry, at, orbits, other, problems):
     for key in ("zeta", "eps", "gap", "eps_lower"):
         a, b = entry.get(key), other.get(key)
-        if key == "eps_lower" and entry.get("gap") is not None:
+        if key == "eps_lower":
+            if entry.get("gap") is None or other.get("gap") is None:
+                continue            # a wall below in one only: the gap's line says so
             a = entry["eps"] if a is None else a        # absent with a gap: the entry's eps
             b = other["eps"] if b is None else b
         if a != b and (b is None or a is None or float(b) != float(a)):
@@ -378,7 +411,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
                  "[inv_beta, delta] and gap fixed)" if entry.get("gap") is not None else
                  "a `plane: [x, y]` in the study, or the attractors block of an orbits entry "
                  "(the paper's (1/beta_f, delta) plane)")
-        problems.add(f"{where}.attractors", "...", "basins and Lyapunov exponents of a study "
+        problems.add(f"{where}.attractors", None, "basins and Lyapunov exponents of a study "
                      "run over its plane, and this study has none", other)
     shapes_ok = True
     for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
@@ -684,7 +717,7 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
                      "11, 12: a curve per play)", "leave spectra out, or put them in a study "
                      "without a plane at the plane's fixed values")
     if entry.get("escape") and set(plane) & set(NOISE_PARAMETERS):
-        problems.add(f"{where}.escape", "...", f"the escape runs its own noise levels "
+        problems.add(f"{where}.escape", None, f"the escape runs its own noise levels "
                      f"(escape.rms), and the plane {plane} has the rms as an axis",
                      "leave escape out, or a plane without rms")
         ok = False
@@ -756,7 +789,7 @@ def _check_plane_attractors(where, entry, plane, grids, problems):
     before = len(problems)
     noise_axes = sorted(set(plane) & set(NOISE_PARAMETERS))
     if noise_axes:
-        problems.add(at, "...", f"basins and Lyapunov exponents are those of the harmonic force "
+        problems.add(at, None, f"basins and Lyapunov exponents are those of the harmonic force "
                      f"alone, which has no {noise_axes[0]} (a parameter of the noise): the plane "
                      f"{plane} has none", "leave attractors out, or a plane over zeta, eps, "
                      "eps_lower, delta, gap, amplitude or inv_beta")
@@ -1026,10 +1059,15 @@ def _check_orbits_plane(where, entry, problems, limits):
     if "gap" not in plane:
         _check_walls(where, entry, problems)
     if entry.get("attractors"):
-        problems.add(f"{where}.attractors", "...", f"basins and Lyapunov exponents over the "
+        # the one orbits entry with them is a one-wall entry over (inv_beta, delta); a study
+        # with a plane has them over any plane, with a second wall too
+        elsewhere = ("a study with plane: " + str(plane) + " and this gap has them (its "
+                     "`attractors` block)" if entry.get("gap") is not None else
+                     "an entry over (inv_beta, delta) without a gap has them, and so does a "
+                     f"study with plane: {plane}")
+        problems.add(f"{where}.attractors", None, f"basins and Lyapunov exponents over the "
                      f"plane {plane} are not a job of an orbits entry", "leave the attractors "
-                     "block out of an entry with a plane (an entry over (inv_beta, delta) "
-                     "has them)")
+                     f"block out of an entry with a plane; {elsewhere}")
         ok = False
     return ok
 
@@ -1047,7 +1085,7 @@ def _check_two_wall_orbits(where, entry, problems):
                          "solve for", f"[m_upper, m_lower, n] with m_upper + m_lower >= 1 and "
                          f"1 <= n <= {MAX_SHOOTING_N}")
     if entry.get("attractors"):
-        problems.add(f"{where}.attractors", "...", "basins and Lyapunov exponents of a "
+        problems.add(f"{where}.attractors", None, "basins and Lyapunov exponents of a "
                      "two-wall entry are not a workflow job yet", "leave the attractors "
                      "block out of an entry with gap")
 

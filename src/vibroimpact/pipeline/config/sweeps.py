@@ -114,6 +114,9 @@ def _plane(entry):
 def _swept(entry):
     """Whether a study entry is expanded: it lists a value of SWEEP_KEYS that is no axis of
     its plane, or overrides its noise (an rms axis too: its record is the unit-rms one)."""
+    raw = entry.get("plane")
+    if isinstance(raw, list) and any(p not in PLANE_PARAMETERS for p in raw):
+        return False        # a misspelt axis (Eps): the schema names it; no sweep is meant
     plane = _plane(entry)
     return any(isinstance(entry.get(k), list) for k in SWEEP_KEYS if k not in plane) or any(
         k in entry for k in NOISE_KEYS)
@@ -133,10 +136,8 @@ def _axes(name, entry, problems, max_studies):
             problems.add(f"studies.{name}.{key}", value, "an empty list sweeps nothing", allowed_)
             ok = False
         elif any(isinstance(v, (list, dict)) for v in items):
-            named = isinstance(entry.get("plane"), list) and key in entry["plane"]
-            problems.add(f"studies.{name}.{key}", value, "not a number or a list of numbers"
-                         + (f" (plane names {key}, but {key} can be no axis: a plane is two "
-                            f"of {', '.join(PLANE_PARAMETERS)})" if named else ""), allowed_)
+            problems.add(f"studies.{name}.{key}", value, "not a number or a list of numbers",
+                         allowed_)
             ok = False
         elif isinstance(value, list):
             repeated = sorted({_short(v) for i, v in enumerate(value) if v in value[:i]})
