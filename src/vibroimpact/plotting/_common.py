@@ -235,12 +235,13 @@ def symbols(text):
 HEADER_CHARS_PER_INCH = 14.0
 
 
-def _header(fig, title, params):
+def _header(fig, title, params, fit=True):
     """The figure's title and its parameter lines (plain names as symbols, `symbols`),
     long lines broken at their ``";  "`` separators (`HEADER_WIDTH`, or the characters a
-    narrower figure holds); a line still wider than the figure, as its title's font draws it
-    (`_points`), breaks again: at the last ``";  "``, else ``", "``, else space outside maths
-    where what comes before fits."""
+    narrower figure holds); with ``fit``, a line still wider than the figure, as its title's
+    font draws it (`_points`), breaks again: at the last ``";  "``, else ``", "``, else space
+    outside maths where what comes before fits (a figure that shrinks its header's font
+    instead passes ``fit=False``)."""
     width = min(HEADER_WIDTH, int(fig.get_figwidth() * HEADER_CHARS_PER_INCH))
     prop = fig.suptitle(title).get_fontproperties()
     room = 72.0 * fig.get_figwidth() - 2 * HEADER_MARGIN_PT
@@ -250,7 +251,7 @@ def _header(fig, title, params):
             cut = line.rfind(";  ", 0, width + 10)
             lines.append(line[:cut + 1])
             line = line[cut + 3:]
-        while _points(line, prop) > room:
+        while fit and _points(line, prop) > room:
             cut, skip = _break_outside_math(line, lambda head: _points(head, prop) <= room)
             if cut < 0:
                 break

@@ -329,7 +329,7 @@ def work_precision(ds):
     width = fig.get_figwidth()
     key.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 1.0), fontsize=7.5,
                ncols=max(1, min(len(handles), int(width // LEGEND_COLUMN_WIDTH))))
-    _header(fig, WP_TITLE, _wp_params(ds))
+    _header(fig, WP_TITLE, _wp_params(ds), fit=False)     # its two lines kept: `_fit_header`
     notes = [_restart_footnote(ds, starred)] if starred else []
     if missing:
         notes.append(f"{missing} runs found no impact (not drawn)")
