@@ -14,10 +14,14 @@ import subprocess
 import pytest
 
 from helpers import ROOT, SNAKEMAKE, assert_same_data, data_files, make_workdir
+from vibroimpact.pipeline import cluster as cluster_site
+from vibroimpact.pipeline.config import costs
 
 pytestmark = pytest.mark.slurm
 
 CLUSTER = ROOT / "tests" / "slurm" / "cluster.sh"
+#: The test cluster's one partition, and its node's CPUs (all of this host's).
+PARTITION, NODE_CPUS = "debug", os.cpu_count()
 #: Seconds the SLURM build may take; then SIGINT (snakemake cancels its SLURM jobs and
 #: exits), and SIGKILL GRACE seconds later.
 TIMEOUT, GRACE = 900, 60
@@ -45,11 +49,12 @@ def cluster():
         _cluster("stop", 120)
 
 
-def run_bounded(cmd, cwd, timeout=TIMEOUT):
-    """``cmd`` in ``cwd``: (return code, stdout and stderr); past ``timeout`` seconds, SIGINT
-    (snakemake cancels its SLURM jobs and exits), SIGKILL if it still runs, and a failure."""
+def run_bounded(cmd, cwd, timeout=TIMEOUT, env=None):
+    """``cmd`` in ``cwd`` (``env``: its environment): (return code, stdout and stderr); past
+    ``timeout`` seconds, SIGINT (snakemake cancels its SLURM jobs and exits), SIGKILL if it
+    still runs, and a failure."""
     proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                            text=True)
+                            text=True, env=env)
     try:
         out, _ = proc.communicate(timeout=timeout)
     except subprocess.TimeoutExpired:
@@ -64,31 +69,52 @@ def run_bounded(cmd, cwd, timeout=TIMEOUT):
     return proc.returncode, out
 
 
-def slurm_states(run_id):
-    """``{jobid: state}`` of this run's SLURM jobs, from squeue (finished jobs stay listed
-    for MinJobAge, 600 s in tests/slurm/cluster.sh)."""
-    out = subprocess.run(["squeue", "--noheader", "--states=all", "--format=%i|%T",
+def slurm_jobs(run_id):
+    """``{jobid: (state, CPUs, memory MB)}`` of this run's SLURM jobs, from squeue (finished
+    jobs stay listed for MinJobAge, 600 s in tests/slurm/cluster.sh)."""
+    out = subprocess.run(["squeue", "--noheader", "--states=all", "--format=%i|%T|%C|%m",
                           "--name", run_id], capture_output=True, text=True, timeout=60,
                          check=True)
-    return dict(line.split("|") for line in out.stdout.split())
+    jobs = {}
+    for line in out.stdout.split():
+        jobid, state, cpus, mem = line.split("|")
+        jobs[jobid] = (state, int(cpus), _mb(mem))
+    return jobs
+
+
+def _mb(text):
+    """MB of squeue's memory (``1754M``, ``2G``)."""
+    scale = {"K": 1 / 1024, "M": 1, "G": 1024, "T": 1024**2}.get(text[-1:], None)
+    return float(text[:-1]) * scale if scale else float(text)
 
 
 def test_the_datasets_through_slurm_equal_the_local_build(cluster, built, tmp_path):
     workdir = make_workdir(tmp_path / "slurm")
     targets = [str(p) for p in data_files(built)]
+    # what a user of this cluster gives: its partition, no account (it has none), and its
+    # node's CPUs, fewer than the profile's `cores`
+    env = {**os.environ, cluster_site.ACCOUNT_ENV: cluster_site.NO_ACCOUNT,
+           cluster_site.PARTITION_ENV: PARTITION}
     cmd = [SNAKEMAKE, *targets, "--workflow-profile", "workflow/profiles/slurm",
-           "--configfile", "config/test.yaml"]
-    code, out = run_bounded(cmd, cwd=workdir)
+           "--cores", str(NODE_CPUS), "--configfile", "config/test.yaml"]
+    code, out = run_bounded(cmd, cwd=workdir, env=env)
     assert code == 0, out[-5000:]
 
     # SLURM ran them: every submitted job id is a completed job of this run, with its log
     run_id = re.search(r"SLURM run ID: (\S+)", out).group(1)
     submitted = set(re.findall(r"submitted with SLURM jobid (\d+)", out))
     assert submitted, out[-3000:]
-    states = slurm_states(run_id)
-    assert {j: states.get(j) for j in submitted} == {j: "COMPLETED" for j in submitted}
+    jobs = slurm_jobs(run_id)
+    assert {j: jobs.get(j, ("missing",))[0] for j in submitted} == {
+        j: "COMPLETED" for j in submitted}
     logs = workdir / "results" / "logs" / "slurm"
     assert {p.stem for p in logs.rglob("*.log")} == submitted
+    # What SLURM was asked: each job at least the memory of one job of the cost model, and
+    # the threaded orbit tiles their profile's threads (set-threads: 4), capped at --cores
+    kind = {p.stem: p.relative_to(logs).parts[0] for p in logs.rglob("*.log")}
+    assert all(mem >= costs.BASE_MEM_MB for _, _, mem in jobs.values()), jobs
+    tiles = [jobs[j][1] for j in submitted if kind[j].startswith("group_orbit_tiles")]
+    assert tiles and set(tiles) == {min(4, NODE_CPUS)}, (tiles, kind)
     # The profile's groups batched the tiles (a group's log directory is named after the group
     # and its rules); the localrules kept aggregation and figures on the submit host.
     kinds = sorted(p.name for p in logs.iterdir())

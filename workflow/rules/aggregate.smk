@@ -16,8 +16,8 @@ rule aggregate_events:
         "results/benchmarks/aggregate_events/{study}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_events"),
+        runtime=job_runtime("aggregate_events"),
     params:
         block=study_block("events"),
         code=script_code("aggregate_events"),
@@ -41,8 +41,8 @@ rule aggregate_spectra:
         "results/benchmarks/aggregate_spectra/{study}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_spectra"),
+        runtime=job_runtime("aggregate_spectra"),
     params:
         block=study_block("spectra"),
         code=script_code("aggregate_spectra"),
@@ -66,8 +66,8 @@ rule aggregate_map:
     threads: 1
     priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_map"),
+        runtime=job_runtime("aggregate_map"),
     params:
         block=study_block("map"),
         code=script_code("aggregate_map"),
@@ -90,8 +90,8 @@ rule aggregate_escape:
         "results/benchmarks/aggregate_escape/{study}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_escape"),
+        runtime=job_runtime("aggregate_escape"),
     params:
         block=study_block("escape"),
         noise=escape_noise,

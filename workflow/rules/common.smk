@@ -9,7 +9,6 @@
 # by the jobs at run time, never passed through params (a commit alone must not rerun
 # anything).
 from pathlib import Path
-import math
 import shlex
 import sys
 from types import SimpleNamespace
@@ -17,13 +16,12 @@ from types import SimpleNamespace
 from snakemake_interface_executor_plugins.settings import DeploymentMethod
 
 from vibroimpact.pipeline import figures, forked, layout, targets
-from vibroimpact.pipeline.config import costs
+from vibroimpact.pipeline.config import requests
 from vibroimpact.pipeline.digest_cache import cached_code_digest
 from vibroimpact.pipeline.study import (
     JOB_KEYS,
     ORBIT_JOB_KEYS,
     attractor_rows,
-    grid_values,
     orbit_rows,
     plane_attractor_rows,
 )
@@ -113,6 +111,9 @@ def own_files(inputs):
 # cores each (one on 2 cores), so that they pack beside the one-core jobs. Asking for every
 # core, such a job waited until the other jobs drained: in a fresh clone of 70e002c on 2
 # cores, the orbit and attractor tiles ran at 73-108 s of a 142 s build, one after the other.
+# That is this machine's rule; on a cluster the cores of Snakemake's process say nothing of
+# a node's, and the SLURM profile sets each threaded rule's threads itself (`set-threads`,
+# workflow/profiles/slurm), which replaces this default.
 TILE_THREADS = max(1, workflow.cores // 2)
 
 
@@ -367,81 +368,33 @@ def all_targets():
     return targets.all_targets(config, PLAN.drawn)
 
 
-# Resources: the cost model of vibroimpact.pipeline.config.costs (README, "Job costs"), the one
-# the plan uses too.
-BASE_MEM_MB = costs.BASE_MEM_MB
-NOISE_MEM_MB = costs.NOISE_MEM_MB
+# Resources: what a job asks of a scheduler, from its work (cells, steps, records, the
+# map's cells) by the plan's cost model (vibroimpact.pipeline.config.requests; README, "On a
+# SLURM cluster"), times the attempt: a job retried (the SLURM profile's `retries`) asks
+# twice, then three times as much memory and time.
 
 
-def _study_noise_entry(study):
-    return config["noises"][config["studies"][study]["noise"]]
+def job_mem_mb(name):
+    """The memory (MB) a job of rule ``name`` asks at its attempt."""
+
+    def mem_mb(wildcards, attempt):
+        return requests.job_request(name, config, STUDIES, dict(wildcards.items()), attempt).mem_mb
+
+    return mem_mb
 
 
-def simulate_mem_mb(wildcards):
-    scaled = "rms" in STUDIES[wildcards.study].axis_names  # unit record and a cell's
-    return costs.simulate_mem_mb(
-        int(_study_noise_entry(wildcards.study)["n_samples"]), records=2 if scaled else 1
-    )
+def job_runtime(name):
+    """The run time (minutes) a job of rule ``name`` asks at its attempt."""
 
-
-def simulate_runtime(kind):
-    """Minutes of a ``kind`` tile: its cells at the steps of one cell (a map cell: to the cap
-    of the longest forcing period), plus start-up."""
-
-    def runtime(wildcards):
-        if kind == "trace":
-            return costs.simulate_runtime_min(0, 0)
-        entry = config["studies"][wildcards.study]
-        study = STUDIES[wildcards.study]
-        steps = costs.study_steps(
-            kind,
-            entry,
-            _study_noise_entry(wildcards.study),
-            float(study.inv_beta.max()) if kind == "map" else None,
-        )
-        grid = "events" if kind == "map" else kind
-        cells = len(study.tile(int(wildcards.tile), grid))
-        return costs.simulate_runtime_min(cells, steps, audit=kind == "events")
+    def runtime(wildcards, attempt):
+        return requests.job_request(
+            name, config, STUDIES, dict(wildcards.items()), attempt
+        ).runtime
 
     return runtime
-
-
-def escape_runtime_min(wildcards):
-    """Minutes of an escape job: its record generated, its cells simulated on it."""
-    entry = config["studies"][wildcards.study]
-    cpu = costs.escape_cpu_s(entry, escape_noise(wildcards)["dt"], levels=1)
-    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)
-
-
-def escape_mem_mb(wildcards):
-    """Memory of an escape job: the simulate job's, over its own record."""
-    entry = config["studies"][wildcards.study]
-    return costs.simulate_mem_mb(costs.escape_record_samples(entry, escape_noise(wildcards)["dt"]))
-
-
-def attractor_runtime_min(wildcards):
-    """Minutes of an attractor tile: its cells' starts at the cost model's CPU time each,
-    with the simulate jobs' margin and floor."""
-    entry = config["orbits"][wildcards.orbits]
-    rows, n_tiles = attractor_rows(entry)
-    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(
-        grid_values(entry["attractors"]["delta"])
-    )
-    cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
-    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)
 
 
 def plane_attractor_tiles(wildcards):
     """The attractor tiles of plane study ``{study}``."""
     _, n = plane_attractor_rows(config["studies"][wildcards.study])
     return [f"results/cells/{wildcards.study}/attractors/{t}.nc" for t in range(n)]
-
-
-def plane_attractor_runtime_min(wildcards):
-    """Minutes of a plane study's attractor tile: its cells' starts at the cost model's CPU
-    time each, with the simulate jobs' margin and floor."""
-    entry = config["studies"][wildcards.study]
-    rows, n_tiles = plane_attractor_rows(entry)
-    cells = len(rows[int(wildcards.tile) :: n_tiles]) * len(grid_values(entry[entry["plane"][1]]))
-    cpu = costs.attractor_cpu_s(cells, int(entry["attractors"]["n_starts"]))
-    return costs.RUNTIME_FLOOR_MIN + math.ceil(costs.RUNTIME_MARGIN * cpu / 60)

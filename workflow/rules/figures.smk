@@ -29,8 +29,8 @@ rule draw_figure:
         "results/logs/draw_figure/{owner}/{fig}.log",
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("draw_figure"),
+        runtime=job_runtime("draw_figure"),
     conda:
         "../envs/vibroimpact.yaml"
     params:
@@ -58,8 +58,8 @@ rule copy_paper_figure:
         "results/logs/copy_paper_figure/{paper_fig}.log",
     threads: 1
     resources:
-        mem_mb=100,
-        runtime=1,
+        mem_mb=job_mem_mb("copy_paper_figure"),
+        runtime=job_runtime("copy_paper_figure"),
     shell:
         "(cp {input.png} {output.png}.tmp && cp {input.pdf} {output.pdf}.tmp"
         " && mv {output.png}.tmp {output.png} && mv {output.pdf}.tmp {output.pdf}) > {log} 2>&1"

@@ -11,8 +11,8 @@ rule generate_noise:
     threads: 1
     priority: 3  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=NOISE_MEM_MB,
-        runtime=20,
+        mem_mb=job_mem_mb("generate_noise"),
+        runtime=job_runtime("generate_noise"),
     params:
         entry=noise_entry,
         code=script_code("generate_noise"),

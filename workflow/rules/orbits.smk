@@ -16,8 +16,8 @@ rule solve_orbit_tile:
     threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB + 200,
-        runtime=30,
+        mem_mb=job_mem_mb("solve_orbit_tile"),
+        runtime=job_runtime("solve_orbit_tile"),
     params:
         entry=orbits_block("orbits"),
         code=script_code("solve_orbit_tile"),
@@ -37,8 +37,8 @@ rule solve_clearance_orbit_tile:
         "results/benchmarks/solve_clearance_orbit_tile/{orbits}/{tile}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB + 200,
-        runtime=30,
+        mem_mb=job_mem_mb("solve_clearance_orbit_tile"),
+        runtime=job_runtime("solve_clearance_orbit_tile"),
     params:
         entry=orbits_block("orbits"),
         code=script_code("solve_clearance_orbit_tile"),
@@ -62,8 +62,8 @@ rule aggregate_orbits:
     threads: 1
     priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_orbits"),
+        runtime=job_runtime("aggregate_orbits"),
     params:
         entry=orbits_block("orbits"),
         code=script_code("aggregate_orbits"),
@@ -86,8 +86,8 @@ rule solve_map_orbits:
     threads: 1
     priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB + 200,
-        runtime=10,
+        mem_mb=job_mem_mb("solve_map_orbits"),
+        runtime=job_runtime("solve_map_orbits"),
     params:
         code=script_code("solve_map_orbits"),
     script:
@@ -109,8 +109,8 @@ rule trace_boundaries:
     threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB + 200,
-        runtime=30,
+        mem_mb=job_mem_mb("trace_boundaries"),
+        runtime=job_runtime("trace_boundaries"),
     params:
         entry=orbits_block("boundaries"),
         code=script_code("trace_boundaries"),
@@ -132,8 +132,8 @@ rule solve_attractor_tile:
     threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB + 300,
-        runtime=attractor_runtime_min,
+        mem_mb=job_mem_mb("solve_attractor_tile"),
+        runtime=job_runtime("solve_attractor_tile"),
     params:
         entry=orbits_block("attractors"),
         code=script_code("solve_attractor_tile"),
@@ -157,8 +157,8 @@ rule aggregate_attractors:
         "results/benchmarks/aggregate_attractors/{orbits}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_attractors"),
+        runtime=job_runtime("aggregate_attractors"),
     params:
         entry=orbits_block("attractors"),
         code=script_code("aggregate_attractors"),

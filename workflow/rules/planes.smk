@@ -16,8 +16,8 @@ rule solve_plane_attractor_tile:
     # starts run in parallel numba threads: exactly the rule's threads
     threads: TILE_THREADS  # common.smk, "Threads of the tiles"
     resources:
-        mem_mb=BASE_MEM_MB + 300,
-        runtime=plane_attractor_runtime_min,
+        mem_mb=job_mem_mb("solve_plane_attractor_tile"),
+        runtime=job_runtime("solve_plane_attractor_tile"),
     params:
         entry=study_block("attractors"),
         code=script_code("solve_plane_attractor_tile"),
@@ -41,8 +41,8 @@ rule aggregate_plane_attractors:
         "results/benchmarks/aggregate_plane_attractors/{study}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("aggregate_plane_attractors"),
+        runtime=job_runtime("aggregate_plane_attractors"),
     params:
         entry=study_block("attractor_basins"),
         code=script_code("aggregate_plane_attractors"),

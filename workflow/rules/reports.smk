@@ -34,8 +34,8 @@ rule map_predictors:
     threads: 1
     priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB + 300,
-        runtime=10,
+        mem_mb=job_mem_mb("map_predictors"),
+        runtime=job_runtime("map_predictors"),
     params:
         code=script_code("map_predictors"),
     script:
@@ -74,8 +74,8 @@ rule study_report:
         "results/benchmarks/report/{study}/{report}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB + 400,
-        runtime=10,
+        mem_mb=job_mem_mb("study_report"),
+        runtime=job_runtime("study_report"),
     conda:
         "../envs/vibroimpact.yaml"
     params:
@@ -106,8 +106,8 @@ rule orbits_report:
         "results/benchmarks/report/orbits/{orbits}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB + 400,
-        runtime=10,
+        mem_mb=job_mem_mb("orbits_report"),
+        runtime=job_runtime("orbits_report"),
     conda:
         "../envs/vibroimpact.yaml"
     params:
@@ -138,8 +138,8 @@ rule validation_report:
         "results/benchmarks/report/validation/{vreport}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB + 400,
-        runtime=10,
+        mem_mb=job_mem_mb("validation_report"),
+        runtime=job_runtime("validation_report"),
     conda:
         "../envs/vibroimpact.yaml"
     params:

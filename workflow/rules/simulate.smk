@@ -13,8 +13,8 @@ rule simulate_events:
     threads: 1
     priority: 1  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=simulate_mem_mb,
-        runtime=simulate_runtime("events"),
+        mem_mb=job_mem_mb("simulate_events"),
+        runtime=job_runtime("simulate_events"),
     params:
         block=study_block("events"),
         code=script_code("simulate_events"),
@@ -37,8 +37,8 @@ rule simulate_spectra:
     threads: 1
     priority: 1  # a report chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=simulate_mem_mb,
-        runtime=simulate_runtime("spectra"),
+        mem_mb=job_mem_mb("simulate_spectra"),
+        runtime=job_runtime("simulate_spectra"),
     params:
         block=study_block("spectra"),
         code=script_code("simulate_spectra"),
@@ -60,8 +60,8 @@ rule simulate_trace:
         "results/benchmarks/simulate_trace/{study}.tsv"
     threads: 1
     resources:
-        mem_mb=simulate_mem_mb,
-        runtime=simulate_runtime("trace"),
+        mem_mb=job_mem_mb("simulate_trace"),
+        runtime=job_runtime("simulate_trace"),
     params:
         block=study_block("trace"),
         code=script_code("simulate_trace"),
@@ -84,8 +84,8 @@ rule simulate_map:
     threads: 1
     priority: 2  # a long chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=simulate_mem_mb,
-        runtime=simulate_runtime("map"),
+        mem_mb=job_mem_mb("simulate_map"),
+        runtime=job_runtime("simulate_map"),
     params:
         block=study_block("map"),
         code=script_code("simulate_map"),
@@ -106,8 +106,8 @@ rule simulate_escape:
     threads: 1
     priority: 1  # a report chain's head (common.smk, "Priorities")
     resources:
-        mem_mb=escape_mem_mb,
-        runtime=escape_runtime_min,
+        mem_mb=job_mem_mb("simulate_escape"),
+        runtime=job_runtime("simulate_escape"),
     params:
         block=study_block("escape"),
         noise=escape_noise,

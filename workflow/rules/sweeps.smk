@@ -27,8 +27,8 @@ rule draw_sweep:
         "results/benchmarks/draw_sweep/{sweep}.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("draw_sweep"),
+        runtime=job_runtime("draw_sweep"),
     params:
         labels=sweep_labels,
         code=script_code("draw_sweep"),

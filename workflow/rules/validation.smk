@@ -1,8 +1,9 @@
 # The validation targets (docs/figures.md, "Beyond the paper"): the work-precision run of the
 # simulator against its peers, and a seeded sample of the stress families; drawing is
 # cheap and runs locally. The work-precision job compares wall times, so it holds every core
-# of the run (threads = --cores): no other job of the build runs beside it. On SLURM its
-# profile asks for a node to itself (workflow/profiles/slurm).
+# of the run (threads = --cores): no other job of the build runs beside it. On SLURM it is
+# one CPU of a node, or the whole node when the profile's --exclusive is uncommented
+# (workflow/profiles/slurm).
 
 
 rule measure_work_precision:
@@ -18,8 +19,8 @@ rule measure_work_precision:
     threads: workflow.cores
     priority: 7  # first, while every core is free (common.smk, "Priorities")
     resources:
-        mem_mb=BASE_MEM_MB + 200,
-        runtime=10,
+        mem_mb=job_mem_mb("measure_work_precision"),
+        runtime=job_runtime("measure_work_precision"),
     params:
         block=config["validation"]["work_precision"],
         code=script_code("measure_work_precision"),
@@ -39,8 +40,8 @@ rule sample_stress_families:
         "results/benchmarks/sample_stress_families.tsv"
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB + 200,
-        runtime=10,
+        mem_mb=job_mem_mb("sample_stress_families"),
+        runtime=job_runtime("sample_stress_families"),
     params:
         block=config["validation"]["stress"],
         code=script_code("sample_stress_families"),
@@ -67,8 +68,8 @@ rule draw_validation_figure:
         "results/logs/draw_validation_figure/{validation_fig}.log",
     threads: 1
     resources:
-        mem_mb=BASE_MEM_MB,
-        runtime=5,
+        mem_mb=job_mem_mb("draw_validation_figure"),
+        runtime=job_runtime("draw_validation_figure"),
     conda:
         "../envs/vibroimpact.yaml"
     params:

@@ -40,7 +40,7 @@ import subprocess
 import sys
 
 from vibroimpact import _files
-from vibroimpact.pipeline import config, io, layout
+from vibroimpact.pipeline import cluster, config, io, layout
 
 __all__ = ["main"]
 
@@ -80,8 +80,9 @@ def _parser():
                            help=f"the report, relative to the project directory (default "
                                 f"{REPORT}; .html)")
         else:
-            p.add_argument("--cores", type=_cores, default="all",
-                           help="cores of the build: a number, or all (default: all of them)")
+            p.add_argument("--cores", type=_cores, default=None,
+                           help="cores of the build: a number, or all (default: all of them; "
+                                "through a SLURM profile, the profile's)")
         p.add_argument("--directory", default=".",
                        help="the working directory, where results/ is (default .)")
         p.add_argument("-v", "--verbose", action="store_true",
@@ -118,6 +119,20 @@ def _cores(text):
     if value < 1:
         raise argparse.ArgumentTypeError(f"--cores {text}: allowed: a number >= 1, or all")
     return value
+
+
+def profiles(extra):
+    """The profile folders among Snakemake's arguments ``extra`` (``--workflow-profile X``,
+    ``--profile X``, or with ``=``)."""
+    found = []
+    for i, arg in enumerate(extra):
+        name, _, value = arg.partition("=")
+        if name in ("--workflow-profile", "--profile"):
+            if value:
+                found.append(value)
+            elif i + 1 < len(extra):
+                found.append(extra[i + 1])
+    return found
 
 
 def _fail(message, code=2):
@@ -399,7 +414,13 @@ def main(argv=None):
     config_args = ["--configfile", *args.configfile] if args.configfile else []
     if args.command == "report":
         return write_report(root, config_args, args.output)
-    print(plan.format(args.cores), file=sys.stderr if args.command == "run" else sys.stdout)
+    slurm = any(cluster.is_slurm_profile(root / folder) for folder in profiles(extra))
+    if slurm and cluster.site_problem():
+        return _fail(cluster.site_problem())
+    # a cluster's jobs run on its nodes: the cores of this machine are not theirs
+    cores = args.cores or _cores("all")
+    cores_args = [] if slurm and args.cores is None else ["--cores", str(cores)]
+    print(plan.format(cores), file=sys.stderr if args.command == "run" else sys.stdout)
     if args.command == "plan":
         return 0
     unwritable = unwritable_folders(root)
@@ -425,7 +446,7 @@ def main(argv=None):
     if code:
         return code
     # targets before --configfile, which would take them as more config files
-    cmd = [*_snakemake(root), "--cores", str(args.cores), *extra, *config_args]
+    cmd = [*_snakemake(root), *cores_args, *extra, *config_args]
     sys.stdout.flush()
     sys.stderr.flush()
     # a first build (no file under results yet) has no output to miss beneath an up-to-date

@@ -2,17 +2,21 @@
 
 One model, in functions of plain numbers, for the plan (`vibroimpact.pipeline.config.plan`:
 what a build costs, printed and checked against ``limits`` before it runs) and for the
-resources each rule asks of a scheduler (``workflow/rules/common.smk``). The costs were
-measured on the default build (``results/benchmarks/*``, 2 cores; README, "Job costs").
+memory and run time each job asks of a scheduler (`vibroimpact.pipeline.config.requests`,
+which the rules' ``resources:`` call). The costs were measured on the default build
+(``results/benchmarks/*``, 2 cores; README, "Job costs").
 """
+import math
+
 from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps
 
 __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
            "simulate_cpu_s",
-           "simulate_runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
+           "runtime_min", "simulate_mem_mb", "noise_cpu_s", "orbit_cpu_s",
            "orbit_plane_cpu_s",
            "attractor_cpu_s", "boundaries_cpu_s", "escape_record_samples", "escape_cpu_s",
-           "work_precision_cpu_s", "stress_cpu_s", "predictors_cpu_s", "map_orbits_cpu_s"]
+           "work_precision_cpu_s", "stress_cpu_s", "predictors_cpu_s", "map_orbits_cpu_s",
+           "read_mem_mb", "predictors_mem_mb", "orbit_mem_mb", "attractor_mem_mb"]
 
 # --- CPU seconds -----------------------------------------------------------------------------
 #: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
@@ -169,16 +173,37 @@ FIGURE_BYTES = 400_000     # png + pdf
 REPORT_BYTES = 4_000_000   # executed notebook + HTML, figures embedded
 
 # --- what a job asks of a scheduler ----------------------------------------------------------
-#: The simulate job's time asked over the estimate: 2.4 x 25 ns = 60 ns a step, for a slower
-#: or shared node (x3 the ~20 ns measured on one core).
+#: The time a job asks over its CPU estimate: for a simulate job 2.4 x 25 ns = 60 ns a step,
+#: for a slower or shared node (x3 the ~20 ns measured on one core).
 RUNTIME_MARGIN = 2.4
-#: Minutes every simulate job asks besides its steps: start-up, reading, writing.
+#: Minutes every job asks besides its CPU estimate: start-up, reading, writing.
 RUNTIME_FLOOR_MIN = 5
 #: Resident memory of a job (MB): ~550 MB of interpreter, numba and scipy.
 BASE_MEM_MB = 600
 #: A noise job: chunked generation, one chunk (8 MB) plus the 2**22-sample head kept for the
 #: estimates.
 NOISE_MEM_MB = BASE_MEM_MB + 200
+#: What a job that reads a map (its aggregation, its figures, its report, the orbits at its
+#: cells) or simulates a map's tile holds besides `BASE_MEM_MB`, per 1,000 cells of the
+#: largest grid it reads or of its tile: its datasets' variables in memory, a few copies
+#: each. Measured (``benchmarks/job_requests.py``, tests/data/job_requests.json): from the
+#: default map's 5,187 cells to the 20,453 of benchmarks/configs/fine_map.yaml these jobs'
+#: peaks grew by 0.1-1.3 MB per 1,000 cells (aggregate_map 104 -> 123 MB, fig15 236 -> 253,
+#: solve_map_orbits 236 -> 248; a map tile 4 MB per 1,000 cells, 1,297 -> 5,114 cells: 256
+#: -> 271 MB), on peaks of 100-330 MB against the 600 of `BASE_MEM_MB`. 8 (KB a cell) is
+#: twice the tile's growth and six times the readers'.
+READ_MB_PER_KCELL = 8.0
+#: The predictors of a map's P (rule ``map_predictors``), per 1,000 map cells: the bootstrap
+#: of `vibroimpact.reports.predictors` holds up to 7 (resamples, cells) arrays of ranks and
+#: one of cells, 1,000 resamples of 8 bytes (64 MB per 1,000 cells at most). Measured peaks
+#: (``benchmarks/job_requests.py``): 422 MB at the default map's 5,187 cells, 1,049 MB at
+#: the 20,453 of benchmarks/configs/fine_map.yaml (41 MB per 1,000 cells between them), and
+#: 2.87 GB at a map of 81,225 cells (step 0.0125 on both axes, issue 46): asked 808, 1,419
+#: and 3,849 MB.
+PREDICTORS_MB_PER_KCELL = 40.0
+#: An attractor tile's starts (5 float64 a start: the final state, the exponent, the motion)
+#: and an orbit tile's solutions, held while the tile is written: its output's bytes, twice.
+OUTPUT_COPIES = 2
 #: A simulate job: the simulator's chunk buffers (~100 MB at the default chunk of 2**20
 #: samples; the events cell's self-audit adds none measured, its kernel walks the chunk),
 #: besides the noise record held in memory (8 bytes a sample).
@@ -249,9 +274,9 @@ def simulate_cpu_s(cells, steps, audit=False):
     return cells * steps * (NS_PER_STEP + (NS_PER_AUDIT_STEP if audit else 0.0)) * 1e-9
 
 
-def simulate_runtime_min(cells, steps, audit=False):
-    """Minutes a simulate job of ``cells`` cells of ``steps`` steps asks of a scheduler."""
-    return RUNTIME_FLOOR_MIN + int(simulate_cpu_s(cells, steps, audit) * RUNTIME_MARGIN / 60)
+def runtime_min(cpu_s):
+    """Minutes a job of ``cpu_s`` CPU seconds (the plan's estimate) asks a scheduler."""
+    return RUNTIME_FLOOR_MIN + math.ceil(RUNTIME_MARGIN * cpu_s / 60)
 
 
 def simulate_mem_mb(n_samples, records=1):
@@ -259,6 +284,28 @@ def simulate_mem_mb(n_samples, records=1):
     (``records``: copies of it held at once; 2 for a map over the rms, which scales the
     unit-rms record into a cell's)."""
     return BASE_MEM_MB + SIMULATE_BUFFERS_MB + records * -(-8 * n_samples // 2**20)
+
+
+def read_mem_mb(cells):
+    """Memory (MB) a light job adds to `BASE_MEM_MB` reading a grid of ``cells`` cells."""
+    return READ_MB_PER_KCELL * cells / 1000
+
+
+def predictors_mem_mb(cells):
+    """Memory (MB) the predictors of a map of ``cells`` cells add to `BASE_MEM_MB`."""
+    return PREDICTORS_MB_PER_KCELL * cells / 1000
+
+
+def orbit_mem_mb(cells, types=5):
+    """Memory (MB) an orbit tile or the boundaries of ``cells`` cells of ``types`` types add
+    to `BASE_MEM_MB`: its solutions (2 x 34 bytes a cell and type, the plan's bytes)."""
+    return OUTPUT_COPIES * 2 * 34 * cells * types / 2**20
+
+
+def attractor_mem_mb(cells, n_starts):
+    """Memory (MB) an attractor tile of ``cells`` cells of ``n_starts`` starts adds to
+    `BASE_MEM_MB`: its starts' results (the plan's bytes)."""
+    return OUTPUT_COPIES * cells * (8 * 5 * n_starts + 400) / 2**20
 
 
 def noise_cpu_s(n_samples):
