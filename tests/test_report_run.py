@@ -41,9 +41,36 @@ def test_job_costs_read_the_jobs_of_the_owners_and_skip_the_report(tmp_path):
     for rel, row in files.items():
         (bench / rel).parent.mkdir(parents=True, exist_ok=True)
         (bench / rel).write_text(HEADER + row)
-    costs = run.job_costs(["mine", "my_noise", "orbits/mine"], bench)
+    costs = run.job_costs(["mine", "noise/my_noise", "orbits/mine"], bench)
     assert list(costs.rule) == ["aggregate_events", "draw_figure", "generate_noise",
                                 "simulate_events"]
     assert costs["CPU s"].sum() == 7.0 + 1.4 + 2.5 + 0.9
     assert costs["peak memory MB"].max() == 480
     assert run.job_costs(["mine"], tmp_path / "none").empty
+
+
+def test_a_study_and_an_orbits_entry_of_one_name_own_their_own_jobs(tmp_path):
+    """config.yaml names a study and an orbits entry ``harmonic``: the orbits report counts
+    the entry's jobs and the map it reads, not the study's simulations; the study's report
+    not the entry's tiles. A value Snakemake could not measure ("-") is no number."""
+    bench = tmp_path / "benchmarks"
+    files = {"simulate_events/harmonic/0.tsv": "7\t0:00:07\t480\t0\t0\t0\t0\t0\t90\t7.0\n",
+             "draw_figure/harmonic/fig11.tsv": "1\t0:00:01\t200\t0\t0\t0\t0\t0\t80\t0.9\n",
+             "solve_orbit_tile/harmonic/0.tsv": "9\t0:00:09\t300\t0\t0\t0\t0\t0\t90\t9.0\n",
+             "aggregate_attractors/harmonic.tsv": "1\t0:00:01\t-\t0\t0\t0\t0\t0\t90\t0.5\n",
+             "draw_figure/orbits/harmonic/fig16.tsv": "2\t0:00:02\t250\t0\t0\t0\t0\t0\t80\t1.9\n",
+             "simulate_map/motion_map/0.tsv": "30\t0:00:30\t500\t0\t0\t0\t0\t0\t90\t29\n",
+             "simulate_escape/motion_map/0.tsv": "5\t0:00:05\t400\t0\t0\t0\t0\t0\t90\t4.9\n",
+             "generate_noise/harmonic.tsv": "2\t0:00:02\t390\t0\t0\t0\t0\t0\t80\t2.0\n"}
+    for rel, row in files.items():
+        (bench / rel).parent.mkdir(parents=True, exist_ok=True)
+        (bench / rel).write_text(HEADER + row)
+    jobs = {owners: [str(p.relative_to(bench)) for p in run.owner_jobs(owners, bench)]
+            for owners in [("orbits/harmonic", "map/motion_map"), ("harmonic",)]}
+    assert jobs[("orbits/harmonic", "map/motion_map")] == [
+        "aggregate_attractors/harmonic.tsv", "draw_figure/orbits/harmonic/fig16.tsv",
+        "simulate_map/motion_map/0.tsv", "solve_orbit_tile/harmonic/0.tsv"]
+    assert jobs[("harmonic",)] == ["draw_figure/harmonic/fig11.tsv",
+                                   "simulate_events/harmonic/0.tsv"]
+    costs = run.job_costs(["orbits/harmonic"], bench)
+    assert costs["peak memory MB"].isna().sum() == 1 and costs["CPU s"].sum() == 0.5 + 1.9 + 9.0

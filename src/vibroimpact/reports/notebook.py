@@ -1062,12 +1062,14 @@ def run_section(owners, benchmarks, **datasets):
                          f"`{benchmarks}` (a build that kept none, or datasets copied from "
                          f"elsewhere).*"))
         return
+    peak = costs["peak memory MB"]
+    largest = (f"the largest peak memory {peak.max():.0f} MB "
+               f"({costs.loc[peak.idxmax(), 'rule']})" if peak.notna().any()
+               else "no peak memory recorded")
     display(Markdown(
         f"The {len(costs)} jobs behind its datasets and figures, as Snakemake's benchmarks "
         f"measured them: {costs['CPU s'].sum():.1f} CPU-s and {costs['wall s'].sum():.1f} s "
-        f"of wall time in all (jobs run side by side, so the build took less), the largest "
-        f"peak memory {costs['peak memory MB'].max():.0f} MB "
-        f"({costs.loc[costs['peak memory MB'].idxmax(), 'rule']})."))
+        f"of wall time in all (jobs run side by side, so the build took less), {largest}."))
     display(costs.style.format({"CPU s": "{:.2f}", "wall s": "{:.2f}",
                                 "peak memory MB": "{:.0f}"}).hide(axis="index"))
 
@@ -1078,7 +1080,17 @@ def entry_name(path):
     return Path(path).stem if path else ""
 
 
-noise_name = entry_name
+def map_owner(motion_map):
+    """The owner of a map's jobs for :func:`run_section` (``map/<study>``: its tiles and their
+    aggregation), "" for no map."""
+    study = motion_map.attrs.get("study") if motion_map is not None else None
+    return f"map/{study}" if study else ""
+
+
+def noise_name(path):
+    """The owner of a noise record's jobs for :func:`run_section` (``noise/<entry>``), ""
+    for none."""
+    return f"noise/{entry_name(path)}" if path else ""
 
 
 def benchmarks_of(path):

@@ -17,7 +17,17 @@ __all__ = ["versions", "job_costs", "owner_jobs"]
 _TOOL = ("package_version", "git_commit", "git_dirty")
 #: The report's own job is still running while the report is executed: it has no benchmark
 #: yet, and an older one would describe an earlier run.
-_SKIPPED_RULES = ("report", "orbits_report", "validation_report")
+_SKIPPED_RULES = ("report",)
+#: The rules of an owner written ``<kind>/<name>`` (:func:`owner_jobs`): an orbits entry's
+#: (its figures too, ``draw_figure/orbits/<name>/``), a noise record's, and a map study's map
+#: alone (its tiles and their aggregation, not the study's other jobs). A study, an orbits
+#: entry and a noise record may share a name: the kind says whose jobs are meant.
+KINDS = {
+    "orbits": ("solve_orbit_tile", "solve_clearance_orbit_tile", "aggregate_orbits",
+               "trace_boundaries", "solve_attractor_tile", "aggregate_attractors"),
+    "noise": ("generate_noise",),
+    "map": ("simulate_map", "aggregate_map"),
+}
 
 
 def versions(**datasets):
@@ -48,18 +58,31 @@ def versions(**datasets):
 
 
 def owner_jobs(owners, benchmarks):
-    """The benchmark files of the jobs of ``owners`` (studies, orbits entries, noise
-    records; ``orbits/<name>`` for an orbits entry's figures; a rule of one job by its name)
-    under the folder ``benchmarks``: ``<owner>.tsv``, ``<rule>/<owner>.tsv`` and
-    ``<rule>/<owner>/*.tsv``, the report rules left out; sorted by rule and job."""
+    """The benchmark files of the jobs of ``owners`` under the folder ``benchmarks``, the
+    report rules left out, sorted by rule and job. An owner is
+
+    - ``orbits/<name>``, ``noise/<name>`` or ``map/<study>``: the jobs of that kind's rules
+      (`KINDS`) for that entry, ``<rule>/<name>.tsv`` and ``<rule>/<name>/*.tsv``, and an
+      orbits entry's figures;
+    - ``<study>``: every other rule's jobs of that name, its figures among them;
+    - a rule of one job (``measure_work_precision``), or a figure of one
+      (``draw_validation_figure/<name>.tsv``), by its name.
+    """
     root = Path(benchmarks)
+    others = {rule for kind in ("orbits", "noise") for rule in KINDS[kind]}
     found = set()
-    for owner in owners:
-        if not owner:
+    for owner in filter(None, owners):
+        kind, _, name = owner.partition("/")
+        if kind in KINDS and name:
+            for rule in KINDS[kind]:
+                found.update(root.glob(f"{rule}/{name}.tsv"))
+                found.update(root.glob(f"{rule}/{name}/*.tsv"))
+            if kind == "orbits":
+                found.update(root.glob(f"draw_figure/orbits/{name}/*.tsv"))
             continue
         found.update(root.glob(f"{owner}.tsv"))            # a rule of one job
-        found.update(root.glob(f"*/{owner}.tsv"))
-        found.update(root.glob(f"*/{owner}/*.tsv"))
+        found.update(p for p in [*root.glob(f"*/{owner}.tsv"), *root.glob(f"*/{owner}/*.tsv")]
+                     if p.relative_to(root).parts[0] not in others)
     return sorted(p for p in found if p.relative_to(root).parts[0] not in _SKIPPED_RULES)
 
 
@@ -79,7 +102,7 @@ def job_costs(owners, benchmarks):
             continue
         if bench.empty:
             continue
-        last = bench.iloc[-1]
+        last = pd.to_numeric(bench.iloc[-1], errors="coerce")  # Snakemake writes "-" or NA
         rel = path.relative_to(root)
         rows.append({"rule": rel.parts[0], "job": "/".join(rel.parts[1:])[:-len(".tsv")],
                      "CPU s": float(last["cpu_time"]), "wall s": float(last["s"]),
