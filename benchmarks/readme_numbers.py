@@ -273,6 +273,39 @@ def figures_text():
     return "\n".join(rows) + "\n"
 
 
+def requests_text(root=ROOT):
+    """The README's job requests against measured use: per size recorded in
+    tests/data/job_requests.json (``benchmarks/job_requests.py``), each job's peak memory and
+    wall time against what `vibroimpact.pipeline.config.requests` asks at its first attempt."""
+    import json
+
+    from vibroimpact.pipeline.config import costs, requests
+
+    record = json.loads((root / "tests" / "data" / "job_requests.json").read_text())
+    parts = []
+    for size, label in (("default", "Default config"), ("fine_map", "The 4x finer map")):
+        config, plan = configuration.load(root=root, user_files=record[size]["configfiles"])
+        rows = []
+        for job in record[size]["jobs"]:
+            asked = requests.job_request(job["rule"], config, plan.studies, job["wildcards"])
+            rows.append((job["max_rss_mb"], asked.mem_mb, job["s"], asked.runtime, job["rule"]))
+        ratio = sorted(rows, key=lambda r: r[1] / r[0])
+        low, high = ratio[0], ratio[-1]
+        pred = [r for r in rows if r[4] == "map_predictors"]
+        parts.append(
+            f"{label}, {len(rows)} jobs: peaks {min(r[0] for r in rows):,.0f}-"
+            f"{max(r[0] for r in rows):,.0f} MB against requests of "
+            f"{min(r[1] for r in rows):,}-{max(r[1] for r in rows):,} MB, "
+            f"{low[1] / low[0]:.2f} x ({low[4]}, {low[0]:,.0f} of {low[1]:,}) to "
+            f"{high[1] / high[0]:.1f} x ({high[4]}); wall times {min(r[2] for r in rows):.1f}-"
+            f"{max(r[2] for r in rows):.0f} s against {min(r[3] for r in rows)}-"
+            f"{max(r[3] for r in rows)} min"
+            + (f"; `map_predictors` {pred[0][0]:,.0f} of {pred[0][1]:,} MB" if pred else ""))
+    fine = 81_225          # the issue's 16x map, step 0.0125 on both axes
+    return (" " + ". ".join(parts) + f". The predictors of an {fine:,}-cell map (the 16x "
+            f"map, step 0.0125) ask {costs.BASE_MEM_MB + costs.predictors_mem_mb(fine):,.0f} MB. ")
+
+
 def rewrite(readme, blocks):
     """``readme`` with the text of each ``<!-- readme_numbers:NAME -->`` block replaced."""
     text = Path(readme).read_text()
@@ -299,7 +332,7 @@ def main(argv=None):
     args = parser.parse_args(argv)
     blocks = {"plan": plan_text(), "figures": figures_text()}
     blocks.update({name: example_plan_text(name) for name in EXAMPLES},
-                  plan_finer=finer_plan_text())
+                  plan_finer=finer_plan_text(), requests=requests_text())
     docs = {}
     if not args.plan_only:
         numbers = build_numbers(args.results)

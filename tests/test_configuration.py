@@ -131,7 +131,8 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
 def test_the_readme_quotes_the_current_plan_and_figure_table():
     """The README's generated blocks (benchmarks/readme_numbers.py --write README.md) are
     those of this tree: the plans of the default config and of the shipped examples, and the
-    table of which figure an entry may list and what it needs. A change to any fails here
+    table of which figure an entry may list and what it needs, and the jobs' requests against
+    their recorded use (tests/data/job_requests.json). A change to any fails here
     until the script is re-run; the build's own numbers name their build's commit and are
     not checked."""
     import importlib.util
@@ -153,6 +154,7 @@ def test_the_readme_quotes_the_current_plan_and_figure_table():
     for name in module.EXAMPLES:        # the shipped examples' plans, e.g. their job counts
         assert block(name) == module.example_plan_text(name)
     assert block("plan_finer") == module.finer_plan_text()
+    assert block("requests") == module.requests_text()   # the recorded use, today's requests
     for fig in figures.FIGURES:
         assert f"| `{fig}` |" in block("figures")
 

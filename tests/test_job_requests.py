@@ -55,6 +55,13 @@ def test_the_measurements_cover_the_submitted_rules_at_two_sizes():
             for size in ("default", "fine_map")}
     peak = {size: max(j["max_rss_mb"] for j in jobs[size]) for size in jobs}
     assert peak["fine_map"] > 1.5 * peak["default"], peak
+    asked = {}
+    for size in jobs:
+        config, plan = configuration.load(root=ROOT, user_files=MEASURED[size]["configfiles"])
+        asked[size] = max(requests.job_request("map_predictors", config, plan.studies,
+                                               j["wildcards"]).mem_mb for j in jobs[size])
+    # the request grows with the map by more than the base: the model, not a constant
+    assert asked["fine_map"] - asked["default"] > 0.5 * (peak["fine_map"] - peak["default"])
     local = set(re.findall(r"rule (\w+):\n(?:    .*\n)*?    localrule: True", RULES_TEXT))
     every = set(re.findall(r"^rule (\w+):", RULES_TEXT, re.M))
     assert every == set(requests.RULES)

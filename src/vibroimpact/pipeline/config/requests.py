@@ -174,24 +174,24 @@ def _sample_stress_families(config, studies, w):
     return costs.JOB_START_S + costs.stress_cpu_s(block), costs.BASE_MEM_MB
 
 
-def _read_cells(config, studies, w):
-    """The cells of the largest grid a light job (an aggregation, a figure, a report) reads:
-    its study's map (and its ``report_with``'s), or an orbits entry's attractor map and the
-    maps drawn over it."""
+def _read_mem(config, studies, w):
+    """Memory (MB, besides `costs.BASE_MEM_MB`) of the grids a light job (an aggregation, a
+    figure, a report) reads: its study's map (and its ``report_with``'s), or an orbits
+    entry's orbit map and the largest of its attractor map and the maps drawn over it."""
     if "study" in w:
         names = [w["study"], *config["studies"][w["study"]].get("report_with", [])]
-        return max(map_cells(studies, n) for n in names)
+        return costs.read_mem_mb(max(map_cells(studies, n) for n in names))
     if "orbits" in w:
-        return _orbits_read_cells(config, studies, w["orbits"])
+        return _orbits_read_mem(config, studies, w["orbits"])
     if "owner" in w:                # draw_figure: a study's or "orbits/<name>"
         owner = w["owner"]
         if owner.startswith("orbits/"):
-            return _orbits_read_cells(config, studies, owner.split("/", 1)[1])
-        return map_cells(studies, owner)
-    return 0
+            return _orbits_read_mem(config, studies, owner.split("/", 1)[1])
+        return costs.read_mem_mb(map_cells(studies, owner))
+    return 0.0
 
 
-def _orbits_read_cells(config, studies, name):
+def _orbits_read_mem(config, studies, name):
     entry = config["orbits"][name]
     cells = [0]
     if entry.get("attractors"):
@@ -201,12 +201,14 @@ def _orbits_read_cells(config, studies, name):
         for item in s_entry.get("figures", []):
             if isinstance(item, dict) and item.get("orbits") == name:
                 cells.append(map_cells(studies, study))
-    return max(cells)
+    # the orbit map itself (Fig. 16's grid, the largest an orbits entry has), its solutions
+    return (costs.read_mem_mb(max(cells))
+            + costs.orbit_mem_mb(orbit_plane_cells(entry), len(entry["types"])))
 
 
 def _light(cpu_s):
     def work(config, studies, w):
-        return cpu_s, costs.BASE_MEM_MB + costs.read_mem_mb(_read_cells(config, studies, w))
+        return cpu_s, costs.BASE_MEM_MB + _read_mem(config, studies, w)
     return work
 
 
