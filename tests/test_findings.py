@@ -319,6 +319,10 @@ def test_mirror_check_on_a_map_swaps_the_motions_walls():
     table = two_walls.map_mirror_table(ds)
     assert set(table.statistic) == {"P((1,1)/1)", "P((1,0)/1) against P((0,1)/1)"}
     assert table.agree.all() and len(table) == 3     # (1,1)/1 at 0-2; (1,0)/(0,1) at 0-2, 1-1
+    # the same plane written [delta, inv_beta] (a plane study's axes, either order)
+    swapped = ds.transpose("motion", "delta", "inv_beta").assign_attrs(axes=["delta", "inv_beta"])
+    assert two_walls.map_mirror_table(swapped).equals(table)
+    assert two_walls.mirror_check(motion_map=swapped).holds == "yes"
     ds["probability"].loc[dict(motion="(0,1)/1", delta=2.0)] = 0.5
     found = two_walls.mirror_check(motion_map=ds)
     assert found.holds == "no"                       # 2 of 3 agree (< 3 in 4)

@@ -26,9 +26,14 @@ def _grid_text(values):
 
 def _on_grid(ds, motion_map, axes):
     """``ds`` with the map's coordinates; ValueError naming both grids unless its cells are
-    the map's (same values to 1e-9)."""
+    the map's (same values to 1e-9 of the larger of 1 and the grid's largest magnitude, the
+    config check's tolerance: `vibroimpact.pipeline.config.checks`)."""
+    def scale(d):
+        return max(1.0, float(np.abs(motion_map[d].values).max(initial=0.0)))
+
     same = all(d in ds.dims and ds.sizes[d] == motion_map.sizes[d]
-               and np.allclose(ds[d].values, motion_map[d].values, rtol=0.0, atol=1e-9)
+               and np.allclose(ds[d].values, motion_map[d].values, rtol=0.0,
+                               atol=1e-9 * scale(d))
                for d in axes)
     if not same:
         def grid(data):

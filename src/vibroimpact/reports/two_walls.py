@@ -46,7 +46,7 @@ def mirror_pairs(ds):
     ``d <= gap - d`` (a play at gap / 2 is its own mirror image: its two walls are compared).
     Empty when the walls' restitutions differ (then no setting is a mirror image), and for a
     map over another plane than (1/beta_f, delta) (its gap or restitutions may be axes)."""
-    if dataset_axes(ds) != DEFAULT_PLANE:
+    if set(dataset_axes(ds)) != set(DEFAULT_PLANE):     # either order of its axes
         return []
     gap = float(ds.attrs["gap"])
     if not np.isclose(float(ds.attrs["eps"]), float(ds.attrs["eps_lower"]), rtol=0, atol=1e-12):
@@ -197,7 +197,7 @@ def mirror_check(events=None, spectra_shift=None, motion_map=None):
     if not is_two_wall(ds):
         return Finding("mirror", MIRROR_CLAIM, "a one-wall study: no mirror image", "n/a")
     axes = dataset_axes(ds)
-    if axes != DEFAULT_PLANE:
+    if set(axes) != set(DEFAULT_PLANE):
         return Finding("mirror", MIRROR_CLAIM, f"the map runs over ({axes[0]}, {axes[1]}): "
                        f"the check pairs the plays delta and gap - delta at each 1/beta_f, "
                        f"one gap and one restitution (a map over (1/beta_f, delta))", "n/a")
