@@ -102,9 +102,9 @@ class Sweeps:
 
 def _plane(entry):
     """The parameters a study's ``plane`` names that can be axes (grids, not sweeps), or ().
-    A name no plane takes (``seed``) stays a sweep key: the schema names the plane's
-    mistake, and nothing reads the key as an axis meanwhile (a seed list was given the
-    unit-rms value of an rms axis, and refused as "seed = 1.0")."""
+    A name no plane takes (``seed``) is no axis: the schema names the plane's mistake, and
+    nothing reads the key as an axis meanwhile (a seed list was given the unit-rms value of
+    an rms axis, and refused as "seed = 1.0"); such a plane sweeps nothing (`_swept`)."""
     plane = entry.get("plane")
     if not isinstance(plane, list):
         return ()
