@@ -47,6 +47,9 @@ def test_job_costs_read_the_jobs_of_the_owners_and_skip_the_report(tmp_path):
     assert costs["CPU s"].sum() == 7.0 + 1.4 + 2.5 + 0.9
     assert costs["peak memory MB"].max() == 480
     assert run.job_costs(["mine"], tmp_path / "none").empty
+    (bench / "measure_work_precision.tsv").write_text(HEADER + files["aggregate_events/mine.tsv"])
+    one = run.job_costs(["measure_work_precision"], bench)     # a rule of one job
+    assert one[["rule", "job"]].values.tolist() == [["measure_work_precision", ""]]
 
 
 def test_a_study_and_an_orbits_entry_of_one_name_own_their_own_jobs(tmp_path):

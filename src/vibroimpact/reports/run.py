@@ -103,8 +103,8 @@ def job_costs(owners, benchmarks):
         if bench.empty:
             continue
         last = pd.to_numeric(bench.iloc[-1], errors="coerce")  # Snakemake writes "-" or NA
-        rel = path.relative_to(root)
-        rows.append({"rule": rel.parts[0], "job": "/".join(rel.parts[1:])[:-len(".tsv")],
+        rel = path.relative_to(root).with_suffix("")     # <rule>[/<owner>[/<part>]]
+        rows.append({"rule": rel.parts[0], "job": "/".join(rel.parts[1:]),
                      "CPU s": float(last["cpu_time"]), "wall s": float(last["s"]),
                      "peak memory MB": float(last["max_rss"])})
     return pd.DataFrame(rows, columns=["rule", "job", "CPU s", "wall s", "peak memory MB"])
