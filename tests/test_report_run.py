@@ -3,6 +3,7 @@ beside the report's own environment, and the costs of the jobs behind it from Sn
 benchmark files."""
 import json
 
+import pytest
 import xarray as xr
 
 from vibroimpact._release import SOFTWARE, software
@@ -81,3 +82,46 @@ def test_a_study_and_an_orbits_entry_of_one_name_own_their_own_jobs(tmp_path):
                                    "simulate_events/harmonic/0.tsv"]
     costs = run.job_costs(["orbits/harmonic"], bench)
     assert costs["peak memory MB"].isna().sum() == 1 and costs["CPU s"].sum() == 0.5 + 1.9 + 9.0
+
+
+def test_rule_costs_sum_every_job_of_the_build_by_rule_beside_the_plan(tmp_path):
+    """Snakemake's report's table (rule ``job_costs``): the owners of a build
+    (`run.build_owners`) take every job, the reports too (an orbits entry's under
+    ``report/orbits/``), none of another config; the sums by rule and the total row are the
+    files' own; the plan's jobs and CPU stand beside them."""
+    bench = tmp_path / "benchmarks"
+    files = {"simulate_events/mine/0.tsv": (7.5, 480, 7.0),
+             "simulate_events/mine/1.tsv": (6.5, 500, 6.0),
+             "aggregate_events/mine.tsv": (1.5, 180, 1.4),
+             "generate_noise/my_noise.tsv": (2.6, 390, 2.5),
+             "solve_orbit_tile/mine/0.tsv": (9, 300, 8.5),
+             "draw_figure/orbits/mine/fig16.tsv": (1, 200, 0.9),
+             "report/mine/harmonic_random.tsv": (20, 900, 19),
+             "report/orbits/mine.tsv": (4, 250, 3.5),
+             "draw_sweep/my_sweep.tsv": (2, 210, 1.8),
+             "measure_work_precision.tsv": (10, 260, 10.5),
+             "simulate_events/other/0.tsv": (9, 999, 9.0)}      # another config's study
+    _benchmarks(bench, files)
+    build = {"studies": {"mine": {"events"}}, "orbits": {"mine": {"orbits"}},
+             "noises": {"my_noise"}, "sweeps": {"my_sweep"}, "validation": {"x"}}
+    owners = run.build_owners(build)
+    table = run.rule_costs(owners, bench, planned={"simulate_events": (2, 12.0),
+                                                   "report": (2, 20.0)})
+    mine = {k: v for k, v in files.items() if "other" not in k}
+    assert table.loc["all", "jobs"] == len(mine) == table["jobs"].drop("all").sum()
+    assert table.loc["simulate_events"].tolist()[:5] == [2, 13.0, 14.0, 7.5, 500]
+    assert table.loc["report", "jobs"] == 2 and table.loc["report", "CPU s"] == 22.5
+    assert table.loc["all", "CPU s"] == pytest.approx(sum(cpu for _, _, cpu in mine.values()))
+    assert table.loc["all", "peak memory MB"] == 900
+    assert table.loc["all", "longest job s"] == 20
+    assert table.loc["simulate_events", "planned CPU s"] == 12.0
+    assert table.loc["generate_noise", "planned jobs"] == 0       # not in the plan given
+    run.write_rule_costs(table, tmp_path / "costs.html", tmp_path / "costs.tsv")
+    page = (tmp_path / "costs.html").read_text()
+    assert f"{len(mine)} jobs of {len(table) - 1} kinds" in page and "<table" in page
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["benchmarks", "costs.html",
+                                                          "costs.tsv"]
+    empty = run.rule_costs(owners, tmp_path / "none")
+    assert empty.empty
+    run.write_rule_costs(empty, tmp_path / "e.html", tmp_path / "e.tsv")
+    assert "No benchmark file" in (tmp_path / "e.html").read_text()

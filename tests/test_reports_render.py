@@ -19,6 +19,7 @@ from types import SimpleNamespace
 
 import nbformat
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
 import xarray as xr
@@ -318,11 +319,13 @@ def test_the_provenance_table_has_a_column_per_dataset_and_wraps_its_hashes():
     assert "word-break: break-all" in html and "table-layout: fixed" in html
 
 
-def _fake_snakemake(tmp_path, body, code):
+def _fake_snakemake(tmp_path, body, code, costs=0):
     """A `snakemake` command (`cli._snakemake`'s words) that writes ``body`` to its ``--report``
-    file and exits with ``code``."""
+    file and exits with ``code``; called without ``--report`` (the job costs, written first),
+    exits with ``costs``."""
     script = tmp_path / "snakemake"
     script.write_text(f"#!{sys.executable}\nimport sys\n"
+                      f"if '--report' not in sys.argv: sys.exit({costs})\n"
                       f"path = sys.argv[sys.argv.index('--report') + 1]\n"
                       f"open(path, 'w').write({body!r})\nsys.exit({code})\n")
     script.chmod(0o755)
@@ -343,6 +346,10 @@ def test_a_failed_report_leaves_the_previous_one_whole(tmp_path, monkeypatch):
     assert report.read_text() == "<html>whole</html>"
     monkeypatch.setattr(cli, "_snakemake", lambda root: _fake_snakemake(tmp_path, "<html>half", 1))
     assert cli.main(["report", "--directory", str(workdir)]) == 1
+    assert report.read_text() == "<html>whole</html>"
+    monkeypatch.setattr(cli, "_snakemake",
+                        lambda root: _fake_snakemake(tmp_path, "<html>new</html>", 0, costs=1))
+    assert cli.main(["report", "--directory", str(workdir)]) == 1     # the job costs failed
     assert report.read_text() == "<html>whole</html>"
     assert [p.name for p in (workdir / "results").iterdir()] == ["report.html"]
 
@@ -421,8 +428,17 @@ def test_snakemake_report_has_each_figure_once_and_no_docutils_error(built):
     assert len(shown) == len(set(shown))
     paper = [path for paths in categories["paper"].values() for path in paths]
     assert len(paper) == len(copies) and all(p.startswith("results/figures/") for p in paper)
-    reports = [p for p in shown if p.startswith("results/reports/")]
+    reports = [p for p in shown if p.startswith("results/reports/")
+               and p != "results/reports/job_costs.html"]
     assert len(reports) == len(REPORTS) and all(p.endswith(".summary.html") for p in reports)
+    # the build's jobs by rule, every benchmark file of the build counted once
+    assert categories["run"] and "results/reports/job_costs.html" in shown
+    costs = pd.read_csv(built / "results" / "reports" / "job_costs.tsv", sep="\t",
+                        index_col="rule")
+    files = list((built / "results" / "benchmarks").rglob("*.tsv"))
+    assert costs.loc["all", "jobs"] == len(files) == costs["jobs"].drop("all").sum()
+    assert (costs["jobs"].drop("all") == costs["planned jobs"].drop("all")).all()
+    assert {"simulate_events", "report", "draw_figure"} <= set(costs.index)
 
 
 def test_report_parameters_are_typed_as_papermills_command_line_types_them():

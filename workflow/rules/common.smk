@@ -357,6 +357,15 @@ def report_arguments(wildcards, input):
     return arguments.papermill_arguments(parameters)
 
 
+def build_owners(wildcards):
+    """The owners of every job of this build, for rule job_costs
+    (`vibroimpact.reports.run.build_owners`)."""
+    from vibroimpact.pipeline.config.plan import built_entries
+    from vibroimpact.reports import run
+
+    return run.build_owners(built_entries(config, PLAN.drawn)[1])
+
+
 # --- targets of `rule all` ------------------------------------------------------------------
 # The same lists the plan walks (vibroimpact.pipeline.targets.needed_files), so the plan counts
 # the jobs this DAG schedules.

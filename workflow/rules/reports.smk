@@ -148,3 +148,34 @@ rule validation_report:
         code=report_code,
     shell:
         REPORT_SHELL
+
+
+# The costs of the build's jobs by rule, for Snakemake's report: not a target of `rule all`
+# (it reads every job's benchmark file, so it would rerun after every change and sit in
+# every figure's DAG); `vibroimpact report` (and `make`) builds it, forced, just before
+# `snakemake --report`, and asks the report for it beside `all`.
+rule job_costs:
+    """The CPU time, wall time and peak memory of this build's jobs, by rule, beside the plan."""
+    localrule: True
+    output:
+        html=report(
+            "results/reports/job_costs.html",
+            caption="../report/job_costs.rst",
+            category="run",
+            labels={"figure": "job costs by rule"},
+        ),
+        tsv="results/reports/job_costs.tsv",
+    log:
+        "results/logs/job_costs.log",
+    threads: 1
+    resources:
+        mem_mb=job_mem_mb("job_costs"),
+        runtime=job_runtime("job_costs"),
+    conda:
+        "../envs/vibroimpact.yaml"
+    params:
+        owners=build_owners,
+        benchmarks="results/benchmarks",
+        planned=lambda wildcards: PLAN.rule_costs(),
+    script:
+        "../scripts/job_costs.py"

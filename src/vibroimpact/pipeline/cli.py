@@ -19,9 +19,10 @@ config is the base layer of the user's.
           with ``snakemake`` (the default profile, ``profiles/default``, reruns the jobs a
           crash interrupted).
 ``report`` writes Snakemake's own report of the build (``snakemake --report``: every figure
-          once, captioned, and the HTML reports) to ``results/report.html``, whole or not at
-          all: it is rendered elsewhere and moved into place only when complete (``make``
-          runs it after ``run``).
+          once, captioned, the HTML reports, and the costs of the build's jobs by rule,
+          ``results/reports/job_costs.html``, which it writes first from the benchmark
+          files) to ``results/report.html``, whole or not at all: it is rendered elsewhere
+          and moved into place only when complete (``make`` runs it after ``run``).
 ``stale``  lists (``--delete``: removes) the outputs of the config's entries that it no longer
           builds (`vibroimpact.pipeline.stale`).
 ``warm``   compiles every numba kernel the jobs call into numba's cache, once per installation
@@ -106,6 +107,9 @@ OUTPUT_SUFFIXES = (".png", ".pdf", ".nc", ".html", ".ipynb", ".tsv")
 
 #: Where ``report`` writes Snakemake's report (README, "Reports").
 REPORT = "results/report.html"
+#: The costs of the build's jobs by rule (rule ``job_costs``), written by ``report`` just
+#: before Snakemake's report and shown in it.
+JOB_COSTS = "results/reports/job_costs.html"
 
 
 def _cores(text):
@@ -359,7 +363,9 @@ def with_forcerun(cmd, files):
 
 
 def write_report(root, config_args, output=REPORT):
-    """``snakemake --report`` into a scratch directory, then moved to ``root / output`` in
+    """The costs of the build's jobs by rule (`JOB_COSTS`, rule ``job_costs``: no input, so
+    it runs alone, forced, from the benchmark files on disk), then ``snakemake --report``
+    of ``rule all`` and that table into a scratch directory, moved to ``root / output`` in
     one rename (:func:`vibroimpact._files.atomic_path`): a report that fails or is
     interrupted leaves the previous ``output`` as it was, never a half-written one."""
     import tempfile
@@ -367,11 +373,16 @@ def write_report(root, config_args, output=REPORT):
     target = root / output
     if target.suffix != ".html":
         return _fail(f"--output {output}: allowed: a file name ending in .html")
+    sys.stdout.flush()
+    code = subprocess.run([*_snakemake(root), "--cores", "1", "--quiet", "--forcerun",
+                           "job_costs", *config_args, "--", JOB_COSTS], cwd=root).returncode
+    if code != 0:
+        return _fail(f"the job costs ({JOB_COSTS}) failed (exit {code}); {output} is left as "
+                     f"it was", code=1)
     with tempfile.TemporaryDirectory(prefix="vibroimpact-report-") as scratch:
         draft = Path(scratch) / "report.html"
-        sys.stdout.flush()
-        code = subprocess.run([*_snakemake(root), "--report", str(draft), *config_args],
-                              cwd=root).returncode
+        code = subprocess.run([*_snakemake(root), "--report", str(draft), *config_args,
+                               "--", "all", JOB_COSTS], cwd=root).returncode
         if code != 0 or not draft.is_file():
             return _fail(f"snakemake --report failed (exit {code}); {output} is left as it was",
                          code=1)

@@ -242,6 +242,7 @@ _WORK = {
     "study_report": _light(costs.REPORT_S + costs.MAP_REPORT_S + costs.JOB_START_S),
     "orbits_report": _light(costs.REPORT_S + costs.MAP_REPORT_S + costs.JOB_START_S),
     "validation_report": _light(costs.REPORT_S + costs.JOB_START_S),
+    "job_costs": _light(costs.JOB_START_S),
 }
 #: Every rule :func:`job_request` costs (the workflow's rules: tests/test_job_requests.py).
 RULES = tuple(_WORK)
