@@ -19,9 +19,9 @@ CORES  ?= all
 # installation, vibroimpact.warm, and every build and suite loads them from numba's cache)
 FAST_WORKERS ?= -n 2
 # the slow, workflow and SLURM suites in one session on both cores: every test of the built
-# test config on one worker (xdist group `built`, tests/conftest.py), the rebuild-scope
-# module's own build on one worker (group `rebuild_scope`), every other test on whichever
-# worker is free. xdist hands out the largest group first, so the two builds start at once.
+# test config on one worker (xdist group `built`, tests/conftest.py: the rebuild-scope cases
+# start from a copy of that build), every other test on whichever worker is free. xdist
+# hands out the largest group first, so the build starts at once.
 LONG_WORKERS ?= -n 2 --dist loadgroup
 LONG_MARKERS := slow or workflow or slurm
 # The exact environment: requirements.lock (every distribution, its version and hashes,

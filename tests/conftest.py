@@ -6,13 +6,12 @@ workers with ``--dist loadgroup`` (xdist hands out the largest group first, then
 test at a time to whichever worker is free). Every test that reads the build of the test config
 (the ``built`` fixture, directly or through another fixture) is put in one xdist group,
 ``built``, so one worker builds the test config once and runs all of them in turn, while the
-other worker runs the suites that build their own copies (rebuild scope, faults, sweeps,
-degenerate and escape studies) and the slow tests, each test on whichever worker is free. A
-module whose module-scoped fixture is a build of its own (test_rebuild_scope.py) puts its tests
-in one group itself (``pytest.mark.xdist_group``), so that build is made on one worker only;
-the cheap module-scoped copies (test_config_errors.py's ``copy_dir``) are made once per worker,
-and their tests spread over both. Without ``--dist loadgroup`` (plain ``-n 2``, or no xdist)
-the groups are inert and ``built`` is still built once per session.
+other worker runs the suites that build their own copies (faults, sweeps, degenerate and
+escape studies) and the slow tests, each test on whichever worker is free. The rebuild-scope
+cases (test_rebuild_scope.py) start from a copy of ``built`` with Snakemake's records, not from
+a build of their own. The cheap module-scoped copies (test_config_errors.py's ``copy_dir``) are
+made once per worker, and their tests spread over both. Without ``--dist loadgroup`` (plain
+``-n 2``, or no xdist) the groups are inert and ``built`` is still built once per session.
 The numba cache lives beside the installed (editable) package, so every build in every copy
 reuses the kernels compiled by the first; a copy that imports the package from its own sources
 (test_rebuild_scope.py) gets that cache copied (helpers.copy_kernel_cache).

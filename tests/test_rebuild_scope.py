@@ -1,14 +1,16 @@
 """Rebuild scope: after a build, an edit reruns exactly the jobs it touches
 (README, "What reruns").
 
-The test config is built once in a temporary git repository holding the working tree; each case
-edits one thing there and reads the job list of ``snakemake -n``. The package is imported from
+The session's build of the test config (``built``) is copied, with Snakemake's records, into a
+temporary git repository holding the working tree; each case edits one thing there and reads
+the job list of ``snakemake -n``. The package is imported from
 that copy (PYTHONPATH), so an edit of its sources is an edit of the code the workflow runs. A
 code edit is a statement appended to a module: comments and docstrings rerun nothing.
 """
 import os
 from pathlib import Path
 import re
+import shutil
 import socket
 import subprocess
 import sys
@@ -16,11 +18,11 @@ import sys
 import pytest
 import yaml
 
-from helpers import copy_kernel_cache, copy_tree
+from helpers import RUN_STATE, copy_kernel_cache, copy_tree
 
-#: one xdist worker for the module (`make test` runs it with --dist loadgroup): `repo` is a
-#: whole build of the test config, made once
-pytestmark = [pytest.mark.workflow, pytest.mark.xdist_group("rebuild_scope")]
+#: on the worker of the session's build (`make test` runs it with --dist loadgroup): `repo`
+#: starts from a copy of it
+pytestmark = [pytest.mark.workflow, pytest.mark.xdist_group("built")]
 
 ROOT = Path(__file__).resolve().parents[1]
 SNAKEMAKE = str(Path(sys.executable).with_name("snakemake"))
@@ -73,15 +75,19 @@ def scheduled(repo):
 
 
 @pytest.fixture(scope="module")
-def repo(tmp_path_factory):
-    """A git repository holding the working tree, with the test config built (with the kernels
-    the session has compiled: numba's cache is not in git, and no case runs a kernel edited)."""
+def repo(tmp_path_factory, built):
+    """A git repository holding the working tree, with the session's build of the test config
+    and Snakemake's records of it (the code, params and inputs of every output: the package
+    in the copy is the same, so nothing is scheduled), and the kernels the session has
+    compiled (numba's cache is not in git, and no case runs a kernel edited)."""
     repo = copy_tree(tmp_path_factory.mktemp("rebuild"))
     copy_kernel_cache(repo)
+    shutil.copytree(built / "results", repo / "results")
+    shutil.copytree(built / ".snakemake", repo / ".snakemake", symlinks=True,
+                    ignore=shutil.ignore_patterns(*RUN_STATE))
     _git(repo, "init", "-q")
     _git(repo, "add", "-A")
     _git(repo, "commit", "-qm", "base")
-    _snakemake(repo)
     assert scheduled(repo) == {}
     return repo
 
