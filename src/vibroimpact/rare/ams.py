@@ -84,7 +84,7 @@ class SplittingRun:
         return int(self.killed.size)
 
 
-def ams(dynamics, starts, z_max, seed, *, run=0, k=1, max_iterations=10**6):
+def ams(dynamics, starts, seed, *, z_max=math.inf, run=0, k=1, max_iterations=10**6):
     """Adaptive multilevel splitting from the given starting states.
 
     Parameters
@@ -94,10 +94,13 @@ def ams(dynamics, starts, z_max, seed, *, run=0, k=1, max_iterations=10**6):
     starts : sequence of PathState
         The ``n >= 2`` initial states (one path each), distributed as the law the
         probability is conditioned on.
-    z_max : float
-        Stop when the ``k``-th smallest score reaches ``z_max`` (reaction coordinate units).
     seed : int or numpy.random.SeedSequence
         Root of the seed tree (module docstring).
+    z_max : float, optional
+        Stop when the ``k``-th smallest score reaches ``z_max`` (reaction coordinate units;
+        finite, or ``inf``, the default: stop once ``n - k + 1`` paths reached B, each of
+        the others killed on its way, the choice for a coordinate that can exceed the level
+        outside B).
     run : int, optional
         The run's index in the tree, ``>= 0``.
     k : int, optional
@@ -115,7 +118,10 @@ def ams(dynamics, starts, z_max, seed, *, run=0, k=1, max_iterations=10**6):
     if n < 2:
         raise ValueError(f"starts must hold at least 2 states, got {n}")
     k = _checks.integer("k", k, low=1, high=n - 1)
-    z_max = _checks.real("z_max", z_max)
+    if isinstance(z_max, (int, float)) and z_max == math.inf:
+        z_max = math.inf
+    else:
+        z_max = _checks.real("z_max", z_max)
     steps0 = dynamics.n_steps
     paths = [dynamics.run(s, _rng(seed, run, 1, i)) for i, s in enumerate(starts)]
     scores = np.array([p.score for p in paths])
@@ -194,8 +200,8 @@ class FirstPassage:
     n_steps: int
 
 
-def first_passage(dynamics, *, n_clones, n_runs, seed, z_max, x0=0.0, v0=0.0, burn_in,
-                  spacing, k=1):
+def first_passage(dynamics, *, n_clones, n_runs, seed, x0=0.0, v0=0.0, burn_in, spacing,
+                  z_max=math.inf, k=1):
     """Mean first-passage time to B from ``(x0, v0)`` by splitting and renewal.
 
     Parameters
@@ -208,7 +214,7 @@ def first_passage(dynamics, *, n_clones, n_runs, seed, z_max, x0=0.0, v0=0.0, bu
         Independent runs ``R >= 2``, each with its own control run and seeds.
     seed : int or numpy.random.SeedSequence
         Root of the seed tree.
-    z_max : float
+    z_max : float, optional
         The splitting's final level (see :func:`ams`).
     x0, v0 : float, optional
         The initial state at ``tau = 0`` (inside A); the random force starts in a draw of
@@ -281,7 +287,7 @@ def first_passage(dynamics, *, n_clones, n_runs, seed, z_max, x0=0.0, v0=0.0, bu
         cycle.append(mean_gap * dt)
         first.append(exits[0] * dt)
         starts = [dynamics.state_at(control, int(i)) for i in picks[:n_clones]]
-        run = ams(dynamics, starts, z_max, seed, run=r, k=k)
+        run = ams(dynamics, starts, seed, z_max=z_max, run=r, k=k)
         runs.append(run)
         p.append(run.probability)
         succ.extend(run.durations)
