@@ -23,6 +23,122 @@ _BUFFER = 2 * kernels.STEP_HEADROOM
 
 
 @dataclass(frozen=True)
+class SampleState:
+    """The simulator's exact state at a force sample: where a run can be stopped and continued.
+
+    Attributes
+    ----------
+    k : int
+        The sample index; the time is ``k * dt`` (dimensionless), which fixes the phase
+        ``beta k dt`` of the harmonic force.
+    w, wv : float
+        ``x - p_h`` and ``x' - p_h'``: the displacement and velocity less the harmonic
+        particular solution ``p_h = A q sin(beta tau - phi)`` (docs/model.md, section 5); with
+        no harmonic force, ``x`` and ``x'`` themselves.
+    mode : int
+        The kernel's mode (:mod:`vibroimpact.impact.layout`): free, resting on a wall
+        (``STUCK``, ``STUCK_LO``), or free exactly on a wall (``WALL``, ``WALL_LO``).
+    sin_psi, cos_psi : float
+        ``sin psi, cos psi`` with ``psi = beta k dt - phi``, as the kernel carries them
+        (rotated step by step between its resynchronisations).
+
+    Notes
+    -----
+    These are the kernel's own numbers, not ``(x, v)`` rebuilt from them: a run continued
+    from the ``end_state`` of a run stopped at a sample takes, given the same force samples,
+    bit for bit the steps of the run never stopped (tests/test_rare_events.py). Build one from
+    a displacement and velocity with :func:`sample_state`.
+    """
+
+    k: int
+    w: float
+    wv: float
+    mode: int
+    sin_psi: float
+    cos_psi: float
+
+    def vector(self):
+        """The kernel's state vector (float64, slots ``S_*``)."""
+        state = np.empty(kernels.N_STATE)
+        state[[kernels.S_W, kernels.S_WV, kernels.S_MODE, kernels.S_SIN_PSI,
+               kernels.S_COS_PSI]] = (self.w, self.wv, self.mode, self.sin_psi, self.cos_psi)
+        return state
+
+    @classmethod
+    def of_vector(cls, k, state):
+        """The state at sample ``k`` from the kernel's state vector ``state``."""
+        return cls(int(k), float(state[kernels.S_W]), float(state[kernels.S_WV]),
+                   int(state[kernels.S_MODE]), float(state[kernels.S_SIN_PSI]),
+                   float(state[kernels.S_COS_PSI]))
+
+
+def _initial_vector(model, dt, x0, v0, k=0, stuck=False):
+    """The kernel's state vector at sample ``k`` for ``x = x0, x' = v0`` (free) or resting
+    on the wall at ``x = delta`` (``stuck``)."""
+    beta = model.beta
+    amplitude = model.amplitude
+    q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * model.zeta * beta)
+    phi = math.atan2(2.0 * model.zeta * beta, 1.0 - beta * beta)
+    Aq = amplitude * q
+    if k == 0:
+        sin_psi, cos_psi = -math.sin(phi), math.cos(phi)
+    else:
+        bh_hi, bh_lo = kernels.two_prod(beta, dt)
+        psi = kernels.phase(k, 0.0, bh_hi, bh_lo, beta) - phi
+        sin_psi, cos_psi = math.sin(psi), math.cos(psi)
+    state = np.empty(kernels.N_STATE)
+    if stuck:
+        # as the kernel holds a resting mass: w = delta - p_h, w' = -p_h' (so x' = 0)
+        state[[kernels.S_W, kernels.S_WV, kernels.S_MODE]] = (
+            model.delta - Aq * sin_psi, -Aq * beta * cos_psi, kernels.STUCK)
+    elif k == 0:
+        # the expression of every run started at tau = 0 (its results unchanged bit for bit)
+        state[[kernels.S_W, kernels.S_WV, kernels.S_MODE]] = (
+            x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE)
+    else:
+        state[[kernels.S_W, kernels.S_WV, kernels.S_MODE]] = (
+            x0 - Aq * sin_psi, v0 - Aq * beta * cos_psi, kernels.FREE)
+    state[[kernels.S_SIN_PSI, kernels.S_COS_PSI]] = sin_psi, cos_psi
+    return state
+
+
+def sample_state(zeta, delta, dt, x, v=0.0, *, k=0, stuck=False, amplitude=0.0, beta=1.0):
+    """A :class:`SampleState` from a displacement and velocity at sample ``k``.
+
+    Parameters
+    ----------
+    zeta : float
+        Damping ratio, ``0 < zeta < 1``.
+    delta : float
+        The wall's position (the state must satisfy ``x <= delta``).
+    dt : float
+        Sample step (dimensionless time), ``> 0``.
+    x, v : float
+        Displacement and velocity at ``tau = k dt``; ignored (``x = delta``, ``v = 0``) when
+        ``stuck``.
+    k : int, keyword-only
+        Sample index, ``>= 0``: the start time ``k dt`` and so the harmonic force's phase.
+    stuck : bool, keyword-only
+        Resting on the wall at ``x = delta`` (held there while ``f - delta > 0``).
+    amplitude, beta : float, keyword-only
+        The harmonic force ``amplitude sin(beta tau)`` of the run to be started.
+
+    Returns
+    -------
+    SampleState
+        For :func:`simulate`'s ``start`` (one wall, or the upper wall of two).
+    """
+    k = _checks.integer("k", k, low=0)
+    model = Model.paper(_checks.zeta(zeta), 0.0, _checks.real("delta", delta),
+                        _checks.real("amplitude", amplitude),
+                        _checks.real("beta", beta, low=0.0, low_open=True))
+    dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    x = _checks.real("x", x, high=delta)
+    v = _checks.real("v", v)
+    return SampleState.of_vector(k, _initial_vector(model, dt, x, v, k, bool(stuck)))
+
+
+@dataclass(frozen=True)
 class SimulationResult:
     """Events and counters of one simulation (or one chunk of it).
 
@@ -87,6 +203,9 @@ class SimulationResult:
         The wall each sticking interval rests on.
     model : vibroimpact.model.Model
         The oscillator, its walls and its harmonic force.
+    end_state : SampleState or None
+        The kernel's exact state at ``t_end`` when it falls on a sample (None otherwise):
+        pass it as ``start`` to continue the run bit for bit.
     params : dict
         The physical inputs.
     force_record : array_like or None
@@ -122,6 +241,7 @@ class SimulationResult:
     impact_wall: np.ndarray = None
     stick_wall: np.ndarray = None
     model: Model = field(default=None, compare=False)
+    end_state: SampleState = None
 
     def __post_init__(self):
         # results built without walls (one wall): every event at the wall at delta
@@ -195,20 +315,30 @@ class SimulationResult:
 
 
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
-                  chunk_size, gap=None, eps_lower=None):
+                  chunk_size, gap=None, eps_lower=None, start=None):
     zeta = _checks.zeta(zeta)
     eps = _checks.eps(eps)
     delta = _checks.real("delta", delta)
     amplitude = _checks.real("amplitude", amplitude)
     beta = _checks.real("beta", beta, low=0.0, low_open=True)
     model = Model.paper(zeta, eps, delta, amplitude, beta, gap=gap, eps_lower=eps_lower)
-    return (model,) + _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size)
+    return (model,) + _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size,
+                                 start)
 
 
-def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size):
+def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size, start=None):
     """The run's own arguments (everything but the model), checked against its walls."""
     delta, lower = model.delta, model.lower
     dt = _checks.real("dt", dt, low=0.0, low_open=True)
+    k_start = 0
+    if start is not None:
+        if not isinstance(start, SampleState):
+            raise ValueError(f"start must be a SampleState (a result's end_state, or "
+                             f"sample_state(...)), got {type(start).__name__}")
+        if x0 is not None or v0 != 0.0:
+            raise ValueError(f"x0 and v0 must be left at their defaults (None, 0.0) with "
+                             f"start, which holds the state; got x0={x0!r}, v0={v0!r}")
+        k_start = start.k
     # the static position, on the nearer wall when the walls leave it out
     x0 = max(lower, min(0.0, delta)) if x0 is None else _checks.real("x0", x0)
     if x0 > delta:
@@ -224,14 +354,14 @@ def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size):
     if t_end is None:
         if noise is None:
             raise ValueError("t_end is required when noise is None")
-        t_end = (len(noise) - 1) * dt
-    t_end = _checks.real("t_end", t_end, low=0.0, low_open=True)
-    if noise is not None and t_end > (len(noise) - 1) * dt * (1.0 + 1e-12):
-        raise ValueError(f"t_end must not exceed (len(noise) - 1) * dt = "
-                         f"{(len(noise) - 1) * dt!r}, got {t_end!r}")
+        t_end = (k_start + len(noise) - 1) * dt
+    t_end = _checks.real("t_end", t_end, low=k_start * dt, low_open=True)
+    if noise is not None and t_end > (k_start + len(noise) - 1) * dt * (1.0 + 1e-12):
+        raise ValueError(f"t_end must not exceed (start.k + len(noise) - 1) * dt = "
+                         f"{(k_start + len(noise) - 1) * dt!r}, got {t_end!r}")
     record_every = _checks.integer("record_every", record_every, low=0)
     chunk_size = _checks.integer("chunk_size", chunk_size, low=1)
-    return dt, x0, v0, t_end, record_every, chunk_size
+    return dt, x0, v0, t_end, record_every, chunk_size, start
 
 
 def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
@@ -375,7 +505,8 @@ def _raise_status(status, k, dt, r, k0, diag, P):
 
 def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None,
                     v0=0.0, t_end=None, *, record_every=0, chunk_size=2**20,
-                    rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None):
+                    rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None,
+                    start=None):
     """Simulate chunk by chunk; yield one :class:`SimulationResult` per chunk of samples.
 
     Same arguments as :func:`simulate`. Each chunk carries the events of its stretch of
@@ -398,15 +529,16 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     >>> sum(c.n_collisions for c in simulate_chunks(0.05, 0.5, 1.0, r, 0.1, chunk_size=2000))
     2
     """
-    model, dt, x0, v0, t_end, record_every, chunk_size = _check_inputs(
+    model, dt, x0, v0, t_end, record_every, chunk_size, start = _check_inputs(
         zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size,
-        gap, eps_lower)
+        gap, eps_lower, start)
     rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
     yield from _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size,
-                               rebound_floor)
+                               start, rebound_floor)
 
 
-def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, rebound_floor):
+def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, start,
+                    rebound_floor):
     """:func:`simulate_chunks` once its arguments are checked and resolved into ``model``."""
     delta, beta = model.delta, model.beta
     P = model_parameters(model, dt)
@@ -416,24 +548,23 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
                   rebound_floor=rebound_floor)
     if model.n_walls == 2:
         params.update(gap=model.gap, eps_lower=model.eps_lower)
-    Aq, phi = P[kernels.P_AQ], P[kernels.P_PHI]
-    state = np.empty(kernels.N_STATE)
-    state[[kernels.S_W, kernels.S_WV, kernels.S_MODE, kernels.S_SIN_PSI, kernels.S_COS_PSI]] = (
-        x0 + Aq * math.sin(phi), v0 - Aq * beta * math.cos(phi), kernels.FREE,
-        -math.sin(phi), math.cos(phi))
+    k_start = 0 if start is None else start.k
+    state = _initial_vector(model, dt, x0, v0) if start is None else start.vector()
     n_full, rem = _split_steps(t_end, dt)
     stride = int(record_every)
     zeros = None if noise is not None else np.zeros(min(chunk_size, n_full + 1) + 1)
     stick_open = [None, 0]  # start time and wall of an unfinished sticking interval
+    if start is not None and start.mode in (kernels.STUCK, kernels.STUCK_LO):
+        stick_open = [k_start * dt, int(start.mode == kernels.STUCK_LO)]
     buf = _Buffers(chunk_size // stride + 2 if stride else 0)   # reused by every chunk
-    k0 = 0
+    k0 = k_start
     size = chunk_size
     while True:
         k1 = min(k0 + size, n_full)
         if noise is None:
             r = zeros[: k1 - k0 + 1]
         else:
-            r = np.ascontiguousarray(noise[k0 : k1 + 1], dtype=np.float64)
+            r = np.ascontiguousarray(noise[k0 - k_start : k1 - k_start + 1], dtype=np.float64)
         final = k1 == n_full
         buf.grid_n[0] = 0
         buf.ftot[kernels.FT_CONTACT_TIME] = 0.0
@@ -451,6 +582,7 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
                 _raise_status(status, k, dt, r, k0, buf.ftot[kernels.FT_DIAGNOSTICS], P)
         t_chunk = k1 * dt
         x, v, mode = _state_at(state, P, k1)
+        end_state = SampleState.of_vector(k1, state)
         if final and stride and n_full % stride == 0:
             buf.grid[buf.grid_n[0]] = delta - x
             buf.grid_v[buf.grid_n[0]] = v
@@ -460,7 +592,8 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
             if noise is None:
                 r_last = (0.0, 0.0)
             else:
-                r_last = tuple(float(z) for z in noise[n_full : n_full + 2])
+                r_last = tuple(float(z)
+                               for z in noise[n_full - k_start : n_full - k_start + 2])
                 if not all(map(math.isfinite, r_last)):
                     raise ValueError(f"noise must be finite near sample {n_full}")
             b = (r_last[1] - r_last[0]) / dt
@@ -473,9 +606,10 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, r
             _raise_status(status, n_full, dt, r_last, n_full, buf.ftot[kernels.FT_DIAGNOSTICS],
                           P)
             t_chunk = t_end
+            end_state = None
         buf.drain(parts)
         requested = yield _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode,
-                                stick_open, final, noise, model)
+                                stick_open, final, noise, model, end_state)
         k0 = k1
         if final:
             return
@@ -539,7 +673,7 @@ def _pair_sticking(time, kind, stick_open):
 
 
 def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_open, final,
-          noise, model):
+          noise, model, end_state=None):
     def cat(key, dtype):
         """The chunk's events of one kind (one drain, the usual case: its copy as it is)."""
         got = parts[key]
@@ -594,12 +728,13 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
         impact_wall=imp_wall,
         stick_wall=walls,
         model=model,
+        end_state=end_state,
     )
 
 
 def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None, v0=0.0,
              t_end=None, *, record_every=0, chunk_size=2**20,
-             rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None):
+             rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None, start=None):
     """Exact motion of the impact oscillator under a sampled random force plus a harmonic force.
 
     Parameters
@@ -638,6 +773,15 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
         between two walls"). ``None`` (the default): the paper's one wall.
     eps_lower : float, keyword-only
         Restitution coefficient of the second wall, ``0 <= eps_lower <= 1`` (default ``eps``).
+    start : SampleState, keyword-only
+        Start from this exact state at sample ``start.k`` (time ``start.k * dt``, the harmonic
+        force at its phase there) instead of ``x0, v0`` at ``tau = 0``: a previous run's
+        ``end_state`` (the run then continues bit for bit as if never stopped, given the same
+        force samples), or :func:`sample_state` (for instance resting on the wall).
+        ``noise[0]`` is then the force at sample ``start.k``, and ``t_end`` (absolute time,
+        ``> start.k * dt``) defaults to ``(start.k + len(noise) - 1) * dt``. Event times,
+        steps and the recorded grid keep absolute sample indices. None (the default): start
+        at ``tau = 0``.
 
     Returns
     -------
@@ -684,7 +828,8 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
     chunks = list(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                   beta=beta, x0=x0, v0=v0, t_end=t_end,
                                   record_every=record_every, chunk_size=chunk_size,
-                                  rebound_floor=rebound_floor, gap=gap, eps_lower=eps_lower))
+                                  rebound_floor=rebound_floor, gap=gap, eps_lower=eps_lower,
+                                  start=start))
     return concatenate_results(chunks)
 
 
@@ -714,4 +859,5 @@ def concatenate_results(chunks):
         t_end=last.t_end, x_end=last.x_end, v_end=last.v_end, stuck_end=last.stuck_end,
         stuck_since=last.stuck_since, params=last.params, force_record=last.force_record,
         impact_wall=cat("impact_wall"), stick_wall=cat("stick_wall"), model=last.model,
+        end_state=last.end_state,
     )
