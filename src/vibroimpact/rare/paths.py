@@ -72,7 +72,8 @@ class Path:
         Sample step.
     xi, x, v : ndarray of float64
         Reaction coordinate, displacement and velocity at the samples from the start to the
-        end sample (inclusive).
+        end sample (inclusive). The coordinate at the end sample of a path back in A is
+        ``-inf``: the path stopped there, no clone branches there.
     e, r : ndarray of float64
         The unit innovations after the start, and the force samples from the start.
     end : str
@@ -128,7 +129,10 @@ class Dynamics:
     level : float
         Position of the wall (the target set B: the first impact), dimensionless displacement.
     coordinate : callable
-        Reaction coordinate ``xi(x, v)``: arrays in, an array out (vectorized).
+        Reaction coordinate ``xi(x, v)``: arrays in, an array out (vectorized). One with an
+        ``along_path(x, v, r, memory, e)`` method (:class:`~vibroimpact.rare.coordinates.
+        Predicted`) reads the force too: the samples ``r``, the filter's memory at the path's
+        start and the innovations ``e`` after it; its ``force`` must have this force's taps.
     start_set : callable
         The start set A: ``start_set(x, v)`` is a boolean array, true inside A.
     eps : float, optional
@@ -149,6 +153,14 @@ class Dynamics:
         self.model = Model.paper(zeta, _checks.eps(eps), level, _checks.real("amplitude",
                                  amplitude), _checks.real("beta", beta, low=0.0, low_open=True))
         self.filter = ForceFilter(noise, phase)
+        if hasattr(coordinate, "along_path"):
+            theirs = getattr(coordinate, "force", None)
+            if not (isinstance(theirs, ForceFilter) and theirs.kind == self.filter.kind
+                    and theirs.spec == noise and (theirs.taps is None) == (self.filter.taps
+                                                                         is None)
+                    and (theirs.taps is None or np.array_equal(theirs.taps, self.filter.taps))):
+                raise ValueError("the coordinate's force filter is not the paths' (same "
+                                 "spec and phase needed)")
         self.dt = noise.dt
         self.level = level
         self.coordinate = coordinate
@@ -277,9 +289,18 @@ class Dynamics:
                 break
         path.x = np.concatenate(xs)
         path.v = np.concatenate(vs)
-        path.xi = np.asarray(self.coordinate(path.x, path.v), dtype=float)
         path.e = np.concatenate(es) if es else np.empty(0)
         path.r = np.concatenate(rs)
+        along = getattr(self.coordinate, "along_path", None)
+        if along is None:
+            path.xi = np.asarray(self.coordinate(path.x, path.v), dtype=float)
+        else:
+            path.xi = np.asarray(along(path.x, path.v, path.r, start.force.memory, path.e),
+                                 dtype=float)
+        if path.end == RETURNED:
+            # the sample back in A stops the path: no level is reached there and no clone
+            # branches there (a coordinate need not be low on A)
+            path.xi[-1] = -math.inf
         return path
 
     def state_xv(self, vec, k):
