@@ -31,6 +31,11 @@ PARTITION, NODE_CPUS = "debug", os.cpu_count()
 #: Seconds the SLURM build may take; then SIGINT (snakemake cancels its SLURM jobs and
 #: exits), and SIGKILL GRACE seconds later.
 TIMEOUT, GRACE = 900, 60
+#: The one-node test cluster answers at once: its status is asked 2 s after a submission
+#: and every 2 s after (the profile's 40 s and Snakemake's 10 s suit a loaded scheduler;
+#: they made most of this build's wall time).
+QUICK_STATUS = ("--slurm-init-seconds-before-status-checks", "2",
+                "--seconds-between-status-checks", "2")
 #: The datasets built through SLURM: their noise records (rule generate_noise), the events
 #: tiles (group ``cells``), the orbit and attractor tiles (group ``orbit_tiles``).
 SLURM_TARGETS = ("results/datasets/random_events.nc", "results/orbits/harmonic.nc",
@@ -106,7 +111,7 @@ def test_the_datasets_through_slurm_equal_the_local_build(cluster, built, tmp_pa
     env = {**os.environ, cluster_site.ACCOUNT_ENV: cluster_site.NO_ACCOUNT,
            cluster_site.PARTITION_ENV: PARTITION}
     cmd = [SNAKEMAKE, *targets, "--workflow-profile", "workflow/profiles/slurm",
-           "--cores", str(NODE_CPUS), "--configfile", "config/test.yaml"]
+           "--cores", str(NODE_CPUS), "--configfile", "config/test.yaml", *QUICK_STATUS]
     code, out = run_bounded(cmd, cwd=workdir, env=env)
     assert code == 0, out[-5000:]
 
