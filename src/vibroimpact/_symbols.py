@@ -1,4 +1,4 @@
-"""The parameters a map's plane may run over, in the paper's symbols (issue 36).
+"""The parameters a map's plane may run over, in the paper's symbols.
 
 One table for every layer that names a parameter to a reader: the figures' axis labels
 (`vibroimpact.plotting`), the captions that say what a map holds fixed, and the messages of

@@ -1,4 +1,4 @@
-"""Compile every numba kernel the workflow's jobs call, once, at installation (issue 37).
+"""Compile every numba kernel the workflow's jobs call, once, at installation.
 
 numba compiles a kernel on its first call and keeps the machine code in its cache
 (``cache=True``; the package's ``__pycache__`` folders, or ``NUMBA_CACHE_DIR``). On a fresh

@@ -1,4 +1,4 @@
-"""Fig. 16 over any plane, with one wall or two (issue 36).
+"""Fig. 16 over any plane, with one wall or two.
 
 `orbit_plane` here is `vibroimpact.orbits.plane.orbit_plane` (same call, same dataset) that
 also solves a layout with a second wall: Newton shooting on the exact flow

@@ -1,4 +1,4 @@
-"""Periodic motions of any wall layout: Newton shooting on the exact flow (issue 35, section 3).
+"""Periodic motions of any wall layout: Newton shooting on the exact flow.
 
 The closed-form solver (:func:`vibroimpact.periodic_orbits`) knows one wall and a given
 number of impacts. This one knows neither limit: it solves ``Phi_n(X) = X`` for the state

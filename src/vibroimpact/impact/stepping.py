@@ -248,14 +248,13 @@ def slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step
               stk_kind, cnt, ftot):
     """:func:`slow_step` for one wall (``P`` of ``N_PARAMS`` slots), compiled apart.
 
-    The same arguments, results and events as :func:`slow_step` with one wall, with the
-    arithmetic of the one-wall simulator before the second wall (cb9f1ee) operation for
-    operation: no view of ``P`` per event, no sign multiplications, no test for a second
-    wall. :func:`run_steps` calls it when ``lower`` is None (measured by
-    benchmarks/ab_kernels.py: the generic step cost 7-13 % per run with impacts). An edit of
-    the one-wall logic in :func:`slow_step` is made here too; tests/test_two_walls.py holds
-    the two bit for bit (the far wall, the mirror) and tests/test_simulate*.py hold this one
-    to the stress families' references.
+    The same arguments, results and events as :func:`slow_step` with one wall, in the
+    arithmetic of a simulator that knows one wall only, operation for operation: no view of
+    ``P`` per event, no sign multiplications, no test for a second wall. :func:`run_steps`
+    calls it when ``lower`` is None (measured by benchmarks/ab_kernels.py: the generic step
+    cost 7-13 % per run with impacts). An edit of the one-wall logic in :func:`slow_step` is
+    made here too; tests/test_two_walls.py holds the two bit for bit (the far wall, the
+    mirror) and tests/test_simulate*.py hold this one to the stress families' references.
     """
     return _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step,
                           stk_off, stk_kind, cnt, ftot, 0.0, 0.0, 1.0, False)

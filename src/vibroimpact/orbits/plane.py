@@ -1,4 +1,4 @@
-"""Fig. 16 over any plane of the harmonic-force problem's parameters (issue 36).
+"""Fig. 16 over any plane of the harmonic-force problem's parameters.
 
 `orbit_map` classifies the (m/n) motions over the ``(1/beta, delta)`` plane; `orbit_plane`
 does it over any two of the parameters the periodic motions under ``A sin(beta tau)`` depend on:

@@ -27,7 +27,7 @@ Datasets and the figures that read them (docs/figures.md)::
     results/validation/work_precision.nc   work_precision      (validation)
     results/validation/stress_sample.nc    stress              (validation)
 
-A map may run over any two parameters (issue 36): its dataset names them in
+A map may run over any two parameters: its dataset names them in
 ``attrs["axes"]`` (x first) and what it holds fixed in ``attrs["fixed"]`` (JSON); the map
 figures read the axes by name, label them from `LABELS` (every parameter's symbol,
 `vibroimpact._symbols`) and print the fixed caption. A dataset without ``axes`` is the

@@ -372,7 +372,7 @@ def _system_text(ds):
 
 
 # --------------------------------------------------------------------------------------------
-# The plane of a map (issue 36): its two axes and what it holds fixed
+# The plane of a map: its two axes and what it holds fixed
 # --------------------------------------------------------------------------------------------
 
 #: Global attributes a map dataset of the paper's plane carries for its fixed parameters

@@ -1,4 +1,4 @@
-"""A stack of maps side by side: a sweep over a plane's third parameter (issue 36).
+"""A stack of maps side by side: a sweep over a plane's third parameter.
 
 A sweep is a list of studies; when they map one plane and differ in one fixed parameter (the
 rms of the noise, say, for maps over (eps, delta)), `map_stack` draws them as one figure: a

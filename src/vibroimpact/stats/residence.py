@@ -327,7 +327,7 @@ def by_state(motion_map):
     -------
     xarray.Dataset
         Those of the four variables the map holds, over ``("state", *the map's plane)``
-        (``inv_beta, delta`` for the paper's; issue 36: any two parameters), states named
+        (``inv_beta, delta`` for the paper's, any two parameters for another), states named
         as the map's motions ("1/1", ...) then "none".
     """
     import xarray as xr

@@ -20,8 +20,8 @@ __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "s
 
 # --- CPU seconds -----------------------------------------------------------------------------
 #: Interpreter, numpy, xarray (and numba's cache) start-up of one job: the cheapest jobs of
-#: the 15acb54 build took 0.97-1.0 CPU-s (the harmonic trace, noise and the escape levels
-#: that compiled nothing; benchmark files' cpu_time).
+#: a default build take 0.97-1.0 CPU-s (the harmonic trace, noise and the escape levels,
+#: which compile nothing; their benchmark files' cpu_time).
 JOB_START_S = 1.0
 NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measured)
 #: What an events cell costs per step on top of NS_PER_STEP: the self-audit
@@ -30,24 +30,20 @@ NS_PER_STEP = 25.0         # simulated sample step, with impacts (~20 ns measure
 #: benchmarks/bench_audit.py (5e5 steps, zeta 0.05, eps 0.5, band-limited rms 0.5, dt 0.1;
 #: 2-core node, load ~7): 4-5 at delta 3, ~9 at 0.5, ~18 at 0, ~40 at -0.5 and with the
 #: harmonic force; a mean over the sweep's cells, most of them beyond delta = 1. The default
-#: config's five events jobs measured 33.1 CPU-s at 2ec7353 (idle node) and ~27.4 after
-#: the audit's and the record's cuts of 2026-11-27 (the random study's four jobs 25.9
-#: against 31.7 CPU-s for 2ec7353's, alternated in one run, load 6.3-7.2; the harmonic job
-#: 3.07 against 3.27; scaled by 2ec7353's idle figures): 5 s of start-up and 7.26e8 steps
-#: at 25 + 6 ns.
+#: config's five events jobs take ~27.4 CPU-s on an idle 2-core node (their benchmark files
+#: in a default build; `benchmarks/job_costs.py --plan` compares them with the plan): 5 s
+#: of start-up and 7.26e8 steps at 25 + 6 ns.
 NS_PER_AUDIT_STEP = 6.0
 NS_PER_SAMPLE = 50.0       # noise generation
 #: A noise job's sample: generated, written to its netCDF file and checksummed. The default
-#: build's two noise jobs (11.6e6 samples) took 3.0, 3.0 and 3.5 CPU-s in three builds of
-#: 2026-11-27 (a fresh clone of 4ab3037, `benchmarks/issue37.py` at 1d05da6 and at 595f194,
-#: idle 2-core node): (3.2 - 2 JOB_START_S) / 11.6e6 ~ 100 ns.
+#: build's two noise jobs (11.6e6 samples) take 3.0-3.5 CPU-s (their benchmark files in
+#: three default builds, idle 2-core node): (3.2 - 2 JOB_START_S) / 11.6e6 ~ 100 ns.
 NS_PER_NOISE_SAMPLE = 100.0
 US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
-#: One start of the attractor map, settled or run to its cap: 22.6 s of CPU over the default
-#: map's 5,187 cells x 64 starts at 15acb54 (68 us a start); after the solver orbits ran in
-#: parallel and shared their m = 3 scan per row (a38, issue 37), the job took 11.6 CPU-s, its
-#: start-up included (benchmark file of a fresh clone's `make` at 4ab3037, 2 cores, load
-#: ~1.5): (11.6 - JOB_START_S) / 331,968 starts = 32 us.
+#: One start of the attractor map, settled or run to its cap, the solver's orbits run in
+#: parallel and their m = 3 scan shared per row: the default map's job (5,187 cells x 64
+#: starts) takes 11.6 CPU-s, its start-up included (its benchmark file in a default build,
+#: 2 cores, load ~1.5): (11.6 - JOB_START_S) / 331,968 starts = 32 us.
 US_PER_START = 32.0
 #: The share of its cap (`~vibroimpact.pipeline.study.map_cap_steps`) a map cell runs on
 #: average before its probabilities reach their target standard error: 0.34 on the default
@@ -63,42 +59,39 @@ MAP_CAP_FRACTION = 0.34
 MAP_CELL_S = 0.010
 #: The boundary curves of one (m/n) type: 2.7 CPU-s for the default entry's 5 types, start-up
 #: (JOB_START_S) included, with the kernels compiled at installation (its benchmark file in
-#: `python benchmarks/issue37.py --peer a13f0b3`, 2026-11-27, idle 2-core node; 6.2 CPU-s at
-#: 15acb54, when the job compiled them).
+#: a default build, idle 2-core node; 6.2 CPU-s when the job compiles them itself).
 BOUNDARIES_S = 0.35
 #: One cell and type of a plane without delta (`vibroimpact.orbits.periodic_orbits` alone,
 #: no branch to follow: 97 us measured over (zeta, eps), 10 x 10 cells x 3 types, warm cache;
 #: a plane along delta costs `US_PER_ORBIT` a solve, measured 45 us over (eps, delta)), and
-#: one cell of a two-wall plane (the shooting solver, seeded by the simulator: ~135 ms
-#: measured by h35a, issue 35).
+#: one cell of a two-wall plane (the shooting solver, seeded by the simulator: ~135 ms a
+#: cell, timed over a two-wall plane's cells).
 ORBIT_CELL_S = 1.0e-4
 SHOOTING_CELL_S = 0.135
 #: One figure drawn and saved (PNG at 200 dpi and PDF), besides its job's start-up
-#: (`FIGURE_JOB_START_S`): the default build's 19 figure jobs, forked, took 29.0 and 31.0
-#: CPU-s in all (their benchmark files, fresh clones' `make` at 70e002c and 4ab3037, 2
-#: cores, load ~1.5; 0.6-3.3 each): 1.55 a figure, 1.5 besides the fork. At 15acb54, one
-#: process each, they took 36.4 CPU-s (0.9 besides a JOB_START_S).
+#: (`FIGURE_JOB_START_S`): the default build's 19 figure jobs, forked, take 29.0-31.0
+#: CPU-s in all (their benchmark files in two default builds, 2 cores, load ~1.5; 0.6-3.3
+#: each): 1.55 a figure, 1.5 besides the fork. Each in a process of its own, they take
+#: 36.4 CPU-s (0.9 besides a JOB_START_S).
 FIGURE_S = 1.5
 #: The start-up of a figure job (draw_figure, draw_validation_figure): a fork of Snakemake's
 #: process, which imported the plotting modules and drew one small figure once
 #: (`pipeline.forked`, ~1.2 CPU-s in that process, in no job's benchmark file); the fork
 #: and its first writes to shared pages. fig03 forked: 0.78 CPU-s against 1.49 in a process
-#: of its own, load ~2; the default build's 19 figures 28.2 CPU-s against 43.6 (benchmark
-#: files of `bench_make.py --make --peer 2ec7353`, load 6-7).
+#: of its own, load ~2; the default build's 19 figures 28.2 CPU-s forked against 43.6 each
+#: in a process of its own (benchmark files of `benchmarks/bench_make.py --make`, load 6-7).
 FIGURE_JOB_START_S = 0.05
 #: One report notebook executed (papermill, its kernel a process of its own) and rendered
 #: twice (nbconvert) in one job, besides its start-up: the reports that show no map
-#: (random_force, performance, stability) took 1.21-1.48 CPU-s in all at 15acb54 (benchmark
-#: files' cpu_time, a fresh clone's `make`).
+#: (random_force, performance, stability) take 1.21-1.48 CPU-s in all (their benchmark
+#: files' cpu_time in a default build).
 REPORT_S = 0.3
-#: What a report that shows a map adds (``nb.predictors``, now reading the predictors'
-#: dataset of rule ``map_predictors``; ``nb.markov_summary``; ``nb.map_agreement`` with its
-#: import of matplotlib): the three default reports that show the map (the motion_map and
-#: harmonic studies' and the orbits entry's) took 5.56, 5.37 and 4.55 CPU-s at 15acb54, ~3.6
-#: after the predictors' shared bootstrap (r37), and 0.65-0.74 of that once they read the
-#: predictors' dataset (r37b: the jobs' process trees' CPU against 6d7e783, best of 3,
-#: `benchmarks/job_costs.py --jobs --only report`, load 4-6): 2.9-3.9 CPU-s a job; their
-#: benchmark files' cpu_time in a build, 2.6-3.9. ~2.9 a job, 1.6 of it the map's.
+#: What a report that shows a map adds (``nb.predictors``, reading the predictors' dataset
+#: of rule ``map_predictors``; ``nb.markov_summary``; ``nb.map_agreement`` with its import
+#: of matplotlib): the three default reports that show the map (the motion_map and harmonic
+#: studies' and the orbits entry's) take 2.9-3.9 CPU-s a job (the jobs' process trees' CPU,
+#: best of 3, `benchmarks/job_costs.py --jobs --only report`, load 4-6); their benchmark
+#: files' cpu_time in a build, 2.6-3.9. ~2.9 a job, 1.6 of it the map's.
 MAP_REPORT_S = 1.6
 #: The predictors of a map's P (rule ``map_predictors``: `reports.predictors`' bootstrap, 1,000
 #: resamples of the cells for each motion's P and its four predictors, in the stable domain
@@ -117,37 +110,38 @@ MAP_ORBITS_CELL_S = 9.0e-5
 VALIDATION_RULES = {"work_precision": "measure_work_precision",
                     "stress_sample": "sample_stress_families"}
 #: One validation figure drawn, besides its job's start-up: the work-precision and stress
-#: figures took 4.1-4.2 CPU-s together in the same builds (2.0-2.1 each).
+#: figures take 4.1-4.2 CPU-s together (2.0-2.1 each; their benchmark files in a default
+#: build).
 VALIDATION_FIGURE_S = 2.0
 #: One aggregation job (tiles joined into a dataset), start-up included, by kind (default
-#: ``"*"``): 0.44-0.48 CPU-s each at 15acb54 (benchmark files of a fresh clone's `make`), the
-#: events joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
+#: ``"*"``): 0.44-0.48 CPU-s each (their benchmark files in a default build), the events
+#: joins 0.46 and 0.97 (their bins), the spectra joins 0.97-0.98.
 AGGREGATE_S = {"*": 0.5, "aggregate_events": 0.7, "aggregate_spectra": 1.0}
-#: Numba compilation on an empty cache, CPU-s, by the kind of job that compiled in the
-#: default build at 15acb54, a fresh clone whose jobs compiled (solve_orbit_tile 9.6 CPU-s
-#: against 2.4 for the other tiles; simulate_escape 8.0 against 2.0; the random trace 4.9
-#: against 1.0). Since 15572b0 `make` compiles the kernels when it installs
-#: (`vibroimpact.warm`), so the plan of a build charges none of it; `Plan.rule_costs(
-#: cold_cache=True)` adds it, to compare with a build whose jobs compiled.
+#: Numba compilation on an empty cache, CPU-s, by the kind of job that compiles in a default
+#: build whose jobs compile (the first tile of its kind: solve_orbit_tile 9.6 CPU-s against
+#: 2.4 for the other tiles; simulate_escape 8.0 against 2.0; the random trace 4.9 against
+#: 1.0). `make` compiles the kernels when it installs (`vibroimpact.warm`), so the plan of a
+#: build charges none of it; `Plan.rule_costs(cold_cache=True)` adds it, to compare with a
+#: build whose jobs compiled (`benchmarks/job_costs.py --plan --cold-cache`).
 COMPILE_S = {"solve_orbit_tile": 7.0, "simulate_escape": 6.0, "simulate_trace": 4.0}
 #: A spectra cell's analysis besides its sample steps (the Welch estimate of its record):
-#: the default build's 4 spectra tiles (10 + 8 cells) took 6.9 CPU-s at 15acb54, 2.2 more
-#: than their start-up and steps at `NS_PER_STEP`.
+#: the default build's 4 spectra tiles (10 + 8 cells) take 6.9 CPU-s (their benchmark
+#: files), 2.2 more than their start-up and steps at `NS_PER_STEP`.
 SPECTRA_CELL_S = 0.12
-#: A map cell's sample step (the map's own work: the hop check and the collision grouping of
-#: issue 33 on top of the simulator's step): 59.7 CPU-s for the default map's four tiles at
-#: 15acb54 (benchmark files' cpu_time) over 1.42e9 steps, start-up apart: ~38 ns. The
-#: statistics at their floor (issue 37, m38: the lean tally forms, the hops' bounded walk)
-#: take the cell CPU to 0.82 of 2ec7353's (``benchmarks/bench_map_floor.py --stride 4
-#: --no-main --peer 2ec7353``: 11.90 against 14.48 CPU-s over 1297 cells; 0.835 over 649 in
-#: ``benchmarks/bench_map_stats.py``), the simulator's kernel unchanged: ~38 x 0.83 = 31.5.
+#: A map cell's sample step: the simulator's step and the map's own work on top of it (the
+#: hop check with its bounded walk, the physical grouping of the collisions, the statistics
+#: in their lean tally forms): ~31.5 ns over the default map's 1.42e9 steps, start-up
+#: apart. The cells' CPU is measured on a built map by ``benchmarks/bench_map_floor.py
+#: --no-main`` (``--stride 4``: 11.90 CPU-s over 1297 of its cells) and, per part of a
+#: cell, by ``benchmarks/bench_map_stats.py``.
 NS_PER_MAP_STEP = 31.5
 #: The work-precision job (`work_precision_cpu_s`), besides its start-up: imports of scipy and
 #: mpmath, the numba cache loads and the simulator's own runs. With the constants below it
 #: gives 7.8 CPU-s (9.1 with the start-up) at the default sizes, against 7.9-8.9 measured
 #: (benchmarks/ab_validation_sizes.py, 3 runs, load ~22; the job's own CPU: 1.8 s timing
-#: solve_ivp, 3.5 its runs over the compared stretches, 1.0 the references, 0.6 RK4); the
-#: sizes before issue 37 give 43.7 against 45.3 (the default build's benchmark file).
+#: solve_ivp, 3.5 its runs over the compared stretches, 1.0 the references, 0.6 RK4); that
+#: script's larger "old" sizes (impacts 20, stretch 100, long_samples 1e5, repeats 3) give
+#: 43.7 against 45.3 in a default build at those sizes (its benchmark file).
 WP_FIXED_S = 1.0
 #: One restarted solve_ivp run per unit of simulated time (CPU s): 1-6 ms over the default
 #: methods, tolerances and plays (restart overhead: one restart per force sample).
@@ -163,8 +157,8 @@ UNITS_PER_IMPACT = 2.1
 RK4_NS_PER_STEP = 30.0
 #: The stress job, besides its start-up, per size (`stress_cpu_s`): every family's cases, the
 #: streamed record written, streamed by three processes (~0.8 CPU-s each to start) and
-#: replayed. Measured with benchmarks/ab_validation_sizes.py (issue 37; load ~22, the job's
-#: process and its children): 6.7-7.1 CPU-s at ``sample`` (3 runs), 22.6 at ``quick``.
+#: replayed. Measured with benchmarks/ab_validation_sizes.py (load ~22, the job's process
+#: and its children): 6.7-7.1 CPU-s at ``sample`` (3 runs), 22.6 at ``quick``.
 STRESS_S = {"sample": 5.6, "quick": 21.0}
 
 # --- bytes of the outputs (measured file sizes of the default build) -------------------------
@@ -198,7 +192,7 @@ READ_MB_PER_KCELL = 8.0
 #: one of cells, 1,000 resamples of 8 bytes (64 MB per 1,000 cells at most). Measured peaks
 #: (``benchmarks/job_requests.py``): 422 MB at the default map's 5,187 cells, 1,049 MB at
 #: the 20,453 of benchmarks/configs/fine_map.yaml (41 MB per 1,000 cells between them), and
-#: 2.87 GB at a map of 81,225 cells (step 0.0125 on both axes, issue 46): asked 808, 1,419
+#: 2.87 GB at a map of 81,225 cells (step 0.0125 on both axes): asked 808, 1,419
 #: and 3,849 MB.
 PREDICTORS_MB_PER_KCELL = 40.0
 #: An attractor tile's starts (5 float64 a start: the final state, the exponent, the motion)
