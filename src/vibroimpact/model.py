@@ -185,10 +185,6 @@ class Model:
     def eps_lower(self):
         return self.walls[1].eps if self.n_walls == 2 else None
 
-    def contains(self, x):
-        """Whether ``x`` lies in the space the walls leave the mass."""
-        return self.lower <= x <= self.delta
-
     def params(self):
         """The loose parameters, as the results' ``params`` record them."""
         out = dict(zeta=self.zeta, eps=self.eps, delta=self.delta,

@@ -6,7 +6,7 @@ moved or added in one place and not the other fails at once). They are plain mod
 ints: numba reads them as compile-time constants, so ``P[P_DELTA]`` costs what ``P[3]`` did.
 
 - ``P``: the parameter vector (float64, built by
-  :func:`vibroimpact.impact.simulate.kernel_parameters`);
+  :func:`vibroimpact.impact.simulate.model_parameters`);
 - ``c``: the segment tuple returned by :func:`vibroimpact.impact.motion.segment`;
 - ``state``: the kernel's state at a sample point (float64, kept by the driver between calls);
 - ``cnt``: the event counters (int64);
@@ -63,7 +63,6 @@ C_FIELDS = (
 )
 (C_XD, C_V0, C_B, C_SP, C_CP, C_Y0, C_YV0, C_C2, C_D2, C_R, C_G2, C_G3, C_F0, C_DF0,
  C_SIN_T, C_COS_T, C_F_LIN) = range(len(C_FIELDS))
-N_SEGMENT = len(C_FIELDS)
 
 S_FIELDS = (
     ("w", "x - p_h: the displacement less the harmonic particular solution"),

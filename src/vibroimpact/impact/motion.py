@@ -91,7 +91,7 @@ def segment(x0, v0, s, r0, b, theta_k, P):
     """Coefficients of the closed-form motion from state ``(x0, v0)`` at offset ``s`` of a step.
 
     ``P`` is the parameter vector built by
-    :func:`vibroimpact.impact.simulate.kernel_parameters`. Returns the segment tuple ``c``
+    :func:`vibroimpact.impact.simulate.model_parameters`. Returns the segment tuple ``c``
     (its slots: :data:`vibroimpact.impact.layout.C_FIELDS`), read by :func:`seg_eval`,
     :func:`push_eval` and the searches.
     """

@@ -364,12 +364,6 @@ def _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size, start=
     return dt, x0, v0, t_end, record_every, chunk_size, start
 
 
-def kernel_parameters(zeta, eps, delta, dt, amplitude, beta):
-    """The parameter vector ``P`` read by the kernels for the one-wall oscillator
-    (:func:`model_parameters` of the paper's model)."""
-    return model_parameters(Model.paper(zeta, eps, delta, amplitude, beta), dt)
-
-
 def model_parameters(model, dt):
     """The parameter vector ``P`` the simulator's kernels read, for sample step ``dt``.
 
