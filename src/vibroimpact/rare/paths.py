@@ -253,18 +253,8 @@ class Dynamics:
             self.n_steps += n
             x = self.level - self._grid[:n_rec]
             v = self._grid_v[:n_rec].copy()
-            end_i, end = None, None
-            if stop:
-                inside = self.start_set(x, v)
-                if k == k_start:
-                    inside[0] = False       # the start itself does not count as a return
-                ret = np.flatnonzero(inside)
-                if ret.size:
-                    end_i, end = int(ret[0]), RETURNED
-                if not math.isnan(t_hit):
-                    step = step_hit - k
-                    if end_i is None or step < end_i:
-                        end_i, end = step, REACHED
+            end_i, end, t_end = (self._stop(k, k == k_start, x, v, t_hit, step_hit) if stop
+                                 else (None, None, math.nan))
             keep = n_rec if end is None else end_i + 1
             xs.append(x[:keep])
             vs.append(v[:keep])
@@ -272,7 +262,7 @@ class Dynamics:
                 es.append(e[:end_i])
                 rs.append(r[1:end_i + 1])
                 path.end = end
-                path.t_end = t_hit if end == REACHED else (k + end_i) * self.dt
+                path.t_end = t_end
                 break
             es.append(e)
             rs.append(r[1:])
@@ -291,17 +281,40 @@ class Dynamics:
         path.v = np.concatenate(vs)
         path.e = np.concatenate(es) if es else np.empty(0)
         path.r = np.concatenate(rs)
-        along = getattr(self.coordinate, "along_path", None)
-        if along is None:
-            path.xi = np.asarray(self.coordinate(path.x, path.v), dtype=float)
-        else:
-            path.xi = np.asarray(along(path.x, path.v, path.r, start.force.memory, path.e),
-                                 dtype=float)
+        path.xi = self._coordinate_along(path)
         if path.end == RETURNED:
             # the sample back in A stops the path: no level is reached there and no clone
             # branches there (a coordinate need not be low on A)
             path.xi[-1] = -math.inf
         return path
+
+    def _stop(self, k, first, x, v, t_hit, step_hit):
+        """Where a stopping path ends inside a chunk: ``(i, end, t_end)``, ``i`` the index of
+        its end sample in the chunk (samples ``k, k + 1, ...`` at ``x, v``), ``end`` RETURNED
+        or REACHED and ``t_end`` its time, or ``(None, None, nan)`` to go on. ``first``: the
+        chunk starts at the path's start, which does not count as a return. Here A is read
+        at the samples and B is the first impact (``t_hit`` in step ``step_hit``)."""
+        end_i, end, t_end = None, None, math.nan
+        inside = self.start_set(x, v)
+        if first:
+            inside[0] = False       # the start itself does not count as a return
+        ret = np.flatnonzero(inside)
+        if ret.size:
+            end_i, end, t_end = int(ret[0]), RETURNED, (k + int(ret[0])) * self.dt
+        if not math.isnan(t_hit):
+            step = step_hit - k
+            if end_i is None or step < end_i:
+                end_i, end, t_end = step, REACHED, t_hit
+        return end_i, end, t_end
+
+    def _coordinate_along(self, path):
+        """The reaction coordinate at every sample of ``path`` (its ``x, v``, and for a
+        coordinate with ``along_path`` its force)."""
+        along = getattr(self.coordinate, "along_path", None)
+        if along is None:
+            return np.asarray(self.coordinate(path.x, path.v), dtype=float)
+        return np.asarray(along(path.x, path.v, path.r, path.start.force.memory, path.e),
+                          dtype=float)
 
     def state_xv(self, vec, k):
         """``x, x'`` at sample ``k`` from the kernel's state vector."""
