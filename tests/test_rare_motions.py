@@ -1,0 +1,129 @@
+"""The residence of a periodic impact motion by splitting (vibroimpact.rare.motions): exact
+clones with the wall and the harmonic phase, the sets A and B on noiseless runs, and the
+estimate against brute force with the same A and B (slow)."""
+import math
+
+import numpy as np
+import pytest
+
+import vibroimpact
+from vibroimpact import noise
+from vibroimpact.rare.ams import _rng
+from vibroimpact.rare.motions import (REACHED, RETURNED, MotionDynamics, PeriodicMotion,
+                                      _residences, brute_force_residence, residence_time)
+
+# the (1/1) escape cell of config/config.yaml: 1/beta_f = 1.1, delta = 1
+ZETA, EPS, DELTA, BETA_F, AMP = 0.05, 0.5, 1.0, 1.0 / 1.1, 1.0
+
+
+@pytest.fixture(scope="module")
+def orbit():
+    return PeriodicMotion(ZETA, EPS, DELTA, BETA_F, AMP, (1, 1))
+
+
+def _dynamics(orbit, rms, kind="band_limited", **kw):
+    spec = (noise.NoiseSpec("band_limited", rms, 0.1, 4.0) if kind == "band_limited"
+            else noise.NoiseSpec("white", rms, 0.1))
+    kw.setdefault("radius_a", 0.25)
+    kw.setdefault("radius_b", 0.9)
+    return MotionDynamics(ZETA, EPS, DELTA, BETA_F, AMP, spec, orbit, **kw)
+
+
+class _Replay:
+    """A stand-in generator that hands out recorded innovations in order."""
+
+    def __init__(self, e):
+        self.e, self.i = np.asarray(e), 0
+
+    def standard_normal(self, n):
+        out = self.e[self.i:self.i + n]
+        self.i += n
+        return out if out.size == n else np.concatenate([out, np.zeros(n - out.size)])
+
+
+def test_the_tabulated_motion_is_the_periodic_orbit(orbit):
+    ref, = [o for o in vibroimpact.periodic_orbits(1, 1, BETA_F, DELTA, ZETA, EPS) if o.stable]
+    assert orbit.impacts == 1
+    # the impact velocity: the largest velocity of the table, one table step before the wall
+    assert orbit.v.max() == pytest.approx(ref.velocities[0], abs=0.02)
+    assert orbit.x.max() <= DELTA
+    x0, v0 = orbit.at(np.array([0.0, orbit.period, 7.0 * orbit.period]))
+    np.testing.assert_allclose(x0, x0[0], atol=1e-9)
+    np.testing.assert_allclose(v0, v0[0], atol=1e-9)
+
+
+def test_a_clone_continues_bit_for_bit_through_impacts(orbit):
+    dyn = _dynamics(orbit, 0.29)
+    rng = _rng(5, 0)
+    path = dyn.run(dyn.on_motion(rng), rng, stop=False, max_steps=3000)
+    jumps = np.flatnonzero((path.v[:-1] > 0) & (path.v[1:] < 0) & (path.v[:-1] - path.v[1:] > 0.1))
+    j = 1000 + 37                                   # not a chunk boundary
+    assert np.count_nonzero(jumps > j) >= 10          # impacts after the branch point
+    state = dyn.state_at(path, j)
+    assert state.sample.k == path.start.sample.k + j  # the harmonic phase travels with k
+    again = dyn.run(state, _Replay(path.e[j:]), stop=False, max_steps=path.x.size - 1 - j)
+    np.testing.assert_array_equal(again.x, path.x[j:])
+    np.testing.assert_array_equal(again.v, path.v[j:])
+    np.testing.assert_array_equal(again.r, path.r[j:])
+
+
+def test_noiseless_run_stays_in_a_and_never_reaches_b(orbit):
+    dyn = _dynamics(orbit, 0.0, kind="white", radius_a=1e-4, radius_b=1e-3)
+    rng = _rng(1, 0)
+    path = dyn.run(dyn.on_motion(rng), rng, stop=False, max_steps=200 * 70)
+    i, in_a, in_b = dyn.strobe_sets(path)
+    assert in_a.all() and not in_b.any()
+    # one strobe per forcing period, each within a sample after its phase
+    np.testing.assert_allclose(np.diff(i) * dyn.dt, dyn.period, atol=dyn.dt)
+    t = (path.start.sample.k + i) * dyn.dt
+    lag = np.mod(t - dyn.strobe_phase, dyn.period)
+    assert np.all((lag >= 0) & (lag < dyn.dt + 1e-12))
+
+
+@pytest.mark.parametrize("radius_b, end", [(0.4, REACHED), (2.0, RETURNED)])
+def test_a_kicked_start_reaches_b_or_returns_to_the_stable_motion(orbit, radius_b, end):
+    dyn = _dynamics(orbit, 0.0, kind="white", radius_b=radius_b)
+    rng = _rng(2, 0)
+    on = dyn.on_motion(rng)
+    xp, vp = orbit.at(np.array([on.sample.k * dyn.dt]))
+    kicked = dyn.initial(rng, float(xp[0]) - 0.5, float(vp[0]), k=on.sample.k)
+    path = dyn.run(kicked, rng)
+    assert path.end == end
+    if end == REACHED:              # d = 0.5 >= radius_b at the start strobe itself
+        assert path.t_end == on.sample.k * dyn.dt
+    else:                           # the multipliers |lambda| = 0.35: back within a few periods
+        assert 0 < path.duration < 10 * dyn.period
+    assert np.isfinite(path.xi).sum() >= 1
+
+
+def test_residences_count_from_an_entry_to_the_next_b():
+    i = np.arange(10)
+    in_a = np.array([0, 1, 1, 0, 0, 0, 1, 0, 1, 0], bool)
+    in_b = np.array([1, 0, 0, 0, 1, 1, 0, 0, 0, 1], bool)
+    np.testing.assert_array_equal(_residences(i, in_a, in_b), [3.0, 3.0])
+
+
+def test_arguments_are_checked(orbit):
+    with pytest.raises(ValueError, match="radius_b"):
+        _dynamics(orbit, 0.2, radius_a=0.5, radius_b=0.5)
+    with pytest.raises(ValueError, match="coordinate"):
+        _dynamics(orbit, 0.2, coordinate="energy")
+    with pytest.raises(ValueError, match="motion"):
+        MotionDynamics(ZETA, EPS, 0.9, BETA_F, AMP, noise.NoiseSpec("white", 0.2, 0.1), orbit,
+                       radius_a=0.2, radius_b=0.9)
+    with pytest.raises(ValueError, match="m=2"):
+        PeriodicMotion(ZETA, EPS, DELTA, BETA_F, AMP, (2, 1))
+    with pytest.raises(ValueError, match="dynamics"):
+        residence_time(object(), n_clones=2, n_runs=2, seed=0)
+
+
+@pytest.mark.slow
+def test_splitting_meets_brute_force_with_the_same_a_and_b(orbit):
+    """rms 0.29: the residence ~16 forcing periods, where brute force reaches (measured: both
+    ~10 s on one core)."""
+    dyn = _dynamics(orbit, 0.29, coordinate="predicted")
+    est = residence_time(dyn, n_clones=100, n_runs=10, seed=7)
+    times, _ = brute_force_residence(_dynamics(orbit, 0.29), n_periods=40000, seed=3)
+    se = times.std(ddof=1) / math.sqrt(times.size)
+    assert times.size > 1000
+    assert abs(est.time - times.mean()) < 3.0 * math.hypot(est.time_se, se)
