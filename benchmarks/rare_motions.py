@@ -1,8 +1,8 @@
 """Residence in the (1/1) motion of the escape cell [1.1, 1.0]: splitting against brute force
 with the same A and B (vibroimpact.rare.motions), value, interval and cost in sample steps.
 
-    python benchmarks/rare_motions.py ams RMS [--coordinate predicted|distance] [--clones N]
-                                           [--runs R] [--seed S]
+    python benchmarks/rare_motions.py ams RMS [--coordinate predicted|distance|forecast]
+                                           [--clones N] [--runs R] [--seed S]
     python benchmarks/rare_motions.py brute RMS [--periods P] [--seed S]
 
 One process, one core; prints one line. The cell and the force are config/config.yaml's
@@ -25,7 +25,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("mode", choices=["ams", "brute"])
     ap.add_argument("rms", type=float)
-    ap.add_argument("--coordinate", choices=["predicted", "distance"], default="predicted")
+    ap.add_argument("--coordinate", choices=["predicted", "distance", "forecast"],
+                    default="predicted")
     ap.add_argument("--clones", type=int, default=100)
     ap.add_argument("--runs", type=int, default=10)
     ap.add_argument("--periods", type=float, default=40000.0)
@@ -35,7 +36,7 @@ def main():
     spec = noise.NoiseSpec("band_limited", a.rms, 0.1, 4.0)
     dyn = MotionDynamics(ZETA, EPS, DELTA, BETA_F, AMP, spec, orbit, radius_a=RADIUS_A,
                          radius_b=RADIUS_B,
-                         coordinate="predicted" if a.coordinate == "predicted" else None)
+                         coordinate=None if a.coordinate == "distance" else a.coordinate)
     t = time.perf_counter()
     if a.mode == "ams":
         r = residence_time(dyn, n_clones=a.clones, n_runs=a.runs, seed=a.seed)

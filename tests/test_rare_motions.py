@@ -9,7 +9,8 @@ import pytest
 import vibroimpact
 from vibroimpact import noise
 from vibroimpact.rare.ams import _rng
-from vibroimpact.rare.motions import (REACHED, RETURNED, MotionDynamics, PeriodicMotion,
+from vibroimpact.rare.motions import (REACHED, RETURNED, Forecast, MotionDynamics,
+                                      PeriodicMotion,
                                       _residences, brute_force_residence, residence_time)
 
 # the (1/1) escape cell of config/config.yaml: 1/beta_f = 1.1, delta = 1
@@ -96,6 +97,26 @@ def test_a_kicked_start_reaches_b_or_returns_to_the_stable_motion(orbit, radius_
     assert np.isfinite(path.xi).sum() >= 1
 
 
+def test_the_forecast_is_the_noiseless_distance_at_the_next_strobe(orbit):
+    dyn = _dynamics(orbit, 0.0, kind="white", radius_b=2.0, coordinate="forecast")
+    rng = _rng(3, 0)
+    on = dyn.on_motion(rng)
+    xp, vp = orbit.at(np.array([on.sample.k * dyn.dt]))
+    kicked = dyn.initial(rng, float(xp[0]) - 0.3, float(vp[0]), k=on.sample.k)
+    steps = dyn.n_steps
+    path = dyn.run(kicked, rng)
+    assert path.end == RETURNED and dyn.n_steps - steps > path.x.size  # the forecasts' steps
+    i, _, _ = dyn.strobe_sets(path)
+    d = dyn.distance(path.x[i], path.v[i], path.start.sample.k + i)
+    # without noise the forecast from a strobe is the distance at the next strobe, exactly
+    np.testing.assert_allclose(path.xi[i[:-2]], d[1:-1], rtol=1e-12, atol=1e-14)
+    # and every reading between them forecasts the same strobe
+    read = np.flatnonzero(np.isfinite(path.xi))
+    between = read[(read > i[0]) & (read < i[1])]
+    assert between.size >= 5
+    np.testing.assert_allclose(path.xi[between], d[1], rtol=1e-9)
+
+
 def test_residences_count_from_an_entry_to_the_next_b():
     i = np.arange(10)
     in_a = np.array([0, 1, 1, 0, 0, 0, 1, 0, 1, 0], bool)
@@ -108,6 +129,8 @@ def test_arguments_are_checked(orbit):
         _dynamics(orbit, 0.2, radius_a=0.5, radius_b=0.5)
     with pytest.raises(ValueError, match="coordinate"):
         _dynamics(orbit, 0.2, coordinate="energy")
+    with pytest.raises(ValueError, match="every"):
+        Forecast(0)
     with pytest.raises(ValueError, match="motion"):
         MotionDynamics(ZETA, EPS, 0.9, BETA_F, AMP, noise.NoiseSpec("white", 0.2, 0.1), orbit,
                        radius_a=0.2, radius_b=0.9)

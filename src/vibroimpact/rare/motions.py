@@ -39,7 +39,12 @@ the noise. Splitting with :class:`PredictedDeviation` gives 16.3 +- 0.6, 110 +- 
 standard errors off: heavy-tailed). Why the coordinates at the strobes weaken as the noise
 falls: the probability of reaching B before A from a strobe barely depends on its distance
 (0.02 - 0.08 from ``d = 0.25`` to ``0.9`` at rms 0.22, brute force): the strobe map contracts
-by ``|lambda| = 0.35`` a period and the escape is made by the noise inside the last period.
+by ``|lambda| = 0.35`` a period and the escape is made by the noise inside the last period;
+a clone branched at a strobe then seldom rises above its branch value, ties with its
+siblings and dies with them (at rms 0.15, 6 of 20 runs extinct, the runs' ``p`` spread over
+nine decades). :class:`Forecast`, read between the strobes, gives 103 +- 10 (0.22) and
+1278 +- 386 (0.18), and at rms 0.15, beyond brute force, the runs' ``p`` within 2.5 decades
+and no extinction, at about five times the steps a run.
 """
 from __future__ import annotations
 
@@ -226,6 +231,37 @@ class PredictedDeviation:
         return self.predicted.along_path(dx, dv, r, memory, e)
 
 
+@dataclass(frozen=True)
+class Forecast:
+    """The distance B tests at the next strobe, as the path's forecast without new noise: from
+    the exact state at a sample, the exact simulator runs to the next strobe with the force
+    its filter's memory already fixes (every later innovation zero), and ``xi`` is the
+    energy-metric distance from the motion there. Read every ``every`` samples (``k = 0 mod
+    every``) and at the strobes; costs up to one forcing period of steps a reading (counted
+    in ``n_steps``).
+
+    Why: the probability of reaching B before A from a strobe barely depends on the distance
+    there (module docstring): the escape is made inside the last period, which a coordinate
+    read at the strobes does not see; and read at every sample, the deviation from the motion
+    jumps at the impacts. The forecast is nonlinear through the impacts and, with the force's
+    predictable part, moves with each new innovation (as
+    :class:`~vibroimpact.rare.coordinates.Predicted` does for the wall-free problem).
+
+    Parameters
+    ----------
+    every : int, optional
+        Samples between readings, ``>= 1``.
+    """
+
+    every: int = 8
+
+    def __post_init__(self):
+        _checks.integer("every", self.every, low=1)
+
+    def __call__(self, dx, dv):
+        raise TypeError("Forecast reads the path's exact state: MotionDynamics evaluates it")
+
+
 class MotionDynamics(Dynamics):
     """Paths of the oscillator with its wall and harmonic force; A is the motion, B its escape.
 
@@ -253,7 +289,9 @@ class MotionDynamics(Dynamics):
         Reaction coordinate ``xi(dx, dv)`` of the deviations from the motion at the strobes
         (arrays in, array out); default :class:`StrobeDistance` ``()``, ``d`` itself;
         ``"predicted"``: :class:`PredictedDeviation` on this force. It is ``-inf`` at the
-        other samples: clones branch at strobes only.
+        other samples: clones branch at strobes only. ``"forecast"`` (or a
+        :class:`Forecast`): the noiseless forecast of the next strobe's distance, read between
+        the strobes too.
     strobe_phase : float, optional
         ``phi``, a time in ``[0, T)``; default the motion's farthest point from the wall
         (:meth:`PeriodicMotion.far_phase`).
@@ -279,6 +317,8 @@ class MotionDynamics(Dynamics):
             coordinate = StrobeDistance()
         elif isinstance(coordinate, str) and coordinate == "predicted":
             coordinate = PredictedDeviation(zeta, self.filter)
+        elif isinstance(coordinate, str) and coordinate == "forecast":
+            coordinate = Forecast()
         elif not callable(coordinate):
             raise ValueError(f"coordinate must be a callable of (dx, dv) arrays or "
                              f"'predicted', got {coordinate!r}")
@@ -344,6 +384,8 @@ class MotionDynamics(Dynamics):
     def _coordinate_along(self, path):
         k0 = path.start.sample.k
         xi = np.full(path.x.size, -math.inf)
+        if isinstance(self.coordinate, Forecast):
+            return self._forecast_along(path, xi)
         i = self.strobes(k0, k0 + path.x.size - 1) - k0
         dx, dv = self.deviation(path.x[i], path.v[i], k0 + i)
         if isinstance(self.coordinate, PredictedDeviation):
@@ -353,6 +395,27 @@ class MotionDynamics(Dynamics):
                                                path.e)[i]
         else:
             xi[i] = np.asarray(self.coordinate(dx, dv), dtype=float)
+        return xi
+
+    def _forecast_along(self, path, xi):
+        """:class:`Forecast` at the path's samples ``k = 0 mod every`` and its strobes."""
+        k0, n = path.start.sample.k, path.x.size
+        every = self.coordinate.every
+        ks = np.union1d(self.strobes(k0, k0 + n - 1),
+                        np.arange(-(-k0 // every) * every, k0 + n, every))
+        ks = ks[ks < k0 + n]
+        if path.end == RETURNED:
+            ks = ks[ks < k0 + n - 1]                # the return itself is -inf anyway
+        for k in ks:
+            state = self.state_at(path, int(k - k0))
+            k_next = int(self.strobes(int(k) + 1, int(k) + int(self.period / self.dt) + 2)[0])
+            vec = state.sample.vector()
+            r, _ = self.filter.advance(state.force, np.zeros(k_next - int(k)))
+            self._steps(r, int(k), vec, record=False)
+            self.n_steps += k_next - int(k)
+            x, v = self.state_xv(vec, k_next)
+            xi[k - k0] = float(self.distance(np.array([x]), np.array([v]),
+                                             np.array([k_next]))[0])
         return xi
 
     def on_motion(self, rng, period=0):
@@ -554,6 +617,7 @@ def _residences(i, in_a, in_b):
     return np.array(out, dtype=float)
 
 
-__all__ = ["PeriodicMotion", "StrobeDistance", "PredictedDeviation", "MotionDynamics",
+__all__ = ["PeriodicMotion", "StrobeDistance", "PredictedDeviation", "Forecast",
+           "MotionDynamics",
            "Residence", "residence_time", "brute_force_residence",
            "RETURNED", "REACHED"]
