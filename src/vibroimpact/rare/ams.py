@@ -209,6 +209,27 @@ class FirstPassage:
     n_steps: int
 
 
+def starting_exits(exits, burn, gap, n_clones, n_steps, sets):
+    """The exits of A a control run gives as starting states: ``(used, mean gap, picks)``.
+
+    ``exits`` (sample indices of the control run's exits of A, ``n_steps`` long) after
+    ``burn``; every stride-th, so spaced by ``gap`` samples on average, and not the first exit
+    after a fixed delay, which would favour the exits that end long cycles (length bias).
+    ``used``: the exits after ``burn``; the mean gap between them is in samples. Too few
+    exits raise a RuntimeError naming ``sets``, the argument that defines A."""
+    used = exits[exits >= burn]
+    if used.size < 2:
+        raise RuntimeError(f"the control run of {n_steps} steps left A {exits.size} times: "
+                           f"check {sets}")
+    mean_gap = (used[-1] - used[0]) / (used.size - 1)
+    picks = used[::max(1, math.ceil(gap / mean_gap))]
+    if picks.size < n_clones:
+        raise RuntimeError(f"the control run of {n_steps} steps gave {picks.size} starting "
+                           f"exits, fewer than n_clones={n_clones}; check {sets} or shorten "
+                           f"spacing")
+    return used, mean_gap, picks
+
+
 def first_passage(dynamics, *, n_clones, n_runs, seed, x0=0.0, v0=0.0, burn_in, spacing,
                   z_max=math.inf, k=1):
     """Mean first-passage time to B from ``(x0, v0)`` by splitting and renewal.
@@ -281,18 +302,8 @@ def first_passage(dynamics, *, n_clones, n_runs, seed, x0=0.0, v0=0.0, burn_in, 
                                max_steps=burn + 2 * (n_clones + 1) * gap)
         inside = np.asarray(dynamics.start_set(control.x, control.v), dtype=bool)
         exits = np.flatnonzero(inside[:-1] & ~inside[1:]) + 1
-        used = exits[exits >= burn]
-        if used.size < 2:
-            raise RuntimeError(f"the control run of {control.xi.size - 1} steps left A "
-                               f"{exits.size} times: check start_set")
-        mean_gap = (used[-1] - used[0]) / (used.size - 1)
-        # every stride-th exit: spaced by `spacing` on average, and not the first exit after
-        # a fixed delay, which would favour the exits that end long cycles (length bias)
-        picks = used[::max(1, math.ceil(gap / mean_gap))]
-        if picks.size < n_clones:
-            raise RuntimeError(f"the control run of {control.xi.size - 1} steps gave "
-                               f"{picks.size} starting exits, fewer than "
-                               f"n_clones={n_clones}; check start_set or shorten spacing")
+        _, mean_gap, picks = starting_exits(exits, burn, gap, n_clones, control.xi.size - 1,
+                                         "start_set")
         cycle.append(mean_gap * dt)
         first.append(exits[0] * dt)
         starts = [dynamics.state_at(control, int(i)) for i in picks[:n_clones]]

@@ -60,7 +60,7 @@ import numpy as np
 from vibroimpact import _checks
 from vibroimpact import noise as _noise
 from vibroimpact.impact.simulate import _initial_vector
-from vibroimpact.rare.ams import _rng, ams
+from vibroimpact.rare.ams import _rng, ams, starting_exits
 from vibroimpact.rare.paths import CHUNK, REACHED, RETURNED, Dynamics
 
 
@@ -521,15 +521,8 @@ def residence_time(dynamics, *, n_clones, n_runs, seed, burn_in=20.0, spacing=5.
         i, in_a, in_b = dynamics.strobe_sets(control)
         exits = i[1:][in_a[:-1] & ~in_a[1:]]
         entries = i[1:][~in_a[:-1] & in_a[1:]]
-        used = exits[exits >= burn]
-        if used.size < 2:
-            raise RuntimeError(f"the control run of {control.x.size - 1} steps left A "
-                               f"{exits.size} times: check radius_a")
-        mean_gap = (used[-1] - used[0]) / (used.size - 1)
-        picks = used[::max(1, math.ceil(gap / mean_gap))]
-        if picks.size < n_clones:
-            raise RuntimeError(f"the control run gave {picks.size} starting exits, fewer than "
-                               f"n_clones={n_clones}: check radius_a or shorten spacing")
+        used, _, picks = starting_exits(exits, burn, gap, n_clones, control.x.size - 1,
+                                        "radius_a")
         # sojourns: each entry after the burn-in to the next exit
         ent = entries[entries >= burn]
         nxt = np.searchsorted(exits, ent)
