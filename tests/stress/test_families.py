@@ -33,14 +33,20 @@ def test_family_quick_sample(name, wall):
     _check(run_family(name, 4, SEED, wall), 4)
 
 
+#: each family's two full-size tests in one worker, which draws its cases once for both
+#: (`draw_cases`: the stick_onset and grazing draws call the 34-digit reference)
+FULL_SIZE = [pytest.param(name, marks=pytest.mark.xdist_group(f"family-{name}"))
+             for name in sorted(FAMILIES)]
+
+
 @pytest.mark.slow
-@pytest.mark.parametrize("name", sorted(FAMILIES))
+@pytest.mark.parametrize("name", FULL_SIZE)
 def test_family_full_size(name):
     _check(run_family(name, FULL[name], SEED), FULL[name])
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", sorted(FAMILIES))
+@pytest.mark.parametrize("name", FULL_SIZE)
 def test_family_full_size_at_the_lower_wall(name):
     """Every case of every family, at full size, built at the lower wall of a clearance (the
     case mirrored onto it, the upper wall out of reach) runs bit for bit as at the upper wall,

@@ -32,6 +32,7 @@ kernel's step ends:
 :func:`run_family` returns a :class:`~vibroimpact.validation.report.FamilyReport`.
 """
 import dataclasses
+import functools
 import math
 import time
 
@@ -384,6 +385,27 @@ def run_case(case, report, wall="upper"):
         report.fail(show, "; ".join(problems + ([cmp.first_problem] if cmp.first_problem else [])))
 
 
+@functools.lru_cache(maxsize=len(FAMILIES))
+def draw_cases(name, n_cases, seed):
+    """The ``n_cases`` cases of family ``name`` drawn from ``seed`` (a draw that cannot build
+    its singular configuration is drawn again), as a tuple of dicts not to be modified.
+
+    Kept per process: several families' draws call the 34-digit reference (``stick_onset``
+    finds its accumulation point with it), and :func:`run_family` and
+    :func:`mirror_mismatches` run the same cases.
+    """
+    if name not in FAMILIES:
+        raise ValueError(f"family must be one of {sorted(FAMILIES)}, got {name!r}")
+    draw = FAMILIES[name]
+    rng = np.random.default_rng([seed, sum(map(ord, name))])
+    cases = []
+    while len(cases) < n_cases:
+        case = draw(rng)
+        if case is not None:
+            cases.append(case)
+    return tuple(cases)
+
+
 def run_family(name, n_cases, seed, wall="upper"):
     """Run ``n_cases`` seeded random cases of one family; return its :class:`FamilyReport`.
 
@@ -392,24 +414,23 @@ def run_family(name, n_cases, seed, wall="upper"):
     name : str
         A key of :data:`FAMILIES`.
     n_cases : int
-        Cases to run (a draw that cannot build its singular configuration is drawn again).
+        Cases to run (:func:`draw_cases`).
     seed : int
         Seed of ``numpy.random.default_rng``: the same seed gives the same cases.
     wall : {"upper", "lower"}
         The wall the cases are built at (:data:`WALLS`): the same cases either way.
+
+    The report's ``seconds`` count the runs and comparisons, and the draws when this process
+    has not drawn them yet.
     """
     if name not in FAMILIES:
         raise ValueError(f"family must be one of {sorted(FAMILIES)}, got {name!r}")
     if wall not in WALLS:
         raise ValueError(f"wall must be one of {WALLS}, got {wall!r}")
-    draw = FAMILIES[name]
-    rng = np.random.default_rng([seed, sum(map(ord, name))])
     report = FamilyReport(family=name, tolerance=1.0, measure=compare.MEASURE)
     start = time.perf_counter()
-    while report.cases < n_cases:
-        case = draw(rng)
-        if case is not None:
-            run_case(case, report, wall)
+    for case in draw_cases(name, n_cases, seed):
+        run_case(case, report, wall)
     report.seconds = time.perf_counter() - start
     return report
 
@@ -425,14 +446,8 @@ def mirror_mismatches(name, n_cases, seed):
     34-digit reference (:func:`run_family`) holds at the lower wall for every case, at the
     cost of the simulations alone. Returns ``(cases, [(case, what differs), ...])``.
     """
-    if name not in FAMILIES:
-        raise ValueError(f"family must be one of {sorted(FAMILIES)}, got {name!r}")
-    rng = np.random.default_rng([seed, sum(map(ord, name))])
     bad, cases = [], 0
-    while cases < n_cases:
-        case = FAMILIES[name](rng)
-        if case is None:
-            continue
+    for case in draw_cases(name, n_cases, seed):
         cases += 1
         kw = {k: v for k, v in case.items() if k != "note"}
         one = simulate(**kw, record_every=1)
