@@ -637,7 +637,8 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=
 def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
                     motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
                     n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
-                    max_periods=8000, min_switches=10, growth=1.1, gap=None, eps_lower=None):
+                    max_periods=8000, min_switches=10, approach=0.8, approach_unswitched=1.1,
+                    min_growth=1.1, gap=None, eps_lower=None):
     """Probabilities of the (m/n) motions of one cell of the Fig. 15 map, to a target precision.
 
     The cell is simulated from rest over the common record ``noise`` (every cell of a map
@@ -665,8 +666,20 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         Cap on the record after the transient, in forcing periods ``2 pi / beta_f``.
     min_switches : int
         Switches between motions that make a mixed record trustworthy.
-    growth : float
-        Safety factor on the predicted record length (the error falls as 1/sqrt(time)).
+    approach, approach_unswitched, min_growth : float
+        The schedule of the checks. A check short of the target predicts the length where
+        the worst error reaches it (the error falls as 1/sqrt(time)); the next check comes
+        at ``approach`` times that length (``approach_unswitched`` times while the record
+        has not switched between motions), but at least ``min_growth`` times the current
+        one. With ``approach < 1`` a switching record approaches its stopping length from
+        below and stops at the first check that meets the target: the standard error
+        estimated from ``n_batches`` batches varies by about 1/sqrt(2 (n_batches - 1)) (16 %
+        for 20), so a check aimed at the predicted length itself or beyond it mostly lands
+        well below the target, simulating past the precision asked for. A record that has
+        not switched is aimed past the prediction: its error says nothing of a motion it
+        has not visited yet, and stopping it early turned rare episodes of a second motion
+        into zero probabilities. `benchmarks/bench_map_stop.py` measures the schedules on
+        a built map.
     gap, eps_lower : float, optional
         A second wall (`event_statistics`): the collisions' walls classify the two-wall
         motions ``(m_upper, m_lower, n)`` of ``motions``, and ``wall_n_collisions,
@@ -730,8 +743,9 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             if (reached and mixed_ok) or k >= n_cap:
                 break
             length = k * dt - transient
-            predicted = length * (worst / target_stderr) ** 2 * growth if not reached else 0.0
-            wanted = max(predicted, 2.0 * length if not mixed_ok else 0.0, growth * length)
+            aim = approach if res.n_switches else approach_unswitched
+            predicted = length * (worst / target_stderr) ** 2 * aim if not reached else 0.0
+            wanted = max(predicted, 2.0 * length if not mixed_ok else 0.0, min_growth * length)
             n_next = min(n_cap, int(math.ceil((transient + wanted) / dt)))
             request = n_next - k
     finally:

@@ -46,10 +46,10 @@ US_PER_ORBIT = 45.0        # one (1/beta, delta, type) orbit solve
 #: 2 cores, load ~1.5): (11.6 - JOB_START_S) / 331,968 starts = 32 us.
 US_PER_START = 32.0
 #: The share of its cap (`~vibroimpact.pipeline.study.map_cap_steps`) a map cell runs on
-#: average before its probabilities reach their target standard error: 0.34 on the default
-#: map (its `record_end` summed: 1.42e9 steps against 4.18e9 at the caps). A map whose cells
-#: all run to the cap costs up to 1 / 0.34 = 2.9 times the plan's figure.
-MAP_CAP_FRACTION = 0.34
+#: average before its probabilities reach their target standard error: 0.29 on the default
+#: map (its `record_end` summed: 1.20e9 steps against 4.18e9 at the caps). A map whose cells
+#: all run to the cap costs up to 1 / 0.29 = 3.4 times the plan's figure.
+MAP_CAP_FRACTION = 0.29
 #: A map cell's CPU besides its sample steps (its precision checks regroup the collisions
 #: and classify the intervals in Python): measured on config/examples/planes.yaml, fresh
 #: builds on a shared 2-core node, 1.8-2.0 s of cell CPU over 153-204 cells of 1e4-7e4 steps
