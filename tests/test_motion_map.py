@@ -111,6 +111,26 @@ def test_a_cell_stops_at_its_precision_or_at_the_cap(record):
         _map_cell(record[:1000], 2.0, 0.95, transient=200.0, max_periods=50)
 
 
+
+#: the check schedule before the default (each check at 1.1 times the predicted length)
+AIMED_PAST = dict(approach=1.1, approach_unswitched=1.1, min_growth=1.1)
+
+
+@pytest.mark.parametrize("inv_beta, delta", [(2.6, -0.75), (1.4, 0.7), (2.0, 0.95)])
+def test_the_check_schedule_moves_no_probability_beyond_its_error(record, inv_beta, delta):
+    """The schedule of the precision checks is a numerical setting: a record stopped near its
+    target (the default) and one aimed past it give probabilities within three of their
+    standard errors (the records overlap, one a prefix of the other), both at the target."""
+    kw = dict(transient=200.0, max_periods=1500, target_stderr=0.02)
+    near = _map_cell(record, inv_beta, delta, **kw)
+    past = _map_cell(record, inv_beta, delta, **kw, **AIMED_PAST)
+    assert near["reached"] and past["reached"]
+    assert near["record_end"] != past["record_end"]     # the schedules did stop apart
+    for p, se in (("probability", "stderr"), ("stick_probability", "stick_stderr")):
+        bound = 3.0 * np.maximum(near[se], past[se])
+        assert (np.abs(near[p] - past[p]) <= bound).all(), (p, near[p], past[p], bound)
+
+
 # --- residence times and switching rates of a cell (stats.residence_statistics) -------------
 
 @pytest.fixture(scope="module")
