@@ -111,7 +111,6 @@ def test_a_cell_stops_at_its_precision_or_at_the_cap(record):
         _map_cell(record[:1000], 2.0, 0.95, transient=200.0, max_periods=50)
 
 
-
 #: the check schedule before the default (each check at 1.1 times the predicted length)
 AIMED_PAST = dict(approach=1.1, approach_unswitched=1.1, min_growth=1.1)
 
