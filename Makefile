@@ -4,12 +4,13 @@
 # package) and builds every figure and report
 # of the default config, then Snakemake's own report of that build (results/report.html);
 # `make test` installs and runs the linter (ruff: the rules in pyproject.toml), the format
-# of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite, then
+# of the Snakemake files (snakefmt), the import-layer contracts, then the fast suite and
 # the slow (stress/convergence), end-to-end workflow and SLURM suites in one session on two
 # workers (the test config is built once, on one worker, while the other runs the suites that
-# build their own copies and the slow tests; whichever worker is free takes the next test,
-# so neither waits for the other at the end of a suite; the SLURM suite installs and starts
-# a one-node cluster, as root); `make lint` runs Snakemake's linter, ruff and snakefmt.
+# build their own copies, the slow tests and the fast ones; whichever worker is free takes the
+# next test, so neither waits for the other at the end of a suite; the SLURM suite installs
+# and starts a one-node cluster, as root); `make test-fast` runs the fast suite alone (about
+# 3 min), `make test-slow` the others; `make lint` runs Snakemake's linter, ruff and snakefmt.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -24,6 +25,9 @@ FAST_WORKERS ?= -n 2
 # hands out the largest group first, so the build starts at once.
 LONG_WORKERS ?= -n 2 --dist loadgroup
 LONG_MARKERS := slow or workflow or slurm
+# `make test`: the fast suite and the long ones in that one session (one start of the workers,
+# and no worker idle at the end of the fast suite while the other finishes its last test)
+ALL_MARKERS := $(LONG_MARKERS) or not ($(LONG_MARKERS))
 # The exact environment: requirements.lock (every distribution, its version and hashes,
 # written by uv from pyproject.toml's direct requirements: `make lock`) installed by uv alone,
 # `uv pip sync --require-hashes`: .venv then holds the lock's distributions and nothing else,
@@ -75,7 +79,12 @@ test: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks tools workflow/scripts docs
 	$(BIN)/snakefmt --check workflow/
 	$(BIN)/lint-imports
+	$(BIN)/python -m pytest -q -m "$(ALL_MARKERS)" $(LONG_WORKERS)
+
+test-fast: $(STAMP)
 	$(BIN)/python -m pytest -q $(FAST_WORKERS)
+
+test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -m "$(LONG_MARKERS)" $(LONG_WORKERS)
 
 # requirements.lock again from pyproject.toml's direct requirements (the package's, the slurm
