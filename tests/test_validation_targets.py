@@ -19,10 +19,9 @@ from matplotlib.text import Text
 from helpers import assert_figure, make_workdir, scheduled_jobs
 from vibroimpact import plotting
 from vibroimpact.validation import peers
-from vibroimpact.validation.campaign import (CASES, CHUNK_SIZES, COUNTS, ORBIT_CASES, REPLAYS,
-                                             SLOW_ORBIT_CASES,
-                                             STREAM_SAMPLES, campaign_dataset, run_campaign,
-                                             stress_sample)
+from vibroimpact.validation.campaign import (CASES, CHUNK_SIZES, COUNTS, FULL_ORBIT_CASES,
+                                             ORBIT_CASES, REPLAYS, STREAM_SAMPLES,
+                                             campaign_dataset, run_campaign, stress_sample)
 from vibroimpact.validation.families import run_family
 from vibroimpact.validation.orbit_families import run_orbit_family
 from vibroimpact.validation.report import FamilyReport
@@ -234,7 +233,7 @@ def test_the_campaign_sizes_nest():
     """Every family at every size; the sample no larger than the quick sample, itself no larger
     than the full campaign; the sample's record streamed in three chunk sizes (one not a power
     of two), all but the last shorter than the record."""
-    orbit_cases = dict(ORBIT_CASES, full=min(SLOW_ORBIT_CASES.values()))
+    orbit_cases = dict(ORBIT_CASES, full=min(FULL_ORBIT_CASES.values()))
     for small, large in (("sample", "quick"), ("quick", "full")):
         assert CASES[small].keys() == CASES[large].keys()
         assert all(1 <= CASES[small][k] <= CASES[large][k] for k in CASES[small])
@@ -423,7 +422,7 @@ def test_the_plan_costs_the_validation_runs_from_their_sizes():
 def test_the_campaign_table_is_the_slow_suites():
     """``workflow/notebooks/stress_campaign.csv`` (the stability report's and the README's
     table) is :func:`campaign_table` of a full campaign: every family in the campaign's
-    order, at the slow suite's sizes, with its columns."""
+    order, at the full campaign's sizes, with its columns."""
     from vibroimpact.reports.notebook import csv_table
     from vibroimpact.validation.campaign import TABLE_COLUMNS
     from vibroimpact.validation.families import FULL_CASES
@@ -433,7 +432,7 @@ def test_the_campaign_table_is_the_slow_suites():
     table = csv_table(Path(__file__).parents[1] / "workflow" / "notebooks"
                       / "stress_campaign.csv")
     assert tuple(table.columns) == TABLE_COLUMNS
-    sizes = dict(FULL_CASES, **SLOW_ORBIT_CASES, **{STREAMED: 3})
+    sizes = dict(FULL_CASES, **FULL_ORBIT_CASES, **{STREAMED: 3})
     assert list(table["family"]) == list(FULL_CASES) + list(ORBIT_FAMILIES) + [STREAMED]
     assert [int(c) for c in table["cases"]] == [sizes[f] for f in table["family"]]
 

@@ -1,8 +1,10 @@
 """Periodic orbits near folds, period doublings and grazing, against an independent solver.
 
-The slow tests run the three stress families of ``vibroimpact.validation.orbit_families`` at
-full size (``pytest -m slow tests/stress``); the fast ones show that the API works and that
-the independent solver agrees with a third method (mpmath Newton, DOP853) at ordinary points.
+The slow tests run the three stress families of ``vibroimpact.validation.orbit_families``,
+the first half of the full campaign's cases of each (``pytest -m slow tests/stress``;
+``python -m vibroimpact.validation.campaign --size full`` runs them all); the fast ones show
+that the API works and that the independent solver agrees with a third method (mpmath Newton,
+DOP853) at ordinary points.
 ``KNOWN_CASES`` re-run, point by point, disagreements that the families once found (confirmed
 by mpmath and DOP853 then) and that the solver now gets right: regression tests.
 """
@@ -19,9 +21,9 @@ from vibroimpact.validation.orbit_families import (
     period_doubling_points, reference_orbits, run_orbit_family)
 from vibroimpact.validation.report import FamilyReport
 
-# Cases per family for the slow suite: together ~60 s on 2 cores (the fold family ~0.03 s a
-# case, period doubling ~0.08 s, grazing ~0.015 s; a failing case costs ~0.3 s more for the
-# mpmath/DOP853 re-examination).
+# Cases per family for the slow suite (the fold family ~0.03 s a case, period doubling
+# ~0.08 s, grazing ~0.015 s; a failing case costs ~0.3 s more for the mpmath/DOP853
+# re-examination).
 SLOW_CASES = SLOW_ORBIT_CASES
 SEED = SLOW_ORBIT_SEED
 
@@ -113,7 +115,7 @@ def test_tolerance_grows_like_inverse_sqrt_distance():
 
 
 # ------------------------------------------------------------------------------------------
-# slow: the families at full size
+# slow: the first half of each family's full campaign
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", FAMILIES)
