@@ -15,11 +15,12 @@ import os
 import re
 import signal
 import subprocess
+import sys
 
 import pytest
 import xarray as xr
 
-from helpers import ROOT, SNAKEMAKE, data, data_files, make_workdir
+from helpers import ROOT, data, data_files, make_workdir
 from vibroimpact.pipeline import cluster as cluster_site
 from vibroimpact.pipeline.config import costs
 
@@ -36,6 +37,22 @@ TIMEOUT, GRACE = 900, 60
 #: they made most of this build's wall time).
 QUICK_STATUS = ("--slurm-init-seconds-before-status-checks", "2",
                 "--seconds-between-status-checks", "2")
+#: Snakemake's command line, with the SLURM executor's status checks kept every 2 s: the
+#: executor adds 10 s to its interval after every check that finds no job finished (its
+#: `check_active_jobs`, for a busy slurmctld), so on a loaded test machine, where a job takes
+#: a few checks, each stage of the build waited 10-30 s for nothing (the test: 125 s of a
+#: loaded suite, 60 s alone at load 1, about half of it waiting). Only the waiting between
+#: checks changes; submission, the status query and its reading are the executor's own.
+SNAKEMAKE_POLLING = (
+    sys.executable, "-c",
+    "import asyncio, sys\n"
+    "from snakemake_executor_plugin_slurm import Executor\n"
+    "async def sleep(self):\n"
+    "    await asyncio.sleep(2)\n"
+    "Executor.sleep = sleep\n"
+    "from snakemake.cli import main\n"
+    "sys.argv[0] = 'snakemake'\n"
+    "sys.exit(main())\n")
 #: The datasets built through SLURM: their noise records (rule generate_noise), the events
 #: tiles (group ``cells``), the orbit and attractor tiles (group ``orbit_tiles``).
 SLURM_TARGETS = ("results/datasets/random_events.nc", "results/orbits/harmonic.nc",
@@ -110,7 +127,7 @@ def test_the_datasets_through_slurm_equal_the_local_build(cluster, built, tmp_pa
     # node's CPUs, fewer than the profile's `cores`
     env = {**os.environ, cluster_site.ACCOUNT_ENV: cluster_site.NO_ACCOUNT,
            cluster_site.PARTITION_ENV: PARTITION}
-    cmd = [SNAKEMAKE, *targets, "--workflow-profile", "workflow/profiles/slurm",
+    cmd = [*SNAKEMAKE_POLLING, *targets, "--workflow-profile", "workflow/profiles/slurm",
            "--cores", str(NODE_CPUS), "--configfile", "config/test.yaml", *QUICK_STATUS]
     code, out = run_bounded(cmd, cwd=workdir, env=env)
     assert code == 0, out[-5000:]
