@@ -2,7 +2,6 @@
 sticking"): the grouping on hand-made event records, on the public `simulate`, and the
 statistics' independence of every event tolerance of the kernel."""
 import json
-import os
 import subprocess
 import sys
 from pathlib import Path
@@ -172,15 +171,12 @@ AUDIT = {"power_residual": "power_input", "power_residual_stderr": "power_input"
 
 
 def _run(factors, tmp_path, tag):
-    """The runner's results with the kernel's tolerances scaled, compiled afresh; unscaled
-    (no factors), with the kernels every other test uses, from the package's numba cache."""
+    """The runner's results with the kernel's tolerances scaled, its kernels compiled afresh
+    in memory (tests/tolerance_run.py); unscaled (no factors), with the kernels every other
+    test uses, from the package's numba cache."""
     out = tmp_path / f"{tag}.npz"
-    env = dict(os.environ)
-    if factors:
-        env["NUMBA_CACHE_DIR"] = str(tmp_path / f"numba-{tag}")
-        (tmp_path / f"numba-{tag}").mkdir()
-    subprocess.run([sys.executable, str(RUNNER), json.dumps(factors), str(out)], env=env,
-                   check=True, timeout=600)
+    subprocess.run([sys.executable, str(RUNNER), json.dumps(factors), str(out)], check=True,
+                   timeout=600)
     with np.load(out) as data:
         return {k: data[k] for k in data.files}
 

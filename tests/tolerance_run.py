@@ -1,9 +1,12 @@
 """Collision statistics of a few cells with the kernel's event tolerances scaled (a subprocess
 of tests/test_collisions.py).
 
-Usage: ``python tolerance_run.py '{"CHATTER_TIME_TOL": 1000.0, ...}' out.npz``. Run it with
-``NUMBA_CACHE_DIR`` set to an empty directory: numba reads the module's constants when it
-compiles, so the scaled values take effect only in a fresh compilation.
+Usage: ``python tolerance_run.py '{"CHATTER_TIME_TOL": 1000.0, ...}' out.npz``. numba reads
+a module's constants when it compiles, so the scaled values take effect only in a fresh
+compilation: with factors, every kernel of ``vibroimpact.impact`` has its cache turned off
+(numba's ``NullCache``: compiled in memory, nothing read from or written to disk), while the
+kernels of other modules, which read none of the thresholds (the collision tally's), load from
+the package's cache as in any run.
 """
 import json
 import sys
@@ -21,10 +24,25 @@ for name, factor in FACTORS.items():
     for module in MODULES:
         if hasattr(module, name):
             setattr(module, name, value)
+if FACTORS:
+    from numba.core.caching import NullCache
+    from numba.core.dispatcher import Dispatcher
+
+    for module in MODULES:
+        for kernel in vars(module).values():
+            if isinstance(kernel, Dispatcher):
+                kernel._cache = NullCache()
 
 from vibroimpact import simulate                       # noqa: E402  (after the patch)
 from vibroimpact.noise import NoiseSpec, generate_array  # noqa: E402
 from vibroimpact.pipeline import cells                 # noqa: E402
+
+# a kernel module imported only now kept its thresholds: none may read one that is scaled
+LATE = [n for n, m in sorted(sys.modules.items()) if n.startswith("vibroimpact.impact.")
+        and m not in MODULES and any(hasattr(m, name) for name in FACTORS)]
+if LATE:
+    raise SystemExit(f"kernel modules imported after the thresholds were scaled read them: "
+                     f"{LATE}")
 
 BINS = {"v_after": np.linspace(0.0, 2.5, 101), "interval": np.linspace(0.0, 20.0, 201),
         "ratio": np.linspace(0.0, 4.0, 161)}
