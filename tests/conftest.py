@@ -23,6 +23,8 @@ from helpers import make_workdir, snakemake
 
 #: The xdist group of every test that needs the built test config (one build per session).
 BUILT_GROUP = "built"
+#: The markers of the long suites (pyproject.toml): their tests are scheduled first.
+LONG_MARKERS = ("slow", "workflow", "slurm")
 
 
 @pytest.hookimpl(trylast=True)
@@ -34,7 +36,13 @@ def pytest_collection_modifyitems(config, items):
     ``item._id`` instead, so that suffix is lost and every group spreads over both workers
     (measured: the test config built twice). The suffix is set here, on ``_id``, after xdist's
     own hook (``trylast``); the check on the ids' suffix keeps it correct if xdist fixes it.
+
+    The tests of the long suites (``slow``, ``workflow``, ``slurm``) come first, the fast
+    ones after them, each in the order collected: in one session of both (``make test``) the
+    workers start the long tests at once and end on short ones, instead of one worker
+    finishing a minute-long test while the other has nothing left to take.
     """
+    items.sort(key=lambda item: not any(item.get_closest_marker(m) for m in LONG_MARKERS))
     for item in items:
         if "built" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.xdist_group(BUILT_GROUP))
