@@ -40,24 +40,39 @@ def textbook_flight(tau_a, u_a, s, beta, delta, zeta, eps):
     return x, v
 
 
+#: Samples of the flights scanned at once: a flight found above delta leaves the scan, so
+#: most of the range up to smax (sized for the longest flight) is never evaluated.
+SCAN_BLOCK = 128
+
+
 def sampled_impact_map(tau, u, beta, delta, zeta, eps, smax, ds):
     """Vectorized first upward crossing of delta (sampling + bisection); NaN if none by smax."""
     tau = np.asarray(tau, float).ravel()
     u = np.asarray(u, float).ravel()
     s = np.arange(1, int(np.ceil(smax / ds)) + 1) * ds
+    first = np.full(tau.size, -1)               # index of the first sample above delta
+    todo = np.arange(tau.size)
+    for start in range(0, s.size, SCAN_BLOCK):
+        block = s[None, start:start + SCAN_BLOCK]
+        left = []
+        for sl in np.array_split(todo, max(1, todo.size * block.size // 2_000_000)):
+            above = textbook_flight(tau[sl][:, None], u[sl][:, None], block, beta, delta,
+                                    zeta, eps)[0] > delta
+            has = above.any(axis=1)
+            first[sl[has]] = start + np.argmax(above[has], axis=1)
+            left.append(sl[~has])
+        todo = np.concatenate(left) if left else todo
+        if not todo.size:
+            break
     out_t = np.full(tau.size, np.nan)
     out_u = np.full(tau.size, np.nan)
-    for sl in np.array_split(np.arange(tau.size), max(1, tau.size * s.size // 2_000_000)):
-        ta, ua = tau[sl][:, None], u[sl][:, None]
-        above = textbook_flight(ta, ua, s[None, :], beta, delta, zeta, eps)[0] > delta
-        has = above.any(axis=1)
-        k = np.argmax(above, axis=1)
-        lo = np.where(k > 0, s[np.maximum(k - 1, 0)], 0.0)[has]
-        hi = s[k][has]
-        ta1, ua1 = ta[has, 0], ua[has, 0]
-        s1 = _crossing(ta1, ua1, lo, hi, beta, delta, zeta, eps)
-        out_t[sl[has]] = ta1 + s1
-        out_u[sl[has]] = textbook_flight(ta1, ua1, s1, beta, delta, zeta, eps)[1]
+    has = first >= 0
+    k = first[has]
+    lo = np.where(k > 0, s[np.maximum(k - 1, 0)], 0.0)
+    ta1, ua1 = tau[has], u[has]
+    s1 = _crossing(ta1, ua1, lo, s[k], beta, delta, zeta, eps)
+    out_t[has] = ta1 + s1
+    out_u[has] = textbook_flight(ta1, ua1, s1, beta, delta, zeta, eps)[1]
     return out_t, out_u
 
 
