@@ -4,7 +4,7 @@ case compared event by event with the independent 34-digit reference
 
 A family fails on any exception, missed or spurious impact or contact edge, or error above its
 allowance (the worst error is reported as a fraction of its allowance: <= 1 passes). The slow
-suite runs the first half of each family's full campaign (`SLOW_CASES`: the same seed, so the
+suite runs the first third of each family's full campaign (`SLOW_CASES`: the same seed, so the
 same cases; `python -m vibroimpact.validation.campaign --size full` runs them all and writes
 the stress report's table); a few cases of each run in the fast suite to keep the machinery
 honest.

@@ -1,7 +1,7 @@
 """Periodic orbits near folds, period doublings and grazing, against an independent solver.
 
 The slow tests run the three stress families of ``vibroimpact.validation.orbit_families``,
-the first half of the full campaign's cases of each (``pytest -m slow tests/stress``;
+the first third of the full campaign's cases of each (``pytest -m slow tests/stress``;
 ``python -m vibroimpact.validation.campaign --size full`` runs them all); the fast ones show
 that the API works and that the independent solver agrees with a third method (mpmath Newton,
 DOP853) at ordinary points.
@@ -115,7 +115,7 @@ def test_tolerance_grows_like_inverse_sqrt_distance():
 
 
 # ------------------------------------------------------------------------------------------
-# slow: the first half of each family's full campaign
+# slow: the first third of each family's full campaign
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", FAMILIES)
