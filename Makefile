@@ -9,8 +9,8 @@
 # workers (the test config is built once, on one worker, while the others run the suites that
 # build their own copies, the slow tests and the fast ones; whichever worker is free takes the
 # next test, so none waits for the others at the end of a suite; the SLURM suite installs
-# and starts a one-node cluster, as root); `make test-fast` runs the fast suite alone (about
-# 3 min), `make test-slow` the others; `make lint` runs Snakemake's linter, ruff and snakefmt.
+# and starts a one-node cluster, as root); `make test-fast` runs the fast suite alone,
+# `make test-slow` the others; `make lint` runs Snakemake's linter, ruff and snakefmt.
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
@@ -24,8 +24,7 @@ FAST_WORKERS ?= -n 2
 # cases start from a copy of that build), every other test on whichever worker is free. xdist
 # hands out the largest group first, so the build starts at once. Three workers on two
 # cores: a worker often waits (on a build's Snakemake scheduling its jobs, on SLURM, on
-# disk), and the third keeps both cores busy meanwhile (`make test` in fresh clones, one
-# after the other: 15 min 56 s with three, 16 min 56 s and 17 min 18 s with two).
+# disk), and the third keeps both cores busy meanwhile (README, "Tests": measured times)
 LONG_WORKERS ?= -n 3 --dist loadgroup
 LONG_MARKERS := slow or workflow or slurm
 # `make test`: the fast suite and the long ones in that one session (one start of the workers,

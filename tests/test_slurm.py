@@ -40,9 +40,9 @@ QUICK_STATUS = ("--slurm-init-seconds-before-status-checks", "2",
 #: Snakemake's command line, with the SLURM executor's status checks kept every 2 s: the
 #: executor adds 10 s to its interval after every check that finds no job finished (its
 #: `check_active_jobs`, for a busy slurmctld), so on a loaded test machine, where a job takes
-#: a few checks, each stage of the build waited 10-30 s for nothing (the test: 125 s of a
-#: loaded suite, 60 s alone at load 1, about half of it waiting). Only the waiting between
-#: checks changes; submission, the status query and its reading are the executor's own.
+#: a few checks, each stage of the build waited tens of seconds for nothing. Only the waiting
+#: between checks changes; submission, the status query and its reading are the executor's
+#: own.
 SNAKEMAKE_POLLING = (
     sys.executable, "-c",
     "import asyncio, sys\n"

@@ -53,9 +53,9 @@ SLOW_ORBIT_SEED = 20240601
 #: Cases per orbit family of the full campaign.
 FULL_ORBIT_CASES = {"orbit_fold": 600, "orbit_period_doubling": 300, "orbit_grazing": 800}
 #: The slow suite's cases: the first third of every family's full campaign (the same seeds, so
-#: the same cases). At full size the families took 459 s of the slow suites' 1 856 worker-s
-#: (``--durations`` on two workers, the 34-digit reference most of it); the full campaign's
-#: table (``--size full --table``) is the one the stability report shows.
+#: the same cases), which at full size took a quarter of the slow suites' time, the 34-digit
+#: reference most of it (README, "Tests"); the full campaign's table (``--size full
+#: --table``) is the one the stability report shows.
 SLOW_CASES = {name: n // 3 for name, n in FULL_CASES.items()}
 SLOW_ORBIT_CASES = {name: n // 3 for name, n in FULL_ORBIT_CASES.items()}
 #: Samples of the streamed record (full: the 1e8 the campaign promises).
