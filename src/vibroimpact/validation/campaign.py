@@ -207,8 +207,8 @@ def stress_sample(seed, workdir=None, size="quick"):
     ``"sample"``) as a dataset (:func:`campaign_dataset`); the attributes give the seed and the
     sample's size."""
     if size not in ("quick", "sample"):
-        raise ValueError(f"size must be 'quick' or 'sample' (the full campaign runs in the "
-                         f"test suite), got {size!r}")
+        raise ValueError(f"size must be 'quick' or 'sample' (the full campaign is `python -m "
+                         f"vibroimpact.validation.campaign --size full`), got {size!r}")
     reports = run_campaign(seed, workdir=workdir, size=size)
     for report in reports:
         log.info("%s", report.summary())
