@@ -268,9 +268,9 @@ def draw_extreme(rng):
                 note=f"extreme: rms {rms:.1e}, A {A:.1e}, beta {beta:.2f}")
 
 
-#: Cases per family at full size (the full campaign, vibroimpact.validation.campaign; about 5
-#: minutes in all on one core, stick_onset paying for mpmath chatter sequences of up to ~2500
-#: impacts at eps = 0.99; the slow suite runs the first third of each).
+#: Cases per family at full size (the full campaign, vibroimpact.validation.campaign; the
+#: slow suite runs the first third of each). stick_onset's cases are the dearest: mpmath
+#: chatter sequences of up to ~2500 impacts at eps = 0.99.
 FULL_CASES = {"release": 1000, "release_touch": 500, "start_pulled": 500,
               "force_equals_delta": 500, "stick_onset": 150, "grazing": 400, "extreme": 600}
 
