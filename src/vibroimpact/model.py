@@ -16,16 +16,27 @@ between impacts, with the mass confined by its walls:
 A machine designer's symmetric stops at ``+-g/2`` about an offset ``x_c`` are
 ``Model.stops(g, x_c)``: ``delta = x_c + g/2``, ``gap = g``.
 
-Each wall has its own impact law. The law is :class:`Restitution` (Newton's law, the
-paper's eq. 7: the velocity after impact is ``-eps`` times the velocity before); it is the
-one place that law is written: :func:`rebound_velocity`, with its derivative
-:func:`rebound_derivative` and its ratio :func:`rebound_ratio` beside it (plain Python;
-:mod:`vibroimpact._law` compiles them once for the kernels, docs/architecture.md "Adding
-physics").
+Each wall has its own impact law, :class:`Restitution`: the velocity after impact is
+``-eps(u) u`` for the approach velocity ``u``, with
+
+    eps(u) = eps / (1 + |u| / speed_scale),
+
+Newton's law (the paper's eq. 7, ``eps`` constant) when ``speed_scale`` is infinite, the
+default, and a restitution that falls with the impact speed otherwise, as measured
+restitution does (W. Goldsmith, *Impact*, 1960, ch. 6). This module is the one place the law
+and its consequences are written: the rebound :func:`rebound_velocity`, its derivative
+:func:`rebound_derivative` (the saltation matrix, the Jacobians), its ratio
+:func:`rebound_ratio`, and the range of the restitution over a band of speeds
+:func:`restitution_range` (the simulator's proof that chatter has ended). The kernels read
+the law from the compiled model: ``eps`` and ``a = 1 / speed_scale`` (0 for Newton's law) per
+wall. The functions are plain Python (:mod:`vibroimpact._law` compiles them once for the
+kernels, docs/architecture.md "Adding physics"); with ``a = 0`` each rounds exactly as
+Newton's law written in place.
 """
 from dataclasses import dataclass, field
 import math
 
+import numpy as np
 
 from vibroimpact import _checks
 
@@ -35,48 +46,96 @@ ABOVE = 1
 BELOW = -1
 
 
-def rebound_velocity(eps, u):
-    """Velocity just after an impact met at velocity ``u`` (Newton's law, paper eq. 7).
+def rebound_velocity(eps, u, a=0.0):
+    """Velocity just after an impact met at velocity ``u``: ``-eps(u) u``, with
+    ``eps(u) = eps / (1 + a |u|)`` (``a = 1 / speed_scale``; ``a = 0``: Newton's law, paper
+    eq. 7, to the bit: the quotient by ``1.0`` is exact).
 
     In any frame: ``u`` and the result share the frame's sign convention. Plain arithmetic,
     so numba compiles it into the kernels as it is (``vibroimpact.impact.stepping``).
     """
-    return -eps * u
+    return -eps * u / (1.0 + a * abs(u))
 
 
-def rebound_derivative(eps, u):
+def rebound_derivative(eps, u, a=0.0):
     """``d rebound_velocity / du`` at the approach velocity ``u``: the impact's tangent
-    (the orbit solver's and the attractors' Jacobians, the saltation matrix).
+    (the orbit solver's and the attractors' Jacobians, the saltation matrix):
+    ``-eps / (1 + a |u|)^2``; Newton's law: ``-eps``.
 
-    Newton's law: ``-eps``. A new law edits this beside :func:`rebound_velocity`
-    (tests/test_impact_law.py holds the pair to a finite difference).
+    tests/test_impact_law.py holds it to a finite difference of :func:`rebound_velocity`.
     """
-    return -eps
+    d = 1.0 + a * abs(u)
+    return -eps / (d * d)
 
 
-def rebound_ratio(eps, u):
-    """``rebound_velocity(eps, u) / u``: the saltation matrix's position entry, and the
-    orbit solver's ``-v_+ = -rebound_ratio * u`` in its Jacobians' ``d/dtau`` entries.
+def rebound_ratio(eps, u, a=0.0):
+    """``rebound_velocity(eps, u, a) / u = -eps(u)``: the saltation matrix's position entry,
+    and the orbit solver's ``-v_+ = -rebound_ratio * u`` in its Jacobians' ``d/dtau``
+    entries.
 
-    Newton's law: ``-eps``, written out so that it is ``-eps`` to the last bit (the quotient
-    ``(-eps * u) / u`` is not). A new law edits this beside :func:`rebound_velocity`
-    (tests/test_impact_law.py holds the three to one another).
+    Written out so that Newton's law gives ``-eps`` to the last bit (the quotient
+    ``(-eps * u) / u`` does not); tests/test_impact_law.py holds the three to one another.
     """
-    return -eps
+    return -eps / (1.0 + a * abs(u))
+
+
+def restitution_range(eps, a, w):
+    """``(lowest, highest)`` restitution ``eps(u)`` over the speeds ``0 <= |u| <= w``: the
+    law falls with the speed, so ``(eps / (1 + a w), eps)``; Newton's law: ``(eps, eps)``.
+
+    The simulator's chatter proof (:func:`vibroimpact.impact.events.chatter_tail`) bounds the
+    rebounds of a sequence whose speeds stay below ``w`` with it.
+    """
+    return eps / (1.0 + a * w), eps
+
+
+def law_rates(speed_scale=math.inf, speed_scale_lower=None):
+    """``(a, a_lower)``: the kernels' ``1 / speed_scale`` of the wall at ``delta`` and of the
+    second wall (``speed_scale_lower`` None: the first's), 0 for Newton's law, checked."""
+    upper = Restitution(0.0, speed_scale).a
+    lower = upper if speed_scale_lower is None else Restitution(
+        0.0, _speed_scale(speed_scale_lower, "speed_scale_lower")).a
+    return upper, lower
+
+
+def _speed_scale(value, name="speed_scale"):
+    """The law's speed scale checked: a real number > 0, ``inf`` for Newton's law."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool) and value == math.inf:
+        return math.inf
+    try:
+        return _checks.real(name, value, low=0.0, low_open=True)
+    except ValueError:
+        raise ValueError(f"{name} must be a real number > 0, or inf for Newton's law (a "
+                         f"constant restitution), got {value!r}") from None
 
 
 @dataclass(frozen=True)
 class Restitution:
-    """Newton's impact law with a constant coefficient ``0 <= eps <= 1``."""
+    """The impact law of a wall: restitution ``eps(u) = eps / (1 + |u| / speed_scale)`` at
+    the approach speed ``|u|``, ``0 <= eps <= 1`` its value at vanishing speed and
+    ``speed_scale > 0`` the speed at which it has halved; ``speed_scale = inf`` (the default)
+    is Newton's law with the constant coefficient ``eps``."""
 
     eps: float
+    speed_scale: float = math.inf
 
     def __post_init__(self):
         object.__setattr__(self, "eps", _checks.eps(self.eps))
+        object.__setattr__(self, "speed_scale", _speed_scale(self.speed_scale))
+
+    @property
+    def a(self):
+        """``1 / speed_scale``: the kernels' form of the law's speed dependence (0: Newton)."""
+        return 0.0 if math.isinf(self.speed_scale) else 1.0 / self.speed_scale
+
+    @property
+    def newton(self):
+        """Whether the restitution is constant (Newton's law)."""
+        return math.isinf(self.speed_scale)
 
     def rebound(self, u):
         """Velocity after impact for the approach velocity ``u`` (either sign convention)."""
-        return rebound_velocity(self.eps, u)
+        return rebound_velocity(self.eps, u, self.a)
 
 
 @dataclass(frozen=True)
@@ -131,12 +190,15 @@ class Model:
         object.__setattr__(self, "walls", walls)
 
     @classmethod
-    def paper(cls, zeta, eps, delta, amplitude=0.0, beta=1.0, *, gap=None, eps_lower=None):
+    def paper(cls, zeta, eps, delta, amplitude=0.0, beta=1.0, *, gap=None, eps_lower=None,
+              speed_scale=math.inf, speed_scale_lower=None):
         """The paper's oscillator from its loose parameters (the public functions' arguments),
         with an optional second wall ``gap`` below the first (restitution ``eps_lower``,
-        default ``eps``)."""
+        default ``eps``). ``speed_scale`` (and ``speed_scale_lower``, default
+        ``speed_scale``) make a wall's restitution fall with the impact speed
+        (:class:`Restitution`); ``inf``, the default, is Newton's law."""
         delta = _checks.real("delta", delta)
-        walls = [Wall(delta, ABOVE, Restitution(eps))]
+        walls = [Wall(delta, ABOVE, Restitution(eps, speed_scale))]
         if gap is not None:
             gap = _checks.real("gap", gap, low=0.0, low_open=True)
             lower = delta - gap
@@ -144,9 +206,14 @@ class Model:
                 raise ValueError(f"gap must be a finite real number > 0 that leaves "
                                  f"delta - gap below delta, got {gap!r}")
             eps_lower = eps if eps_lower is None else eps_lower
-            walls.append(Wall(lower, BELOW, Restitution(_checks.eps(eps_lower, "eps_lower"))))
-        elif eps_lower is not None:
-            raise ValueError("eps_lower needs a second wall: give gap as well")
+            speed_scale_lower = (speed_scale if speed_scale_lower is None
+                                 else speed_scale_lower)
+            walls.append(Wall(lower, BELOW, Restitution(
+                _checks.eps(eps_lower, "eps_lower"),
+                _speed_scale(speed_scale_lower, "speed_scale_lower"))))
+        elif eps_lower is not None or speed_scale_lower is not None:
+            name = "eps_lower" if eps_lower is not None else "speed_scale_lower"
+            raise ValueError(f"{name} needs a second wall: give gap as well")
         return cls(zeta, tuple(walls), amplitude, beta)
 
     @classmethod
@@ -185,10 +252,33 @@ class Model:
     def eps_lower(self):
         return self.walls[1].eps if self.n_walls == 2 else None
 
+    @property
+    def newton(self):
+        """Whether every wall follows Newton's law (a constant restitution): what the
+        closed-form orbit solvers and the paper's theories assume."""
+        return all(w.law.newton for w in self.walls)
+
+    def restitution(self, u, wall=None):
+        """The restitution ``eps_w(u)`` of each impact met at approach speed ``u`` at wall
+        ``wall`` (0 per impact, the default: the wall at ``delta``; 1: the one below), by each
+        wall's law: the rebound speed is ``restitution * u`` (float64 array)."""
+        u = np.abs(np.asarray(u, dtype=float))
+        upper = self.walls[0].law
+        out = -rebound_ratio(upper.eps, u, upper.a)
+        if self.n_walls == 2 and wall is not None:
+            lower = self.walls[1].law
+            out = np.where(np.asarray(wall) == 1, -rebound_ratio(lower.eps, u, lower.a), out)
+        return out
+
     def params(self):
-        """The loose parameters, as the results' ``params`` record them."""
+        """The loose parameters, as the results' ``params`` record them (a wall's
+        ``speed_scale`` only where its law is not Newton's)."""
         out = dict(zeta=self.zeta, eps=self.eps, delta=self.delta,
                    amplitude=self.amplitude, beta=self.beta)
         if self.n_walls == 2:
             out.update(gap=self.gap, eps_lower=self.eps_lower)
+        if not self.newton:
+            out["speed_scale"] = self.walls[0].law.speed_scale
+            if self.n_walls == 2:
+                out["speed_scale_lower"] = self.walls[1].law.speed_scale
         return out

@@ -25,7 +25,7 @@ from vibroimpact.impact import _jit as _impact_jit
 from vibroimpact.impact.layout import (BUFFER_FULL, FREE, N_COUNTERS, N_FTOT, N_PARAMS,
                                        N_STATE, OK, P_A, P_AQ, P_BETA, P_BH_HI, P_BH_LO,
                                        P_COS_BH, P_COS_PHI, P_DELTA, P_DT, P_EPS, P_INV_DT,
-                                       P_INV_OMEGA, P_M11, P_M12, P_M21, P_M22, P_OMEGA,
+                                       P_LAW_A, P_INV_OMEGA, P_M11, P_M12, P_M21, P_M22, P_OMEGA,
                                        P_PHI, P_SIN_BH, P_SIN_PHI, P_ZETA, S_COS_PSI, S_MODE,
                                        S_SIN_PSI, S_W, S_WV, STICK_LO, STICK_ON, STUCK,
                                        STUCK_LO)
@@ -350,6 +350,7 @@ def _params_upper(zeta, eps, delta, h, beta):
     P[P_INV_OMEGA] = 1.0 / omega
     P[P_COS_BH] = math.cos(beta * h)
     P[P_SIN_BH] = math.sin(beta * h)
+    P[P_LAW_A] = 0.0          # Newton's law: the attractor maps take eps alone
     return P
 
 

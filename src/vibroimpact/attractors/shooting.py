@@ -20,10 +20,13 @@ Method
   of ``x - wall`` on the piece (safeguarded Newton). A flight that rises towards a wall and
   turns back without a sign change at the samples (grazing, double crossing) is therefore
   never jumped over: its maximum is a critical point, computed, and compared with the wall.
-- Impact at wall ``w`` (approach velocity ``u``): ``v -> -eps_w u`` (the model's impact law).
+- Impact at wall ``w`` (approach velocity ``u``): ``v -> R_w(u) = -eps_w(u) u``, the wall's
+  impact law (:mod:`vibroimpact.model`; ``eps_w`` constant under Newton's law).
 - Jacobian of ``Phi_n``: the product of the free propagators ``P(s)`` of the flights and the
-  impacts' saltation matrices ``S = [[-eps, 0], [(a_+ + eps a_-) / u, -eps]]`` (``a_-+`` the
-  accelerations just before and after the impact); ``det = prod eps_w^2 exp(-2 zeta z)``.
+  impacts' saltation matrices ``S = [[R / u, 0], [(a_+ - R' a_-) / u, R']]`` (``a_-+`` the
+  accelerations just before and after the impact, ``R' = dR/du``; Newton's law:
+  ``[[-eps, 0], [(a_+ + eps a_-) / u, -eps]]``); ``det = prod (R R' / u) exp(-2 zeta z)``,
+  ``prod eps_w^2 exp(-2 zeta z)`` under Newton's law.
 - Newton on ``Phi_n(X) - X`` at a phase ``theta`` chosen in the middle of the largest gap
   between the impacts' phases (so no impact sits on the section while Newton moves the orbit),
   with halving of steps that do not reduce the residual; converged when the residual is below
@@ -49,7 +52,8 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact._kernel_cache import kernel_decorator
-from vibroimpact._law import LAW_MODULES, rebound_velocity
+from vibroimpact._law import (LAW_MODULES, rebound_derivative, rebound_ratio,
+                              rebound_velocity)
 from vibroimpact.model import Model
 
 __all__ = ["PeriodicMotion", "SkippedSeed", "MotionSet", "periodic_motions"]
@@ -113,7 +117,7 @@ DEFAULT_STARTS = 12
 # status codes of the flow kernel
 OK, CHATTER = 0, 1
 # parameter vector slots
-_ZETA, _WD, _AQ, _BETA, _PHI, _UPPER, _LOWER, _EPS_U, _EPS_L, _A = range(10)
+_ZETA, _WD, _AQ, _BETA, _PHI, _UPPER, _LOWER, _EPS_U, _EPS_L, _A, _LAW_U, _LAW_L = range(12)
 
 
 def _parameters(model):
@@ -122,8 +126,9 @@ def _parameters(model):
     q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
     phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
     eps_l = model.eps_lower if model.n_walls == 2 else 0.0
+    a_l = model.walls[1].law.a if model.n_walls == 2 else 0.0
     return np.array([zeta, wd, amp * q, beta, phi, model.delta, model.lower, model.eps,
-                     eps_l, amp])
+                     eps_l, amp, model.walls[0].law.a, a_l])
 
 
 # --- kernels ----------------------------------------------------------------------------------
@@ -353,18 +358,23 @@ def advance(t0, t1, x, v, P, M, ev_t, ev_w, ev_u, stack, out):
             status = CHATTER
             break
         eps = P[_EPS_U] if wall == 0 else P[_EPS_L]
+        law_a = P[_LAW_U] if wall == 0 else P[_LAW_L]
         pos = P[_UPPER] if wall == 0 else P[_LOWER]
         t = t + s
         f = amp * math.sin(beta * t)
         a_minus = f - 2.0 * zeta * u - pos
-        v_plus = rebound_velocity(eps, u)       # the impact law (vibroimpact.model)
+        v_plus = rebound_velocity(eps, u, law_a)      # the impact law (vibroimpact.model)
         a_plus = f - 2.0 * zeta * v_plus - pos
-        c21 = (a_plus + eps * a_minus) / u
+        # the saltation matrix [[R / u, 0], [(a_+ - R' a_-) / u, R']] times M (Newton's law:
+        # R / u = R' = -eps, the same bits as -eps written in place)
+        ratio = rebound_ratio(eps, u, law_a)
+        slope = rebound_derivative(eps, u, law_a)
+        c21 = (a_plus - slope * a_minus) / u
         m11, m12 = M[0, 0], M[0, 1]
-        M[1, 0] = c21 * m11 - eps * M[1, 0]
-        M[1, 1] = c21 * m12 - eps * M[1, 1]
-        M[0, 0] = -eps * m11
-        M[0, 1] = -eps * m12
+        M[1, 0] = c21 * m11 + slope * M[1, 0]
+        M[1, 1] = c21 * m12 + slope * M[1, 1]
+        M[0, 0] = ratio * m11
+        M[0, 1] = ratio * m12
         ev_t[n_ev] = t
         ev_w[n_ev] = wall
         ev_u[n_ev] = u
@@ -766,7 +776,8 @@ def periodic_motions(model, n, seeds=None, *, starts=None, settle_periods=SETTLE
     Notes
     -----
     docs/model.md, section 8.8: the flow, the saltation matrix, the Newton section and the
-    determinant ``prod eps_w^2 exp(-2 zeta z)`` of the monodromy.
+    determinant ``prod eps_w^2 exp(-2 zeta z)`` of the monodromy (Newton's law; the module
+    docstring gives it for any law).
 
     Examples
     --------

@@ -10,8 +10,9 @@ With a second wall (``gap``) the events carry their wall: an impact at the lower
 ``(delta - gap) - f`` and its tails to the rows of ``stats.identities.MOMENTS_LOWER``.
 
 Its kernels use no simulator kernel and no constant of another module (the Gauss-Legendre
-rule, the tail threshold and the whole-step forms come in as arguments), so their numba cache
-is stamped with this file alone and an edit here recompiles nothing of the simulator.
+rule, the tail threshold and the whole-step forms come in as arguments) but the impact law,
+so their numba cache is stamped with this file and the law's (`vibroimpact._law`), and an
+edit here recompiles nothing of the simulator.
 """
 import math
 
@@ -19,10 +20,13 @@ import numpy as np
 from numba import njit
 
 from vibroimpact._kernel_cache import kernel_decorator
+from vibroimpact._law import LAW_MODULES, rebound_velocity
+from vibroimpact.model import law_rates
 from vibroimpact.stats.identities import (GAUSS_NODES, TAIL_REBOUND, moment_rows, step_forms,
                                          wall_arrays)
 
-kernel = kernel_decorator(njit, __file__, ("audit.py",), error_model="numpy")
+kernel = kernel_decorator(njit, __file__, ("audit.py",) + tuple(f"../{m}" for m in LAW_MODULES),
+                          error_model="numpy")
 
 #: Whole free steps summed together before joining their batch's sum (round-off of the
 #: running sums ~ (BLOCK + steps / BLOCK) ulp rather than steps ulp).
@@ -38,7 +42,7 @@ _SAMPLE, _IMPACT, _ONSET = 0, 1, 2
 def audit_moments(k_first, a, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                   impact_time=(), impact_velocity=(), stick_start=(), stick_end=(),
                   batch_bounds=None, gap=None, eps_lower=None, impact_wall=None,
-                  stick_wall=None):
+                  stick_wall=None, speed_scale=math.inf, speed_scale_lower=None):
     """:func:`vibroimpact.stats.flight_moments` of the simulator's record ``a = delta - x``.
 
     Parameters
@@ -59,6 +63,10 @@ def audit_moments(k_first, a, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta
         ``batch_bounds[j + 1]`` (nondecreasing, covering the steps). Default: one batch.
     gap, eps_lower, impact_wall, stick_wall
         A second wall, as :func:`vibroimpact.stats.flight_moments` (all or none).
+    speed_scale, speed_scale_lower
+        The walls' impact laws (:class:`vibroimpact.model.Restitution`; ``inf``, the
+        default, Newton's): the velocity leaving each impact is its wall's
+        ``rebound_velocity``.
 
     Returns
     -------
@@ -86,13 +94,14 @@ def audit_moments(k_first, a, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta
     if walls is None:    # one wall: every event at the wall at delta
         walls = (0.0, 0.0, np.zeros(t_imp.size, np.int8), np.zeros(s0.size, np.int8))
     x_lower, e_lower, iw, sw = walls
+    law_a, law_a_lower = law_rates(speed_scale, speed_scale_lower)
     if n:
         _moments(int(k_first), a, v, r, float(dt), float(zeta), float(eps), float(delta),
                  float(amplitude), float(beta_f), t_imp, as_f(impact_velocity),
                  s0, as_f(stick_end), bounds,
                  np.ascontiguousarray(step_forms(dt, zeta, amplitude, beta_f)), _XI, _W,
                  TAIL_REBOUND, float(x_lower), float(e_lower), np.ascontiguousarray(iw),
-                 np.ascontiguousarray(sw), out)
+                 np.ascontiguousarray(sw), law_a, law_a_lower, out)
     return out
 
 
@@ -109,12 +118,13 @@ def _step_of(t, k_first, n, dt):
 
 
 @kernel
-def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1, delta, x_lower, eps_lower, iw, sw):
+def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1, delta, x_lower, eps_lower, iw, sw,
+            law_a, law_a_lower):
     """Impacts, sticking onsets and releases inside the steps, sorted by (time, kind).
 
-    Returns the times, kinds, velocities leaving them (``-eps V``, 0, 0 at the upper wall;
-    ``+eps_lower V`` after an impact at the lower one), positions (the event's wall) and
-    steps."""
+    Returns the times, kinds, velocities leaving them (the wall's law: ``-eps V``, 0, 0 at
+    the upper wall under Newton's law; ``+eps_lower V`` after an impact at the lower one),
+    positions (the event's wall) and steps."""
     t_lo, t_hi = k_first * dt, (k_first + n) * dt
     lists = (t_imp, s0, s1)
     firsts = np.zeros(3, np.int64)
@@ -144,7 +154,9 @@ def _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1, delta, x_lower, eps_lower
                     best, best_t = kind, t
         at_lower = (iw[heads[0]] if best == 0 else sw[heads[best]]) == 1
         if best == 0:
-            ev_v[e] = eps_lower * u_imp[heads[0]] if at_lower else -eps * u_imp[heads[0]]
+            u = u_imp[heads[0]]
+            ev_v[e] = (-rebound_velocity(eps_lower, u, law_a_lower) if at_lower
+                       else rebound_velocity(eps, u, law_a))
         if at_lower:
             ev_x[e] = x_lower
         ev_t[e] = best_t
@@ -457,15 +469,17 @@ def _free_run(a, v, r, i0, i1, k_first, dt, zeta, delta, A, beta, q, cos_phi, si
 
 @kernel
 def _moments(k_first, a, v, r, dt, zeta, eps, delta, A, beta, t_imp, u_imp, s0, s1, bounds,
-             M, xi, wi, tail_rebound, x_lower, eps_lower, iw, sw, out):
+             M, xi, wi, tail_rebound, x_lower, eps_lower, iw, sw, law_a, law_a_lower, out):
     """Add the moments of the steps ``k_first .. k_first + n - 1`` to ``out`` (see
     :func:`audit_moments`); ``M``: the whole-step forms of ``stats.identities.step_forms``;
     ``iw``, ``sw``: the wall of each impact and sticking phase (1: the lower wall, at
-    ``x_lower``, restitution ``eps_lower``)."""
+    ``x_lower``, restitution ``eps_lower``); ``law_a``, ``law_a_lower``: the walls' laws
+    (``1 / speed_scale``, 0 for Newton's)."""
     n = a.size
     m = M.shape[1]
     ev_t, ev_kind, ev_v, ev_x, ev_step = _events(k_first, n, dt, eps, t_imp, u_imp, s0, s1,
-                                                 delta, x_lower, eps_lower, iw, sw)
+                                                 delta, x_lower, eps_lower, iw, sw, law_a,
+                                                 law_a_lower)
     q = phi = 0.0
     if A != 0.0:
         q = A / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)

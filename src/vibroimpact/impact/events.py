@@ -16,10 +16,11 @@ import math
 
 import numpy as np
 
+from vibroimpact._law import restitution_range
 from vibroimpact.impact._jit import kernel
 from vibroimpact.impact.layout import (C_B, C_DF0, C_F0, C_F_LIN, C_G2, C_G3, C_R,
                                        C_V0, C_XD, NO_ROOT, P_A, P_AQ, P_BETA, P_DELTA, P_DT,
-                                       P_EPS, P_ZETA, PRESSED, ROOT, TOUCH)
+                                       P_EPS, P_LAW_A, P_ZETA, PRESSED, ROOT, TOUCH)
 from vibroimpact.impact.motion import bounds, push_eval, seg_eval
 from vibroimpact.impact.tolerances import (BOUND_SAFETY, BRACKET_END_REL, CHATTER_MAXIT,
                                            CHATTER_TIME_TOL, CHATTER_WINDOW,
@@ -422,8 +423,10 @@ def chatter_tail(w, F0, dF0, prev, Hs, P):
     and the gap ``a = delta - x`` below ``a_max``, the acceleration towards the wall,
     ``x'' = F - 2 zeta x' + a``, lies in ``[g_lo, g_hi]``, ``rho = g_hi / g_lo``. A flight
     from speed ``w_k`` then lasts ``[2 w_k / g_hi, 2 w_k / g_lo]`` and returns at
-    ``w_k [rho^-1/2, rho^1/2]``, so with ``q = eps rho^1/2 < 1`` the rebounds accumulate at
-    ``T`` in ``[T_lo, T_hi] = [2 w / (g_hi (1 - eps / rho^1/2)), 2 w / (g_lo (1 - q))]``,
+    ``w_k [rho^-1/2, rho^1/2]``; the impact law's restitution lies in ``[eps_lo, eps]`` at
+    these speeds (:func:`vibroimpact.model.restitution_range`; ``eps_lo = eps`` under
+    Newton's law), so with ``q = eps rho^1/2 < 1`` the rebounds accumulate at ``T`` in
+    ``[T_lo, T_hi] = [2 w / (g_hi (1 - eps_lo / rho^1/2)), 2 w / (g_lo (1 - q))]``,
     where the push is still positive (``g_lo > 0``): the mass sticks there. Returns the
     midpoint when ``w < RESOLVED_REBOUND``, ``T_hi - T_lo <= CHATTER_TIME_TOL`` (the stated
     bound on the sticking onset), ``T_hi <= W``, and the unresolved rebounds are proved to
@@ -432,9 +435,12 @@ def chatter_tail(w, F0, dF0, prev, Hs, P):
     impacts into collisions (:mod:`vibroimpact.stats.collisions`) is the same as with every
     rebound resolved.
     """
-    zeta, eps = P[P_ZETA], P[P_EPS]
+    zeta = P[P_ZETA]
     if w >= RESOLVED_REBOUND:
         return -1.0
+    # the law's restitution over the speeds below 2 w: eps_lo its lowest (at 2 w), eps its
+    # highest (at rest); both P[P_EPS] under Newton's law
+    eps_lo, eps = restitution_range(P[P_EPS], P[P_LAW_A], 2.0 * w)
     MF = abs(P[P_A]) * P[P_BETA] * P[P_BETA] * BOUND_SAFETY
     W = 2.0 * CHATTER_WINDOW * w / (F0 * (1.0 - eps))   # the constant-push estimate, widened
     for _ in range(CHATTER_MAXIT):
@@ -456,7 +462,7 @@ def chatter_tail(w, F0, dF0, prev, Hs, P):
         if T_hi <= W:
             if eps * rho * root >= 1.0 or prev <= 2.0 * w / g_lo:
                 return -1.0
-            T_lo = 2.0 * w / (g_hi * (1.0 - eps / root)) / BOUND_SAFETY
+            T_lo = 2.0 * w / (g_hi * (1.0 - eps_lo / root)) / BOUND_SAFETY
             if T_hi - T_lo > CHATTER_TIME_TOL:
                 return -1.0
             return 0.5 * (T_lo + T_hi)

@@ -17,7 +17,7 @@ ints: numba reads them as compile-time constants, so ``P[P_DELTA]`` costs what `
 P_FIELDS = (
     ("zeta", "damping ratio"),
     ("omega", "damped frequency sqrt(1 - zeta^2)"),
-    ("eps", "restitution coefficient"),
+    ("eps", "restitution coefficient (at vanishing impact speed)"),
     ("delta", "wall position"),
     ("dt", "force sample step h"),
     ("A", "harmonic amplitude"),
@@ -36,10 +36,11 @@ P_FIELDS = (
     ("inv_omega", "1 / omega"),
     ("cos_bh", "cos(beta h): one rotation of the harmonic phase"),
     ("sin_bh", "sin(beta h)"),
+    ("law_a", "the impact law's 1 / speed_scale: eps(u) = eps / (1 + a |u|); 0: Newton's"),
 )
 (P_ZETA, P_OMEGA, P_EPS, P_DELTA, P_DT, P_A, P_BETA, P_AQ, P_PHI, P_COS_PHI, P_SIN_PHI,
  P_BH_HI, P_BH_LO, P_M11, P_M12, P_M21, P_M22, P_INV_DT, P_INV_OMEGA, P_COS_BH,
- P_SIN_BH) = range(len(P_FIELDS))
+ P_SIN_BH, P_LAW_A) = range(len(P_FIELDS))
 N_PARAMS = len(P_FIELDS)
 
 C_FIELDS = (

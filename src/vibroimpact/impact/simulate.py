@@ -148,7 +148,8 @@ class SimulationResult:
         Impact instants tau_j (dimensionless time), increasing.
     impact_velocity : ndarray of float64, shape (n,)
         Approach velocities u_{j-0} > 0 (paper eq. 6); the velocity after impact is
-        ``-eps * impact_velocity`` (eq. 7).
+        ``-eps * impact_velocity`` (eq. 7; ``-eps(u) u`` under a law whose restitution varies
+        with the speed, :meth:`vibroimpact.model.Model.restitution`).
     impact_step, impact_offset : ndarray, shape (n,)
         ``impact_time = impact_step * dt + impact_offset`` with ``0 <= offset <= dt``: the
         full-precision form, for intervals on long records.
@@ -183,7 +184,8 @@ class SimulationResult:
         Instant of each collision's first impact (and its split form, as for impacts).
     collision_velocity : ndarray of float64, shape (n_collisions,)
         Approach velocity of each collision's first impact; its velocity after impact (that
-        of its first rebound) is ``eps * collision_velocity``.
+        of its first rebound) is ``eps * collision_velocity`` (``eps(u) u`` under a
+        speed-dependent law).
     collision_rebounds : ndarray of int64, shape (n_collisions,)
         Rebounds of each collision leaving the wall at speed ``>= rebound_floor``.
     collision_stuck : ndarray of bool, shape (n_collisions,)
@@ -284,8 +286,8 @@ class SimulationResult:
                                           amplitude=p["amplitude"], beta=p["beta"])
             return group_collisions(self.impact_step, self.impact_offset,
                                     self.impact_velocity, start, end, dt=p["dt"],
-                                    eps=p["eps"], floor=p["rebound_floor"], pressed=pressed,
-                                    rule=rule)
+                                    eps=self._restitution(), floor=p["rebound_floor"],
+                                    pressed=pressed, rule=rule)
         # two walls: a rest still going on at the end is on the wall the mass ends on
         start, end, wall = close_open_phase(self.stick_start, self.stick_end, self.stuck_since,
                                             self.t_end, self.stick_wall,
@@ -296,9 +298,23 @@ class SimulationResult:
                                       p["dt"], delta=p["delta"], amplitude=p["amplitude"],
                                       beta=p["beta"], wall=self.impact_wall, gap=p["gap"])
         return group_collisions(self.impact_step, self.impact_offset, self.impact_velocity,
-                                start, end, dt=p["dt"], eps=p["eps"], floor=p["rebound_floor"],
-                                pressed=pressed, rule=rule, wall=self.impact_wall,
-                                stick_wall=wall, eps_lower=p["eps_lower"])
+                                start, end, dt=p["dt"], eps=self._restitution(),
+                                floor=p["rebound_floor"], pressed=pressed, rule=rule,
+                                wall=self.impact_wall, stick_wall=wall,
+                                eps_lower=None if self._speed_law else p["eps_lower"])
+
+    def _restitution(self):
+        """The rebound speed's coefficient for the collisions: ``eps`` under Newton's law
+        (``eps_lower`` then goes with it), else each impact's ``eps_w(u)`` by its wall's
+        law (:meth:`vibroimpact.model.Model.restitution`)."""
+        if not self._speed_law:
+            return self.params["eps"]
+        return self.model.restitution(self.impact_velocity, self.impact_wall)
+
+    @property
+    def _speed_law(self):
+        """Whether a wall's restitution varies with the speed (not Newton's law)."""
+        return self.model is not None and not self.model.newton
 
     n_collisions = property(lambda self: int(self.collisions.first.size))
     collision_time = property(lambda self: self.collisions.time)
@@ -315,13 +331,15 @@ class SimulationResult:
 
 
 def _check_inputs(zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every,
-                  chunk_size, gap=None, eps_lower=None, start=None):
+                  chunk_size, gap=None, eps_lower=None, start=None, speed_scale=math.inf,
+                  speed_scale_lower=None):
     zeta = _checks.zeta(zeta)
     eps = _checks.eps(eps)
     delta = _checks.real("delta", delta)
     amplitude = _checks.real("amplitude", amplitude)
     beta = _checks.real("beta", beta, low=0.0, low_open=True)
-    model = Model.paper(zeta, eps, delta, amplitude, beta, gap=gap, eps_lower=eps_lower)
+    model = Model.paper(zeta, eps, delta, amplitude, beta, gap=gap, eps_lower=eps_lower,
+                        speed_scale=speed_scale, speed_scale_lower=speed_scale_lower)
     return (model,) + _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size,
                                  start)
 
@@ -393,10 +411,12 @@ def model_parameters(model, dt):
         E * (C - zeta * S / omega))
     P[[kernels.P_INV_DT, kernels.P_INV_OMEGA, kernels.P_COS_BH, kernels.P_SIN_BH]] = (
         1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt))
+    P[kernels.P_LAW_A] = model.walls[0].law.a
     if model.n_walls == 2:
         n = kernels.N_PARAMS
         P[n:] = P[:n]
         P[n + kernels.P_EPS] = model.eps_lower
+        P[n + kernels.P_LAW_A] = model.walls[1].law.a
         P[n + kernels.P_DELTA] = -model.lower
         P[n + kernels.P_A] = -amplitude
         P[n + kernels.P_AQ] = -P[kernels.P_AQ]
@@ -500,7 +520,7 @@ def _raise_status(status, k, dt, r, k0, diag, P):
 def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None,
                     v0=0.0, t_end=None, *, record_every=0, chunk_size=2**20,
                     rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None,
-                    start=None):
+                    start=None, speed_scale=math.inf, speed_scale_lower=None):
     """Simulate chunk by chunk; yield one :class:`SimulationResult` per chunk of samples.
 
     Same arguments as :func:`simulate`. Each chunk carries the events of its stretch of
@@ -525,7 +545,7 @@ def simulate_chunks(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.
     """
     model, dt, x0, v0, t_end, record_every, chunk_size, start = _check_inputs(
         zeta, eps, delta, noise, dt, amplitude, beta, x0, v0, t_end, record_every, chunk_size,
-        gap, eps_lower, start)
+        gap, eps_lower, start, speed_scale, speed_scale_lower)
     rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
     yield from _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size,
                                start, rebound_floor)
@@ -542,6 +562,7 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, s
                   rebound_floor=rebound_floor)
     if model.n_walls == 2:
         params.update(gap=model.gap, eps_lower=model.eps_lower)
+    params.update({k: v for k, v in model.params().items() if k.startswith("speed_scale")})
     k_start = 0 if start is None else start.k
     state = _initial_vector(model, dt, x0, v0) if start is None else start.vector()
     n_full, rem = _split_steps(t_end, dt)
@@ -728,7 +749,8 @@ def _wrap(parts, buf, stride, dt, k0, k1, params, t_chunk, x, v, mode, stick_ope
 
 def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=None, v0=0.0,
              t_end=None, *, record_every=0, chunk_size=2**20,
-             rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None, start=None):
+             rebound_floor=DEFAULT_REBOUND_FLOOR, gap=None, eps_lower=None, start=None,
+             speed_scale=math.inf, speed_scale_lower=None):
     """Exact motion of the impact oscillator under a sampled random force plus a harmonic force.
 
     Parameters
@@ -767,6 +789,12 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
         between two walls"). ``None`` (the default): the paper's one wall.
     eps_lower : float, keyword-only
         Restitution coefficient of the second wall, ``0 <= eps_lower <= 1`` (default ``eps``).
+    speed_scale, speed_scale_lower : float, keyword-only
+        The impact law of the wall at ``delta`` (and of the second wall, default
+        ``speed_scale``): the restitution falls with the approach speed ``u`` as
+        ``eps(u) = eps / (1 + u / speed_scale)`` (`vibroimpact.model.Restitution`;
+        docs/model.md, "Impact laws"). ``inf`` (the default) is Newton's law, the paper's
+        eq. 7: ``eps`` at every speed.
     start : SampleState, keyword-only
         Start from this exact state at sample ``start.k`` (time ``start.k * dt``, the harmonic
         force at its phase there) instead of ``x0, v0`` at ``tau = 0``: a previous run's
@@ -823,7 +851,8 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
                                   beta=beta, x0=x0, v0=v0, t_end=t_end,
                                   record_every=record_every, chunk_size=chunk_size,
                                   rebound_floor=rebound_floor, gap=gap, eps_lower=eps_lower,
-                                  start=start))
+                                  start=start, speed_scale=speed_scale,
+                                  speed_scale_lower=speed_scale_lower))
     return concatenate_results(chunks)
 
 

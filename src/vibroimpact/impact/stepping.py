@@ -17,13 +17,14 @@ from vibroimpact.impact.layout import (BAD_NOISE, BUFFER_FULL, C_DF0, C_F0, C_R,
                                        FT_OFFSET, FT_STICK_EVENTS, FT_V, N_PARAMS, NO_ROOT,
                                        OK, P_A,
                                        P_AQ, P_BETA, P_BH_HI, P_BH_LO, P_COS_BH, P_COS_PHI,
-                                       P_DELTA, P_DT, P_EPS, P_INV_DT, P_INV_OMEGA, P_M11,
+                                       P_DELTA, P_DT, P_EPS, P_INV_DT, P_INV_OMEGA,
+                                       P_LAW_A, P_M11,
                                        P_M12, P_M21, P_M22, P_PHI, P_SIN_BH, P_SIN_PHI,
                                        P_ZETA, PRESSED, ROOT, S_COS_PSI, S_MODE, S_SIN_PSI,
                                        S_W, S_WV, STICK_LO, STICK_OFF, STICK_ON, STUCK,
                                        STUCK_LO, TOO_MANY_EVENTS, TOUCH, WALL, WALL_LO)
 from vibroimpact.impact.motion import phase, segment, segment_at
-from vibroimpact._law import rebound_velocity
+from vibroimpact._law import rebound_velocity, restitution_range
 from vibroimpact.impact.tolerances import (BOUND_SAFETY, CHATTER_ESTIMATE_TOL,
                                            ELASTIC_MICRO_FLIGHT, EPS64,
                                            EXCLUSION_MARGIN_REL, MANY_EVENTS,
@@ -147,8 +148,9 @@ def _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, s
         vf = sg * v
         Hs = H - s
         if just_hit and vf < 0.0 and c[C_F0] > 0.0:
-            # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
-            # the tail is summed in closed form as soon as chatter_tail proves where it ends
+            # chatter: rebounds shrink (geometrically under Newton's law) while f pushes the
+            # mass into the wall; the tail is summed in closed form as soon as chatter_tail
+            # proves where it ends
             wv, F, dF = -vf, c[C_F0], c[C_DF0]
             if eps < 1.0:
                 n = cnt[CNT_IMPACTS] - 1    # the impact just recorded, and the one before it
@@ -160,9 +162,11 @@ def _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, s
                 if not ok:
                     # no bracket inside the step (a tail across a sample point, eps near 1):
                     # the first-order estimate once its neglected terms are below round-off
+                    # (and the law's fall of eps(u) over the rebounds' speeds, below wv)
                     tail = 2.0 * wv / (F * (1.0 - eps))
+                    eps_lo = restitution_range(eps, Pw[P_LAW_A], wv)[0]
                     ok = (tail * (2.0 * Pw[P_ZETA] * wv + abs(dF) * tail) / F
-                          <= CHATTER_ESTIMATE_TOL)
+                          + (eps - eps_lo) / (1.0 - eps) <= CHATTER_ESTIMATE_TOL)
                     F_end = (F + dF * tail
                              - 0.5 * abs(Pw[P_A]) * Pw[P_BETA] * Pw[P_BETA] * tail * tail)
             else:
@@ -239,7 +243,7 @@ def _slow_step(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_step, s
             continue
         _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, sg * u)
         cnt[CNT_IMPACTS] += 1
-        v = sg * rebound_velocity(Pw[P_EPS], u)      # the law of the wall just met
+        v = sg * rebound_velocity(Pw[P_EPS], u, Pw[P_LAW_A])   # the law of the wall met
         just_hit = True
 
 
@@ -307,8 +311,9 @@ def _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_ste
             c = segment(x, v, s, r0, b, theta_k, P)
         Hs = H - s
         if just_hit and v < 0.0 and c[C_F0] > 0.0:
-            # chatter: rebounds shrink geometrically while f pushes the mass into the wall;
-            # the tail is summed in closed form as soon as chatter_tail proves where it ends
+            # chatter: rebounds shrink (geometrically under Newton's law) while f pushes the
+            # mass into the wall; the tail is summed in closed form as soon as chatter_tail
+            # proves where it ends
             wv, F, dF = -v, c[C_F0], c[C_DF0]
             if eps < 1.0:
                 n = cnt[CNT_IMPACTS] - 1    # the impact just recorded, and the one before it
@@ -320,8 +325,11 @@ def _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_ste
                 if not ok:
                     # no bracket inside the step (a tail across a sample point, eps near 1):
                     # the first-order estimate once its neglected terms are below round-off
+                    # (and the law's fall of eps(u) over the rebounds' speeds, below wv)
                     tail = 2.0 * wv / (F * (1.0 - eps))
-                    ok = tail * (2.0 * zeta * wv + abs(dF) * tail) / F <= CHATTER_ESTIMATE_TOL
+                    eps_lo = restitution_range(eps, P[P_LAW_A], wv)[0]
+                    ok = (tail * (2.0 * zeta * wv + abs(dF) * tail) / F
+                          + (eps - eps_lo) / (1.0 - eps) <= CHATTER_ESTIMATE_TOL)
                     F_end = (F + dF * tail
                              - 0.5 * abs(P[P_A]) * P[P_BETA] * P[P_BETA] * tail * tail)
             else:
@@ -378,7 +386,7 @@ def _slow_step_one(k, H, x, v, mode, r0, b, P, imp_step, imp_off, imp_u, stk_ste
             continue
         _record_event(imp_step, imp_off, imp_u, cnt[CNT_IMPACTS], k, s, u)
         cnt[CNT_IMPACTS] += 1
-        v = rebound_velocity(eps, u)      # inlined: rounds as -eps * u
+        v = rebound_velocity(eps, u, P[P_LAW_A])   # inlined; Newton's: rounds as -eps * u
         just_hit = True
 
 

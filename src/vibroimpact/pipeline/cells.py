@@ -77,26 +77,37 @@ def study_model(study, cell):
                        **walls)
 
 
-def _walls(gap, eps_lower, eps=None):
-    """The second wall as `simulate_chunks` keywords: ``{}`` with one wall (``gap`` None), so
-    a one-wall cell makes the call it always made; ``eps_lower`` None is ``eps``."""
+def _walls(gap, eps_lower, eps=None, speed_scale=math.inf, speed_scale_lower=None):
+    """The second wall and the impact laws as `simulate_chunks` keywords: ``{}`` with one
+    wall (``gap`` None) under Newton's law, so such a cell makes the call it always made;
+    ``eps_lower`` None is ``eps``."""
     if gap is None:
         if eps_lower is not None:
             raise ValueError("eps_lower needs a second wall: give gap as well")
-        return {}
-    return dict(gap=float(gap), eps_lower=float(eps if eps_lower is None else eps_lower))
+        out = {}
+    else:
+        out = dict(gap=float(gap), eps_lower=float(eps if eps_lower is None else eps_lower))
+    if speed_scale != math.inf or speed_scale_lower is not None:
+        out.update(speed_scale=speed_scale, speed_scale_lower=speed_scale_lower)
+    return out
 
 
-def _rebound_eps(eps, walls, wall):
-    """Restitution of each collision's wall (``wall``: 0 or 1 per collision)."""
-    return np.where(wall == 0, eps, walls["eps_lower"])
+def _cell_model(zeta, eps, delta, amplitude, beta_f, walls):
+    """The cell's `Model` from its loose parameters and `_walls` keywords."""
+    return Model.paper(zeta, eps, delta, amplitude, beta_f, **walls)
+
+
+def _v_after(model, col):
+    """Speed after each collision's first impact: its wall's law at its approach speed
+    (Newton's law: ``eps_w u``, to the bit)."""
+    return model.restitution(col.velocity, col.wall) * col.velocity
 
 
 def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                      transient=0.0, t_end=None, bins, n_batches=stats.DEFAULT_N_BATCHES,
                      motion_window=stats.DEFAULT_MOTION_WINDOW, motions=stats.DEFAULT_MOTIONS,
                      rebound_floor=stats.DEFAULT_REBOUND_FLOOR, chunk_size=2**20, gap=None,
-                     eps_lower=None):
+                     eps_lower=None, speed_scale=math.inf, speed_scale_lower=None):
     """Collision statistics of one cell (Figs. 7-9, 13, 14).
 
     Every statistic counts collisions (:mod:`vibroimpact.stats.collisions`): an impact after
@@ -114,6 +125,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     gap, eps_lower : float, optional
         A second wall at ``x = delta - gap`` with restitution ``eps_lower`` (default
         ``eps``); None: one wall.
+    speed_scale, speed_scale_lower : float, optional
+        The walls' impact laws (`vibroimpact.model.Restitution`): ``eps(u) = eps / (1 + u /
+        speed_scale)``; ``inf`` (the default) is Newton's law. Every statistic of a rebound
+        (the velocity after impact, the rebound counts, the self-audit's impact sums) takes
+        it from the law.
     transient : float
         Time discarded before statistics (collisions that begin before it are dropped).
     t_end : float, optional
@@ -181,8 +197,9 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
     n_batches = int(n_batches)
     harmonic = amplitude != 0.0
-    walls = _walls(gap, eps_lower, eps)
-    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
+    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
+    model = _cell_model(zeta, eps, delta, amplitude, beta_f, walls)
+    events = _EventRecord(dt, noise, model)
     audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, zeta=zeta, eps=eps,
                             delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
@@ -190,12 +207,12 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                                  chunk_size=chunk_size, **walls):
         events.add(chunk)
         audit.add(chunk)
-    col = events.collisions(eps, rebound_floor, transient)
+    col = events.collisions(rebound_floor, transient)
     contact = _clipped_contact(*events.sticking()[:2], transient)
     duration = t_end - transient
-    wall = events.collision_walls(col) if walls else None
-    v_after = (stats.velocity_after_impact(col.velocity, eps) if not walls
-               else _rebound_eps(eps, walls, wall) * col.velocity)
+    two = model.n_walls == 2
+    wall = events.collision_walls(col) if two else None
+    v_after = _v_after(model, col)
     z = col.intervals
     cell = (f"cell delta={delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
     v_stats = stats.batch_means(v_after, n_batches) if v_after.size else None
@@ -206,9 +223,9 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     _lag1_check("the interval", z_stats, cell)
     v_dens = stats.density(v_after, bins["v_after"], total=v_after.size, n_batches=n_batches)
     z_dens = stats.density(z, bins["interval"], total=z.size, n_batches=n_batches)
-    rebound_v = events.rebound_speeds(eps, rebound_floor, transient)
+    rebound_v = events.rebound_speeds(rebound_floor, transient)
     nan = math.nan
-    motion_walls = {} if not walls else dict(walls=wall)
+    motion_walls = {} if not two else dict(walls=wall)
     mean = lambda a: float(a.mean()) if a.size else nan
     out = dict(
         n_collisions=int(v_after.size),
@@ -238,19 +255,19 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         interval_beyond=z_dens.beyond,
     )
     out.update(audit.result())
-    if walls:
-        out.update(stats.wall_statistics(col, transient, t_end, eps=eps,
-                                         eps_lower=walls["eps_lower"], bins=bins,
-                                         n_batches=n_batches,
+    if two:
+        laws = [w.law for w in model.walls]
+        out.update(stats.wall_statistics(col, transient, t_end, eps=laws[0], eps_lower=laws[1],
+                                         bins=bins, n_batches=n_batches,
                                          beta_f=beta_f if harmonic else None))
-    out.update(_rule_statistics(events, col, eps=eps, floor=rebound_floor, transient=transient,
+    out.update(_rule_statistics(events, col, floor=rebound_floor, transient=transient,
                                 duration=duration, n_batches=n_batches,
                                 beta_f=beta_f if harmonic else None,
                                 motion_window=motion_window, motions=motions))
     if harmonic:
         ratio_dens = stats.density(stats.interval_ratio(z, beta_f), bins["ratio"], total=z.size,
                                    n_batches=n_batches)
-        if walls:
+        if two:
             motion_walls["walls"] = wall[:-1]
         motion = list(stats.impact_motion_probabilities(
             z, beta_f, motion_window, total_time=duration, motions=motions,
@@ -262,7 +279,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     return out
 
 
-def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches, beta_f,
+def _rule_statistics(events, col, *, floor, transient, duration, n_batches, beta_f,
                      motion_window, motions):
     """The statistics a figure draws under each grouping rule (`stats.RULES`: physical,
     impacts-only, per rebound above ``floor``), stacked along the rules: ``rule_n_events,
@@ -272,11 +289,10 @@ def _rule_statistics(events, col, *, eps, floor, transient, duration, n_batches,
     choice of rule weighs (the reports' sensitivity table)."""
     rows = []
     for rule in stats.RULES:
-        c = col if rule == "physical" else events.collisions(eps, floor, transient, rule=rule)
+        c = col if rule == "physical" else events.collisions(floor, transient, rule=rule)
         z = c.intervals
         walls = {} if not events.walls else dict(walls=events.collision_walls(c)[:-1])
-        v_after = (stats.velocity_after_impact(c.velocity, eps) if not events.walls else
-                   _rebound_eps(eps, events.walls, events.collision_walls(c)) * c.velocity)
+        v_after = _v_after(events.model, c)
         # the same estimators as the cell's own: T/N and the mean of every value
         row = dict(rule_n_events=c.time.size, rule_collision_rate=c.time.size / duration,
                    rule_v_after_mean=stats.mark_mean(
@@ -317,25 +333,27 @@ class _EventRecord:
     Collisions are grouped on the whole record at the end (a chatter sequence may cross a
     chunk boundary). Impacts are kept from the start of the record, so that a collision that
     begins before the transient is grouped as it happened and then dropped. The physical rule
-    reads the force (``noise``, ``delta``, ``amplitude``, ``beta_f``) along each flight. With
-    a second wall (``gap``) the walls of the impacts and of the sticking phases are gathered
-    too, and the grouping is per wall (`stats.group_collisions` with ``wall``: a collision
-    never spans the two walls, a hop is pressed onto the wall it is at).
+    reads the force (``noise`` and the ``model``'s harmonic force) along each flight; the
+    rebounds' speeds are the model's walls' laws. With a second wall the walls of the impacts
+    and of the sticking phases are gathered too, and the grouping is per wall
+    (`stats.group_collisions` with ``wall``: a collision never spans the two walls, a hop is
+    pressed onto the wall it is at).
     """
 
     steps, offsets, u, starts, ends = _Joined(), _Joined(), _Joined(), _Joined(), _Joined()
     wall, stick_wall = _Joined(), _Joined()
 
-    def __init__(self, dt, noise=None, *, delta=0.0, amplitude=0.0, beta_f=1.0, gap=None,
-                 eps_lower=None):
+    def __init__(self, dt, noise, model):
         from vibroimpact import tally     # compiled: the jobs that group collisions load it
 
         self._tally = tally
         self._sticking = None       # `sticking` of the record as it stands
         self.dt = dt
-        self.force = dict(noise=noise, delta=delta, amplitude=amplitude, beta=beta_f)
+        self.model = model
+        self.force = dict(noise=noise, delta=model.delta, amplitude=model.amplitude,
+                          beta=model.beta)
         #: the second wall (``{}``: one wall)
-        self.walls = _walls(gap, eps_lower)
+        self.walls = _walls(model.gap, model.eps_lower)
         self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
         self.stuck_wall = 0      # the wall of a rest still going on at the last chunk's end
@@ -375,13 +393,23 @@ class _EventRecord:
                                        stuck_wall=self.stuck_wall))
         return self._sticking
 
-    def rebound_speeds(self, eps, floor, transient):
-        """Speeds ``eps u`` (two walls: ``eps_w u``) of the rebounds at or after
-        ``transient`` that reach ``floor``."""
+    def restitution(self):
+        """The restitution of each impact of the record so far, by its wall's law at its
+        speed, for the grouping: ``{eps, eps_lower}`` of the walls (floats) under Newton's
+        law, ``{eps: one per impact, eps_lower: None}`` otherwise."""
+        if self.model.newton:
+            return dict(eps=self.model.eps,
+                        eps_lower=self.walls["eps_lower"] if self.walls else self.model.eps)
+        wall = self.wall[0] if self.walls else None
+        return dict(eps=self.model.restitution(self.u[0], wall), eps_lower=None)
+
+    def rebound_speeds(self, floor, transient):
+        """Speeds ``eps_w(u) u`` (each rebound by its wall's law) of the rebounds at or
+        after ``transient`` that reach ``floor``."""
         t = self.steps[0] * self.dt + self.offsets[0]
-        if self.walls:      # each rebound with its wall's restitution
-            eps = _rebound_eps(eps, self.walls, self.wall[0])[t >= transient]
-        v = eps * self.u[0][t >= transient]
+        keep = t >= transient
+        u = self.u[0][keep]
+        v = self.model.restitution(u, self.wall[0][keep] if self.walls else None) * u
         return v[v >= floor]
 
     def pressed(self):
@@ -405,24 +433,25 @@ class _EventRecord:
             self._pressed, self._n_pressed = np.concatenate((self._pressed, new)), n
         return self._pressed
 
-    def collisions(self, eps, floor, transient, rule="physical"):
+    def collisions(self, floor, transient, rule="physical"):
         """Collisions of the record so far that begin at or after ``transient``, grouped by
         ``rule`` (:data:`vibroimpact.stats.RULES`)."""
         from vibroimpact import tally     # compiled: the jobs that group collisions load it
 
         pressed = self.pressed() if rule == "physical" else None
+        law = self.restitution()
         if not self.walls:
             start, end = self.sticking()
             return tally.group_collisions(self.steps[0], self.offsets[0], self.u[0], start,
-                                          end, dt=self.dt, eps=eps, floor=floor,
+                                          end, dt=self.dt, eps=law["eps"], floor=floor,
                                           pressed=pressed, rule=rule, after=transient)
         start, end, wall = self.sticking()
         return tally.group_collisions(self.steps[0], self.offsets[0], self.u[0], start, end,
-                                      dt=self.dt, eps=eps, floor=floor, pressed=pressed,
+                                      dt=self.dt, eps=law["eps"], floor=floor, pressed=pressed,
                                       rule=rule, wall=self.wall[0], stick_wall=wall,
-                                      eps_lower=self.walls["eps_lower"], after=transient)
+                                      eps_lower=law["eps_lower"], after=transient)
 
-    def firsts(self, eps, floor, transient, rule="physical"):
+    def firsts(self, floor, transient, rule="physical"):
         """`collisions` reduced to what a map cell reads: the `_Firsts` of each collision's
         first impact (the same values as the `Collisions` fields of those names), grouped by
         one compiled call without the per-impact fields or the arguments' checks (the
@@ -433,13 +462,12 @@ class _EventRecord:
         if step.size == 0:
             return _Firsts(np.zeros(0), step, offset, u, wall, np.zeros(0, bool))
         pressed = self.pressed() if rule == "physical" else np.zeros(0, bool)
-        eps_lower = self.walls["eps_lower"] if self.walls else eps
         _, *fields = self._tally.collision_firsts(
-            step, offset, u, self.sticking()[0], dt=self.dt, eps=eps, eps_lower=eps_lower,
+            step, offset, u, self.sticking()[0], dt=self.dt, **self.restitution(),
             floor=floor, pressed=pressed, rule=rule, wall=wall, after=transient)
         return _Firsts(*fields)
 
-    def rule_probabilities(self, tallied, eps, floor, transient, rules, duration):
+    def rule_probabilities(self, tallied, floor, transient, rules, duration):
         """``[(probability, stick_probability)]`` of the collisions at or after
         ``transient`` of each rule of ``rules`` (not the physical one), as ``tallied``
         (`tally.MotionTally`) gives them for `firsts` of that rule: one compiled call for
@@ -447,8 +475,8 @@ class _EventRecord:
         wall = self.wall[0] if self.walls else np.zeros(self.steps[0].size, np.int8)
         return self._tally.rule_probabilities(
             tallied, self.steps[0], self.offsets[0], self.u[0], self.sticking()[0], dt=self.dt,
-            eps=eps, eps_lower=self.walls["eps_lower"] if self.walls else eps, floor=floor,
-            rules=rules, wall=wall, after=transient, duration=duration)
+            **self.restitution(), floor=floor, rules=rules, wall=wall, after=transient,
+            duration=duration)
 
 
 class _Firsts(NamedTuple):
@@ -480,6 +508,13 @@ class _IdentityRecord:
     def __init__(self, noise, dt, transient, t_end, n_batches, **params):
         self.noise, self.dt, self.params = noise, dt, params
         self.two = params.get("gap") is not None
+        # a law whose restitution varies with the speed: the impact sums carry its factors
+        # (`stats.identity_residuals`)
+        self.model = Model.paper(params["zeta"], params["eps"], params["delta"],
+                                 params.get("amplitude", 0.0), params.get("beta_f", 1.0),
+                                 **_walls(params.get("gap"), params.get("eps_lower"),
+                                          params["eps"], params.get("speed_scale", math.inf),
+                                          params.get("speed_scale_lower")))
         self.k_start = int(math.ceil(transient / dt - 1e-9))
         self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
         self.n_batches = n_batches
@@ -527,15 +562,20 @@ class _IdentityRecord:
         step = chunk.impact_step
         hit = (step >= self.k_start) & (step < self.k_stop)
         u, b = chunk.impact_velocity[hit], self._batch(step[hit])
+        u2 = u * u
+        if not self.model.newton:
+            e = self.model.restitution(u, np.asarray(chunk.impact_wall)[hit] if self.two
+                                       else None)
+            u, u2 = (1.0 + e) * u, (1.0 - e * e) * u2
         if not self.two:
             self.sum_u += np.bincount(b, weights=u, minlength=self.n_batches)
-            self.sum_u2 += np.bincount(b, weights=u * u, minlength=self.n_batches)
+            self.sum_u2 += np.bincount(b, weights=u2, minlength=self.n_batches)
             return
         wall = np.asarray(chunk.impact_wall)[hit]
         for w in (0, 1):
             at = wall == w
             self.sum_u[w] += np.bincount(b[at], weights=u[at], minlength=self.n_batches)
-            self.sum_u2[w] += np.bincount(b[at], weights=u[at] ** 2, minlength=self.n_batches)
+            self.sum_u2[w] += np.bincount(b[at], weights=u2[at], minlength=self.n_batches)
 
     def result(self):
         """The residuals and their errors, as ``event_statistics`` keys (NaN: no batches)."""
@@ -544,9 +584,12 @@ class _IdentityRecord:
             nan = math.nan
             return dict(power_residual=nan, power_residual_stderr=nan, power_input=nan,
                         virial_residual=nan, virial_residual_stderr=nan, virial_scale=nan)
-        walls = {} if not self.two else dict(gap=p["gap"], eps_lower=p["eps_lower"])
+        eps, eps_lower = p["eps"], p.get("eps_lower")
+        if not self.model.newton:       # the sums carry the laws' factors
+            eps, eps_lower = 0.0, 0.0 if self.two else None
+        walls = {} if not self.two else dict(gap=p["gap"], eps_lower=eps_lower)
         res = stats.identity_residuals(self.moments, self.sum_u, self.sum_u2,
-                                       self.steps * self.dt, zeta=p["zeta"], eps=p["eps"],
+                                       self.steps * self.dt, zeta=p["zeta"], eps=eps,
                                        delta=p["delta"], **walls)
         return dict(power_residual=res.power, power_residual_stderr=res.power_stderr,
                     power_input=res.power_input, virial_residual=res.virial,
@@ -560,7 +603,8 @@ def _clipped_contact(start, end, transient):
 
 def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                        transient=0.0, t_end=None, nperseg=4096, chunk_size=2**20, gap=None,
-                       eps_lower=None, n_batches=None):
+                       eps_lower=None, n_batches=None, speed_scale=math.inf,
+                       speed_scale_lower=None):
     """Welch PSDs of a(tau) and of the random input r(tau) for one cell (Figs. 6, 11, 12).
 
     a(tau) is recorded at every sample and fed segment by segment to a
@@ -577,8 +621,9 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
         ``S_f`` is the random part r(tau) of the input only: the harmonic
         part ``amplitude sin(beta_f tau)`` is a spectral line of power ``amplitude**2 / 2``,
         which a Welch estimate would smear over its window's main lobe (Fig. 11 draws it as
-        the line it is). ``gap, eps_lower``: a second wall (`event_statistics`); a(tau) is
-        measured from the wall at delta whatever the walls.
+        the line it is). ``gap, eps_lower``: a second wall, ``speed_scale,
+        speed_scale_lower``: the walls' impact laws (`event_statistics`); a(tau) is measured
+        from the wall at delta whatever the walls.
     """
     t_end = _record_end(noise, dt, t_end)
     skip = int(math.ceil(transient / dt - 1e-9))
@@ -594,7 +639,7 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     acc_f = stats.WelchAccumulator(dt, nperseg)
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=t_end, record_every=1, chunk_size=chunk_size,
-                                 **_walls(gap, eps_lower, eps)):
+                                 **_walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)):
         k = np.rint(chunk.grid_time / dt).astype(np.int64)
         keep = k >= skip
         if not keep.any():
@@ -611,15 +656,15 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
 
 
 def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=None,
-          eps_lower=None):
+          eps_lower=None, speed_scale=math.inf, speed_scale_lower=None):
     """A short sampled record from rest (Figs. 3 and 10): force, a(tau), impacts and the
     collision of each impact; with a second wall (``gap``) also the wall of each impact
-    (``impact_wall``).
+    (``impact_wall``); the walls' laws as in `event_statistics`.
 
     ``t_end`` longer than the noise record raises ValueError.
     """
     t_end = _record_end(noise, dt, t_end)
-    walls = _walls(gap, eps_lower, eps)
+    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
     res = next(iter(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                     beta=beta_f, t_end=t_end, record_every=1,
                                     chunk_size=int(math.ceil(t_end / dt)) + 1, **walls)))
@@ -629,7 +674,7 @@ def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=
     out = dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
                impact_time=res.impact_time, impact_velocity=res.impact_velocity,
                impact_collision=res.impact_collision)
-    if walls:
+    if gap is not None:
         out["impact_wall"] = np.asarray(res.impact_wall, dtype=np.int8)
     return out
 
@@ -638,7 +683,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
                     motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
                     n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
                     max_periods=8000, min_switches=10, approach=0.8, approach_unswitched=1.1,
-                    min_growth=1.1, gap=None, eps_lower=None):
+                    min_growth=1.1, gap=None, eps_lower=None, speed_scale=math.inf,
+                    speed_scale_lower=None):
     """Probabilities of the (m/n) motions of one cell of the Fig. 15 map, to a target precision.
 
     The cell is simulated from rest over the common record ``noise`` (every cell of a map
@@ -718,13 +764,15 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
 
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
-    walls = _walls(gap, eps_lower, eps)
+    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
+    model = _cell_model(zeta, eps, delta, amplitude, beta_f, walls)
+    two = model.n_walls == 2
     gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                           beta=beta_f, t_end=n_cap * dt, chunk_size=n_next, **walls)
-    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
+    events = _EventRecord(dt, noise, model)
     # the motion statistics of every check and rule, their arguments checked once
     tallied = tally.MotionTally(beta_f, window=window, motions=motions, n_batches=n_batches,
-                                walls=bool(walls))
+                                walls=two)
     floor = stats.DEFAULT_REBOUND_FLOOR
 
     k, n_checks, request = 0, 0, None
@@ -734,7 +782,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
             events.add(chunk)
             k += chunk.n_steps
             n_checks += 1
-            col = events.firsts(eps, floor, transient)
+            col = events.firsts(floor, transient)
             res = tallied.statistics(col.time, col.step, col.offset, dt, col.stuck, transient,
                                      k * dt, walls=col.wall)
             worst = float(max(res.stderr.max(), res.stick_stderr.max()))
@@ -754,11 +802,11 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     n_resolved = int(np.count_nonzero(events.steps[0] * dt + events.offsets[0] >= transient))
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)
     by_rule = [(res.probability, res.stick_probability)] + events.rule_probabilities(
-        tallied, eps, floor, transient, stats.RULES[1:], duration)
+        tallied, floor, transient, stats.RULES[1:], duration)
+    v_after = _v_after(model, col)
     per_wall = {}
-    if walls:
+    if two:
         wall = col.wall
-        v_after = _rebound_eps(eps, walls, wall) * col.velocity
         n_w = np.array([np.count_nonzero(wall == w) for w in range(len(WALLS))])
         per_wall = dict(
             wall_n_collisions=n_w, wall_collision_rate=n_w / duration,
@@ -771,7 +819,8 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
                 n_switches=res.n_switches,
                 n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
                 n_impacts_resolved=n_resolved,
-                v_after_mean=float(eps * col.velocity.mean()) if col.time.size else math.nan,
+                v_after_mean=(float(eps * col.velocity.mean()) if model.newton
+                              else float(v_after.mean())) if col.time.size else math.nan,
                 simulated_time=duration, record_end=k * dt, reached=bool(reached),
                 few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks,
                 **stays, **per_wall)
@@ -794,7 +843,8 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
 
 def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
                 record_length, motions=stats.DEFAULT_MOTIONS,
-                window=stats.DEFAULT_MOTION_WINDOW, gap=None, eps_lower=None):
+                window=stats.DEFAULT_MOTION_WINDOW, gap=None, eps_lower=None,
+                speed_scale=math.inf, speed_scale_lower=None):
     """Residence times of one cell on a record of fixed length (escape against noise level).
 
     The labelling of `motion_map_cell` (the same collisions, classification and
@@ -838,15 +888,16 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         raise ValueError(f"record_length = {record_length!r} after the transient "
                          f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
                          f"holds {len(noise)}")
-    walls = _walls(gap, eps_lower, eps)
-    events = _EventRecord(dt, noise, delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
+    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
+    events = _EventRecord(dt, noise, _cell_model(zeta, eps, delta, amplitude, beta_f, walls))
+    two = gap is not None
     k = 0
     for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
                                  beta=beta_f, t_end=n_end * dt, **walls):
         events.add(chunk)
         k += chunk.n_steps
-    col = events.firsts(eps, stats.DEFAULT_REBOUND_FLOOR, transient)
-    res = tally.MotionTally(beta_f, window=window, motions=motions, walls=bool(walls)).statistics(
+    col = events.firsts(stats.DEFAULT_REBOUND_FLOOR, transient)
+    res = tally.MotionTally(beta_f, window=window, motions=motions, walls=two).statistics(
         col.time, col.step, col.offset, dt, col.stuck, transient, k * dt, walls=col.wall)
     share = res.probability + res.stick_probability
     stays = _residence(col.time, res.labels, transient, k * dt, len(motions), beta_f)

@@ -318,8 +318,10 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         ends there), increasing.
     dt : float
         Sample step.
-    eps : float
-        Restitution coefficient (rebound speed ``eps * u``) of the wall at ``delta``.
+    eps : float or array_like, shape (n,)
+        Restitution coefficient (rebound speed ``eps * u``) of the wall at ``delta``; or one
+        per impact, under a law whose restitution varies with the speed
+        (`vibroimpact.model.Model.restitution`, both walls' impacts, ``eps_lower`` None).
     floor : float
         Rebounds leaving the wall at speed ``>= floor`` are counted in ``rebounds``
         (default `DEFAULT_REBOUND_FLOOR`; ``>= MIN_REBOUND_FLOOR``).
@@ -406,7 +408,7 @@ def _checked(impact_step, impact_offset, impact_velocity, stick_start, stick_end
     start = np.asarray(stick_start, dtype=float)
     end = np.asarray(stick_end, dtype=float)
     dt = _checks.real("dt", dt, low=0.0, low_open=True)
-    eps = _checks.eps(eps)
+    eps = _restitution(eps, u.shape)
     floor = _checks.real("rebound_floor", floor, low=MIN_REBOUND_FLOOR)
     if rule not in RULES:
         raise ValueError(f"rule must be one of {RULES}, got {rule!r}")
@@ -433,6 +435,19 @@ def _checked(impact_step, impact_offset, impact_velocity, stick_start, stick_end
             raise ValueError(f"pressed must have one value per flight, shape "
                              f"({max(n - 1, 0)},), got {pressed.shape}")
     return step, offset, u, start, end, dt, eps, floor, pressed, wall
+
+
+def _restitution(eps, shape):
+    """``eps`` checked: one coefficient (a float), or one per impact (a law whose restitution
+    varies with the speed, `vibroimpact.model.Model.restitution`), each in [0, 1]."""
+    if np.ndim(eps) == 0:
+        return _checks.eps(eps)
+    eps = np.asarray(eps, dtype=float)
+    if eps.shape != shape or not np.all((eps >= 0.0) & (eps <= 1.0)):
+        raise ValueError(f"eps must be a real number in [0, 1] or one such value per impact "
+                         f"(shape {shape}), got an array of shape {eps.shape}"
+                         + ("" if eps.shape != shape else " with values outside [0, 1]"))
+    return eps
 
 
 def _no_collisions(floor, dt):

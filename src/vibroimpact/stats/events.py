@@ -14,6 +14,7 @@ from typing import NamedTuple
 import numpy as np
 
 from vibroimpact import _checks
+from vibroimpact.model import Restitution
 
 __all__ = ["DEFAULT_N_BATCHES", "impact_intervals", "velocity_after_impact", "interval_ratio",
            "Density", "density", "t_quantile", "BatchMeans", "batch_means", "poisson_interval",
@@ -65,15 +66,19 @@ def impact_intervals(step, offset, dt: float, *, wall=None, at=None) -> np.ndarr
     return np.diff(step).astype(float) * float(dt) + np.diff(offset)
 
 
-def velocity_after_impact(u_minus, eps: float, *, wall=None, eps_lower=None) -> np.ndarray:
+def velocity_after_impact(u_minus, eps, *, wall=None, eps_lower=None) -> np.ndarray:
     """Speed just after impact, ``eps * u_{j-0}`` (paper eq. 7: u_{j+0} = -eps u_{j-0}).
 
-    Returned as a positive speed (the rebound velocity itself is its negative). With two
-    walls, ``wall`` (0 or 1 per impact) and ``eps_lower`` give each impact its wall's
-    restitution: ``eps_w u`` (``eps`` at the wall at delta, ``eps_lower`` at delta - gap).
+    Returned as a positive speed (the rebound velocity itself is its negative). ``eps``: the
+    restitution coefficient, or the wall's impact law, a `vibroimpact.model.Restitution`
+    (its rebound ``eps(u) u``; a one-wall call). With two walls, ``wall`` (0 or 1 per
+    impact) and ``eps_lower`` give each impact its wall's restitution: ``eps_w u`` (``eps``
+    at the wall at delta, ``eps_lower`` at delta - gap).
     """
-    _checks.eps(eps)
     u = np.asarray(u_minus, dtype=float)
+    if isinstance(eps, Restitution) and wall is None and eps_lower is None:
+        return -eps.rebound(u)          # Newton's law: eps * u, to the bit
+    _checks.eps(eps)
     if wall is None and eps_lower is None:
         return eps * u
     if wall is None or eps_lower is None:
@@ -539,8 +544,8 @@ def wall_statistics(collisions, t0: float, t1: float, *, eps: float, eps_lower: 
         ``wall``.
     t0, t1 : float
         The record observed (the transient and the record's end).
-    eps, eps_lower : float
-        Restitution of the wall at delta and of the wall at delta - gap.
+    eps, eps_lower : float or vibroimpact.model.Restitution
+        Restitution (or impact law) of the wall at delta and of the wall at delta - gap.
     bins : mapping
         Bin edges (or counts) of the densities: ``"v_after"``, ``"interval"`` and, with
         ``beta_f``, ``"ratio"``.

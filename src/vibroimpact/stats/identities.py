@@ -21,15 +21,19 @@ sign (it pushes up, the upper wall down). A chatter tail
 the simulator summed in closed form adds, per tail, ``w^2 / 2`` to the power's loss and
 ``-w`` to the virial's impulse, ``w`` its last resolved rebound (:func:`flight_moments`).
 The averages of the motion are exact integrals of the closed-form motion between events,
-so the residuals test the impact record against the motion.
+so the residuals test the impact record against the motion. Under an impact law whose
+restitution varies with the speed (`vibroimpact.model.Restitution`) the sums carry it:
+``sum_j (1 - eps(V_j)^2) V_j^2`` and ``sum_j (1 + eps(V_j)) V_j`` (:func:`identity_residuals`).
 
 Pure numpy: no simulation; :mod:`vibroimpact.pipeline.cells` feeds it chunk by chunk.
 """
+import math
 from typing import NamedTuple
 
 import numpy as np
 
 from vibroimpact import _checks
+from vibroimpact.model import law_rates, rebound_velocity
 
 #: Gauss-Legendre nodes per piece of motion between events. A piece is at most one force
 #: step long (h = 0.1 in the studies); its integrands are x, v, f and their products, entire
@@ -86,7 +90,7 @@ _XI, _W = np.polynomial.legendre.leggauss(GAUSS_NODES)
 def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
                    impact_time=(), impact_velocity=(), stick_start=(), stick_end=(),
                    batch=None, n_batches=1, gap=None, eps_lower=None, impact_wall=None,
-                   stick_wall=None):
+                   stick_wall=None, speed_scale=math.inf, speed_scale_lower=None):
     """Exact integrals of v^2, x^2, f v, x f and the wall's push over force steps.
 
     Parameters
@@ -118,6 +122,9 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
         With a second wall: the wall of each impact and of each sticking phase (0: at
         delta, 1: at delta - gap; the simulator's ``impact_wall``, ``stick_wall``). An
         impact at the lower wall leaves at ``+eps_lower V``.
+    speed_scale, speed_scale_lower : float, optional
+        The walls' impact laws (`vibroimpact.model.Restitution`; ``inf``, the default,
+        Newton's): an impact leaves at its wall's ``rebound_velocity``.
 
     Returns
     -------
@@ -168,7 +175,10 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
     # sample sets the state after it
     ev_t = np.concatenate([t_imp[hit], on, off])
     ev_kind = np.repeat([1.0, 2.0, 3.0], [np.count_nonzero(hit), on.size, off.size])
-    ev_v = np.concatenate([-eps * u_imp[hit], np.zeros(on.size + off.size)])
+    law_a, law_a_lower = law_rates(speed_scale, speed_scale_lower)
+    # the velocity leaving each impact, by its wall's law (Newton's: -eps V, to the bit)
+    ev_v = np.concatenate([rebound_velocity(eps, u_imp[hit], law_a),
+                           np.zeros(on.size + off.size)])
     ev_x = np.full(ev_t.size, delta)
     if walls is not None:
         # the lower wall's events: at x_L, leaving an impact upwards at eps_L V
@@ -176,7 +186,7 @@ def flight_moments(k_first, x, v, r, dt, *, zeta, eps, delta, amplitude=0.0, bet
         ev_lower = np.concatenate([iw[hit], sw[on_mask], sw[off_mask]]) == 1
         ev_x[ev_lower] = x_lower
         i_lower = np.flatnonzero(ev_lower[:np.count_nonzero(hit)])
-        ev_v[i_lower] = e_lower * u_imp[hit][i_lower]
+        ev_v[i_lower] = -rebound_velocity(e_lower, u_imp[hit][i_lower], law_a_lower)
     ev_step = np.searchsorted(tk, ev_t, side="right") - 1
     busy = np.zeros(n, bool)
     busy[ev_step] = True
@@ -392,7 +402,10 @@ def identity_residuals(moments, impact_sum, impact_sum2, durations, *, zeta, eps
         Per-batch integrals from :func:`flight_moments` (summed over a record's chunks).
     impact_sum, impact_sum2 : array_like, shape (B,)
         Per batch, the sum of the approach velocities ``V_j`` and of ``V_j^2`` of every
-        impact (every rebound) in the batch.
+        impact (every rebound) in the batch. Under an impact law whose restitution varies
+        with the speed: the sums of ``(1 + eps(V_j)) V_j`` (the momentum each impact
+        exchanges) and ``(1 - eps(V_j)^2) V_j^2`` (twice the energy it takes), with ``eps``
+        and ``eps_lower`` 0, which leaves them as they are.
     durations : array_like, shape (B,)
         Length of each batch (contiguous stretches of the record).
     zeta, eps, delta : float

@@ -180,8 +180,8 @@ def rule_probabilities(tallied, impact_step, impact_offset, impact_velocity, sti
     if duration <= 0.0:                 # as `stats.motions._fractions`
         return [(np.zeros(m), np.zeros(m)) for _ in rules]
     gathered, bounds = tallied._kernels.rule_fractions(
-        impact_step, impact_offset, impact_velocity, stick_start, float(dt), float(eps),
-        float(eps_lower), float(floor), np.zeros(0, np.bool_),
+        impact_step, impact_offset, impact_velocity, stick_start, float(dt),
+        restitutions(eps, eps_lower, wall), float(floor), np.zeros(0, np.bool_),
         np.array([_collisions.RULES.index(r) for r in rules], dtype=np.int64), wall,
         float(after), tallied.scale, tallied.walls, tallied.window, tallied.lengths,
         tallied.periods, tallied.lowers, m)
@@ -208,13 +208,26 @@ def collision_firsts(impact_step, impact_offset, impact_velocity, stick_start, *
     `stats.Collisions` fields of those names (`kernels.firsts`). Nothing is checked: the
     arguments are the simulator's arrays as `group_collisions` takes them after its checks
     (``wall`` int8 per impact, zeros with one wall; ``eps_lower`` the restitution at wall
-    1; ``pressed`` bool per flight for the physical rule)."""
+    1, or ``eps`` one per impact, `restitutions`; ``pressed`` bool per flight for the
+    physical rule)."""
     from vibroimpact.stats import collisions as _collisions
     from vibroimpact.tally import kernels
 
+    # the physical rule reads no restitution (its collisions are no rebound counts)
+    eps = restitutions(eps, eps_lower, wall) if rule != "physical" else np.zeros(0)
     return kernels.firsts(impact_step, impact_offset, impact_velocity, stick_start, float(dt),
-                          float(eps), float(eps_lower), float(floor), pressed,
-                          _collisions.RULES.index(rule), wall, float(after))
+                          eps, float(floor), pressed, _collisions.RULES.index(rule), wall,
+                          float(after))
+
+
+def restitutions(eps, eps_lower, wall):
+    """Each impact's restitution as the kernels read it (float64, one per impact of
+    ``wall``): ``eps`` given per impact (a law whose restitution varies with the speed,
+    `vibroimpact.model.Model.restitution`) as it is, else ``eps_lower`` at wall 1 and
+    ``eps`` at wall 0."""
+    if np.ndim(eps) != 0:
+        return np.ascontiguousarray(eps, dtype=float)
+    return np.where(np.asarray(wall) == 1, float(eps_lower), float(eps))
 
 
 def residence_statistics(edges, states, n_states):

@@ -198,13 +198,13 @@ def group(step, offset, u, start, end, dt, eps, floor, pressed, rule, wall, t0):
 
 
 @kernel
-def firsts(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rule, wall, t0):
+def firsts(step, offset, u, start, dt, eps, floor, pressed, rule, wall, t0):
     """The collisions at or after ``t0`` as `group` finds them, reduced to what a map cell
     reads at each precision check: of each one's first impact its index, instant, split
     instant, velocity and wall, and whether a sticking phase begins before the next
     collision (`group`'s ``first, time, step, offset, velocity, wall, stuck``: the same mask
-    and merge, without the other fields). ``eps`` and ``eps_lower`` are the walls'
-    restitutions (an impact at wall 1 rebounds at ``eps_lower u``). The physical rule's
+    and merge, without the other fields). ``eps`` holds each impact's restitution (its
+    wall's law at its speed: it rebounds at ``eps[i] u[i]``), as in `group`. The physical rule's
     backward scan is `_chatter_firsts` with the links formed on the way (no array of
     them)."""
     n = step.size
@@ -228,7 +228,7 @@ def firsts(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rule, wal
     else:
         counted = np.empty(n, np.bool_)
         for i in range(n):
-            counted[i] = (eps_lower if wall[i] == 1 else eps) * u[i] >= floor
+            counted[i] = eps[i] * u[i] >= floor
         first_mask = _first_mask(step, offset, u, t, ends, counted, dt, pressed, rule, wall)
         if rule == REBOUNDS and not counted.any():
             first_mask[:] = False       # no rebound reaches the floor: no event at all
@@ -299,8 +299,8 @@ def motion_pass(t, step, offset, dt, scale, stuck, walls, refine, window, length
 
 
 @kernel
-def rule_fractions(step, offset, u, start, dt, eps, eps_lower, floor, pressed, rules, wall, t0,
-                   scale, walls, window, lengths, periods, lowers, n_motions):
+def rule_fractions(step, offset, u, start, dt, eps, floor, pressed, rules, wall, t0, scale,
+                   walls, window, lengths, periods, lowers, n_motions):
     """For each rule code of ``rules``: `firsts` at or after ``t0``, then `motion_pass` of
     its collisions with their ``stuck`` flags (and walls when ``walls``), no edges; returns
     per rule ``(gathered, bounds)`` stacked: the intervals of every class of every rule in
@@ -312,7 +312,7 @@ def rule_fractions(step, offset, u, start, dt, eps, eps_lower, floor, pressed, r
     total = 0
     for q in range(rules.size):
         _, time, c_step, c_offset, _, c_wall, stuck = firsts(
-            step, offset, u, start, dt, eps, eps_lower, floor, pressed, rules[q], wall, t0)
+            step, offset, u, start, dt, eps, floor, pressed, rules[q], wall, t0)
         n = max(time.size - 1, 0)
         w = c_wall[:n].copy() if walls else np.zeros(0, np.int8)
         _, _, _, _, gathered, b = motion_pass(time, c_step, c_offset, dt, scale,

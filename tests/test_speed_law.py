@@ -1,0 +1,192 @@
+"""A restitution that falls with the impact speed, eps(u) = eps / (1 + |u| / speed_scale),
+checked against references that share none of the simulator's code but the law itself.
+
+- The law's own consequences: its derivative against a finite difference, its ratio, the range
+  the chatter proof uses, Newton's law as the limit ``speed_scale = inf`` to the bit.
+- The simulator against the 34-digit event-located reference integration
+  (:func:`vibroimpact.validation.reference.reference_impacts`) run with the same law: impact
+  times and speeds on the prefix that a 53-bit run of the reference still reproduces, and the
+  sticking onsets that close chatter sequences (the chatter proof, with the law's range).
+- The shooting solver's periodic motion under the law against scipy's DOP853 with event
+  location (the flow map returns to the state; the monodromy equals finite differences of
+  that independent flow), and the monodromy's determinant against the law's saltation.
+"""
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from vibroimpact import model as law
+from vibroimpact.attractors.shooting import periodic_motions
+from vibroimpact.impact.simulate import simulate, simulate_model
+from vibroimpact.model import Model
+from vibroimpact.validation.reference import (agreeing_prefix, chatter_tail_mask,
+                                              comparable_impacts, reference_impacts)
+
+ZETA, DT = 0.05, 0.1
+# the reference and the simulator agree to TOL on well-conditioned impacts, as for Newton's law
+# (tests/test_simulate_reference.py: float64 computes an impact to ~1e-13; 1e-9 leaves room for
+# the amplification of round-off along a sequence); X_ERR the float64 position error near the
+# wall, U_TAIL the speed below which chatter tails are compared by their accumulation point
+TOL, X_ERR, U_TAIL = 1e-9, 1e-14, 1e-4
+
+
+@pytest.mark.parametrize("a", [0.0, 0.3, 2.0])
+@pytest.mark.parametrize("eps", [0.0, 0.5, 1.0])
+@pytest.mark.parametrize("u", [1e-3, 0.7, 4.0, -2.5])
+def test_the_law_and_its_consequences_agree(a, eps, u):
+    h = 1e-6 * max(1.0, abs(u))
+    fd = (law.rebound_velocity(eps, u + h, a) - law.rebound_velocity(eps, u - h, a)) / (2 * h)
+    # a central difference of a law smooth away from u = 0: error O(h^2) + 1e-16 / h
+    assert law.rebound_derivative(eps, u, a) == pytest.approx(fd, rel=1e-8, abs=1e-9)
+    assert law.rebound_ratio(eps, u, a) * u == pytest.approx(law.rebound_velocity(eps, u, a),
+                                                             rel=1e-15, abs=1e-300)
+    assert -law.rebound_ratio(eps, u, a) == pytest.approx(eps / (1 + a * abs(u)), rel=1e-15)
+    lo, hi = law.restitution_range(eps, a, 2 * abs(u))
+    speeds = np.linspace(0, 2 * abs(u), 101)
+    e = -law.rebound_ratio(eps, speeds, a)
+    assert np.all(e >= lo * (1 - 1e-15)) and np.all(e <= hi)
+    assert e[0] == hi and e[-1] == pytest.approx(lo, rel=1e-15)
+
+
+def test_newton_is_the_infinite_speed_scale_to_the_bit():
+    rng = np.random.default_rng(5)
+    for eps, u in zip(rng.uniform(0, 1, 100), rng.normal(0, 3, 100)):
+        assert law.rebound_velocity(eps, u, 0.0) == -eps * u
+        assert law.rebound_derivative(eps, u, 0.0) == -eps
+        assert law.rebound_ratio(eps, u, 0.0) == -eps
+        assert law.restitution_range(eps, 0.0, abs(u)) == (eps, eps)
+    assert law.Restitution(0.5).a == 0.0 and law.Restitution(0.5, 4.0).a == 0.25
+    noise = np.random.default_rng(2).normal(size=4001)
+    a = simulate(ZETA, 0.5, 0.0, noise, DT)
+    b = simulate_model(Model.paper(ZETA, 0.5, 0.0, speed_scale=math.inf), noise, DT)
+    for name in ("impact_time", "impact_velocity", "stick_start", "stick_end"):
+        np.testing.assert_array_equal(getattr(a, name), getattr(b, name))
+    assert "speed_scale" not in b.params
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, float("nan"), "fast", True])
+def test_a_bad_speed_scale_names_the_field(bad):
+    with pytest.raises(ValueError, match="speed_scale must be a real number > 0, or inf"):
+        Model.paper(ZETA, 0.5, 0.2, speed_scale=bad)
+    with pytest.raises(ValueError, match="speed_scale_lower needs a second wall"):
+        Model.paper(ZETA, 0.5, 0.2, speed_scale_lower=1.0)
+
+
+def _sim_impacts(res):
+    tail = np.array(chatter_tail_mask(res.impact_time, res.impact_velocity, res.stick_start,
+                                      res.stick_end, U_TAIL), dtype=bool)
+    return res.impact_time[~tail], res.impact_velocity[~tail]
+
+
+# (eps, delta, noise rms, amplitude, beta, speed_scale, seed, least impacts compared)
+CASES = {
+    "random, chatter at the wall": (0.5, 0.0, 1.0, 0.0, 1.0, 0.5, 12, 25),
+    "random, below the rest": (0.8, -0.5, 1.0, 0.0, 1.0, 2.0, 13, 20),
+    "harmonic and noise": (0.5, 0.3, 0.29, 1.0, 0.8, 1.0, 14, 15),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_simulator_agrees_with_the_reference_under_the_law(case):
+    eps, delta, rms, amp, beta, scale, seed, least = CASES[case]
+    noise = rms * np.random.default_rng(seed).standard_normal(601)
+    kw = dict(amplitude=amp, beta=beta, max_impacts=250, speed_scale=scale)
+    ref = reference_impacts(ZETA, eps, delta, noise, DT, dps=34, **kw)
+    ref53 = reference_impacts(ZETA, eps, delta, noise, DT, prec=53, **kw)
+    n = agreeing_prefix(ref, ref53, tol=TOL / 10, u_tail=U_TAIL)
+    assert n >= least, f"only {n} well-conditioned impacts: the case tests too little"
+    res = simulate_model(Model.paper(ZETA, eps, delta, amp, beta, speed_scale=scale), noise, DT)
+    t_sim, u_sim = _sim_impacts(res)
+    t_ref, u_ref, a_ref = (np.array(v[:n], dtype=float) for v in comparable_impacts(ref, U_TAIL))
+    assert t_sim.size >= n
+    tol_t = TOL + X_ERR / u_ref
+    tol_u = TOL + X_ERR * np.abs(a_ref) / u_ref ** 2
+    assert np.all(np.abs(t_sim[:n] - t_ref) <= tol_t)
+    assert np.all(np.abs(u_sim[:n] / u_ref - 1) <= tol_u)
+    # the sticking onsets closing chatter sequences (the chatter proof with the law's range)
+    # and the releases before the last impact compared, to 1e-8 as for Newton's law
+    ref_ss = [float(s) for s in ref["stick_start"] if s < t_ref[-1]]
+    ref_se = [float(s) for s in ref["stick_end"]][:len(ref_ss)]
+    if case == "random, chatter at the wall":
+        closed = [c for c in ref["chatter_end"] if c < t_ref[-1]]
+        assert closed and res.n_chatter >= len(closed), "no chatter sequence compared"
+    np.testing.assert_allclose(res.stick_start[:len(ref_ss)], ref_ss, rtol=0, atol=1e-8)
+    np.testing.assert_allclose(res.stick_end[:len(ref_se)], ref_se, rtol=0, atol=1e-8)
+    # the collisions' rebounds count the law's rebound speeds
+    col = res.collisions
+    speed = res.model.restitution(res.impact_velocity) * res.impact_velocity
+    assert np.array_equal(col.rebounds, np.add.reduceat(
+        (speed >= res.rebound_floor).astype(np.int64), col.first))
+
+
+def test_two_walls_each_with_its_law_agree_with_the_reference_in_the_mirror():
+    """The second wall's law runs in the mirrored frame: a wall below the mass with
+    speed_scale_lower hit by -x is the reference's wall above it with that law."""
+    noise = np.random.default_rng(21).standard_normal(601)
+    m = Model.paper(ZETA, 0.6, 3.0, gap=3.4, eps_lower=0.5, speed_scale=5.0,
+                    speed_scale_lower=0.4)
+    res = simulate_model(m, noise, DT)
+    ref = reference_impacts(ZETA, 0.5, 0.4, -noise, DT, dps=34, max_impacts=250,
+                            speed_scale=0.4)
+    ref53 = reference_impacts(ZETA, 0.5, 0.4, -noise, DT, prec=53, max_impacts=250,
+                              speed_scale=0.4)
+    n = agreeing_prefix(ref, ref53, tol=TOL / 10, u_tail=U_TAIL)
+    assert n >= 10
+    t_ref = np.array(comparable_impacts(ref, U_TAIL)[0][:n], dtype=float)
+    assert not np.any(res.impact_wall[res.impact_time <= t_ref[-1]] == 0), "the upper wall is far"
+    t_sim, u_sim = _sim_impacts(res)
+    np.testing.assert_allclose(t_sim[:n], t_ref, rtol=0, atol=1e-8)
+
+
+def _flow(model, state, t0, t1):
+    """The exact flow of x'' + 2 zeta x' + x = A sin(beta t) with impacts at x = delta by the
+    model's law, by DOP853 with event location (scipy), from (t0, state) to t1."""
+    zeta, A, beta, delta = model.zeta, model.amplitude, model.beta, model.delta
+    wall = model.walls[0].law
+
+    def rhs(t, y):
+        return [y[1], A * math.sin(beta * t) - 2 * zeta * y[1] - y[0]]
+
+    def hit(t, y):
+        return y[0] - delta
+    hit.terminal, hit.direction = True, 1
+    t, y = t0, np.array(state, float)
+    while t < t1:
+        sol = solve_ivp(rhs, (t, t1), y, method="DOP853", rtol=1e-13, atol=1e-14, events=hit)
+        if sol.status == 1:
+            t, y = sol.t_events[0][0], sol.y_events[0][0].copy()
+            y[0] = delta
+            y[1] = wall.rebound(y[1])
+        else:
+            t, y = t1, sol.y[:, -1]
+    return y
+
+
+@pytest.mark.parametrize("inv_beta, impacts", [(1.0, 1), (1.4, 3)])
+def test_a_periodic_motion_under_the_law_against_an_independent_flow(inv_beta, impacts):
+    m = Model.paper(ZETA, 0.7, 0.3, 1.0, 1.0 / inv_beta, speed_scale=1.5)
+    found = [p for p in periodic_motions(m, 1).motions if p.stable
+             and p.counts == (impacts, 0)]
+    assert found, f"no stable motion of {impacts} impacts a period"
+    p = found[0]
+    T = 2 * math.pi / m.beta
+    # a period of the independent flow returns to the state (DOP853 at rtol 1e-13 over one
+    # period with one located impact: ~1e-10)
+    np.testing.assert_allclose(_flow(m, p.state, 0.0, T), p.state, rtol=0, atol=1e-8)
+    # the monodromy against central differences of that flow (h = 1e-5: O(h^2) ~ 1e-10 plus
+    # the integrator's 1e-12 / h ~ 1e-7)
+    h, fd = 1e-5, np.empty((2, 2))
+    for j in range(2):
+        e = np.zeros(2)
+        e[j] = h
+        fd[:, j] = (_flow(m, p.state + e, 0.0, T) - _flow(m, p.state - e, 0.0, T)) / (2 * h)
+    np.testing.assert_allclose(p.monodromy, fd, rtol=0, atol=1e-5)
+    # det = prod (R R' / u) exp(-2 zeta T): the law's saltation, not eps^2
+    u = p.impact_velocity
+    eps_u = m.restitution(u)
+    det = np.prod(eps_u * -law.rebound_derivative(m.eps, u, m.walls[0].law.a)) * math.exp(
+        -2 * ZETA * T)
+    assert np.linalg.det(p.monodromy) == pytest.approx(det, rel=1e-9)
+    assert not math.isclose(det, m.eps ** 2 * math.exp(-2 * ZETA * T), rel_tol=1e-3)
