@@ -67,7 +67,8 @@ def plan_text(root=ROOT):
 
 #: The shipped examples whose plan the README quotes: block name, config file.
 EXAMPLES = {"plan_clearance": "config/examples/clearance.yaml",
-            "plan_planes": "config/examples/planes.yaml"}
+            "plan_planes": "config/examples/planes.yaml",
+            "plan_impact_law": "config/examples/impact_law.yaml"}
 
 
 def example_plan_text(name, root=ROOT):

@@ -180,6 +180,15 @@ CASES = [
        "studies.random.delta", "limits.max_cells"),
     _c("inv_beta_wrong_type", H + ("inv_beta",), "0.909, 1.1", "studies.harmonic.inv_beta",
        "{start, stop, step}"),
+    # --- impact laws -----------------------------------------------------------------------
+    _c("law_speed_scale_zero", R + ("law",), {"speed_scale": 0.0},
+       "studies.random.law.speed_scale", "> 0"),
+    _c("law_without_speed_scale", R + ("law",), {"scale": 0.5}, "studies.random.law",
+       "speed_scale"),
+    _c("law_lower_one_wall", R + ("law_lower",), {"speed_scale": 1.0},
+       "studies.random.law_lower", "give studies.random.gap > 0"),
+    _c("law_under_closed_form_orbits", M + ("law",), {"speed_scale": 0.5},
+       "studies.motion_map.figures", "the shooting solver takes any law"),
     # --- noise records ---------------------------------------------------------------------
     _c("n_samples_huge", N + ("n_samples",), 10_000_000_000, "limits.max_disk_gb",
        "raise limits.max_disk_gb"),

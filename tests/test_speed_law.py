@@ -190,3 +190,80 @@ def test_a_periodic_motion_under_the_law_against_an_independent_flow(inv_beta, i
         -2 * ZETA * T)
     assert np.linalg.det(p.monodromy) == pytest.approx(det, rel=1e-9)
     assert not math.isclose(det, m.eps ** 2 * math.exp(-2 * ZETA * T), rel_tol=1e-3)
+
+
+# --- the law in the statistics and the workflow ------------------------------------------------
+
+def _bins():
+    from vibroimpact.pipeline import datasets
+
+    return datasets.bin_edges(dict(v_after=dict(max=2.5, n=50), interval=dict(max=20.0, n=80),
+                                   ratio=dict(max=4.0, n=80)))
+
+
+@pytest.fixture(scope="module")
+def record():
+    from vibroimpact import noise
+
+    spec = noise.NoiseSpec(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0)
+    return noise.generate_array(spec, 400_001, seed=19740914)
+
+
+@pytest.mark.parametrize("delta, amplitude, gap", [(0.0, 0.0, None), (-0.5, 0.0, None),
+                                                   (0.25, 1.0, None), (1.0, 0.0, 2.0)])
+def test_the_energy_and_momentum_balances_hold_under_the_law(record, delta, amplitude, gap):
+    """The self-audit's identities (docs/model.md 7.1) with each impact's loss by the law:
+    ``(1 - eps(u)^2) u^2 / 2`` of energy, ``(1 + eps(u)) u`` of momentum. They hold to their
+    standard errors (3 s.e., as for Newton's law in tests/test_identities.py); the same
+    record's sums weighed as Newton's law would (the constant eps) miss the power balance at
+    delta = 0 by about 80 s.e. The law's ceiling on the rebound speed, ``eps * speed_scale``,
+    bounds the mean velocity after impact, which Newton's law at the same eps exceeds."""
+    from vibroimpact.pipeline import cells
+
+    walls = {} if gap is None else dict(gap=gap, eps_lower=0.8, speed_scale_lower=2.0)
+    kw = dict(zeta=ZETA, eps=0.7, delta=delta, amplitude=amplitude, beta_f=1 / 1.1,
+              transient=200.0, bins=_bins(), n_batches=20, **walls)
+    out = cells.event_statistics(record, 0.1, speed_scale=0.3, **kw)
+    assert out["n_collisions"] > 1000
+    for name in ("power", "virial"):
+        res, se = out[f"{name}_residual"], out[f"{name}_residual_stderr"]
+        assert abs(res) < 3.0 * se, (name, res, se)
+    # every rebound below its wall's ceiling eps * speed_scale
+    if gap is None:
+        assert out["v_after_mean"] < 0.7 * 0.3
+    else:
+        assert out["wall_v_after_mean"][0] < 0.7 * 0.3 < out["wall_v_after_mean"][1] < 0.8 * 2
+        assert np.all(out["wall_n_collisions"] > 100)
+    newton = cells.event_statistics(record, 0.1, speed_scale=math.inf,
+                                    **dict(kw, speed_scale_lower=None) if gap else kw)
+    assert newton["v_after_mean"] > 2 * out["v_after_mean"]
+
+
+def test_a_study_carries_its_law_to_every_job():
+    """`law` and `law_lower` reach the cells' model (`Study`, `study_model`, the jobs'
+    keywords), on the paper's plane and on another; a Newton study's keywords are those it
+    always had."""
+    from vibroimpact.pipeline import tasks
+    from vibroimpact.pipeline.cells import study_model
+    from vibroimpact.pipeline.study import JOB_KEYS, Study
+
+    entry = dict(noise="n", zeta=0.05, eps=0.5, amplitude=1.0, inv_beta=[1.1],
+                 delta=[0.0, 1.0], tile_size=4, gap=2.0, law={"speed_scale": 0.5},
+                 law_lower={"speed_scale": 3.0})
+    study = Study.from_config("soft", entry)
+    cell = study.cells()[1]
+    m = study_model(study, cell)
+    assert [w.law.speed_scale for w in m.walls] == [0.5, 3.0]
+    physics = tasks._physics(study, cell)
+    assert physics["speed_scale"] == 0.5 and physics["speed_scale_lower"] == 3.0
+    plane = dict(entry, plane=["eps", "delta"], eps=[0.3, 0.6], inv_beta=1.1)
+    plane.pop("law_lower")
+    study = Study.from_config("soft_plane", plane)
+    m = study_model(study, study.cells()[0])
+    assert [w.law.speed_scale for w in m.walls] == [0.5, 0.5]
+    for kind in ("events", "map", "spectra", "trace", "escape", "plane_trace",
+                 "plane_escape"):
+        assert {"law", "law_lower"} <= set(JOB_KEYS[kind]), kind
+    newton = Study.from_config("n", dict(entry, law=None, law_lower=None))
+    assert "speed_scale" not in tasks._physics(newton, newton.cells()[0])
+    assert newton.laws() == {}

@@ -87,7 +87,9 @@ def _suite_configs():
             "mine_with_the_papers_validation": MINE + "validation:\n  build: true\n",
             "degenerate": yaml.safe_dump(DEGENERATE), "sweeps": SWEEPS,
             # maps, basins, escape and a trace over planes (issue 36)
-            "planes": (ROOT / "config" / "examples" / "planes.yaml").read_text()}
+            "planes": (ROOT / "config" / "examples" / "planes.yaml").read_text(),
+            # a wall whose restitution falls with the speed, beside its Newton twin (issue 47)
+            "impact_law": (ROOT / "config" / "examples" / "impact_law.yaml").read_text()}
 
 
 @pytest.mark.parametrize("name", sorted(_suite_configs()))

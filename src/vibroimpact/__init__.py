@@ -30,6 +30,9 @@ _LAZY = {
     "domain_boundaries": "vibroimpact.orbits.boundaries",
     "attractor_map": "vibroimpact.attractors.api",
     "snakefile": "vibroimpact.pipeline.layout",
+    # the oscillator, its walls and their impact laws (`periodic_motions`, `simulate_model`)
+    "Model": "vibroimpact.model",
+    "Restitution": "vibroimpact.model",
 }
 
 # PLE0604: ruff cannot see that the keys of _LAZY are strings

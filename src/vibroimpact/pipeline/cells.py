@@ -74,7 +74,7 @@ def study_model(study, cell):
     p = study.parameters(cell)      # a plane's cell: the fixed values with its axes in
     walls = {} if study.gap is None else dict(gap=p["gap"], eps_lower=p["eps_lower"])
     return Model.paper(p["zeta"], p["eps"], p["delta"], p["amplitude"], 1.0 / p["inv_beta"],
-                       **walls)
+                       **walls, **study.laws())
 
 
 def _walls(gap, eps_lower, eps=None, speed_scale=math.inf, speed_scale_lower=None):

@@ -39,8 +39,11 @@ def grid_decimals(scale):
 #: ``gap`` and ``eps_lower`` (the second wall) are job keys of every kind that simulates; a
 #: one-wall entry has neither, so its params are those it had before walls could be two.
 _WALLS = ("gap", "eps_lower")
+#: ``law`` and ``law_lower`` (the walls' impact laws) likewise, of the kinds that simulate: an
+#: entry under Newton's law has neither
+_LAWS = ("law", "law_lower")
 _PHYSICS = ("noise", "zeta", "eps", "amplitude", "inv_beta", "transient", "tile_size",
-            "sweep") + _WALLS
+            "sweep") + _WALLS + _LAWS
 JOB_KEYS = {
     "events": _PHYSICS + ("delta", "t_end", "n_batches", "motion_window", "motions", "bins",
                           "rebound_floor"),
@@ -52,12 +55,13 @@ JOB_KEYS = {
     # its own records (no noise file, no grid): the noise entry's spectrum and seed reach the
     # job as a param of their own (common.smk, ``escape_noise``)
     "escape": ("noise", "zeta", "eps", "amplitude", "transient", "sweep", "motion_window",
-               "motions", "escape") + _WALLS,
+               "motions", "escape") + _WALLS + _LAWS,
     # a plane study's trace is at its cell [x, y] (and the rms axis's value scales the record)
     "plane_trace": _PHYSICS + ("trace", "plane", "delta", "rms"),
     # a plane study's escape cells are [x, y] in its plane: the fixed values of the others
     "plane_escape": ("noise", "zeta", "eps", "amplitude", "inv_beta", "delta", "plane",
-                     "transient", "sweep", "motion_window", "motions", "escape") + _WALLS,
+                     "transient", "sweep", "motion_window", "motions", "escape") + _WALLS
+    + _LAWS,
     # a plane study's basins and Lyapunov exponents: the harmonic force alone (no noise, no
     # record), over the study's plane
     "attractors": ("zeta", "eps", "amplitude", "inv_beta", "delta", "tile_size", "plane",
@@ -182,6 +186,10 @@ class Study:
     #: field above that is an axis holds NaN (its values are the cells').
     plane: tuple | None = None
     axes: dict | None = None
+    #: the walls' impact laws: the speed scales of `vibroimpact.model.Restitution` (inf:
+    #: Newton's law; the lower wall's None: the upper wall's)
+    speed_scale: float = math.inf
+    speed_scale_lower: float | None = None
 
     @classmethod
     def from_config(cls, name, entry, grids=None):
@@ -213,7 +221,7 @@ class Study:
                                   if spectra.get("delta") else np.empty(0)),
                    tile_size=int(entry["tile_size"]),
                    motions=tuple(tuple(int(k) for k in m) for m in entry.get("motions", ())),
-                   gap=gap, eps_lower=eps_lower)
+                   gap=gap, eps_lower=eps_lower, **laws(entry, f"studies.{name}"))
 
     @classmethod
     def _from_plane(cls, name, entry, grids):
@@ -247,7 +255,8 @@ class Study:
                    amplitude=fixed("amplitude", 0.0), inv_beta=inv_beta, delta=delta,
                    spectra_delta=np.empty(0), tile_size=int(entry["tile_size"]),
                    motions=tuple(tuple(int(k) for k in m) for m in entry.get("motions", ())),
-                   gap=gap, eps_lower=eps_lower, plane=plane, axes=axes)
+                   gap=gap, eps_lower=eps_lower, plane=plane, axes=axes,
+                   **laws(entry, f"studies.{name}"))
 
     @property
     def n_walls(self):
@@ -287,10 +296,17 @@ class Study:
     def walls(self):
         """``{"gap": ..., "eps_lower": ...}`` for a two-wall study (the keywords of
         `vibroimpact.simulate` and of `pipeline.cells`), ``{}`` for one wall (so a one-wall
-        call is the call it always was)."""
-        if self.gap is None:
+        call is the call it always was); with the walls' laws (`laws`)."""
+        out = {} if self.gap is None else dict(gap=self.gap, eps_lower=self.eps_lower)
+        return dict(out, **self.laws())
+
+    def laws(self):
+        """``{"speed_scale": ..., "speed_scale_lower": ...}`` of a study whose walls do not
+        follow Newton's law (the keywords of `vibroimpact.model.Model.paper`), ``{}``
+        otherwise."""
+        if self.speed_scale == math.inf and self.speed_scale_lower is None:
             return {}
-        return dict(gap=self.gap, eps_lower=self.eps_lower)
+        return dict(speed_scale=self.speed_scale, speed_scale_lower=self.speed_scale_lower)
 
 
     def cells(self, kind="events"):
@@ -327,6 +343,31 @@ class Study:
         if not 0 <= t < n:
             raise ValueError(f"tile must lie in [0, {n - 1}], got {t!r}")
         return self.cells(kind)[t::n]
+
+
+def laws(entry, where):
+    """``{speed_scale, speed_scale_lower}`` of a study's ``law`` and ``law_lower`` (the
+    keywords of `Study`): ``inf`` and None under Newton's law.
+
+    Raises
+    ------
+    ValueError
+        For ``law_lower`` without ``gap`` (naming ``where``) or a speed scale not > 0 (the
+        schema checks these first; jobs read blocks too).
+    """
+    out = {}
+    for key, field in (("law", "speed_scale"), ("law_lower", "speed_scale_lower")):
+        law = entry.get(key)
+        if law is None:
+            continue
+        if key == "law_lower" and entry.get("gap") is None:
+            raise ValueError(f"{where}.law_lower = {law!r} needs a second wall: give "
+                             f"{where}.gap (> 0) as well, or leave law_lower out")
+        scale = float(law["speed_scale"])
+        if not scale > 0.0:
+            raise ValueError(f"{where}.{key}.speed_scale must be > 0, got {scale!r}")
+        out[field] = scale
+    return out
 
 
 def walls(entry, where):

@@ -20,7 +20,7 @@ from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
                                         grid_size, grid_values, map_cap_steps, orbit_rows,
                                         orbit_tiled_axis, plane_attractor_rows,
-                                        walls)
+                                        laws, walls)
 
 log = logging.getLogger("vibroimpact")
 
@@ -129,12 +129,14 @@ def _study_attrs(study, block, noise_attrs):
         if study.gap is not None:   # the second wall's words (its values: fixed or axes)
             attrs.update({k: v for k, v in _wall_attrs(1.0, 1.0).items()
                           if k not in ("gap", "eps_lower")})
+        attrs.update(_law_attrs(study.laws()))
         return attrs
     attrs = dict(provenance(block, int(noise_attrs["seed"])), study=study.name,
                  zeta=study.zeta, eps=study.eps, amplitude=study.amplitude,
                  noise=block["noise"], dt=float(noise_attrs["dt"]))
     attrs.update(noise)
     attrs.update(_wall_attrs(study.gap, study.eps_lower))
+    attrs.update(_law_attrs(study.laws()))
     return attrs
 
 
@@ -163,6 +165,19 @@ def _wall_attrs(gap, eps_lower):
     return dict(gap=float(gap), eps_lower=float(eps_lower), n_walls=2,
                 walls="upper: x = delta (hit from below, eps); lower: x = delta - gap (hit "
                       "from above, eps_lower)")
+
+
+def _law_attrs(laws):
+    """The impact laws' attributes of a study's datasets whose walls do not follow Newton's
+    law (``laws``: `Study.laws`; none under Newton's law: its attributes are those it
+    always had)."""
+    if not laws:
+        return {}
+    out = dict(speed_scale=float(laws["speed_scale"]),
+               impact_law="eps(u) = eps / (1 + u / speed_scale), u the approach speed")
+    if laws.get("speed_scale_lower") is not None:
+        out["speed_scale_lower"] = float(laws["speed_scale_lower"])
+    return out
 
 
 def _record_attrs(block, t_end, n_samples, dt):
@@ -342,6 +357,7 @@ def _plane_trace(name, block, noise_path, out, cells):
                       noise_unit_rms=float(noise_attrs["noise_rms"]))
     if "gap" in p and p.get("eps_lower") is None:
         p["eps_lower"] = p["eps"]
+    p.update(laws(block, f"studies.{name}"))
     beta_f = 1.0 / p.pop("inv_beta")
     tr = cells.trace(samples, dt, **p, beta_f=beta_f, t_end=float(spec["t_end"]))
     fixed = _plane_fixed(block)
@@ -354,6 +370,7 @@ def _plane_trace(name, block, noise_path, out, cells):
                  fixed=json.dumps(fixed, sort_keys=True))
     if "gap" in p:
         attrs.update({k: v for k, v in _wall_attrs(p["gap"], p["eps_lower"]).items()})
+    attrs.update(_law_attrs(laws(block, f"studies.{name}")))
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
 
 
@@ -367,7 +384,8 @@ def _escape_attrs(name, block, noise):
         fixed = _plane_fixed(block)
         return dict(provenance(dict(block, noise_entry=noise), int(noise["seed"])),
                     study=name, noise=block["noise"], dt=float(noise["dt"]), **spec,
-                    **fixed, axes=list(block["plane"]),
+                    **fixed, **_law_attrs(laws(block, f"studies.{name}")),
+                    axes=list(block["plane"]),
                     fixed=json.dumps(fixed, sort_keys=True),
                     transient=float(block["transient"]),
                     record_length=float(escape["record_length"]),
@@ -377,6 +395,7 @@ def _escape_attrs(name, block, noise):
                 zeta=float(block["zeta"]), eps=float(block["eps"]),
                 amplitude=float(block["amplitude"]), noise=block["noise"],
                 dt=float(noise["dt"]), **spec, **_wall_attrs(*walls(block, f"studies.{name}")),
+                **_law_attrs(laws(block, f"studies.{name}")),
                 transient=float(block["transient"]),
                 record_length=float(escape["record_length"]),
                 motion_window=float(block["motion_window"]),
@@ -407,6 +426,7 @@ def escape_cells(block):
         gap, eps_lower = walls(block, f"studies.{block.get('name', '')}".rstrip("."))
         if gap is not None:
             fixed.update(gap=gap, eps_lower=eps_lower)
+    fixed.update(laws(block, f"studies.{block.get('name', '')}".rstrip(".")))
     out = []
     for cell in block["escape"]["cells"]:
         p = dict(fixed, **{k: float(v) for k, v in zip(plane, cell)})

@@ -365,10 +365,28 @@ def two_wall_dataset(ds):
 
 def _system_text(ds):
     text = rf"$\zeta$ = {_num(_attr(ds, 'zeta'))}, $\varepsilon$ = {_num(_attr(ds, 'eps'))}"
+    text += _law_text(ds)
     if two_wall_dataset(ds):    # two walls: the second wall's place and restitution
         text += (rf";  lower wall at $\delta$ - {_num(ds.attrs['gap'])}, "
                  rf"$\varepsilon_l$ = {_num(ds.attrs['eps_lower'])}")
+        if "speed_scale_lower" in ds.attrs:
+            text += rf" (at $u$ = 0, halved at $u$ = {_num(ds.attrs['speed_scale_lower'])})"
     return text
+
+
+def speed_law(ds):
+    """Whether a dataset's walls follow an impact law other than Newton's (a restitution
+    that falls with the impact speed: its ``speed_scale`` attribute)."""
+    return "speed_scale" in ds.attrs
+
+
+def _law_text(ds):
+    """The impact law of a dataset whose restitution falls with the speed, for its header
+    (empty under Newton's law): the figure says which law drew it."""
+    if not speed_law(ds):
+        return ""
+    return (rf" at $u$ = 0, falling as $\varepsilon(u) = \varepsilon / (1 + u / "
+            rf"{_num(ds.attrs['speed_scale'])})$")
 
 
 # --------------------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ from vibroimpact.plotting._common import (
     CONFIDENCE, FEW_IMPACTS, SPECTRUM_BETA_MAX, STOP_BAND_LEVEL, _attr, _density_figure,
     _events_params, _figure, _header, _headroom, _num, _padded, _panel_tag, _psd_label, _require,
     _density_deltas, _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label,
-    family_styles, no_collision_text, note_on_axes, t_quantile)
+    family_styles, no_collision_text, note_on_axes, speed_law, t_quantile)
 from vibroimpact.plotting.walls import two_walls, wall_density_figure, wall_means_figure
 from vibroimpact.stats.theory import (
     ENVELOPE_DELTA_MIN, ENVELOPE_EPS_MIN, energy_envelope, envelope_v_after_pdf,
@@ -487,7 +487,8 @@ def _envelope(events, envelope):
     if envelope == "never" or sigma_x is None or not float(sigma_x) > 0.0:
         return None
     eps, zeta = float(_attr(events, "eps")), float(_attr(events, "zeta"))
-    inside = eps >= ENVELOPE_EPS_MIN
+    # the theory's restitution is a constant: a law that falls with the speed is outside it
+    inside = eps >= ENVELOPE_EPS_MIN and not speed_law(events)
     if envelope == "auto" and not inside:
         return None
     return dict(eps=eps, zeta=zeta, S0=4.0 * zeta * float(sigma_x) ** 2, inside=inside,
@@ -502,7 +503,8 @@ def _envelope_label(theory, what, sep=" "):
             rf"$\delta \geq$ {_num(ENVELOPE_DELTA_MIN)}")
     if not theory["inside"]:
         text += (";\n" rf"OUTSIDE its range ($\varepsilon$ = {_num(theory['eps'])} < "
-                 rf"{_num(ENVELOPE_EPS_MIN)}): for orientation only")
+                 rf"{_num(ENVELOPE_EPS_MIN)}, or a restitution that falls with the speed): "
+                 rf"for orientation only")
     return text
 
 
@@ -512,6 +514,9 @@ def _envelope_absent(events, theory, sep=" "):
     a random part (no wall-free sigma_x), where it has nothing to say."""
     if theory is not None:
         return rf"energy-envelope theory: no $\delta \geq$ {_num(ENVELOPE_DELTA_MIN)} to draw"
+    if float(events.attrs.get("linear_sigma_x", 0.0)) > 0.0 and speed_law(events):
+        return (rf"energy-envelope theory not drawn:{sep}its restitution is a constant, this "
+                rf"wall's falls with the impact speed")
     if float(events.attrs.get("linear_sigma_x", 0.0)) > 0.0 and float(
             _attr(events, "eps")) < ENVELOPE_EPS_MIN:
         return (rf"energy-envelope theory ($\varepsilon \to 1$) not drawn:{sep}"

@@ -372,6 +372,29 @@ def _check_walls(where, entry, problems):
     return True
 
 
+def _check_laws(where, entry, problems):
+    """The walls' impact laws (``law``, ``law_lower``): the second wall's only with one, and
+    none where a solver holds Newton's law (the closed-form orbits of fig15_vs_fig16, the
+    attractors block)."""
+    laws = [k for k in ("law", "law_lower") if entry.get(k) is not None]
+    if "law_lower" in laws and entry.get("gap") is None:
+        problems.add(f"{where}.law_lower", entry["law_lower"], "the impact law of a second "
+                     "wall, and this entry has one wall (no gap)",
+                     f"leave it out, or give {where}.gap > 0 (the wall at x = delta - gap)")
+    if not laws:
+        return
+    names = [f if isinstance(f, str) else f.get("name") for f in entry.get("figures", [])]
+    if "fig15_vs_fig16" in names:
+        problems.add(f"{where}.figures", "fig15_vs_fig16", f"the closed-form orbits it draws "
+                     f"under the map hold Newton's law, and {where}.{laws[0]} is another",
+                     f"leave fig15_vs_fig16 out, or leave {where}.{laws[0]} out (Newton's "
+                     f"law); the shooting solver takes any law (vibroimpact.periodic_motions)")
+    if entry.get("attractors"):
+        problems.add(f"{where}.attractors", None, f"the attractor maps hold Newton's law, and "
+                     f"{where}.{laws[0]} is another", f"leave attractors out, or leave "
+                     f"{where}.{laws[0]} out (Newton's law)")
+
+
 def _check_motions(where, entry, two_walls, problems):
     """The motions a study classifies: walls, repeats, ratios that cannot be told apart."""
     motions = [tuple(m) for m in entry["motions"]]
@@ -429,6 +452,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
     if not shapes_ok:
         return None
     two_walls = _check_walls(where, entry, problems)
+    _check_laws(where, entry, problems)
     _check_report_with(config, name, entry, problems)
     if entry["noise"] not in config["noises"]:
         problems.add(f"{where}.noise", entry["noise"], "no such noise record",
@@ -699,6 +723,7 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         ok = False
     if "gap" not in plane:
         _check_walls(where, entry, problems)
+    _check_laws(where, entry, problems)
     two_walls = entry.get("gap") is not None
     _check_report_with(config, name, entry, problems)
     for key, default in _EVENT_ONLY.items():
