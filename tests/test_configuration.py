@@ -128,6 +128,38 @@ def test_stale_lists_only_the_drawn_entries_outputs_the_config_no_longer_builds(
     assert all((tmp_path / rel).exists() for rel in [*current, *twins, *other])
 
 
+@pytest.mark.parametrize("files", [[], ["config/test.yaml"], ["config/examples/clearance.yaml"],
+                                   ["config/examples/planes.yaml"],
+                                   ["config/examples/impact_law.yaml"]])
+def test_every_dataset_a_build_needs_is_a_kind_of_the_one_table(files):
+    """Every dataset the plan counts (`targets.needed_files`: the default config, the test
+    config, each shipped example) is of one kind of `targets.DATASETS`, and `make stale`
+    (`stale.owned_datasets`) scans that kind's place for its owner: a kind added to the
+    table is listed by both, and a dataset written outside the table fails here."""
+    import fnmatch
+    from vibroimpact.pipeline import stale, targets
+
+    config, plan = configuration.load(root=ROOT, user_files=[ROOT / f for f in files])
+    kinds = {k: p.replace("{name}", "*").replace("{noise}", "*")
+             for k, p in targets.DATASETS.items()}
+    owned = {section: set(stale.owned_datasets(section)) for section in ("studies", "orbits")}
+    seen = set()
+    for path in sorted(targets.needed_files(config, plan.drawn)):
+        if not path.startswith(("results/datasets/", "results/orbits/", "results/traces/",
+                                "results/noise/")):
+            continue
+        # the table's most specific pattern that matches (``{name}.nc`` also matches
+        # ``{name}_boundaries.nc``; an owner's name never holds the kinds' suffixes here)
+        match = [k for k, pattern in kinds.items() if fnmatch.fnmatch(path, pattern)]
+        assert match, f"{path}: of no kind of targets.DATASETS"
+        kind = max(match, key=lambda k: len(targets.DATASETS[k]))
+        seen.add(kind)
+        if kind != "noise":
+            section = "orbits" if path.startswith("results/orbits/") else "studies"
+            assert targets.DATASETS[kind] in owned[section], (path, kind)
+    assert seen, "no dataset needed"
+
+
 def test_the_readme_quotes_the_current_plan_and_figure_table():
     """The README's generated blocks (benchmarks/readme_numbers.py --write README.md) are
     those of this tree: the plans of the default config and of the shipped examples, and the

@@ -119,7 +119,7 @@ def test_band_limited_fir_realizes_target():
     target in the pass band and below 1e-4 S_0 in the stop band (outside the transition
     band), autocorrelation within FIR_PHI_DEVIATION rms^2 of the ideal sinc."""
     spec = SPECS["band_limited"]
-    taps = noise._band_limited_taps(spec)
+    taps = noise.band_limited_taps(spec)
     assert np.dot(taps, taps) == pytest.approx(spec.rms**2, rel=1e-12)
     theta = np.linspace(0.0, math.pi, 20_001)
     beta = theta / spec.dt

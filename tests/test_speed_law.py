@@ -267,3 +267,20 @@ def test_a_study_carries_its_law_to_every_job():
     newton = Study.from_config("n", dict(entry, law=None, law_lower=None))
     assert "speed_scale" not in tasks._physics(newton, newton.cells()[0])
     assert newton.laws() == {}
+
+
+def test_rices_large_play_rebound_under_the_law():
+    """Fig. 9's large-play asymptote (a): the mean rebound speed over the Rayleigh speeds of
+    high up-crossings, by the law (scipy's adaptive quadrature as the reference, to 1e-9),
+    and Newton's closed form eps sigma_v sqrt(pi / 2) without a law."""
+    import xarray as xr
+    from scipy.integrate import quad
+    from vibroimpact.plotting.random import _rice_rebound
+
+    sigma_v, eps, scale = 0.98, 0.5, 0.5
+    ref = quad(lambda u: eps * u / (1 + u / scale) * u / sigma_v**2
+               * math.exp(-0.5 * (u / sigma_v) ** 2), 0, math.inf)[0]
+    law_ds = xr.Dataset(attrs=dict(speed_scale=scale))
+    assert _rice_rebound(law_ds, eps, sigma_v) == pytest.approx(ref, rel=1e-9)
+    assert _rice_rebound(xr.Dataset(), eps, sigma_v) == eps * sigma_v * math.sqrt(math.pi / 2)
+    assert ref < eps * scale < eps * sigma_v * math.sqrt(math.pi / 2)

@@ -184,7 +184,7 @@ class NoiseSpec:
         phi = np.array(self._phi_lag(k), dtype=float)
         if not np.all(on_grid):
             phi[~on_grid] = self.rms**2 * _sinc_series(
-                lambda t: _lowpass2_correlation(t, self.beta_c, self.zeta_f),
+                lambda t: lowpass2_correlation(t, self.beta_c, self.zeta_f),
                 tau[~on_grid], self.dt, _lowpass2_span(self.beta_c, self.zeta_f))
         return phi
 
@@ -241,7 +241,7 @@ class NoiseSpec:
         """``phi_k`` at integer lags k (float array), in closed form for every kind."""
         tau = np.asarray(k, dtype=float) * self.dt
         if self.kind == "lowpass2":
-            return self.rms**2 * _lowpass2_correlation(tau, self.beta_c, self.zeta_f)
+            return self.rms**2 * lowpass2_correlation(tau, self.beta_c, self.zeta_f)
         return self.autocorrelation(tau)
 
     def _psd_periodic(self, beta):
@@ -252,7 +252,7 @@ class NoiseSpec:
         if self.kind == "band_limited":
             level = math.pi * self.rms**2 / self.beta_c
             return np.where(theta <= self.beta_c * self.dt, level, 0.0)
-        b, a = _lowpass2_arma(self)
+        b, a = lowpass2_arma(self)
         _, h = scipy.signal.freqz(b, a, worN=theta.ravel())
         return (self.dt * np.abs(h) ** 2).reshape(theta.shape)
 
@@ -401,7 +401,7 @@ def _blocks(spec, rng):
     if spec.kind == "white" or (spec.kind == "band_limited" and spec._full_band):
         return _white_blocks(spec.rms, rng)
     if spec.kind == "band_limited":
-        return _fir_blocks(_band_limited_taps(spec), rng)
+        return _fir_blocks(band_limited_taps(spec), rng)
     return _lowpass2_blocks(spec, rng)
 
 
@@ -432,10 +432,10 @@ def _lowpass2_blocks(spec, rng):
     y_{n-1}, -a_2 y_n)``; ``(y_{n-1}, e_n)`` are independent with unit variance (for rms=1)
     and ``y_n = rho_1 y_{n-1} + b_0 e_n + sqrt(1 - rho_1^2 - b_0^2) xi``.
     """
-    b, a = _lowpass2_arma(spec)
+    b, a = lowpass2_arma(spec)
     unit = NoiseSpec("lowpass2", 1.0, spec.dt, spec.beta_c, spec.zeta_f)
-    b_u, _ = _lowpass2_arma(unit)
-    rho_1 = _lowpass2_correlation(spec.dt, spec.beta_c, spec.zeta_f)
+    b_u, _ = lowpass2_arma(unit)
+    rho_1 = lowpass2_correlation(spec.dt, spec.beta_c, spec.zeta_f)
     y_prev, e, xi = rng.standard_normal(3)
     y = rho_1 * y_prev + b_u[0] * e + math.sqrt(max(1.0 - rho_1**2 - b_u[0] ** 2, 0.0)) * xi
     zi = spec.rms * np.array([b_u[1] * e - a[1] * y - a[2] * y_prev, -a[2] * y])
@@ -470,7 +470,7 @@ def _fir_order(theta_c):
     return fir_taps(theta_c), scipy.signal.kaiser_beta(FIR_ATTENUATION_DB)
 
 
-def _band_limited_taps(spec):
+def band_limited_taps(spec):
     """FIR taps whose output, for unit white input, has variance rms^2 and PSD ~ target.
 
     The cut-off is nudged so that the realized ``int |H|^2`` equals the ideal brick wall's
@@ -486,7 +486,7 @@ def _band_limited_taps(spec):
     return taps * (spec.rms / math.sqrt(np.dot(taps, taps)))
 
 
-def _lowpass2_correlation(tau, beta_c, zeta_f):
+def lowpass2_correlation(tau, beta_c, zeta_f):
     """``phi_c(tau) / rms^2`` of second-order low-pass filtered white noise (all zeta_f > 0).
 
     ``exp(-a t) [cos(w t) + a sin(w t) / w]``, ``a = zeta_f beta_c``, ``w = beta_c
@@ -515,7 +515,7 @@ def _lowpass2_span(beta_c, zeta_f):
     return t
 
 
-def _lowpass2_arma(spec):
+def lowpass2_arma(spec):
     """``(b, a)`` of the ARMA(2, 1) whose unit-innovation output is the sampled process.
 
     AR part from the poles ``z = exp(p dt)``; the MA part from the lag-0 and lag-1
@@ -527,7 +527,7 @@ def _lowpass2_arma(spec):
     a1 = -2.0 * math.exp(-zeta_f * beta_c * dt) * np.cosh(root * beta_c * dt).real
     a2 = math.exp(-2.0 * zeta_f * beta_c * dt)
     a = np.array([1.0, a1, a2])
-    phi = _lowpass2_correlation(np.arange(4) * dt, beta_c, zeta_f)
+    phi = lowpass2_correlation(np.arange(4) * dt, beta_c, zeta_f)
     g0 = sum(a[i] * a[j] * phi[abs(i - j)] for i in range(3) for j in range(3))
     g1 = sum(a[i] * a[j] * phi[abs(1 + j - i)] for i in range(3) for j in range(3))
     plus, minus = math.sqrt(max(g0 + 2 * g1, 0.0)), math.sqrt(max(g0 - 2 * g1, 0.0))

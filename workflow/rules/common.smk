@@ -97,20 +97,20 @@ def own_files(inputs):
 # use). The heads of the build's longest chains carry one: the noise records (every
 # simulation reads one) 3; the map's tiles, the attractor and orbit tiles and the orbits'
 # join 2; the events tiles, the map's join, its predictors, the boundaries, and the spectra
-# and escape jobs (heads of the chains that end in the reports: in a fresh clone of 4ab3037
-# the escape levels ran last and the map's report waited on their figure) 1; figures,
+# and escape jobs (heads of the chains that end in the reports: without a priority the
+# escape levels could run last, and the map's report wait on their figure) 1; figures,
 # reports and the rest 0. The work-precision run holds every core, and a job starts only
 # when its cores are free at once: it has 7, more than any two other jobs together (3 + 3),
 # so it starts first, while every core is free, not at the end, where the build would wait
-# for it alone. Replayed on the job times of a default build (2ec7353, 2 cores, 270 core-s
-# held), the priorities of the long chains end the build at 139 s (136-143) over 200
-# random orders of the jobs of equal priority, against 142 s (136-150) with none.
+# for it alone. Replayed on the job times of a default build, the priorities of the long
+# chains ended it a few seconds earlier, and within a narrower range over random orders of
+# the jobs of equal priority, than none.
 
 # --- Threads of the tiles that run numba threads ---------------------------------------------
 # The orbit, attractor and boundary jobs run their rows and starts on numba threads: half the
 # cores each (one on 2 cores), so that they pack beside the one-core jobs. Asking for every
-# core, such a job waited until the other jobs drained: in a fresh clone of 70e002c on 2
-# cores, the orbit and attractor tiles ran at 73-108 s of a 142 s build, one after the other.
+# core, such a job waited until the other jobs drained: on 2 cores the orbit and attractor
+# tiles then ran one after the other, near the end of the build.
 # That is this machine's rule; on a cluster the cores of Snakemake's process say nothing of
 # a node's, and the SLURM profile sets each threaded rule's threads itself (`set-threads`,
 # workflow/profiles/slurm), which replaces this default.

@@ -35,10 +35,10 @@ from vibroimpact.impact.tolerances import STEP_HEADROOM
 from vibroimpact.orbits import _jit as _orbits_jit
 from vibroimpact.orbits.flight import (flight_max, harmonic_constants, lam_of, monodromy,
                                       orbit_margin, propagator)
-from vibroimpact.orbits.intervals import _fill_interval_system, _start_from_intervals
-from vibroimpact.orbits.linalg import _cofactors
+from vibroimpact.orbits.intervals import fill_interval_system, start_from_intervals
+from vibroimpact.orbits.linalg import cofactors
 from vibroimpact.orbits.newton import N_WORK
-from vibroimpact.orbits.scan_m3 import _bilinear_root
+from vibroimpact.orbits.scan_m3 import bilinear_root
 from vibroimpact.orbits.solve import solve_type
 from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, M3_CIRCLE_NEAR,
                                            M3_MIN_NODES, M3_NODE_OFFSET, MAX_SOLUTIONS,
@@ -174,7 +174,7 @@ def _m3_nodes(n, beta, zeta, eps, npt, f1, hyp, wt):
     """The node values of ``vibroimpact.orbits.scan_m3._scan_m3`` that do not depend on
     delta, on its ``npt`` grid: ``f1`` (normalised ``det K``), and of the null vector ``w`` of
     rows 1-5, ``hyp = |w_SC|`` and ``wt = w_t`` (what its ``_circle_factors`` reads). The
-    same statements as there (K does not involve delta: ``_fill_interval_system`` ignores it).
+    same statements as there (K does not involve delta: ``fill_interval_system`` ignores it).
     """
     wd, q, phi = harmonic_constants(beta, zeta)
     z = 2.0 * math.pi * n / beta
@@ -191,8 +191,8 @@ def _m3_nodes(n, beta, zeta, eps, npt, f1, hyp, wt):
             zs[0] = (i + M3_NODE_OFFSET) * hz
             zs[1] = (k + M3_NODE_OFFSET) * hz
             zs[2] = z - zs[0] - zs[1]
-            _fill_interval_system(zs, m, beta, 0.0, zeta, eps, wd, kmat)
-            _cofactors(kmat, 1, ncol, sub, nvec)
+            fill_interval_system(zs, m, beta, 0.0, zeta, eps, wd, kmat)
+            cofactors(kmat, 1, ncol, sub, nvec)
             det = 0.0
             cn = 0.0
             rn = 0.0
@@ -255,7 +255,7 @@ def _m3_cell(n, beta, delta, zeta, eps, f1, hyp, wt, sols):
                 hi2 = max(max(b00, b10), max(b01, b11))
                 if (lo2 > 0.0 or hi2 < 0.0) and min(abs(lo2), abs(hi2)) > M3_CIRCLE_NEAR:
                     continue
-                ok_, si, ti = _bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11)
+                ok_, si, ti = bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11)
                 if not ok_:
                     continue
                 zs[0] = (i + M3_NODE_OFFSET + si) * hz
@@ -263,7 +263,7 @@ def _m3_cell(n, beta, delta, zeta, eps, f1, hyp, wt, sols):
                 zs[2] = z - zs[0] - zs[1]
                 if zs[0] <= 0.0 or zs[1] <= 0.0 or zs[2] <= 0.0:
                     continue
-                count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps,
+                count = start_from_intervals(zs, m, n, beta, delta, zeta, eps,
                                               1.0 if f == 0 else -1.0, kmat, sub, nvec, y,
                                               sols, count, work, jac)
     return count

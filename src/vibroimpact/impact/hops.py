@@ -169,9 +169,9 @@ def _pressed(step, offset, r, k_lo, dt, delta_upper, delta_lower, amplitude_uppe
 def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0.0, beta=1.0,
                     flights=None, wall=None, gap=None):
     """:func:`vibroimpact.stats.pressed_flights` compiled (same arguments and result)."""
-    from vibroimpact.stats.collisions import _flight_sides
+    from vibroimpact.stats.collisions import flight_sides
 
-    sides = _flight_sides(impact_step, wall, gap, flights)
+    sides = flight_sides(impact_step, wall, gap, flights)
     step = np.ascontiguousarray(impact_step, dtype=np.int64)
     offset = np.ascontiguousarray(impact_offset, dtype=np.float64)
     n = step.size

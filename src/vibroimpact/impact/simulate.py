@@ -72,7 +72,7 @@ class SampleState:
                    float(state[kernels.S_COS_PSI]))
 
 
-def _initial_vector(model, dt, x0, v0, k=0, stuck=False):
+def initial_vector(model, dt, x0, v0, k=0, stuck=False):
     """The kernel's state vector at sample ``k`` for ``x = x0, x' = v0`` (free) or resting
     on the wall at ``x = delta`` (``stuck``)."""
     beta = model.beta
@@ -135,7 +135,7 @@ def sample_state(zeta, delta, dt, x, v=0.0, *, k=0, stuck=False, amplitude=0.0, 
     dt = _checks.real("dt", dt, low=0.0, low_open=True)
     x = _checks.real("x", x, high=delta)
     v = _checks.real("v", v)
-    return SampleState.of_vector(k, _initial_vector(model, dt, x, v, k, bool(stuck)))
+    return SampleState.of_vector(k, initial_vector(model, dt, x, v, k, bool(stuck)))
 
 
 @dataclass(frozen=True)
@@ -423,7 +423,7 @@ def model_parameters(model, dt):
     return P
 
 
-def _split_steps(t_end, dt):
+def split_steps(t_end, dt):
     ratio = t_end / dt
     n_full = int(round(ratio))
     if abs(ratio - n_full) > 1e-9 * max(1.0, ratio):
@@ -564,8 +564,8 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, s
         params.update(gap=model.gap, eps_lower=model.eps_lower)
     params.update({k: v for k, v in model.params().items() if k.startswith("speed_scale")})
     k_start = 0 if start is None else start.k
-    state = _initial_vector(model, dt, x0, v0) if start is None else start.vector()
-    n_full, rem = _split_steps(t_end, dt)
+    state = initial_vector(model, dt, x0, v0) if start is None else start.vector()
+    n_full, rem = split_steps(t_end, dt)
     stride = int(record_every)
     zeros = None if noise is not None else np.zeros(min(chunk_size, n_full + 1) + 1)
     stick_open = [None, 0]  # start time and wall of an unfinished sticking interval
@@ -596,7 +596,7 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, s
             else:
                 _raise_status(status, k, dt, r, k0, buf.ftot[kernels.FT_DIAGNOSTICS], P)
         t_chunk = k1 * dt
-        x, v, mode = _state_at(state, P, k1)
+        x, v, mode = state_at(state, P, k1)
         end_state = SampleState.of_vector(k1, state)
         if final and stride and n_full % stride == 0:
             buf.grid[buf.grid_n[0]] = delta - x
@@ -633,7 +633,7 @@ def _simulate_model(model, noise, dt, x0, v0, t_end, record_every, chunk_size, s
                                    high=chunk_size if stride else None)
 
 
-def _state_at(state, P, k):
+def state_at(state, P, k):
     """Displacement, velocity and mode at sample ``k`` from the kernel's state vector."""
     delta, beta, Aq = P[kernels.P_DELTA], P[kernels.P_BETA], P[kernels.P_AQ]
     mode = int(state[kernels.S_MODE])

@@ -12,12 +12,12 @@ import numpy as np
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants, propagator
-from vibroimpact.orbits.linalg import _cofactors
+from vibroimpact.orbits.linalg import cofactors
 from vibroimpact.orbits.solutions import _try_start
 
 
 @kernel
-def _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat):
+def fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat):
     """Linear system of the (m/n) equations for fixed intervals ``zs`` (eqs. 10-11).
 
     Unknowns ``w = (S0, C0, u_0..u_{m-1}, t)`` with ``S0 = q sin psi_0``, ``C0 = q cos psi_0``
@@ -87,7 +87,7 @@ def _circle_factors(nvec, ncol, delta, q):
 
 
 @kernel
-def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub, nvec, y, sols,
+def start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub, nvec, y, sols,
                           count, work, jac):
     """Newton from the linear solution at fixed intervals ``zs``, scaled by ``sign q/|w_SC|``."""
     wd, q, phi = harmonic_constants(beta, zeta)
@@ -95,8 +95,8 @@ def _start_from_intervals(zs, m, n, beta, delta, zeta, eps, sign, kmat, sub, nve
     tf = 2.0 * pi / beta
     scale = 1.0 + abs(delta) + q * (1.0 + beta)
     ncol = m + 3
-    _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
-    _cofactors(kmat, 2 * m - ncol + 1, ncol, sub, nvec)
+    fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
+    cofactors(kmat, 2 * m - ncol + 1, ncol, sub, nvec)
     if _guess_from_null(nvec, m, zs, q, phi, beta, sign, y):
         count = _try_start(y, m, z, beta, delta, zeta, eps, scale, tf, scale, sols, count,
                            work, jac)

@@ -44,7 +44,7 @@ def _solve_inplace(a, b, n):
 
 
 @kernel
-def _cofactors(kmat, row0, ncol, sub, out):
+def cofactors(kmat, row0, ncol, sub, out):
     """Signed cofactors of the ``(ncol-1) x ncol`` block ``kmat[row0:row0+ncol-1]``.
 
     ``out[k] = (-1)^k det(block without column k)``: the generalized cross product, a null

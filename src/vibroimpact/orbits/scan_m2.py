@@ -12,8 +12,8 @@ import numpy as np
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants
-from vibroimpact.orbits.intervals import _circle_factors, _fill_interval_system, _guess_from_null
-from vibroimpact.orbits.linalg import _cofactors, _norm
+from vibroimpact.orbits.intervals import _circle_factors, fill_interval_system, _guess_from_null
+from vibroimpact.orbits.linalg import cofactors, _norm
 from vibroimpact.orbits.newton import WORK_RES, _residual_jacobian, uncertainty
 from vibroimpact.orbits.solutions import _accept, _try_start, _valid
 from vibroimpact.orbits.tolerances import (BRENT_ROOT_REL, EDGE_LEVELS, GOLDEN_SECTION,
@@ -40,7 +40,7 @@ def _fill_symmetric_system(o, h, beta, delta, zeta, eps, wd, kmat):
     """(2/n) system for even n at ``z_1 = h + o``, ``z_2 = h - o`` (``h = z/2``), regular at o = 0.
 
     For even n the flights' forcing phases differ by ``beta o`` only, and at o = 0 the four
-    rows of ``_fill_interval_system`` have rank 3: the doubled (1/(n/2)) motion solves them for
+    rows of ``fill_interval_system`` have rank 3: the doubled (1/(n/2)) motion solves them for
     every delta, and their null vector, a 0/0 there, is computed with an error ~ 1e-16 / o.
     This is that matrix with its rows recombined into the sums ``(r_1 + r_3)/2``,
     ``(r_2 + r_4)/2`` and the differences ``(r_1 - r_3)/(2 o)``, ``(r_2 - r_4)/(2 o)`` of the two
@@ -110,7 +110,7 @@ def _m2_null(x, z, even, beta, delta, zeta, eps, wd, zs, kmat, sub, nvec):
         h = 0.5 * z
         o = x - h
         _fill_symmetric_system(o, h, beta, delta, zeta, eps, wd, kmat)
-        _cofactors(kmat, 0, 5, sub, nvec)
+        cofactors(kmat, 0, 5, sub, nvec)
         up = nvec[2]
         ub = nvec[3]
         nvec[2] = up + o * ub
@@ -118,8 +118,8 @@ def _m2_null(x, z, even, beta, delta, zeta, eps, wd, zs, kmat, sub, nvec):
     else:
         zs[0] = x
         zs[1] = z - x
-        _fill_interval_system(zs, 2, beta, delta, zeta, eps, wd, kmat)
-        _cofactors(kmat, 0, 5, sub, nvec)
+        fill_interval_system(zs, 2, beta, delta, zeta, eps, wd, kmat)
+        cofactors(kmat, 0, 5, sub, nvec)
 
 
 @kernel

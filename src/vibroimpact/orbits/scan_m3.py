@@ -7,16 +7,16 @@ import numpy as np
 
 from vibroimpact.orbits._jit import kernel
 from vibroimpact.orbits.flight import harmonic_constants
-from vibroimpact.orbits.intervals import (_circle_factors, _fill_interval_system,
-                                          _start_from_intervals)
-from vibroimpact.orbits.linalg import _cofactors
+from vibroimpact.orbits.intervals import (_circle_factors, fill_interval_system,
+                                          start_from_intervals)
+from vibroimpact.orbits.linalg import cofactors
 from vibroimpact.orbits.tolerances import (BILINEAR_ACCEPT, BILINEAR_DIVERGED, BILINEAR_MAXIT,
                                            BILINEAR_XTOL, M3_CIRCLE_NEAR, M3_MIN_NODES,
                                            M3_NODE_OFFSET)
 
 
 @kernel
-def _bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11):
+def bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11):
     """Common zero ``(s, t)`` of the bilinear interpolants of two functions on a unit cell.
 
     Returns ``(found, s, t)``; ``found`` when Newton converges within the cell widened by a
@@ -71,8 +71,8 @@ def _scan_m3(n, beta, delta, zeta, eps, scan_step, sols, count, work, jac, y):
             zs[0] = (i + M3_NODE_OFFSET) * hz
             zs[1] = (k + M3_NODE_OFFSET) * hz
             zs[2] = z - zs[0] - zs[1]            # slightly negative on the outer row: fine
-            _fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
-            _cofactors(kmat, 1, ncol, sub, nvec)
+            fill_interval_system(zs, m, beta, delta, zeta, eps, wd, kmat)
+            cofactors(kmat, 1, ncol, sub, nvec)
             det = 0.0
             cn = 0.0
             rn = 0.0
@@ -96,7 +96,7 @@ def _scan_m3(n, beta, delta, zeta, eps, scan_step, sols, count, work, jac, y):
                 hi2 = max(max(b00, b10), max(b01, b11))
                 if (lo2 > 0.0 or hi2 < 0.0) and min(abs(lo2), abs(hi2)) > M3_CIRCLE_NEAR:
                     continue
-                ok_, si, ti = _bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11)
+                ok_, si, ti = bilinear_root(a00, a10, a01, a11, b00, b10, b01, b11)
                 if not ok_:
                     continue
                 zs[0] = (i + M3_NODE_OFFSET + si) * hz
@@ -104,7 +104,7 @@ def _scan_m3(n, beta, delta, zeta, eps, scan_step, sols, count, work, jac, y):
                 zs[2] = z - zs[0] - zs[1]
                 if zs[0] <= 0.0 or zs[1] <= 0.0 or zs[2] <= 0.0:
                     continue
-                count = _start_from_intervals(zs, m, n, beta, delta, zeta, eps,
+                count = start_from_intervals(zs, m, n, beta, delta, zeta, eps,
                                               1.0 if f == 0 else -1.0, kmat, sub, nvec, y,
                                               sols, count, work, jac)
     return count

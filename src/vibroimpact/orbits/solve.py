@@ -25,7 +25,7 @@ def solve_general(m, n, beta, delta, zeta, eps, seeds, nseed, scan_step, sols):
     Notes
     -----
     For fixed intervals the 2m equations are linear in ``(S0, C0, u_0..u_{m-1}, t=delta)``
-    (``_fill_interval_system``). For m = 2 the 4x5 matrix has a cofactor null vector ``w(z_1)``
+    (``fill_interval_system``). For m = 2 the 4x5 matrix has a cofactor null vector ``w(z_1)``
     and the solutions are the roots of the two factors of the circle condition
     ``delta^2 (w_S^2 + w_C^2) = q^2 w_t^2`` (``_circle_factors``), smooth functions of ``z_1``
     scanned over ``0 < z_1 < z`` (``_scan_m2``): every sign change is solved to a few ulps

@@ -15,7 +15,7 @@ from vibroimpact import stats
 from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
-from vibroimpact.impact.simulate import _split_steps
+from vibroimpact.impact.simulate import split_steps
 from vibroimpact.model import Model
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
@@ -630,7 +630,7 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     batches = None
     if n_batches is not None:
         # the samples fed: the grid's k = skip .. n_steps (a(tau) at every step from 0)
-        n_samples = _split_steps(t_end, dt)[0] + 1 - skip
+        n_samples = split_steps(t_end, dt)[0] + 1 - skip
         step = nperseg - nperseg // 2
         n_segments = max((n_samples - nperseg) // step + 1, 0)
         if n_segments:      # none: `result` says so; a batch holds at least one segment

@@ -19,19 +19,22 @@ import sys
 
 from vibroimpact.pipeline import targets
 
-__all__ = ["stale_files", "main"]
+__all__ = ["stale_files", "owned_datasets", "main"]
 
 #: Files made beside an output (a figure's PDF beside its PNG, a report's notebook and its
 #: rendering without images beside its HTML): current when that output is.
 _TWINS = {".pdf": ".png", ".ipynb": ".html", ".summary.html": ".html"}
 
 
-#: The datasets a study may own (``results/datasets/<study>_<kind>.nc``,
-#: `vibroimpact.pipeline.targets.DATASETS`): its statistics, map, spectra, escape, the
-#: predictors of its map, the orbits at its cells and, over a plane, its basins and Lyapunov
-#: exponents.
-STUDY_DATASETS = ("events", "map", "spectra", "escape", "predictors", "map_orbits", "basins",
-                  "lyapunov")
+def owned_datasets(section):
+    """The path patterns of the datasets an entry of ``section`` (``"studies"`` or
+    ``"orbits"``) may own, from the one table of them (`targets.DATASETS`): a study's under
+    ``results/datasets/`` and its trace, an orbits entry's under ``results/orbits/``; the
+    noise records are shared, no entry's."""
+    under = ("results/orbits/",) if section == "orbits" else ("results/datasets/",
+                                                             "results/traces/")
+    return sorted({pattern for pattern in targets.DATASETS.values()
+                   if "{name}" in pattern and pattern.startswith(under)})
 
 
 def summary(files):
@@ -48,15 +51,17 @@ def stale_files(config, drawn, root="."):
     root = Path(root)
     needed = targets.needed_files(config, drawn)
     places = []                     # (directory, glob) owned by a drawn entry
+    def datasets(section, name):
+        return [tuple(pattern.format(name=name).rsplit("/", 1))
+                for pattern in owned_datasets(section)]
+
     for name in drawn["studies"]:
-        places += [(f"results/figures/{name}", "*"), (f"results/reports/{name}", "*"),
-                   ("results/traces", f"{name}.nc")]
-        places += [("results/datasets", f"{name}_{kind}.nc") for kind in STUDY_DATASETS]
+        places += [(f"results/figures/{name}", "*"), (f"results/reports/{name}", "*")]
+        places += datasets("studies", name)
     for name in drawn["orbits"]:
         places += [(f"results/figures/orbits/{name}", "*"),
-                   (f"results/reports/orbits/{name}", "*"), ("results/orbits", f"{name}.nc")]
-        places += [("results/orbits", f"{name}_{kind}.nc")
-                   for kind in ("boundaries", "basins", "lyapunov")]
+                   (f"results/reports/orbits/{name}", "*")]
+        places += datasets("orbits", name)
     for name in config.get("sweeps", {}):
         if set(config["sweeps"][name]["studies"]) <= drawn["studies"]:
             places.append((f"results/figures/{name}", "sweep.*"))

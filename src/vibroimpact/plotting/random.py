@@ -11,6 +11,7 @@ from vibroimpact.plotting._common import (
     _density_deltas, _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label,
     family_styles, no_collision_text, note_on_axes, speed_law, t_quantile)
 from vibroimpact.plotting.walls import two_walls, wall_density_figure, wall_means_figure
+from vibroimpact.model import rebound_velocity
 from vibroimpact.stats.theory import (
     ENVELOPE_DELTA_MIN, ENVELOPE_EPS_MIN, energy_envelope, envelope_v_after_pdf,
     upcrossing_rate)
@@ -348,7 +349,7 @@ def fig09(events, envelope="auto"):
     if rice:
         d_rice = np.linspace(d_lo, d_hi, 200)
         eps = float(_attr(ds, "eps"))
-        asymptotes = (np.full_like(d_rice, eps * sigma_v * np.sqrt(np.pi / 2.0)),
+        asymptotes = (np.full_like(d_rice, _rice_rebound(ds, eps, sigma_v)),
                       1.0 / upcrossing_rate(d_rice, sigma_x, sigma_v))
     theory = _envelope(events, envelope)
     if theory is not None:
@@ -440,9 +441,12 @@ def fig09(events, envelope="auto"):
                                   f"throughout{rest})"))
     if rice:
         marks.append(Line2D([], [], color="0.25", ls="--", lw=1.1,
-                            label=r"Rice, large $\delta$: (a) $\varepsilon\sigma_v\sqrt{\pi/2}$, "
-                                  r"(b) $1/\nu^+(\delta)$, $\nu^+ = \frac{\sigma_v}{2\pi\sigma_x}"
-                                  r"e^{-\delta^2/2\sigma_x^2}$ "
+                            label=r"Rice, large $\delta$: (a) "
+                                  + (r"$\langle\varepsilon(u)u\rangle$ ($u$ Rayleigh), "
+                                     if speed_law(ds)
+                                     else r"$\varepsilon\sigma_v\sqrt{\pi/2}$, ")
+                                  + r"(b) $1/\nu^+(\delta)$, $\nu^+ = "
+                                  r"\frac{\sigma_v}{2\pi\sigma_x}e^{-\delta^2/2\sigma_x^2}$ "
                                   rf"($\sigma_x$ = {_num(sigma_x)}, $\sigma_v$ = {_num(sigma_v)}: "
                                   "wall-free response)"))
     if theory is not None and d_env.size:
@@ -475,6 +479,20 @@ ENVELOPE_LS, ENVELOPE_OUTSIDE_LS = "-", "-."
 #: Width of fig07's theory densities: wide and pale (alpha 0.4), behind the measured ones.
 ENVELOPE_DENSITY_LW = 3.0
 _ENVELOPE_MODES = ("auto", "always", "never")
+
+
+def _rice_rebound(ds, eps, sigma_v):
+    """Rice's large-play mean velocity after impact: the wall is met at Rayleigh speeds of
+    scale ``sigma_v`` (the wall-free response's up-crossings of a high level), each leaving at
+    its law's rebound speed: ``eps sigma_v sqrt(pi / 2)`` under Newton's law, the mean of
+    ``eps(u) u`` over that distribution under a law that falls with the speed (a quadrature
+    on 4001 points to 12 sigma_v: the density's tail beyond is below 1e-31)."""
+    if not speed_law(ds):
+        return eps * sigma_v * np.sqrt(np.pi / 2.0)
+    u = np.linspace(0.0, 12.0 * sigma_v, 4001)
+    density = u / sigma_v**2 * np.exp(-0.5 * (u / sigma_v) ** 2)
+    rebound = -rebound_velocity(eps, u, 1.0 / float(ds.attrs["speed_scale"]))
+    return float(np.trapezoid(rebound * density, u))
 
 
 def _envelope(events, envelope):

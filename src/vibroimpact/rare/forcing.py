@@ -84,12 +84,12 @@ class ForceFilter:
             self.kind = spec.kind
         self.taps = None
         if self.kind == "band_limited":
-            self.taps = _noise._band_limited_taps(spec)
+            self.taps = _noise.band_limited_taps(spec)
             if phase == "minimum":
                 taps = scipy.signal.minimum_phase(self.taps, "homomorphic", n_fft=MIN_PHASE_FFT,
                                                   half=False)
                 self.taps = taps * (spec.rms / math.sqrt(np.dot(taps, taps)))
-        self.arma = _noise._lowpass2_arma(spec) if self.kind == "lowpass2" else None
+        self.arma = _noise.lowpass2_arma(spec) if self.kind == "lowpass2" else None
 
     @property
     def n_memory(self):
@@ -120,8 +120,8 @@ class ForceFilter:
         spec = self.spec
         b, a = self.arma
         unit = _noise.NoiseSpec("lowpass2", 1.0, spec.dt, spec.beta_c, spec.zeta_f)
-        b_u, _ = _noise._lowpass2_arma(unit)
-        rho_1 = _noise._lowpass2_correlation(spec.dt, spec.beta_c, spec.zeta_f)
+        b_u, _ = _noise.lowpass2_arma(unit)
+        rho_1 = _noise.lowpass2_correlation(spec.dt, spec.beta_c, spec.zeta_f)
         y_prev, e, xi = rng.standard_normal(3)
         y = rho_1 * y_prev + b_u[0] * e + math.sqrt(max(1.0 - rho_1**2 - b_u[0] ** 2, 0.0)) * xi
         zi = spec.rms * np.array([b_u[1] * e - a[1] * y - a[2] * y_prev, -a[2] * y])

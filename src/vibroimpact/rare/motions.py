@@ -59,7 +59,7 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact import noise as _noise
-from vibroimpact.impact.simulate import _initial_vector
+from vibroimpact.impact.simulate import initial_vector
 from vibroimpact.rare.ams import _rng, ams, starting_exits
 from vibroimpact.rare.paths import CHUNK, REACHED, RETURNED, Dynamics
 
@@ -123,7 +123,7 @@ class PeriodicMotion:
         h = self.period / per_period
         dyn = Dynamics(zeta, _noise.NoiseSpec("white", 0.0, h), delta, _never, _never, eps=eps,
                        amplitude=amplitude, beta=beta_f)
-        vec = _initial_vector(dyn.model, h, _checks.real("x0", x0, high=delta),
+        vec = initial_vector(dyn.model, h, _checks.real("x0", x0, high=delta),
                               _checks.real("v0", v0), 0, False)
         n_tab = n * per_period
         k0 = settle * per_period

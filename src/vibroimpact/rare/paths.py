@@ -25,7 +25,7 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
-from vibroimpact.impact.simulate import (SampleState, _initial_vector, model_parameters)
+from vibroimpact.impact.simulate import (SampleState, initial_vector, model_parameters)
 from vibroimpact.model import Model
 from vibroimpact.rare.forcing import ForceFilter, ForceState
 
@@ -181,7 +181,7 @@ class Dynamics:
         a draw of its stationary state from ``rng``."""
         x0 = _checks.real("x0", x0, high=self.level)
         v0 = _checks.real("v0", v0)
-        vec = _initial_vector(self.model, self.dt, x0, v0, _checks.integer("k", k, low=0),
+        vec = initial_vector(self.model, self.dt, x0, v0, _checks.integer("k", k, low=0),
                               bool(stuck))
         return PathState(SampleState.of_vector(k, vec), self.filter.stationary(rng))
 
@@ -318,9 +318,9 @@ class Dynamics:
 
     def state_xv(self, vec, k):
         """``x, x'`` at sample ``k`` from the kernel's state vector."""
-        from vibroimpact.impact.simulate import _state_at
+        from vibroimpact.impact.simulate import state_at
 
-        x, v, _ = _state_at(vec, self.P, k)
+        x, v, _ = state_at(vec, self.P, k)
         return float(x), float(v)
 
     def state_at(self, path, j):

@@ -48,7 +48,7 @@ def response_moments(zeta, force):
     dt = spec.dt
     theta = np.linspace(0.0, math.pi, N_GRID // 2 + 1)
     if spec.kind == "band_limited" and not spec._full_band:
-        taps = force.taps if force is not spec else _noise._band_limited_taps(spec)
+        taps = force.taps if force is not spec else _noise.band_limited_taps(spec)
         s_d = dt * np.abs(scipy.fft.rfft(taps, N_GRID)) ** 2
     else:
         s_d = spec._psd_periodic(theta / dt)

@@ -206,7 +206,7 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
     -------
     ndarray of bool, shape (max(n - 1, 0),)
     """
-    sides = _flight_sides(impact_step, wall, gap, flights)
+    sides = flight_sides(impact_step, wall, gap, flights)
     if sides is None:
         return _pressed(impact_step, impact_offset, noise, dt, delta, amplitude, beta, flights)
     upper, lower = sides
@@ -217,7 +217,7 @@ def pressed_flights(impact_step, impact_offset, noise, dt, *, delta, amplitude=0
     return out
 
 
-def _flight_sides(impact_step, wall, gap, flights):
+def flight_sides(impact_step, wall, gap, flights):
     """None with one wall; else the flights to examine at the upper and at the lower wall
     (both impacts at that wall, and among ``flights``), checked."""
     if wall is None and gap is None:
