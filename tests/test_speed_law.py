@@ -284,3 +284,16 @@ def test_rices_large_play_rebound_under_the_law():
     assert _rice_rebound(law_ds, eps, sigma_v) == pytest.approx(ref, rel=1e-9)
     assert _rice_rebound(xr.Dataset(), eps, sigma_v) == eps * sigma_v * math.sqrt(math.pi / 2)
     assert ref < eps * scale < eps * sigma_v * math.sqrt(math.pi / 2)
+
+
+def test_every_header_names_the_law():
+    """A dataset under a law says so in the system line of every figure (`_system_text`) and
+    in a plane's caption of fixed values (`law_caption`); a Newton dataset's are as before."""
+    import xarray as xr
+    from vibroimpact.plotting._common import _system_text, law_caption
+
+    law = xr.Dataset(attrs=dict(zeta=0.05, eps=0.5, speed_scale=0.5, speed_scale_lower=2.0))
+    assert "(1 + u / 0.5)" in _system_text(law)
+    assert law_caption(law, math=False) == "ε(u) = ε/(1 + u/0.5), ε_l(u) = ε_l/(1 + u/2)"
+    newton = xr.Dataset(attrs=dict(zeta=0.05, eps=0.5))
+    assert law_caption(newton) == "" and "u/" not in _system_text(newton)

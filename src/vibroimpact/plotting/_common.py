@@ -449,7 +449,25 @@ def plane_caption(ds, math=True):
     if ("gap" in axes or "gap" in fixed) and "eps_lower" not in axes and "eps_lower" not in fixed:
         text += (", " if text else "") + (r"$\varepsilon_l = \varepsilon$" if math
                                           else "ε_l = ε")
+    law = law_caption(ds, math=math)
+    if law:
+        text += (", " if text else "") + law
     return f"fixed: {text}" if text else "nothing fixed"
+
+
+def law_caption(ds, math=True):
+    """The impact law of a dataset whose restitution falls with the speed, as a caption's
+    item (``"ε(u) = ε/(1 + u/0.5)"``; the second wall's after it); empty under Newton's
+    law."""
+    if not speed_law(ds):
+        return ""
+    parts = [(r"$\varepsilon(u) = \varepsilon/(1 + u/" + _num(ds.attrs["speed_scale"]) + ")$")
+             if math else f"ε(u) = ε/(1 + u/{_num(ds.attrs['speed_scale'])})"]
+    if "speed_scale_lower" in ds.attrs:
+        scale = _num(ds.attrs["speed_scale_lower"])
+        parts.append(rf"$\varepsilon_l(u) = \varepsilon_l/(1 + u/{scale})$" if math
+                     else f"ε_l(u) = ε_l/(1 + u/{scale})")
+    return ", ".join(parts)
 
 
 def on_plane(da, ds):

@@ -18,7 +18,7 @@ from matplotlib.ticker import FuncFormatter
 from vibroimpact._symbols import fixed_caption, parameter_symbol
 from vibroimpact.plotting._common import (CONFIDENCE, _attr, _decoded, _header, _num,
                                           _spectrum_parts, _styled, _system_text, motion_title,
-                                          note_on_axes)
+                                          law_caption, note_on_axes)
 from vibroimpact.plotting.maps import TYPE_COLORS
 from vibroimpact.stats.escape import MIN_FIT_LEVELS, censored_bound
 from vibroimpact.stats.events import t_quantile
@@ -213,7 +213,8 @@ def escape_vs_noise(escape):
     noise = ", ".join(_spectrum_parts(escape.attrs))
     system, force = ((f"{_system_text(escape)};  ", r"$\sin(\beta_f\tau) + r(\tau)$")
                      if _cell_axes(escape) == ("inv_beta", "delta") else
-                     (f"fixed: {fixed_caption(_decoded(escape.attrs['fixed'], 'fixed'))};  ",
+                     (f"fixed: {fixed_caption(_decoded(escape.attrs['fixed'], 'fixed'))}"
+                      + (f", {law_caption(escape)}" if law_caption(escape) else "") + ";  ",
                       r"$A\sin(\beta_f\tau) + r(\tau)$"))
     _header(fig, "Escape from the impact motions against the noise level",
             f"{system}"
