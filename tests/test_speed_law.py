@@ -297,3 +297,9 @@ def test_every_header_names_the_law():
     assert law_caption(law, math=False) == "ε(u) = ε/(1 + u/0.5), ε_l(u) = ε_l/(1 + u/2)"
     newton = xr.Dataset(attrs=dict(zeta=0.05, eps=0.5))
     assert law_caption(newton) == "" and "u/" not in _system_text(newton)
+    lower = xr.Dataset(attrs=dict(zeta=0.05, eps=0.5, speed_scale_lower=2.0))
+    assert law_caption(lower, math=False) == "ε_l(u) = ε_l/(1 + u/2)"
+    from vibroimpact.pipeline.tasks import _law_attrs
+
+    attrs = _law_attrs({"speed_scale": math.inf, "speed_scale_lower": 2.0})
+    assert "speed_scale" not in attrs and attrs["speed_scale_lower"] == 2.0

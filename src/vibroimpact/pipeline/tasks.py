@@ -9,6 +9,7 @@ entry the task reads (the workflow passes nothing else, so nothing else can reru
 import contextlib
 import json
 import logging
+import math
 import sys
 
 import numpy as np
@@ -173,8 +174,9 @@ def _law_attrs(laws):
     always had)."""
     if not laws:
         return {}
-    out = dict(speed_scale=float(laws["speed_scale"]),
-               impact_law="eps(u) = eps / (1 + u / speed_scale), u the approach speed")
+    out = dict(impact_law="eps(u) = eps / (1 + u / speed_scale), u the approach speed")
+    if laws.get("speed_scale", math.inf) != math.inf:       # (a law at the lower wall alone)
+        out["speed_scale"] = float(laws["speed_scale"])
     if laws.get("speed_scale_lower") is not None:
         out["speed_scale_lower"] = float(laws["speed_scale_lower"])
     return out

@@ -377,13 +377,13 @@ def _system_text(ds):
 def speed_law(ds):
     """Whether a dataset's walls follow an impact law other than Newton's (a restitution
     that falls with the impact speed: its ``speed_scale`` attribute)."""
-    return "speed_scale" in ds.attrs
+    return "speed_scale" in ds.attrs or "speed_scale_lower" in ds.attrs
 
 
 def _law_text(ds):
     """The impact law of a dataset whose restitution falls with the speed, for its header
     (empty under Newton's law): the figure says which law drew it."""
-    if not speed_law(ds):
+    if "speed_scale" not in ds.attrs:
         return ""
     return (rf" at $u$ = 0, falling as $\varepsilon(u) = \varepsilon / (1 + u / "
             rf"{_num(ds.attrs['speed_scale'])})$")
@@ -459,10 +459,11 @@ def law_caption(ds, math=True):
     """The impact law of a dataset whose restitution falls with the speed, as a caption's
     item (``"ε(u) = ε/(1 + u/0.5)"``; the second wall's after it); empty under Newton's
     law."""
-    if not speed_law(ds):
-        return ""
-    parts = [(r"$\varepsilon(u) = \varepsilon/(1 + u/" + _num(ds.attrs["speed_scale"]) + ")$")
-             if math else f"ε(u) = ε/(1 + u/{_num(ds.attrs['speed_scale'])})"]
+    parts = []
+    if "speed_scale" in ds.attrs:
+        scale = _num(ds.attrs["speed_scale"])
+        parts.append(rf"$\varepsilon(u) = \varepsilon/(1 + u/{scale})$" if math
+                     else f"ε(u) = ε/(1 + u/{scale})")
     if "speed_scale_lower" in ds.attrs:
         scale = _num(ds.attrs["speed_scale_lower"])
         parts.append(rf"$\varepsilon_l(u) = \varepsilon_l/(1 + u/{scale})$" if math

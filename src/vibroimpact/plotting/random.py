@@ -443,7 +443,7 @@ def fig09(events, envelope="auto"):
         marks.append(Line2D([], [], color="0.25", ls="--", lw=1.1,
                             label=r"Rice, large $\delta$: (a) "
                                   + (r"$\langle\varepsilon(u)u\rangle$ ($u$ Rayleigh), "
-                                     if speed_law(ds)
+                                     if "speed_scale" in ds.attrs
                                      else r"$\varepsilon\sigma_v\sqrt{\pi/2}$, ")
                                   + r"(b) $1/\nu^+(\delta)$, $\nu^+ = "
                                   r"\frac{\sigma_v}{2\pi\sigma_x}e^{-\delta^2/2\sigma_x^2}$ "
@@ -487,7 +487,7 @@ def _rice_rebound(ds, eps, sigma_v):
     its law's rebound speed: ``eps sigma_v sqrt(pi / 2)`` under Newton's law, the mean of
     ``eps(u) u`` over that distribution under a law that falls with the speed (a quadrature
     on 4001 points to 12 sigma_v: the density's tail beyond is below 1e-31)."""
-    if not speed_law(ds):
+    if "speed_scale" not in ds.attrs:       # the wall at delta: Newton's law
         return eps * sigma_v * np.sqrt(np.pi / 2.0)
     u = np.linspace(0.0, 12.0 * sigma_v, 4001)
     density = u / sigma_v**2 * np.exp(-0.5 * (u / sigma_v) ** 2)
