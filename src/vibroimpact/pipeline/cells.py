@@ -819,6 +819,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
                 n_switches=res.n_switches,
                 n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
                 n_impacts_resolved=n_resolved,
+                # Newton's law: eps times the mean speed, rounded as it always was
                 v_after_mean=(float(eps * col.velocity.mean()) if model.newton
                               else float(v_after.mean())) if col.time.size else math.nan,
                 simulated_time=duration, record_end=k * dt, reached=bool(reached),

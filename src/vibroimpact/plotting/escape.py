@@ -211,10 +211,11 @@ def escape_vs_noise(escape):
     fig.legend(handles=handles, loc="outside lower center",
                ncols=len(handles) if ncols >= 3 else 1, fontsize=7)
     noise = ", ".join(_spectrum_parts(escape.attrs))
+    law = law_caption(escape)
     system, force = ((f"{_system_text(escape)};  ", r"$\sin(\beta_f\tau) + r(\tau)$")
                      if _cell_axes(escape) == ("inv_beta", "delta") else
                      (f"fixed: {fixed_caption(_decoded(escape.attrs['fixed'], 'fixed'))}"
-                      + (f", {law_caption(escape)}" if law_caption(escape) else "") + ";  ",
+                      + (f", {law}" if law else "") + ";  ",
                       r"$A\sin(\beta_f\tau) + r(\tau)$"))
     _header(fig, "Escape from the impact motions against the noise level",
             f"{system}"
