@@ -29,7 +29,7 @@ import time
 
 import numpy as np
 
-from vibroimpact import noise, stats
+from vibroimpact import Model, noise, stats
 from vibroimpact.impact import audit, simulate_chunks
 from vibroimpact.pipeline import cells
 
@@ -55,8 +55,9 @@ def cpu_best(fn, repeats):
 def run_audit(record, chunks, moments):
     """The audit of ``pipeline.cells`` over stored chunks, integrating with ``moments``."""
     dt = SPEC.dt
-    rec = cells._IdentityRecord(record, dt, TRANSIENT, (record.size - 1) * dt, BATCHES,
-                                **chunks["params"])
+    p = chunks["params"]
+    model = Model.paper(p["zeta"], p["eps"], p["delta"], p["amplitude"], p["beta_f"])
+    rec = cells._IdentityRecord(record, dt, TRANSIENT, (record.size - 1) * dt, BATCHES, model)
     compiled, cells.audit_moments = cells.audit_moments, moments    # what `add` calls
     try:
         for chunk in chunks["chunks"]:

@@ -41,6 +41,8 @@ from vibroimpact.pipeline.cells import escape_cell, motion_map_cell  # noqa: E40
 from vibroimpact.pipeline.study import escape_samples, escape_seed  # noqa: E402
 from vibroimpact.pipeline.tasks import noise_spec  # noqa: E402
 
+from cell_calls import call  # noqa: E402
+
 
 def _cpu(func, *args, **kwargs):
     start = time.process_time()
@@ -56,8 +58,8 @@ def in_process(config, study):
                   amplitude=float(entry["amplitude"]))
     transient, length = float(entry["transient"]), float(block["record_length"])
     warm = generate_array(noise_spec(dict(noise, rms=0.3)), 20001, 0)
-    escape_cell(warm, float(noise["dt"]), **system, delta=1.0, beta_f=1.0, transient=100.0,
-                record_length=1000.0)
+    call(escape_cell, warm, float(noise["dt"]), 1.0, 1.0, **system, transient=100.0,
+         record_length=1000.0)
     print(f"studies.{study}.escape: {len(block['cells'])} cells x {len(block['rms'])} levels, "
           f"record {length:g} after the transient {transient:g}")
     print(f"{'rms':>6} {'cell':>12} {'gen s':>7} {'escape s':>9} {'map s':>7} {'sim s':>7} "
@@ -73,9 +75,10 @@ def in_process(config, study):
         totals[0] += t_gen
         for inv_beta, delta in block["cells"]:
             beta_f = 1.0 / float(inv_beta)
-            cell = dict(system, delta=float(delta), beta_f=beta_f, transient=transient)
-            t_esc, got = _cpu(escape_cell, r, spec.dt, **cell, record_length=length)
-            t_map, ref = _cpu(motion_map_cell, r, spec.dt, **cell, target_stderr=0.5,
+            cell = dict(system, inv_beta=float(inv_beta), delta=float(delta),
+                        transient=transient)
+            t_esc, got = _cpu(call, escape_cell, r, spec.dt, **cell, record_length=length)
+            t_map, ref = _cpu(call, motion_map_cell, r, spec.dt, **cell, target_stderr=0.5,
                               min_time=length, min_switches=1,
                               max_periods=int(length * beta_f / (2 * np.pi)) + 1)
             same = np.array_equal(got["residence_time"], ref["residence_time"], equal_nan=True)

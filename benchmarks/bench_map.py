@@ -52,6 +52,8 @@ from vibroimpact import stats
 from vibroimpact.pipeline.cells import motion_map_cell
 from vibroimpact.pipeline.io import read_noise
 
+from cell_calls import call
+
 SEED = 19741015
 DEFAULT_BOX = (1.0, 1.5, -0.5, 0.5)  # inv_beta lo, hi, delta lo, hi
 BLOCKS = (7, 9)  # blocks along inv_beta, delta
@@ -204,7 +206,7 @@ def warm_up(samples, dt, kw):
     simulate(kw["zeta"], kw["eps"], 0.0, noise=samples[:2001], dt=dt, amplitude=kw["amplitude"],
              beta=1.0, t_end=200.0)
     short = dict(kw, transient=10.0, min_time=100.0, max_periods=20)
-    motion_map_cell(samples, dt, delta=0.0, beta_f=1.0, **short)
+    call(motion_map_cell, samples, dt, 1.0, 0.0, **short)
     return time.process_time() - c0
 
 
@@ -239,8 +241,8 @@ def peer(ds, samples, dt, kw, n_cells, repeats, seed):
         t_sim, res = cpu_best(lambda: simulate(kw["zeta"], kw["eps"], delta, noise=samples, dt=dt,
                                                amplitude=kw["amplitude"], beta=1.0 / inv_beta,
                                                t_end=t_end), repeats)
-        t_map, cell = cpu_best(lambda: motion_map_cell(samples, dt, delta=delta,
-                                                       beta_f=1.0 / inv_beta, **kw), repeats)
+        t_map, cell = cpu_best(lambda: call(motion_map_cell, samples, dt, inv_beta, delta, **kw),
+                               repeats)
         after = int(np.sum(res.impact_time >= kw["transient"]))
         rows.append(dict(
             inv_beta=inv_beta, delta=delta, steps=t_end / dt, impacts_all=int(res.n_impacts),
@@ -361,8 +363,8 @@ def run_grid(samples, dt, kw, inv_betas, deltas):
     impacts = 0
     for ib in inv_betas:
         for d in deltas:
-            impacts += motion_map_cell(samples, dt, delta=float(d), beta_f=1.0 / float(ib),
-                                       **kw)["n_impacts"]
+            impacts += call(motion_map_cell, samples, dt, float(ib), float(d),
+                            **kw)["n_impacts"]
     return time.process_time() - c0, impacts
 
 

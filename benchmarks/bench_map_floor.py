@@ -231,10 +231,12 @@ def split(dataset, noise_path, stride, n_free):
     from vibroimpact import simulate
     from vibroimpact.pipeline.cells import motion_map_cell
     from vibroimpact.pipeline.io import read_noise
+
+    from cell_calls import call
     cells, kw = map_job(dataset, noise_path, stride)
     noise, dt, _ = read_noise(noise_path)
     noise = np.asarray(noise[:], dtype=float)
-    motion_map_cell(noise, dt, beta_f=1.0 / 2.5, delta=-1.0, **dict(kw, max_periods=50))
+    call(motion_map_cell, noise, dt, 2.5, -1.0, **dict(kw, max_periods=50))
     free = noise[: n_free + 1]
     simulate(kw["zeta"], kw["eps"], 100.0, free[:1001], dt)
     ns_free = np.inf
@@ -247,7 +249,7 @@ def split(dataset, noise_path, stride, n_free):
     c0 = time.process_time()
     prof.enable()
     for inv_beta, delta in cells:
-        cell = motion_map_cell(noise, dt, beta_f=1.0 / inv_beta, delta=delta, **kw)
+        cell = call(motion_map_cell, noise, dt, inv_beta, delta, **kw)
         steps += round(float(cell["simulated_time"]) / dt)
         impacts += int(cell["n_impacts_resolved"])
         collisions += int(cell["n_collisions"])

@@ -84,8 +84,13 @@ def worker(job):
     from vibroimpact.pipeline import cells
     from vibroimpact.pipeline.io import read_noise
 
+    from cell_calls import call
+
     kernel_cpu = [0.0]
-    plain = cells.simulate_chunks
+    # the chunk generator the cells call: of a Model since they take one, loose before
+    source = "simulate_model_chunks" if hasattr(cells, "simulate_model_chunks") else (
+        "simulate_chunks")
+    plain = getattr(cells, source)
 
     def timed(*args, **kwargs):
         gen = plain(*args, **kwargs)
@@ -101,17 +106,17 @@ def worker(job):
         finally:
             gen.close()
 
-    cells.simulate_chunks = timed
+    setattr(cells, source, timed)
     noise, dt, _ = read_noise(job["noise"])
     noise = np.asarray(noise[:], dtype=float)
     kw = dict(job["kwargs"])
     kw["motions"] = tuple(tuple(m) for m in kw["motions"])
-    cells.motion_map_cell(noise, dt, beta_f=1.0 / 2.5, delta=-1.0, **dict(kw, max_periods=50))
+    call(cells.motion_map_cell, noise, dt, 2.5, -1.0, **dict(kw, max_periods=50))
     total, kernel, digest = [], [], []
     for inv_beta, delta in job["cells"]:
         kernel_cpu[0] = 0.0
         c0 = time.process_time()
-        out = cells.motion_map_cell(noise, dt, beta_f=1.0 / inv_beta, delta=delta, **kw)
+        out = call(cells.motion_map_cell, noise, dt, inv_beta, delta, **kw)
         total.append(time.process_time() - c0)
         kernel.append(kernel_cpu[0])
         h = hashlib.sha256()

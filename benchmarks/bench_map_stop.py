@@ -34,6 +34,8 @@ from bench_map import load_map
 from vibroimpact.pipeline.cells import motion_map_cell
 from vibroimpact.pipeline.io import read_noise
 
+from cell_calls import call
+
 
 KEYS = ("approach", "approach_unswitched", "min_growth")
 
@@ -47,8 +49,8 @@ def run(noise, dt, kwargs, cells, schedule):
     out = dict(cpu=0.0, simulated=0.0, checks=0, capped=0, worst=[], p=[], se=[])
     for inv_beta, delta in cells:
         start = time.process_time()
-        cell = motion_map_cell(noise, dt, beta_f=1.0 / inv_beta, delta=delta,
-                               **dict(zip(KEYS, schedule)), **kwargs)
+        cell = call(motion_map_cell, noise, dt, inv_beta, delta, **dict(zip(KEYS, schedule)),
+                    **kwargs)
         out["cpu"] += time.process_time() - start
         out["simulated"] += cell["simulated_time"]
         out["checks"] += cell["n_checks"]
@@ -81,7 +83,7 @@ def main():
     schedules = {"default": default_schedule(),
                  "peer": tuple(float(v) for v in args.peer.split(","))}
     # compile and warm the kernels on a busy cell before any timing
-    motion_map_cell(noise, dt, beta_f=1.0 / 2.5, delta=-1.0, **dict(kwargs, max_periods=50))
+    call(motion_map_cell, noise, dt, 2.5, -1.0, **dict(kwargs, max_periods=50))
     best = {}
     for _ in range(args.rounds):
         for name, schedule in schedules.items():

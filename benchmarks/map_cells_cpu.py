@@ -25,6 +25,8 @@ import vibroimpact
 from vibroimpact.pipeline.cells import motion_map_cell
 from vibroimpact.pipeline.io import read_noise
 
+from cell_calls import call
+
 
 def main():
     job = json.load(sys.stdin)
@@ -32,11 +34,11 @@ def main():
     noise = np.asarray(noise[:], dtype=float)
     kw = dict(job["kwargs"])
     # compile and warm the kernels on a busy cell before any timing
-    motion_map_cell(noise, dt, beta_f=1.0 / 2.5, delta=-1.0, **dict(kw, max_periods=50))
+    call(motion_map_cell, noise, dt, 2.5, -1.0, **dict(kw, max_periods=50))
     cpu, probability, record_end = [], [], []
     for inv_beta, delta in job["cells"]:
         start = time.process_time()
-        cell = motion_map_cell(noise, dt, beta_f=1.0 / inv_beta, delta=delta, **kw)
+        cell = call(motion_map_cell, noise, dt, inv_beta, delta, **kw)
         cpu.append(time.process_time() - start)
         probability.append([float(p) for p in cell["probability"]])
         record_end.append(float(cell["record_end"]))

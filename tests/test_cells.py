@@ -5,7 +5,7 @@ import logging
 import numpy as np
 import pytest
 
-from vibroimpact import noise, stats
+from vibroimpact import Model, noise, stats
 from vibroimpact.pipeline import cells, datasets
 from vibroimpact.pipeline.study import Study
 
@@ -18,7 +18,7 @@ def test_psd_without_impacts_is_linear_response():
     resonance peak (half-width zeta = 0.05 spans ~2.5 bins of 0.02)."""
     spec = noise.NoiseSpec(kind="band_limited", rms=1.0, dt=0.05, beta_c=8.0)
     r = noise.generate_array(spec, 2_000_001, seed=7)
-    out = cells.spectra_statistics(r, spec.dt, zeta=0.05, eps=0.5, delta=1e3, transient=200.0,
+    out = cells.spectra_statistics(r, spec.dt, Model.paper(0.05, 0.5, 1e3), transient=200.0,
                                    nperseg=8192)
     beta, S_a = out["beta"], out["S_a"]
     S_lin = stats.linear_psd_response(beta, spec.psd_piecewise_linear(beta), 0.05)
@@ -46,24 +46,26 @@ def record():
 
 def test_t_end_beyond_the_record_is_refused(record):
     # 40 001 samples at dt = 0.1 end at tau = 4000: asking for more must not be cut silently
-    kw = dict(zeta=0.05, eps=0.5, delta=0.0)
+    model = Model.paper(0.05, 0.5, 0.0)
     with pytest.raises(ValueError, match=r"t_end = 5000\.0.*40001 samples.*4000"):
-        cells.event_statistics(record, NOISE.dt, **kw, t_end=5000.0, bins=BINS)
+        cells.event_statistics(record, NOISE.dt, model, t_end=5000.0, bins=BINS)
     with pytest.raises(ValueError, match="t_end"):
-        cells.spectra_statistics(record, NOISE.dt, **kw, t_end=4000.5, nperseg=256)
+        cells.spectra_statistics(record, NOISE.dt, model, t_end=4000.5, nperseg=256)
     with pytest.raises(ValueError, match="t_end"):
-        cells.trace(record, NOISE.dt, **kw, t_end=1e6)
+        cells.trace(record, NOISE.dt, model, t_end=1e6)
     # the record's own end, written in decimal, is accepted
-    out = cells.event_statistics(record, NOISE.dt, **kw, t_end=4000.0, bins=BINS, transient=50.0)
+    out = cells.event_statistics(record, NOISE.dt, model, t_end=4000.0, bins=BINS,
+                                 transient=50.0)
     assert out["simulated_time"] == pytest.approx(3950.0, rel=1e-12)
 
 
 def test_ratio_statistics_only_with_a_harmonic_force(record):
     # Without a harmonic force there is no forcing period: z_j / z and the (m/n) motions
     # would be computed with a dummy beta, so they are absent from the results and datasets.
-    kw = dict(zeta=0.05, eps=0.5, delta=0.0, transient=50.0, bins=BINS)
-    plain = cells.event_statistics(record, NOISE.dt, **kw)
-    forced = cells.event_statistics(record, NOISE.dt, **kw, amplitude=1.0, beta_f=1 / 1.1)
+    kw = dict(transient=50.0, bins=BINS)
+    plain = cells.event_statistics(record, NOISE.dt, Model.paper(0.05, 0.5, 0.0), **kw)
+    forced = cells.event_statistics(record, NOISE.dt, Model.paper(0.05, 0.5, 0.0, 1.0, 1 / 1.1),
+                                    **kw)
     harmonic_only = {"ratio_density", "ratio_density_stderr", "ratio_beyond",
                      "motion_probability"}
     assert not harmonic_only & set(plain) and harmonic_only <= set(forced)
@@ -87,9 +89,9 @@ def test_batch_statistics_and_their_lag1_warning(record, caplog):
     # collision statistics drift: the 20 batch means follow the slow cycle (lag-1 ~0.55-0.7,
     # above 2/sqrt(20) = 0.45) and the cell warns. The stationary cell (delta = 0, noise only) has
     # a lag-1 correlation near 0 and stays silent.
-    kw = dict(zeta=0.05, eps=0.5, transient=50.0, bins=BINS, n_batches=20)
+    kw = dict(transient=50.0, bins=BINS, n_batches=20)
     with caplog.at_level(logging.WARNING, logger="vibroimpact"):
-        calm = cells.event_statistics(record, NOISE.dt, delta=0.0, **kw)
+        calm = cells.event_statistics(record, NOISE.dt, Model.paper(0.05, 0.5, 0.0), **kw)
     assert not caplog.records
     assert calm["n_batches"] == 20 and abs(calm["v_after_lag1"]) < 2 / np.sqrt(20)
     # density errors are the batch-means ones of stats.density
@@ -97,8 +99,8 @@ def test_batch_statistics_and_their_lag1_warning(record, caplog):
     assert np.nansum(v_after * np.diff(BINS["v_after"])) + calm["v_after_beyond"] == \
         pytest.approx(1.0, abs=1e-12)
     with caplog.at_level(logging.WARNING, logger="vibroimpact"):
-        drift = cells.event_statistics(record, NOISE.dt, delta=0.5, amplitude=0.8,
-                                       beta_f=2 * np.pi / 2000, **kw)
+        drift = cells.event_statistics(
+            record, NOISE.dt, Model.paper(0.05, 0.5, 0.5, 0.8, 2 * np.pi / 2000), **kw)
     assert drift["v_after_lag1"] > 2 / np.sqrt(20) and drift["interval_lag1"] > 2 / np.sqrt(20)
     messages = [r.getMessage() for r in caplog.records]
     assert len(messages) == 2 and all("lag-1" in m and "delta=0.5" in m for m in messages)

@@ -15,7 +15,7 @@ import xarray as xr
 import yaml
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 
-from vibroimpact import stats
+from vibroimpact import Model, stats
 from vibroimpact.noise import NoiseSpec, generate_array
 from vibroimpact.pipeline import config as configuration
 from vibroimpact.pipeline import datasets, tasks
@@ -141,11 +141,10 @@ def test_escape_cell_labels_as_motion_map_cell_bit_for_bit():
                        escape_samples(transient, length, dt) + 400, 5)
     beta_f = 1.0 / 1.1
     for delta in (1.0, 0.1, 2.5):
-        got = escape_cell(r, dt, **SYSTEM, delta=delta, beta_f=beta_f, transient=transient,
-                          record_length=length)
-        ref = motion_map_cell(r, dt, **SYSTEM, delta=delta, beta_f=beta_f,
-                              transient=transient, target_stderr=0.5, min_time=length,
-                              max_periods=int(length * beta_f / (2 * np.pi)) + 1,
+        model = Model.paper(SYSTEM["zeta"], SYSTEM["eps"], delta, SYSTEM["amplitude"], beta_f)
+        got = escape_cell(r, dt, model, transient=transient, record_length=length)
+        ref = motion_map_cell(r, dt, model, transient=transient, target_stderr=0.5,
+                              min_time=length, max_periods=int(length * beta_f / (2 * np.pi)) + 1,
                               min_switches=1)
         assert got["record_end"] == ref["record_end"] == transient + length
         for key in ("residence_time", "residence_time_stderr", "n_stretches", "n_censored"):
@@ -158,7 +157,7 @@ def test_escape_cell_labels_as_motion_map_cell_bit_for_bit():
 
 def test_escape_cell_refuses_a_short_record():
     with pytest.raises(ValueError, match="record_length"):
-        escape_cell(np.zeros(100), 0.1, **SYSTEM, delta=1.0, beta_f=1.0, transient=5.0,
+        escape_cell(np.zeros(100), 0.1, Model.paper(0.05, 0.5, 1.0, 1.0, 1.0), transient=5.0,
                     record_length=10.0)
 
 

@@ -8,7 +8,7 @@ record (velocities scaled by 1.1) leaves a bias that shows as many standard erro
 import numpy as np
 import pytest
 
-from vibroimpact import noise, simulate, stats
+from vibroimpact import Model, noise, simulate, stats
 from vibroimpact.pipeline import cells, datasets
 from vibroimpact.pipeline.study import Cell
 
@@ -28,9 +28,9 @@ def record():
 @pytest.mark.parametrize("delta, amplitude", [(1.0, 0.0), (0.5, 0.0), (0.0, 0.0),
                                               (-0.5, 0.0), (-1.0, 0.0), (0.25, 1.0)])
 def test_the_identities_hold_to_their_standard_error(record, eps, delta, amplitude):
-    out = cells.event_statistics(record, NOISE.dt, zeta=ZETA, eps=eps, delta=delta,
-                                 amplitude=amplitude, beta_f=1 / 1.1, transient=TRANSIENT,
-                                 bins=BINS, n_batches=B)
+    model = Model.paper(ZETA, eps, delta, amplitude, 1 / 1.1)
+    out = cells.event_statistics(record, NOISE.dt, model, transient=TRANSIENT, bins=BINS,
+                                 n_batches=B)
     assert out["n_collisions"] > 1000
     for name in ("power", "virial"):
         res, se = out[f"{name}_residual"], out[f"{name}_residual_stderr"]
@@ -91,16 +91,17 @@ def test_a_tampered_impact_velocity_shows(record, eps, delta, identity):
 
 def test_chunks_do_not_change_the_residuals(record):
     """Sticking phases and chatter across chunk boundaries: the same integrals."""
-    kw = dict(zeta=ZETA, eps=0.5, delta=-0.5, transient=TRANSIENT, t_end=10_000.0, bins=BINS)
-    whole = cells.event_statistics(record, NOISE.dt, **kw)
-    parts = cells.event_statistics(record, NOISE.dt, **kw, chunk_size=777)
+    kw = dict(transient=TRANSIENT, t_end=10_000.0, bins=BINS)
+    model = Model.paper(ZETA, 0.5, -0.5)
+    whole = cells.event_statistics(record, NOISE.dt, model, **kw)
+    parts = cells.event_statistics(record, NOISE.dt, model, **kw, chunk_size=777)
     for name in ("power_residual", "power_residual_stderr", "power_input", "virial_residual",
                  "virial_residual_stderr", "virial_scale"):
         assert parts[name] == pytest.approx(whole[name], rel=1e-9, abs=1e-14), name
 
 
 def test_the_events_tile_carries_the_audit(record):
-    out = cells.event_statistics(record, NOISE.dt, zeta=ZETA, eps=0.5, delta=0.0,
+    out = cells.event_statistics(record, NOISE.dt, Model.paper(ZETA, 0.5, 0.0),
                                  transient=TRANSIENT, t_end=5000.0, bins=BINS)
     cell = Cell(index=0, i_inv_beta=0, i_delta=0, inv_beta=1.0, delta=0.0)
     ds = datasets.events_tile([cell], [out], BINS, {})

@@ -3,7 +3,7 @@ simulating the cell alone (`simulate`) and classifying its impacts."""
 import numpy as np
 import pytest
 
-from vibroimpact import periodic_orbits, simulate, stats
+from vibroimpact import Model, periodic_orbits, simulate, stats
 from vibroimpact.noise import NoiseSpec, generate_array
 from vibroimpact.pipeline.cells import motion_map_cell
 
@@ -14,7 +14,7 @@ TRANSIENT = 3000.0   # e^(-zeta * 3000) = 1e-65: the transient from rest has die
 
 def _map_cell(noise, inv_beta, delta, **kw):
     kw = dict(dict(transient=TRANSIENT, min_time=2000.0, max_periods=600), **kw)
-    return motion_map_cell(noise, DT, zeta=ZETA, eps=EPS, delta=delta, beta_f=1.0 / inv_beta,
+    return motion_map_cell(noise, DT, Model.paper(ZETA, EPS, delta, 1.0, 1.0 / inv_beta),
                            motions=MOTIONS, **kw)
 
 
@@ -143,11 +143,11 @@ def test_config_map():
     spec = dict(config["noises"][study["noise"]])
     n, seed = spec.pop("n_samples"), spec.pop("seed")
     noise = generate_array(NoiseSpec(**spec), n, seed)
-    kw = dict(zeta=study["zeta"], eps=study["eps"], amplitude=study["amplitude"],
-              transient=study["transient"], n_batches=study["n_batches"],
+    kw = dict(transient=study["transient"], n_batches=study["n_batches"],
               window=study["motion_window"], motions=tuple(map(tuple, study["motions"])),
               **study["map"])
-    return noise, spec["dt"], kw
+    system = (study["zeta"], study["eps"], study["amplitude"])
+    return noise, spec["dt"], system, kw
 
 
 # many switches, 7 switches with none (a few-switches cell), and the (2/1)-dominated cell
@@ -161,8 +161,9 @@ def test_stationary_distribution_of_the_rates_is_the_time_on_the_cell(test_confi
     switch by which the first and last states' ins and outs differ: an identity of the
     bookkeeping, Markov or not (`stats.residence_statistics`). Measured (the four cells):
     |pi - p| <= 0.014, at most 0.46 of the standard error."""
-    noise, dt, kw = test_config_map
-    cell = motion_map_cell(noise, dt, delta=delta, beta_f=1.0 / inv_beta, **kw)
+    noise, dt, (zeta, eps, amplitude), kw = test_config_map
+    cell = motion_map_cell(noise, dt, Model.paper(zeta, eps, delta, amplitude, 1.0 / inv_beta),
+                           **kw)
     p = cell["probability"] + cell["stick_probability"]
     p = np.append(p, 1.0 - p.sum())
     err = np.hypot(cell["stderr"], cell["stick_stderr"])
@@ -228,7 +229,7 @@ def test_the_map_dataset_stores_residence_and_rates_beside_the_probabilities(tmp
     from vibroimpact.pipeline import io
 
     samples, dt, _ = io.read_noise(noise)
-    cell = motion_map_cell(samples, dt, zeta=ZETA, eps=EPS, delta=1.0, beta_f=0.5,
+    cell = motion_map_cell(samples, dt, Model.paper(ZETA, EPS, 1.0, 1.0, 0.5),
                            transient=200.0, target_stderr=0.05, min_time=500.0,
                            max_periods=300, min_switches=10, motions=MOTIONS)
     got = ds.sel(inv_beta=2.0, delta=1.0)

@@ -4,7 +4,7 @@ above the floor; the reports tabulate them and re-read findings 2 and 3 under ea
 import numpy as np
 import pytest
 
-from vibroimpact import noise, simulate, stats
+from vibroimpact import Model, noise, simulate, stats
 from vibroimpact.pipeline import cells, datasets
 from vibroimpact.pipeline.study import Study
 from vibroimpact.reports import sensitivity
@@ -12,7 +12,7 @@ from vibroimpact.reports import sensitivity
 NOISE = noise.NoiseSpec(kind="band_limited", rms=0.5, dt=0.1, beta_c=4.0)
 BINS = {"v_after": np.linspace(0, 2.5, 51), "interval": np.linspace(0, 20, 41),
         "ratio": np.linspace(0, 4, 41)}
-KW = dict(zeta=0.05, eps=0.5, transient=50.0, bins=BINS, n_batches=10)
+KW = dict(transient=50.0, bins=BINS, n_batches=10)
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +23,7 @@ def record():
 @pytest.fixture(scope="module")
 def pressed_cells(record):
     """Random-force cells at negative play, where the rules differ (and one at 0.5)."""
-    return {d: cells.event_statistics(record, NOISE.dt, delta=d, **KW)
+    return {d: cells.event_statistics(record, NOISE.dt, Model.paper(0.05, 0.5, d), **KW)
             for d in (-1.0, -0.5, -0.2, 0.5)}
 
 
@@ -52,15 +52,14 @@ def test_each_rule_row_is_what_its_grouping_gives(record, pressed_cells):
 
 def test_the_harmonic_and_map_cells_carry_the_motions_under_each_rule(record):
     motions = ((1, 1), (2, 1), (1, 2))
-    out = cells.event_statistics(record, NOISE.dt, delta=-0.5, amplitude=1.0, beta_f=0.5,
-                                 motions=motions, **KW)
+    model = Model.paper(0.05, 0.5, -0.5, 1.0, 0.5)
+    out = cells.event_statistics(record, NOISE.dt, model, motions=motions, **KW)
     assert out["rule_motion_probability"].shape == (3, 3)
     assert np.array_equal(out["rule_motion_probability"][0], out["motion_probability"])
     assert np.array_equal(out["rule_motion_stick_probability"][0],
                           out["motion_stick_probability"])
-    m = cells.motion_map_cell(record, NOISE.dt, zeta=0.05, eps=0.5, delta=-0.5, beta_f=0.5,
-                              transient=50.0, motions=motions, min_time=1000.0,
-                              max_periods=100)
+    m = cells.motion_map_cell(record, NOISE.dt, model, transient=50.0, motions=motions,
+                              min_time=1000.0, max_periods=100)
     assert np.array_equal(m["rule_probability"][0], m["probability"])
     assert np.array_equal(m["rule_stick_probability"][0], m["stick_probability"])
     cell_list = Study.from_config("map", dict(zeta=0.05, eps=0.5, amplitude=1.0,

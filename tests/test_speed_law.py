@@ -220,10 +220,11 @@ def test_the_energy_and_momentum_balances_hold_under_the_law(record, delta, ampl
     bounds the mean velocity after impact, which Newton's law at the same eps exceeds."""
     from vibroimpact.pipeline import cells
 
-    walls = {} if gap is None else dict(gap=gap, eps_lower=0.8, speed_scale_lower=2.0)
-    kw = dict(zeta=ZETA, eps=0.7, delta=delta, amplitude=amplitude, beta_f=1 / 1.1,
-              transient=200.0, bins=_bins(), n_batches=20, **walls)
-    out = cells.event_statistics(record, 0.1, speed_scale=0.3, **kw)
+    walls = {} if gap is None else dict(gap=gap, eps_lower=0.8)
+    kw = dict(transient=200.0, bins=_bins(), n_batches=20)
+    lower = {} if gap is None else dict(speed_scale_lower=2.0)
+    model = Model.paper(ZETA, 0.7, delta, amplitude, 1 / 1.1, speed_scale=0.3, **walls, **lower)
+    out = cells.event_statistics(record, 0.1, model, **kw)
     assert out["n_collisions"] > 1000
     for name in ("power", "virial"):
         res, se = out[f"{name}_residual"], out[f"{name}_residual_stderr"]
@@ -234,8 +235,8 @@ def test_the_energy_and_momentum_balances_hold_under_the_law(record, delta, ampl
     else:
         assert out["wall_v_after_mean"][0] < 0.7 * 0.3 < out["wall_v_after_mean"][1] < 0.8 * 2
         assert np.all(out["wall_n_collisions"] > 100)
-    newton = cells.event_statistics(record, 0.1, speed_scale=math.inf,
-                                    **dict(kw, speed_scale_lower=None) if gap else kw)
+    newton = cells.event_statistics(
+        record, 0.1, Model.paper(ZETA, 0.7, delta, amplitude, 1 / 1.1, **walls), **kw)
     assert newton["v_after_mean"] > 2 * out["v_after_mean"]
 
 
@@ -243,7 +244,6 @@ def test_a_study_carries_its_law_to_every_job():
     """`law` and `law_lower` reach the cells' model (`Study`, `study_model`, the jobs'
     keywords), on the paper's plane and on another; a Newton study's keywords are those it
     always had."""
-    from vibroimpact.pipeline import tasks
     from vibroimpact.pipeline.cells import study_model
     from vibroimpact.pipeline.study import JOB_KEYS, Study
 
@@ -254,7 +254,7 @@ def test_a_study_carries_its_law_to_every_job():
     cell = study.cells()[1]
     m = study_model(study, cell)
     assert [w.law.speed_scale for w in m.walls] == [0.5, 3.0]
-    physics = tasks._physics(study, cell)
+    physics = m.params()
     assert physics["speed_scale"] == 0.5 and physics["speed_scale_lower"] == 3.0
     plane = dict(entry, plane=["eps", "delta"], eps=[0.3, 0.6], inv_beta=1.1)
     plane.pop("law_lower")
@@ -265,7 +265,7 @@ def test_a_study_carries_its_law_to_every_job():
                  "plane_escape"):
         assert {"law", "law_lower"} <= set(JOB_KEYS[kind]), kind
     newton = Study.from_config("n", dict(entry, law=None, law_lower=None))
-    assert "speed_scale" not in tasks._physics(newton, newton.cells()[0])
+    assert study_model(newton, newton.cells()[0]).newton
     assert newton.laws() == {}
 
 

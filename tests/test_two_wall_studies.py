@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import yaml
 
+from vibroimpact.model import Model
 from vibroimpact.pipeline import cells, datasets
 from vibroimpact.pipeline import config as configuration
 from vibroimpact.pipeline.cells import study_model
@@ -130,10 +131,10 @@ def test_symmetric_stops_mirror_the_walls_exactly():
     statistics under r are the other wall's under -r (to round-off: the two walls are
     searched in mirrored frames by the same code)."""
     r = _noise(rms=1.2)
-    kw = dict(zeta=0.05, eps=0.5, delta=1.0, gap=2.0, eps_lower=0.5, transient=50.0,
-              bins=BINS, n_batches=10)
-    a = cells.event_statistics(r, 0.1, **kw)
-    b = cells.event_statistics(-r, 0.1, **kw)
+    model = Model.paper(0.05, 0.5, 1.0, gap=2.0, eps_lower=0.5)
+    kw = dict(transient=50.0, bins=BINS, n_batches=10)
+    a = cells.event_statistics(r, 0.1, model, **kw)
+    b = cells.event_statistics(-r, 0.1, model, **kw)
     assert a["wall_n_collisions"].sum() == a["n_collisions"] > 100
     assert a["wall_n_collisions"].min() > 20
     assert a["wall_n_collisions"].tolist() == b["wall_n_collisions"][::-1].tolist()
@@ -151,9 +152,11 @@ def test_each_wall_rebounds_with_its_own_restitution():
     below under -r: the mirror image, so the walls' statistics swap (velocity after impact
     eps_w u with each wall's own eps_w)."""
     r = _noise(rms=1.2, seed=11)
-    kw = dict(zeta=0.05, delta=1.0, gap=2.0, transient=50.0, bins=BINS, n_batches=10)
-    a = cells.event_statistics(r, 0.1, eps=0.7, eps_lower=0.3, **kw)
-    b = cells.event_statistics(-r, 0.1, eps=0.3, eps_lower=0.7, **kw)
+    kw = dict(transient=50.0, bins=BINS, n_batches=10)
+    a = cells.event_statistics(r, 0.1, Model.paper(0.05, 0.7, 1.0, gap=2.0, eps_lower=0.3),
+                               **kw)
+    b = cells.event_statistics(-r, 0.1, Model.paper(0.05, 0.3, 1.0, gap=2.0, eps_lower=0.7),
+                               **kw)
     assert a["wall_n_collisions"].min() > 20
     assert a["wall_n_collisions"].tolist() == b["wall_n_collisions"][::-1].tolist()
     np.testing.assert_allclose(a["wall_v_after_mean"], b["wall_v_after_mean"][::-1], rtol=1e-9)
@@ -169,10 +172,10 @@ def test_a_far_second_wall_gives_the_one_wall_cell():
     """A lower wall 1e3 below (never reached): every statistic of the one-wall cell, and
     every collision at the upper wall."""
     r = _noise(20001, seed=5)
-    kw = dict(zeta=0.05, eps=0.5, delta=0.5, amplitude=1.0, beta_f=1.0 / 1.1,
-              transient=50.0, bins=BINS, n_batches=10, motions=((1, 1), (2, 1), (1, 2)))
-    one = cells.event_statistics(r, 0.1, **kw)
-    two = cells.event_statistics(r, 0.1, gap=1e3, **kw)
+    kw = dict(transient=50.0, bins=BINS, n_batches=10, motions=((1, 1), (2, 1), (1, 2)))
+    one = cells.event_statistics(r, 0.1, Model.paper(0.05, 0.5, 0.5, 1.0, 1.0 / 1.1), **kw)
+    two = cells.event_statistics(r, 0.1, Model.paper(0.05, 0.5, 0.5, 1.0, 1.0 / 1.1, gap=1e3),
+                                 **kw)
     assert two["wall_n_collisions"].tolist() == [one["n_collisions"], 0]
     for name in ("n_collisions", "v_after_mean", "interval_mean", "v_after_density",
                  "interval_density", "ratio_density", "motion_probability",
@@ -187,10 +190,8 @@ def test_the_two_wall_tile_dataset_has_a_wall_dimension():
                                         delta=[1.0], tile_size=1, gap=2.0, eps_lower=0.3,
                                         motions=[[1, 1, 1], [1, 0, 1]]))
     cell = study.cells()[0]
-    params = study_model(study, cell).params()
-    params["beta_f"] = params.pop("beta")
-    result = cells.event_statistics(r, 0.1, **params, transient=50.0, bins=BINS, n_batches=10,
-                                    motions=study.motions)
+    result = cells.event_statistics(r, 0.1, study_model(study, cell), transient=50.0, bins=BINS,
+                                    n_batches=10, motions=study.motions)
     ds = datasets.events_tile([cell], [result], BINS, {}, motions=study.motions)
     assert ds["wall"].values.tolist() == ["upper", "lower"]
     assert ds["wall_v_after_density"].dims == ("cell", "wall", "v_after")
@@ -275,18 +276,18 @@ def test_a_two_wall_config_builds_its_datasets_and_a_figure(tmp_path):
 
 
 def test_the_paper_cells_get_the_arguments_they_always_got():
-    """The jobs resolve each cell's model (`Study.model`); for the paper's one-wall studies
-    the keywords it gives the cells are the loose values the jobs passed before models,
-    float for float (so their datasets stay bit for bit)."""
-    from vibroimpact.pipeline.tasks import _physics
-
+    """The jobs resolve each cell's model (`cells.study_model`); for the paper's one-wall
+    studies it is the model of the loose values the jobs passed before models, float for
+    float (so their datasets stay bit for bit)."""
     config, plan = configuration.load(root=ROOT)
     for name, study in plan.studies.items():
         for kind in ("events", "spectra"):
             for cell in study.cells(kind):
-                assert _physics(study, cell) == dict(
-                    zeta=study.zeta, eps=study.eps, delta=cell.delta,
-                    amplitude=study.amplitude, beta_f=1.0 / cell.inv_beta), (name, cell)
+                model = study_model(study, cell)
+                assert model == Model.paper(study.zeta, study.eps, cell.delta,
+                                            study.amplitude, 1.0 / cell.inv_beta), (name, cell)
+                assert (model.zeta, model.eps, model.delta, model.amplitude, model.beta) == (
+                    study.zeta, study.eps, cell.delta, study.amplitude, 1.0 / cell.inv_beta)
 
 
 def test_the_plan_resolves_each_study_once_from_the_checked_grids():

@@ -33,7 +33,7 @@ if FACTORS:
             if isinstance(kernel, Dispatcher):
                 kernel._cache = NullCache()
 
-from vibroimpact import simulate                       # noqa: E402  (after the patch)
+from vibroimpact import Model, simulate                # noqa: E402  (after the patch)
 from vibroimpact.noise import NoiseSpec, generate_array  # noqa: E402
 from vibroimpact.pipeline import cells                 # noqa: E402
 
@@ -60,18 +60,18 @@ def main(out):
                                   19741001) for rms in (0.5, 0.29)}
     result = {"applied": np.array([getattr(kernels, n) for n in sorted(FACTORS)], dtype=float)}
     for name, rms, amplitude, inv_beta, delta in CASES:
-        stats = cells.event_statistics(noises[rms], 0.1, zeta=0.05, eps=0.5, delta=delta,
-                                       amplitude=amplitude, beta_f=1.0 / inv_beta,
-                                       transient=200.0, bins=BINS)
+        model = Model.paper(0.05, 0.5, delta, amplitude, 1.0 / inv_beta)
+        stats = cells.event_statistics(noises[rms], 0.1, model, transient=200.0, bins=BINS)
         for key, value in stats.items():
             result[f"{name}/{key}"] = np.asarray(value, dtype=float)
         res = simulate(0.05, 0.5, delta, noise=noises[rms], dt=0.1, amplitude=amplitude,
                        beta=1.0 / inv_beta)
         result[f"{name}/n_impacts_resolved"] = np.asarray(float(res.n_impacts))
         if amplitude:
-            cell = cells.motion_map_cell(noises[rms], 0.1, zeta=0.05, eps=0.5, delta=delta,
-                                         beta_f=1.0 / inv_beta, transient=200.0,
-                                         max_periods=1000, target_stderr=0.02)
+            cell = cells.motion_map_cell(noises[rms], 0.1,
+                                         Model.paper(0.05, 0.5, delta, 1.0, 1.0 / inv_beta),
+                                         transient=200.0, max_periods=1000,
+                                         target_stderr=0.02)
             for key in ("probability", "stderr", "n_collisions", "record_end",
                         "rule_probability", "rule_stick_probability"):
                 result[f"{name}/map_{key}"] = np.asarray(cell[key], dtype=float)

@@ -39,18 +39,18 @@ def _simulator():
              for name, top in (("v_after", 3.0), ("interval", 20.0), ("ratio", 1.0))}
     for walls in ({}, {"gap": 1.5, "eps_lower": 0.6}):
         for amplitude, delta in ((0.0, 0.3), (1.0, -0.2)):
-            physics = dict(zeta=ZETA, eps=EPS, delta=delta, amplitude=amplitude,
-                           beta_f=1.0 / 1.1, **walls)
-            cells.event_statistics(noise, DT, **physics, transient=10.0, bins=edges,
-                                   n_batches=4)
-            cells.spectra_statistics(noise, DT, **physics, nperseg=256)
-            cells.trace(noise, DT, **physics, t_end=50.0)
-        physics = dict(zeta=ZETA, eps=EPS, delta=0.2, beta_f=1.0 / 1.1, amplitude=1.0, **walls)
-        cells.motion_map_cell(noise, DT, **physics, transient=20.0, n_batches=4,
-                              target_stderr=0.5, min_time=50.0, max_periods=30,
-                              min_switches=1, motions=stats.DEFAULT_MOTIONS if not walls
+            model = cells.cell_model(dict(zeta=ZETA, eps=EPS, delta=delta, amplitude=amplitude,
+                                          inv_beta=1.1, **walls))
+            cells.event_statistics(noise, DT, model, transient=10.0, bins=edges, n_batches=4)
+            cells.spectra_statistics(noise, DT, model, nperseg=256)
+            cells.trace(noise, DT, model, t_end=50.0)
+        model = cells.cell_model(dict(zeta=ZETA, eps=EPS, delta=0.2, inv_beta=1.1,
+                                      amplitude=1.0, **walls))
+        cells.motion_map_cell(noise, DT, model, transient=20.0, n_batches=4, target_stderr=0.5,
+                              min_time=50.0, max_periods=30, min_switches=1,
+                              motions=stats.DEFAULT_MOTIONS if not walls
                               else ((1, 1, 1), (1, 0, 1)))
-        cells.escape_cell(noise, DT, **physics, transient=20.0, record_length=100.0,
+        cells.escape_cell(noise, DT, model, transient=20.0, record_length=100.0,
                           motions=stats.DEFAULT_MOTIONS if not walls else ((1, 1, 1),))
 
 

@@ -857,14 +857,25 @@ def simulate(zeta, eps, delta, noise=None, dt=0.1, amplitude=0.0, beta=1.0, x0=N
 
 
 def simulate_model(model, noise=None, dt=0.1, x0=None, v0=0.0, t_end=None, *, record_every=0,
-                   chunk_size=2**20, rebound_floor=DEFAULT_REBOUND_FLOOR):
+                   chunk_size=2**20, rebound_floor=DEFAULT_REBOUND_FLOOR, start=None):
     """:func:`simulate` of a :class:`vibroimpact.model.Model` (its walls placed exactly where
     the model puts them); the other arguments as for :func:`simulate`."""
+    return concatenate_results(list(simulate_model_chunks(
+        model, noise, dt, x0, v0, t_end, record_every=record_every, chunk_size=chunk_size,
+        rebound_floor=rebound_floor, start=start)))
+
+
+def simulate_model_chunks(model, noise=None, dt=0.1, x0=None, v0=0.0, t_end=None, *,
+                          record_every=0, chunk_size=2**20, rebound_floor=DEFAULT_REBOUND_FLOOR,
+                          start=None):
+    """:func:`simulate_chunks` of a :class:`vibroimpact.model.Model`: the generator of chunks
+    (``send(n)`` included) the pipeline's cells consume; the other arguments as for
+    :func:`simulate`."""
     if not isinstance(model, Model):
         raise ValueError(f"model must be a vibroimpact.model.Model, got {type(model).__name__}")
-    run = _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size)
+    run = _check_run(model, noise, dt, x0, v0, t_end, record_every, chunk_size, start)
     rebound_floor = _checks.real("rebound_floor", rebound_floor, low=MIN_REBOUND_FLOOR)
-    return concatenate_results(list(_simulate_model(model, noise, *run, rebound_floor)))
+    yield from _simulate_model(model, noise, *run, rebound_floor)
 
 
 def concatenate_results(chunks):

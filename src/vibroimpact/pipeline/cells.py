@@ -1,9 +1,11 @@
 """Statistics of one parameter cell, computed while the simulation streams.
 
-Each function runs :func:`vibroimpact.simulate_chunks` over a force record and reduces what
-the figures need on the fly: impact events for densities and means (no a(tau) recorded),
-Welch spectra of a(tau) accumulated segment by segment (no long series kept), or a short
-sampled trace. Inputs are arrays or sliceable records; outputs are dicts of numpy values.
+Each function takes the cell's resolved :class:`vibroimpact.model.Model` (the oscillator, its
+walls and their impact laws, its harmonic force; `study_model` builds it from a study), runs
+the simulator over a force record and reduces what the figures need on the fly: impact events
+for densities and means (no a(tau) recorded), Welch spectra of a(tau) accumulated segment by
+segment (no long series kept), or a short sampled trace. Inputs are arrays or sliceable
+records; outputs are dicts of numpy values.
 """
 import logging
 import math
@@ -12,10 +14,9 @@ from typing import NamedTuple
 import numpy as np
 
 from vibroimpact import stats
-from vibroimpact.impact import simulate_chunks
 from vibroimpact.impact.audit import audit_moments
 from vibroimpact.impact.hops import pressed_flights
-from vibroimpact.impact.simulate import split_steps
+from vibroimpact.impact.simulate import simulate_model_chunks, split_steps
 from vibroimpact.model import Model
 from vibroimpact.pipeline.study import escape_samples, map_cap_steps
 
@@ -77,24 +78,20 @@ def study_model(study, cell):
                        **walls, **study.laws())
 
 
-def _walls(gap, eps_lower, eps=None, speed_scale=math.inf, speed_scale_lower=None):
-    """The second wall and the impact laws as `simulate_chunks` keywords: ``{}`` with one
-    wall (``gap`` None) under Newton's law, so such a cell makes the call it always made;
-    ``eps_lower`` None is ``eps``."""
-    if gap is None:
-        if eps_lower is not None:
-            raise ValueError("eps_lower needs a second wall: give gap as well")
-        out = {}
-    else:
-        out = dict(gap=float(gap), eps_lower=float(eps if eps_lower is None else eps_lower))
-    if speed_scale != math.inf or speed_scale_lower is not None:
-        out.update(speed_scale=speed_scale, speed_scale_lower=speed_scale_lower)
-    return out
+def cell_model(params):
+    """The `Model` of a cell given as the config spells it: ``{zeta, eps, delta, amplitude,
+    inv_beta}`` with, optionally, ``gap, eps_lower, speed_scale, speed_scale_lower`` (an
+    escape cell, a plane study's trace: `pipeline.tasks.escape_cells`)."""
+    p = dict(params)
+    return Model.paper(p.pop("zeta"), p.pop("eps"), p.pop("delta"), p.pop("amplitude", 0.0),
+                       1.0 / p.pop("inv_beta"), **p)
 
 
-def _cell_model(zeta, eps, delta, amplitude, beta_f, walls):
-    """The cell's `Model` from its loose parameters and `_walls` keywords."""
-    return Model.paper(zeta, eps, delta, amplitude, beta_f, **walls)
+def _loose(model):
+    """The model as the keywords of `audit_moments` (``beta_f`` its forcing frequency)."""
+    params = model.params()
+    params["beta_f"] = params.pop("beta")
+    return params
 
 
 def _v_after(model, col):
@@ -103,11 +100,10 @@ def _v_after(model, col):
     return model.restitution(col.velocity, col.wall) * col.velocity
 
 
-def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
-                     transient=0.0, t_end=None, bins, n_batches=stats.DEFAULT_N_BATCHES,
-                     motion_window=stats.DEFAULT_MOTION_WINDOW, motions=stats.DEFAULT_MOTIONS,
-                     rebound_floor=stats.DEFAULT_REBOUND_FLOOR, chunk_size=2**20, gap=None,
-                     eps_lower=None, speed_scale=math.inf, speed_scale_lower=None):
+def event_statistics(noise, dt, model, *, transient=0.0, t_end=None, bins,
+                     n_batches=stats.DEFAULT_N_BATCHES, motion_window=stats.DEFAULT_MOTION_WINDOW,
+                     motions=stats.DEFAULT_MOTIONS, rebound_floor=stats.DEFAULT_REBOUND_FLOOR,
+                     chunk_size=2**20):
     """Collision statistics of one cell (Figs. 7-9, 13, 14).
 
     Every statistic counts collisions (:mod:`vibroimpact.stats.collisions`): an impact after
@@ -119,17 +115,12 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     ----------
     noise : array_like, shape (N,)
         Random force samples at spacing ``dt``.
-    zeta, eps, delta, amplitude, beta_f : float
-        Physical parameters (``beta_f``: frequency ratio of ``amplitude * sin(beta_f tau)``;
-        unused when ``amplitude == 0``).
-    gap, eps_lower : float, optional
-        A second wall at ``x = delta - gap`` with restitution ``eps_lower`` (default
-        ``eps``); None: one wall.
-    speed_scale, speed_scale_lower : float, optional
-        The walls' impact laws (`vibroimpact.model.Restitution`): ``eps(u) = eps / (1 + u /
-        speed_scale)``; ``inf`` (the default) is Newton's law. Every statistic of a rebound
-        (the velocity after impact, the rebound counts, the self-audit's impact sums) takes
-        it from the law.
+    model : vibroimpact.model.Model
+        The oscillator, its wall at ``delta`` (and a second wall at ``delta - gap``), their
+        impact laws and the harmonic force ``amplitude sin(beta tau)`` (``beta``: the
+        frequency ratio beta_f; unused when ``amplitude == 0``). Every statistic of a
+        rebound (the velocity after impact, the rebound counts, the self-audit's impact
+        sums) takes it from the wall's law.
     transient : float
         Time discarded before statistics (collisions that begin before it are dropped).
     t_end : float, optional
@@ -170,7 +161,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
         ``rule_motion_probability, rule_motion_stick_probability`` (rules x motions); the
         physical row equals the statistics above.
 
-        With two walls (``gap``) the statistics above are over the collisions at either wall
+        With two walls the statistics above are over the collisions at either wall
         (a velocity after impact is ``eps_w u`` with its wall's restitution), the motions
         are classified with the collisions' walls (two-wall motions ``(m_upper, m_lower,
         n)``, `stats.motions`), the per-wall statistics of `stats.wall_statistics` are added
@@ -196,15 +187,11 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     if not 0.0 <= transient < t_end:
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
     n_batches = int(n_batches)
-    harmonic = amplitude != 0.0
-    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
-    model = _cell_model(zeta, eps, delta, amplitude, beta_f, walls)
+    harmonic, beta_f = model.amplitude != 0.0, model.beta
     events = _EventRecord(dt, noise, model)
-    audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, zeta=zeta, eps=eps,
-                            delta=delta, amplitude=amplitude, beta_f=beta_f, **walls)
-    for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                 beta=beta_f, t_end=t_end, record_every=1,
-                                 chunk_size=chunk_size, **walls):
+    audit = _IdentityRecord(noise, dt, transient, t_end, n_batches, model)
+    for chunk in simulate_model_chunks(model, noise, dt, t_end=t_end, record_every=1,
+                                       chunk_size=chunk_size):
         events.add(chunk)
         audit.add(chunk)
     col = events.collisions(rebound_floor, transient)
@@ -214,7 +201,7 @@ def event_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
     wall = events.collision_walls(col) if two else None
     v_after = _v_after(model, col)
     z = col.intervals
-    cell = (f"cell delta={delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
+    cell = (f"cell delta={model.delta:g}" + (f", beta_f={beta_f:g}" if harmonic else ""))
     v_stats = stats.batch_means(v_after, n_batches) if v_after.size else None
     z_stats = stats.batch_means(z, n_batches) if z.size else None
     rate = stats.event_rate(col.time, transient, t_end, n_batches)
@@ -352,8 +339,8 @@ class _EventRecord:
         self.model = model
         self.force = dict(noise=noise, delta=model.delta, amplitude=model.amplitude,
                           beta=model.beta)
-        #: the second wall (``{}``: one wall)
-        self.walls = _walls(model.gap, model.eps_lower)
+        #: whether the model has a second wall
+        self.walls = model.n_walls == 2
         self._pressed, self._n_pressed = np.zeros(0, bool), 0   # flights of the first impacts
         self.stuck_since = math.nan
         self.stuck_wall = 0      # the wall of a rest still going on at the last chunk's end
@@ -399,7 +386,7 @@ class _EventRecord:
         law, ``{eps: one per impact, eps_lower: None}`` otherwise."""
         if self.model.newton:
             return dict(eps=self.model.eps,
-                        eps_lower=self.walls["eps_lower"] if self.walls else self.model.eps)
+                        eps_lower=self.model.eps_lower if self.walls else self.model.eps)
         wall = self.wall[0] if self.walls else None
         return dict(eps=self.model.restitution(self.u[0], wall), eps_lower=None)
 
@@ -425,8 +412,7 @@ class _EventRecord:
             t = step * self.dt + offset
             # a flight with a sticking phase is no hop: left out (it would cost its samples)
             free = self._tally.ends_in_sticking(t, self.sticking()[0])[:-1]
-            walls = {} if not self.walls else dict(wall=self.wall[0][i:],
-                                                   gap=self.walls["gap"])
+            walls = {} if not self.walls else dict(wall=self.wall[0][i:], gap=self.model.gap)
             new = pressed_flights(step, offset, f["noise"], self.dt, delta=f["delta"],
                                   amplitude=f["amplitude"], beta=f["beta"], flights=~free,
                                   **walls)
@@ -501,20 +487,15 @@ class _IdentityRecord:
     samples (``record_every=1``) and its impacts and sticking phases;
     :func:`vibroimpact.impact.audit.audit_moments` (the compiled
     :func:`vibroimpact.stats.flight_moments`) integrates its steps exactly. With a second
-    wall (``gap``, ``eps_lower`` in ``params``) the identities have a term per wall
-    (docs/model.md, "Two walls"): the impact sums are kept per wall.
+    wall in the ``model`` the identities have a term per wall (docs/model.md, "Two walls"):
+    the impact sums are kept per wall. A law whose restitution varies with the speed puts its
+    factors into the impact sums (`stats.identity_residuals`).
     """
 
-    def __init__(self, noise, dt, transient, t_end, n_batches, **params):
-        self.noise, self.dt, self.params = noise, dt, params
-        self.two = params.get("gap") is not None
-        # a law whose restitution varies with the speed: the impact sums carry its factors
-        # (`stats.identity_residuals`)
-        self.model = Model.paper(params["zeta"], params["eps"], params["delta"],
-                                 params.get("amplitude", 0.0), params.get("beta_f", 1.0),
-                                 **_walls(params.get("gap"), params.get("eps_lower"),
-                                          params["eps"], params.get("speed_scale", math.inf),
-                                          params.get("speed_scale_lower")))
+    def __init__(self, noise, dt, transient, t_end, n_batches, model):
+        self.noise, self.dt, self.model = noise, dt, model
+        self.params = _loose(model)         # `audit_moments`' keywords
+        self.two = model.n_walls == 2
         self.k_start = int(math.ceil(transient / dt - 1e-9))
         self.k_stop = max(int(math.floor(t_end / dt + 1e-9)), self.k_start)
         self.n_batches = n_batches
@@ -552,7 +533,7 @@ class _IdentityRecord:
                 start, end, stick_wall = stats.close_open_phase(
                     chunk.stick_start, chunk.stick_end, chunk.stuck_since, chunk.t_end,
                     stick_wall=chunk.stick_wall,
-                    stuck_wall=int(chunk.x_end != self.params["delta"]))
+                    stuck_wall=int(chunk.x_end != self.model.delta))
                 walls = dict(impact_wall=chunk.impact_wall, stick_wall=stick_wall)
             self.moments += audit_moments(
                 lo, chunk.a[keep], chunk.v[keep], r, self.dt,
@@ -579,18 +560,18 @@ class _IdentityRecord:
 
     def result(self):
         """The residuals and their errors, as ``event_statistics`` keys (NaN: no batches)."""
-        p = self.params
+        m = self.model
         if self.n_batches < 2 or np.any(self.steps == 0):
             nan = math.nan
             return dict(power_residual=nan, power_residual_stderr=nan, power_input=nan,
                         virial_residual=nan, virial_residual_stderr=nan, virial_scale=nan)
-        eps, eps_lower = p["eps"], p.get("eps_lower")
-        if not self.model.newton:       # the sums carry the laws' factors
+        eps, eps_lower = m.eps, m.eps_lower
+        if not m.newton:       # the sums carry the laws' factors
             eps, eps_lower = 0.0, 0.0 if self.two else None
-        walls = {} if not self.two else dict(gap=p["gap"], eps_lower=eps_lower)
+        walls = {} if not self.two else dict(gap=m.gap, eps_lower=eps_lower)
         res = stats.identity_residuals(self.moments, self.sum_u, self.sum_u2,
-                                       self.steps * self.dt, zeta=p["zeta"], eps=eps,
-                                       delta=p["delta"], **walls)
+                                       self.steps * self.dt, zeta=m.zeta, eps=eps,
+                                       delta=m.delta, **walls)
         return dict(power_residual=res.power, power_residual_stderr=res.power_stderr,
                     power_input=res.power_input, virial_residual=res.virial,
                     virial_residual_stderr=res.virial_stderr, virial_scale=res.virial_scale)
@@ -601,10 +582,8 @@ def _clipped_contact(start, end, transient):
     return float(np.sum(np.clip(end, transient, None) - np.clip(start, transient, None)))
 
 
-def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0,
-                       transient=0.0, t_end=None, nperseg=4096, chunk_size=2**20, gap=None,
-                       eps_lower=None, n_batches=None, speed_scale=math.inf,
-                       speed_scale_lower=None):
+def spectra_statistics(noise, dt, model, *, transient=0.0, t_end=None, nperseg=4096,
+                       chunk_size=2**20, n_batches=None):
     """Welch PSDs of a(tau) and of the random input r(tau) for one cell (Figs. 6, 11, 12).
 
     a(tau) is recorded at every sample and fed segment by segment to a
@@ -621,9 +600,8 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
         ``S_f`` is the random part r(tau) of the input only: the harmonic
         part ``amplitude sin(beta_f tau)`` is a spectral line of power ``amplitude**2 / 2``,
         which a Welch estimate would smear over its window's main lobe (Fig. 11 draws it as
-        the line it is). ``gap, eps_lower``: a second wall, ``speed_scale,
-        speed_scale_lower``: the walls' impact laws (`event_statistics`); a(tau) is measured
-        from the wall at delta whatever the walls.
+        the line it is). ``model`` as in `event_statistics`; a(tau) is measured from the
+        wall at delta whatever the walls.
     """
     t_end = _record_end(noise, dt, t_end)
     skip = int(math.ceil(transient / dt - 1e-9))
@@ -637,9 +615,8 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
             batches = (min(int(n_batches), n_segments), n_segments)
     acc_a = stats.WelchAccumulator(dt, nperseg, batches=batches)
     acc_f = stats.WelchAccumulator(dt, nperseg)
-    for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                 beta=beta_f, t_end=t_end, record_every=1, chunk_size=chunk_size,
-                                 **_walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)):
+    for chunk in simulate_model_chunks(model, noise, dt, t_end=t_end, record_every=1,
+                                       chunk_size=chunk_size):
         k = np.rint(chunk.grid_time / dt).astype(np.int64)
         keep = k >= skip
         if not keep.any():
@@ -655,36 +632,31 @@ def spectra_statistics(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0
     return out
 
 
-def trace(noise, dt, *, zeta, eps, delta, amplitude=0.0, beta_f=1.0, t_end, gap=None,
-          eps_lower=None, speed_scale=math.inf, speed_scale_lower=None):
-    """A short sampled record from rest (Figs. 3 and 10): force, a(tau), impacts and the
-    collision of each impact; with a second wall (``gap``) also the wall of each impact
-    (``impact_wall``); the walls' laws as in `event_statistics`.
+def trace(noise, dt, model, *, t_end):
+    """A short sampled record from rest (Figs. 3 and 10) of ``model`` (`event_statistics`):
+    force, a(tau), impacts and the collision of each impact; with a second wall also the wall
+    of each impact (``impact_wall``).
 
     ``t_end`` longer than the noise record raises ValueError.
     """
     t_end = _record_end(noise, dt, t_end)
-    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
-    res = next(iter(simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                    beta=beta_f, t_end=t_end, record_every=1,
-                                    chunk_size=int(math.ceil(t_end / dt)) + 1, **walls)))
+    res = next(iter(simulate_model_chunks(model, noise, dt, t_end=t_end, record_every=1,
+                                          chunk_size=int(math.ceil(t_end / dt)) + 1)))
     k = np.rint(res.grid_time / dt).astype(np.int64)
     r = np.asarray(noise[k[0] : k[-1] + 1], dtype=float)
-    f = r + amplitude * np.sin(beta_f * res.grid_time)
-    out = dict(tau=res.grid_time, r=r, f=f, a=res.a, x=delta - res.a,
+    f = r + model.amplitude * np.sin(model.beta * res.grid_time)
+    out = dict(tau=res.grid_time, r=r, f=f, a=res.a, x=model.delta - res.a,
                impact_time=res.impact_time, impact_velocity=res.impact_velocity,
                impact_collision=res.impact_collision)
-    if gap is not None:
+    if model.n_walls == 2:
         out["impact_wall"] = np.asarray(res.impact_wall, dtype=np.int8)
     return out
 
 
-def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
-                    motions=stats.DEFAULT_MOTIONS, window=stats.DEFAULT_MOTION_WINDOW,
-                    n_batches=stats.DEFAULT_N_BATCHES, target_stderr=0.01, min_time=2000.0,
-                    max_periods=8000, min_switches=10, approach=0.8, approach_unswitched=1.1,
-                    min_growth=1.1, gap=None, eps_lower=None, speed_scale=math.inf,
-                    speed_scale_lower=None):
+def motion_map_cell(noise, dt, model, *, transient, motions=stats.DEFAULT_MOTIONS,
+                    window=stats.DEFAULT_MOTION_WINDOW, n_batches=stats.DEFAULT_N_BATCHES,
+                    target_stderr=0.01, min_time=2000.0, max_periods=8000, min_switches=10,
+                    approach=0.8, approach_unswitched=1.1, min_growth=1.1):
     """Probabilities of the (m/n) motions of one cell of the Fig. 15 map, to a target precision.
 
     The cell is simulated from rest over the common record ``noise`` (every cell of a map
@@ -697,8 +669,12 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     ----------
     noise : array_like, shape (N,)
         Random force samples at spacing ``dt``; long enough for ``transient`` plus the cap.
-    zeta, eps, delta, beta_f, amplitude : float
-        Physical parameters; the force is ``amplitude sin(beta_f tau) + r(tau)``.
+    model : vibroimpact.model.Model
+        The cell's oscillator, walls and laws (`event_statistics`); the force is
+        ``amplitude sin(beta_f tau) + r(tau)`` with ``beta_f = model.beta``. With a second
+        wall the collisions' walls classify the two-wall motions ``(m_upper, m_lower, n)`` of
+        ``motions``, and ``wall_n_collisions, wall_collision_rate, wall_v_after_mean`` (over
+        `WALLS`) are added.
     transient : float
         Time discarded before statistics.
     motions, window, n_batches
@@ -726,10 +702,6 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
         has not visited yet, and stopping it early turned rare episodes of a second motion
         into zero probabilities. `benchmarks/bench_map_stop.py` measures the schedules on
         a built map.
-    gap, eps_lower : float, optional
-        A second wall (`event_statistics`): the collisions' walls classify the two-wall
-        motions ``(m_upper, m_lower, n)`` of ``motions``, and ``wall_n_collisions,
-        wall_collision_rate, wall_v_after_mean`` (over `WALLS`) are added.
 
     Returns
     -------
@@ -762,13 +734,11 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
     """
     from vibroimpact import tally     # compiled: the jobs that group collisions load it
 
+    beta_f = model.beta
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
-    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
-    model = _cell_model(zeta, eps, delta, amplitude, beta_f, walls)
     two = model.n_walls == 2
-    gen = simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                          beta=beta_f, t_end=n_cap * dt, chunk_size=n_next, **walls)
+    gen = simulate_model_chunks(model, noise, dt, t_end=n_cap * dt, chunk_size=n_next)
     events = _EventRecord(dt, noise, model)
     # the motion statistics of every check and rule, their arguments checked once
     tallied = tally.MotionTally(beta_f, window=window, motions=motions, n_batches=n_batches,
@@ -820,7 +790,7 @@ def motion_map_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, trans
                 n_collisions=int(col.time.size), collision_rate=col.time.size / duration,
                 n_impacts_resolved=n_resolved,
                 # Newton's law: eps times the mean speed, rounded as it always was
-                v_after_mean=(float(eps * col.velocity.mean()) if model.newton
+                v_after_mean=(float(model.eps * col.velocity.mean()) if model.newton
                               else float(v_after.mean())) if col.time.size else math.nan,
                 simulated_time=duration, record_end=k * dt, reached=bool(reached),
                 few_switches=bool(0 < res.n_switches < min_switches), n_checks=n_checks,
@@ -842,10 +812,8 @@ def _residence(impact_time, labels, t_start, t_stop, n_motions, beta_f):
                 switch_rate=r.rate * period, switch_count=r.count)
 
 
-def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient,
-                record_length, motions=stats.DEFAULT_MOTIONS,
-                window=stats.DEFAULT_MOTION_WINDOW, gap=None, eps_lower=None,
-                speed_scale=math.inf, speed_scale_lower=None):
+def escape_cell(noise, dt, model, *, transient, record_length, motions=stats.DEFAULT_MOTIONS,
+                window=stats.DEFAULT_MOTION_WINDOW):
     """Residence times of one cell on a record of fixed length (escape against noise level).
 
     The labelling of `motion_map_cell` (the same collisions, classification and
@@ -858,8 +826,9 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
     noise : array_like, shape (N,)
         Random force samples at spacing ``dt``; at least
         ``study.escape_samples(transient, record_length, dt)`` of them.
-    zeta, eps, delta, beta_f, amplitude : float
-        Physical parameters; the force is ``amplitude sin(beta_f tau) + r(tau)``.
+    model : vibroimpact.model.Model
+        The cell's oscillator, walls and laws; the force is ``amplitude sin(beta_f tau) +
+        r(tau)``, ``beta_f = model.beta``.
     transient, record_length : float
         Time discarded, and the record after it.
     motions, window
@@ -889,12 +858,11 @@ def escape_cell(noise, dt, *, zeta, eps, delta, beta_f, amplitude=1.0, transient
         raise ValueError(f"record_length = {record_length!r} after the transient "
                          f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
                          f"holds {len(noise)}")
-    walls = _walls(gap, eps_lower, eps, speed_scale, speed_scale_lower)
-    events = _EventRecord(dt, noise, _cell_model(zeta, eps, delta, amplitude, beta_f, walls))
-    two = gap is not None
+    beta_f = model.beta
+    events = _EventRecord(dt, noise, model)
+    two = model.n_walls == 2
     k = 0
-    for chunk in simulate_chunks(zeta, eps, delta, noise=noise, dt=dt, amplitude=amplitude,
-                                 beta=beta_f, t_end=n_end * dt, **walls):
+    for chunk in simulate_model_chunks(model, noise, dt, t_end=n_end * dt):
         events.add(chunk)
         k += chunk.n_steps
     col = events.firsts(stats.DEFAULT_REBOUND_FLOOR, transient)

@@ -196,15 +196,6 @@ def _rebound_floor(block):
     return float(block.get("rebound_floor", DEFAULT_REBOUND_FLOOR))
 
 
-def _physics(study, cell):
-    """The cell's resolved model (`cells.study_model`) as the keywords of `pipeline.cells`."""
-    from vibroimpact.pipeline.cells import study_model    # the jobs that simulate only
-
-    params = study_model(study, cell).params()
-    params["beta_f"] = params.pop("beta")
-    return params
-
-
 def _tile_job(study, tile, grid, what, run_cell, to_dataset, out):
     """The skeleton of every ``simulate_*`` tile job.
 
@@ -233,7 +224,7 @@ def events_tile(name, block, tile, noise_path, out):
 
     def run_cell(cell):
         return cells.event_statistics(
-            samples, dt, **_physics(study, cell), transient=float(block["transient"]),
+            samples, dt, cells.study_model(study, cell), transient=float(block["transient"]),
             t_end=block.get("t_end"), bins=edges, n_batches=int(block["n_batches"]),
             motion_window=float(block["motion_window"]), motions=study.motions,
             rebound_floor=_rebound_floor(block))
@@ -276,10 +267,9 @@ def map_tile(name, block, tile, noise_path, out):
 
     def run_cell(cell):
         start = time.process_time()
-        physics = _physics(study, cell)
         record = samples if unit is None else study.parameters(cell)["rms"] * unit
         result = cells.motion_map_cell(
-            record, dt, **physics, transient=float(block["transient"]),
+            record, dt, cells.study_model(study, cell), transient=float(block["transient"]),
             motions=study.motions, window=float(block["motion_window"]),
             n_batches=int(block["n_batches"]), target_stderr=float(spec["target_stderr"]),
             min_time=float(spec["min_time"]), max_periods=int(spec["max_periods"]),
@@ -312,7 +302,7 @@ def spectra_tile(name, block, tile, noise_path, out):
 
     def run_cell(cell):
         return cells.spectra_statistics(
-            samples, dt, **_physics(study, cell), transient=float(block["transient"]),
+            samples, dt, cells.study_model(study, cell), transient=float(block["transient"]),
             t_end=spectra.get("t_end"), nperseg=int(spectra["nperseg"]),
             n_batches=None if block.get("n_batches") is None else int(block["n_batches"]))
 
@@ -335,9 +325,9 @@ def trace(name, block, noise_path, out):
     samples, dt, noise_attrs = io.read_noise(noise_path)
     spec = block["trace"]
     inv_beta = float(spec.get("inv_beta", study.inv_beta[0]))
-    tr = cells.trace(samples, dt, zeta=study.zeta, eps=study.eps, delta=float(spec["delta"]),
-                     amplitude=study.amplitude, beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]),
-                     **study.walls())
+    model = cells.cell_model(dict(zeta=study.zeta, eps=study.eps, delta=float(spec["delta"]),
+                                  amplitude=study.amplitude, inv_beta=inv_beta, **study.walls()))
+    tr = cells.trace(samples, dt, model, t_end=float(spec["t_end"]))
     attrs = dict(_study_attrs(study, block, noise_attrs), delta=float(spec["delta"]),
                  beta_f=1.0 / inv_beta, t_end=float(spec["t_end"]))
     io.write_dataset(datasets.trace_dataset(tr, attrs), out)
@@ -360,8 +350,8 @@ def _plane_trace(name, block, noise_path, out, cells):
     if "gap" in p and p.get("eps_lower") is None:
         p["eps_lower"] = p["eps"]
     p.update(laws(block, f"studies.{name}"))
+    tr = cells.trace(samples, dt, cells.cell_model(p), t_end=float(spec["t_end"]))
     beta_f = 1.0 / p.pop("inv_beta")
-    tr = cells.trace(samples, dt, **p, beta_f=beta_f, t_end=float(spec["t_end"]))
     fixed = _plane_fixed(block)
     if "rms" not in plane and noise_attrs.get("noise_rms") is not None:
         fixed["rms"] = float(noise_attrs["noise_rms"])
@@ -418,9 +408,10 @@ def _plane_fixed(block):
 
 
 def escape_cells(block):
-    """``[{zeta, eps, amplitude, beta_f, delta[, gap, eps_lower]}]``: the model of each
-    escape cell of a study: ``[inv_beta, delta]``, or in a plane study ``[x, y]`` in the
-    plane's coordinates with every other parameter fixed."""
+    """``[{zeta, eps, amplitude, inv_beta, delta[, gap, eps_lower][, speed_scale...]}]``:
+    the model of each escape cell of a study, as `cells.cell_model` reads it: ``[inv_beta,
+    delta]``, or in a plane study ``[x, y]`` in the plane's coordinates with every other
+    parameter fixed."""
     plane = block.get("plane") or ("inv_beta", "delta")
     fixed = _plane_fixed(block) if block.get("plane") is not None else {
         k: float(block[k]) for k in ("zeta", "eps", "amplitude")}
@@ -434,7 +425,6 @@ def escape_cells(block):
         p = dict(fixed, **{k: float(v) for k, v in zip(plane, cell)})
         if "gap" in p and p.get("eps_lower") is None:
             p["eps_lower"] = p["eps"]
-        p["beta_f"] = 1.0 / p.pop("inv_beta")
         out.append(p)
     return out
 
@@ -463,7 +453,7 @@ def escape_level(name, block, noise, index, out):
     results = []
     for p in escape_cells(block):
         results.append(cells.escape_cell(
-            samples, spec.dt, **p, transient=transient, record_length=length,
+            samples, spec.dt, cells.cell_model(p), transient=transient, record_length=length,
             motions=motions, window=float(block["motion_window"])))
         progress.cell_done(results[-1])
     io.write_dataset(datasets.escape_part(index, rms, escape["cells"], results, motions,
