@@ -82,7 +82,7 @@ def _plane_attractors(tmp_path, text, name):
     _, n = plane_attractor_rows(entry)
     tiles = [tmp_path / f"{name}_tile{t}.nc" for t in range(n)]
     for t, path in enumerate(tiles):
-        tasks.plane_attractor_tile(name, block, t, path)
+        tasks.attractor_tile(block, t, path, study=name)
     out = tmp_path / f"{name}_basins.nc", tmp_path / f"{name}_lyapunov.nc"
     tasks.aggregate_plane_attractors(block, tiles, *out)
     return [xr.load_dataset(p) for p in out]

@@ -324,10 +324,12 @@ def test_the_two_wall_orbit_map_sees_the_mirror_of_its_cells():
     each other's mirror image (x -> -x with the force's half-period shift), so the (1,0)/1
     motion of one is the (0,1)/1 motion of the other, with the same degree of stability (to
     the solver's precision)."""
-    from vibroimpact.pipeline.cells import two_wall_orbit_map
+    from vibroimpact.attractors.plane import orbit_plane
 
     types = [(1, 1, 1), (1, 0, 1), (0, 1, 1)]
-    out = two_wall_orbit_map([0.75], [0.25, 1.0, 1.75], types, zeta=0.05, eps=0.5, gap=2.0)
+    ds = orbit_plane("inv_beta", [0.75], "delta", [0.25, 1.0, 1.75],
+                     dict(zeta=0.05, eps=0.5, gap=2.0), types)
+    out = {k: ds[k].values for k in ("S", "reason")}
     assert out["S"].shape == (3, 1, 3)
     assert out["reason"][0, 0, 1] == 0 and out["S"][0, 0, 1] > 0
     mirror = {0: 0, 1: 2, 2: 1}

@@ -2,6 +2,6 @@
 from vibroimpact.pipeline import tasks
 
 with tasks.logged(snakemake.log[0]):
-    tasks.plane_attractor_tile(snakemake.wildcards.study, snakemake.params.entry,
-                               int(snakemake.wildcards.tile), snakemake.output[0],
-                               threads=snakemake.threads)
+    tasks.attractor_tile(snakemake.params.entry, int(snakemake.wildcards.tile),
+                         snakemake.output[0], threads=snakemake.threads,
+                         study=snakemake.wildcards.study)

@@ -522,22 +522,30 @@ def figure(target, inputs, out_png, options):
         plotting.save(draw(*[io.load_dataset(p) for p in inputs], **options), out_png)
 
 
-def orbit_tile(entry, tile, out, threads=None):
-    """Rule ``solve_orbit_tile``: existence and stability of (m/n) motions on some rows.
+def orbit_tile(entry, tile, out, threads=None, solver=None):
+    """Rules ``solve_orbit_tile`` and ``solve_clearance_orbit_tile``: existence and stability
+    of the periodic motions of an ``orbits`` entry on some rows of its plane (the paper's
+    (1/beta_f, delta) unless it names one; rows strided over the tiles, `orbit_rows`).
 
-    ``threads``: numba threads of the row-parallel map (the rule's ``threads``).
+    One wall on the paper's plane is Fig. 16's closed form (`vibroimpact.orbits.orbit_map`,
+    its rows in ``threads`` numba threads); any other plane, and a second wall, is
+    ``solver(x_name, x_values, y_name, y_values, fixed, types, progress=...)``: by default
+    `vibroimpact.orbits.plane.orbit_plane` (the one-wall closed form); the two-wall rule's
+    script gives `vibroimpact.attractors.plane.orbit_plane` (any wall layout: the shooting
+    solver, seeded by the simulator). The script passes it so that the one-wall tiles' code
+    reaches no simulator (their code digest, `pipeline.provenance.code_closure`).
     """
     import numba
 
-    from vibroimpact.orbits import orbit_map
-
     if threads is not None:
         numba.set_num_threads(int(threads))
-    if entry.get("plane"):
-        from vibroimpact.orbits.plane import orbit_plane
-
-        io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
+    if entry.get("plane") or entry.get("gap") is not None:
+        if solver is None:
+            from vibroimpact.orbits.plane import orbit_plane as solver
+        io.write_dataset(_plane_tile(entry, tile, solver), out)
         return
+    from vibroimpact.orbits import orbit_map
+
     rows, n_tiles = orbit_rows(entry)
     rows, deltas = rows[tile::n_tiles], grid_values(entry["delta"])
     progress = Progress(f"orbit tile {tile}", rows.size * deltas.size)
@@ -549,48 +557,26 @@ def orbit_tile(entry, tile, out, threads=None):
     io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
 
 
-def clearance_orbit_tile(entry, tile, out):
-    """Rule ``solve_clearance_orbit_tile``: the stable periodic motions of a two-wall
-    ``orbits`` entry on some 1/beta rows (`pipeline.cells.two_wall_orbit_map`: the shooting
-    solver, seeded by the simulator; a rule of its own, so that the one-wall orbit tiles'
-    code reaches no simulator)."""
-    if entry.get("plane"):
-        from vibroimpact.attractors.plane import orbit_plane
-
-        io.write_dataset(_plane_tile(entry, tile, orbit_plane), out)
-        return
-    from vibroimpact.pipeline.cells import two_wall_orbit_map
-
-    rows, n_tiles = orbit_rows(entry)
-    rows, deltas = rows[tile::n_tiles], grid_values(entry["delta"])
-    gap, eps_lower = walls(entry, "orbits")
-    progress = Progress(f"clearance orbit tile {tile}", rows.size * deltas.size)
-    result = two_wall_orbit_map(rows, deltas, entry["types"], zeta=float(entry["zeta"]),
-                                eps=float(entry["eps"]), gap=gap, eps_lower=eps_lower,
-                                progress=progress.advance)
-    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
-                 amplitude=1.0, **_wall_attrs(gap, eps_lower))
-    io.write_dataset(datasets.orbit_map_dataset(result, attrs), out)
-
-
 #: The parameters of an ``orbits`` entry with a plane that its map holds fixed when given.
 ORBIT_PLANE_PARAMETERS = ("zeta", "eps", "eps_lower", "delta", "gap", "amplitude", "inv_beta")
 
 
 def orbit_plane_fixed(entry):
-    """``{parameter: value}`` an ``orbits`` entry with a plane holds fixed (its amplitude 1
-    when not given)."""
+    """``{parameter: value}`` an ``orbits`` entry holds fixed off its plane (the paper's
+    (1/beta_f, delta) without one), its amplitude 1 when not given."""
+    plane = entry.get("plane") or ("inv_beta", "delta")
     fixed = {k: float(entry[k]) for k in ORBIT_PLANE_PARAMETERS
-             if k not in entry["plane"] and entry.get(k) is not None}
-    if "amplitude" not in entry["plane"]:
+             if k not in plane and entry.get(k) is not None}
+    if "amplitude" not in plane:
         fixed.setdefault("amplitude", 1.0)
     return fixed
 
 
 def _plane_tile(entry, tile, orbit_plane):
-    """One tile of an ``orbits`` entry with a plane: `orbit_plane` over its share of the
-    tiled axis (`orbit_tiled_axis`, values strided over tiles) by the whole other axis."""
-    x_name, y_name = entry["plane"]
+    """One tile of an ``orbits`` entry on its plane (the paper's without one): `orbit_plane`
+    (`orbit_tile`'s ``solver``) over its share of the tiled axis (`orbit_tiled_axis`, values
+    strided over tiles) by the whole other axis."""
+    x_name, y_name = entry.get("plane") or ("inv_beta", "delta")
     rows, n_tiles = orbit_rows(entry)
     values = {k: grid_values(entry[k]) for k in (x_name, y_name)}
     values[orbit_tiled_axis(entry)] = rows[tile::n_tiles]
@@ -600,6 +586,8 @@ def _plane_tile(entry, tile, orbit_plane):
                      progress=progress.advance)
     ds.attrs.update(provenance(entry), reason_codes="0 stable, 1 no solution, 2 inadmissible, "
                                                     "3 unstable")
+    if entry.get("gap") is not None and "gap" not in (x_name, y_name):
+        ds.attrs.update(_wall_attrs(*walls(entry, "orbits")))
     return ds
 
 
@@ -702,37 +690,63 @@ def plane_boundaries(entry, orbits_path, out, threads=None):
     io.write_dataset(datasets.boundaries_dataset(curves, attrs, axes), out)
 
 
-def _attractor_attrs(entry):
+def _attractor_attrs(entry, study=None):
+    """An attractor tile's attributes: the starts and their box; an ``orbits`` entry's
+    oscillator (a study's plane carries its own fixed values) or the study's name."""
     block = entry["attractors"]
     gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
-    return dict(zeta=float(entry["zeta"]), eps=float(entry["eps"]),
-                n_starts=int(block["n_starts"]), max_time=float(block["max_time"]),
-                seed=int(block["seed"]), start_gap=list(gap), velocity=list(vel),
-                box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
-                    f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
+    starts = dict(n_starts=int(block["n_starts"]), max_time=float(block["max_time"]),
+                  seed=int(block["seed"]), start_gap=list(gap), velocity=list(vel))
+    if study is None:
+        return dict(zeta=float(entry["zeta"]), eps=float(entry["eps"]), **starts,
+                    box=f"forcing phase in [0, 2 pi), x0 = delta - g with g in [{gap[0]:g}, "
+                        f"{gap[1]:g}], v0 in [{vel[0]:g}, {vel[1]:g}]")
+    return dict(study=study, **starts,
+                box=f"forcing phase in [0, 2 pi), x0 = delta - s (s: distance below the "
+                    f"wall at delta) with s in [{gap[0]:g}, {gap[1]:g}], v0 in "
+                    f"[{vel[0]:g}, {vel[1]:g}]")
 
 
-def attractor_tile(entry, tile, out, threads=None):
-    """Rule ``solve_attractor_tile``: basins and Lyapunov exponents on some 1/beta rows of
-    the entry's attractor grid (rows strided over tiles, as the orbit tiles)."""
+def attractor_tile(entry, tile, out, threads=None, study=None):
+    """Rules ``solve_attractor_tile`` (an ``orbits`` entry's attractors, on the paper's
+    (1/beta_f, delta) plane) and ``solve_plane_attractor_tile`` (study ``study``'s attractors
+    on its plane): basins and Lyapunov exponents under the harmonic force alone on some values
+    of the plane's first axis (strided over the tiles, as the orbit tiles), every value of
+    its second (`vibroimpact.attractors.plane.attractor_plane`; on the paper's plane that is
+    one `vibroimpact.attractor_map` call, bit for bit).
+
+    ``threads``: numba threads of the starts (the rule's ``threads``).
+    """
     import numba
 
-    from vibroimpact.attractors import attractor_map
+    from vibroimpact.attractors.plane import attractor_plane
 
     if threads is not None:
         numba.set_num_threads(int(threads))
     block = entry["attractors"]
-    rows, n_tiles = attractor_rows(entry)
-    rows, deltas = rows[tile::n_tiles], grid_values(block["delta"])
-    attrs = _attractor_attrs(entry)
-    progress = Progress(f"attractor tile {tile}", rows.size * deltas.size)
-    result = attractor_map(rows, deltas, float(entry["zeta"]), float(entry["eps"]),
-                           types=[tuple(int(k) for k in t) for t in entry["types"]],
-                           n_starts=attrs["n_starts"], gap=tuple(attrs["start_gap"]),
-                           velocity=tuple(attrs["velocity"]), max_time=attrs["max_time"],
-                           seed=attrs["seed"], progress=progress.advance)
-    attrs = dict(provenance(entry), **attrs)
-    io.write_dataset(datasets.attractor_tile_dataset(result, attrs), out)
+    if study is None:       # an orbits entry: the paper's plane, its own grid
+        rows, n_tiles = attractor_rows(entry)
+        (x, y), ys = ("inv_beta", "delta"), grid_values(block["delta"])
+        fixed, types = dict(zeta=float(entry["zeta"]), eps=float(entry["eps"])), entry["types"]
+        what = f"attractor tile {tile}"
+    else:
+        plane = Study.from_config(study, entry)
+        rows, n_tiles = plane_attractor_rows(entry)
+        (x, y), ys = plane.plane, plane.axes[plane.plane[1]]
+        fixed, types = plane.fixed(), block["types"]
+        what = f"studies.{study} attractor tile {tile}"
+    attrs = _attractor_attrs(entry, study)
+    rows = rows[tile::n_tiles]
+    progress = Progress(what, rows.size * ys.size)
+    types = [tuple(int(k) for k in t) for t in types]
+    result = attractor_plane(x, rows, y, ys, fixed, types=types, n_starts=attrs["n_starts"],
+                             gap=tuple(attrs["start_gap"]), velocity=tuple(attrs["velocity"]),
+                             max_time=attrs["max_time"], seed=attrs["seed"],
+                             progress=progress.advance)
+    if study is None:       # the paper's plane: its datasets are those they always were
+        del result["axes"], result["fixed"]
+    io.write_dataset(datasets.attractor_tile_dataset(result, dict(provenance(entry), **attrs)),
+                     out)
 
 
 def aggregate_attractors(entry, tiles, out_basins, out_lyapunov, motions=None):
@@ -742,38 +756,6 @@ def aggregate_attractors(entry, tiles, out_basins, out_lyapunov, motions=None):
     joined.attrs.update(provenance(entry))
     io.write_dataset(datasets.basins_dataset(joined, motions), out_basins)
     io.write_dataset(datasets.lyapunov_dataset(joined), out_lyapunov)
-
-
-def plane_attractor_tile(name, entry, tile, out, threads=None):
-    """Rule ``solve_plane_attractor_tile``: basins and Lyapunov exponents under the harmonic
-    force alone on some values of the first axis of study ``name``'s plane (strided over the
-    tiles), every value of its second (`vibroimpact.attractors.plane.attractor_plane`)."""
-    import numba
-
-    from vibroimpact.attractors.plane import attractor_plane
-
-    if threads is not None:
-        numba.set_num_threads(int(threads))
-    study = Study.from_config(name, entry)
-    x, y = study.plane
-    rows, n_tiles = plane_attractor_rows(entry)
-    block = entry["attractors"]
-    gap, vel = (tuple(float(v) for v in block[k]) for k in ("gap", "velocity"))
-    attrs = dict(study=name, n_starts=int(block["n_starts"]),
-                 max_time=float(block["max_time"]), seed=int(block["seed"]),
-                 start_gap=list(gap), velocity=list(vel),
-                 box=f"forcing phase in [0, 2 pi), x0 = delta - s (s: distance below the "
-                     f"wall at delta) with s in [{gap[0]:g}, {gap[1]:g}], v0 in "
-                     f"[{vel[0]:g}, {vel[1]:g}]")
-    rows = rows[tile::n_tiles]
-    progress = Progress(f"studies.{name} attractor tile {tile}", rows.size * study.axes[y].size)
-    result = attractor_plane(x, rows, y, study.axes[y], study.fixed(),
-                             types=[tuple(int(k) for k in t) for t in block["types"]],
-                             n_starts=attrs["n_starts"], gap=gap, velocity=vel,
-                             max_time=attrs["max_time"], seed=attrs["seed"],
-                             progress=progress.advance)
-    io.write_dataset(datasets.attractor_tile_dataset(result, dict(provenance(entry), **attrs)),
-                     out)
 
 
 def aggregate_plane_attractors(entry, tiles, out_basins, out_lyapunov):
