@@ -575,20 +575,25 @@ def boundaries_dataset(curves_by_type, attrs, axes=("inv_beta", "delta")):
     ``eps``, ``delta`` ..., and ``codim2_<axis>``).
     """
     x_name, y_name = axes
-    default = tuple(axes) == ("inv_beta", "delta")
+
+    def xy(point):      # a plane's curve or point has x, y; domain_boundaries' its own names
+        return (point.x, point.y) if hasattr(point, "x") else (point.inv_beta, point.delta)
+
     xs, ys, index, kinds, types, ends = [], [], [], [], [], []
     c_x, c_y, c_type, c_kinds = [], [], [], []
     for (m, n), result in curves_by_type.items():
         for curve in result:
-            xs.append(np.asarray(curve.inv_beta if default else curve.x, dtype=float))
-            ys.append(np.asarray(curve.delta if default else curve.y, dtype=float))
+            x, y = xy(curve)
+            xs.append(np.asarray(x, dtype=float))
+            ys.append(np.asarray(y, dtype=float))
             index.append(np.full(xs[-1].size, len(kinds), dtype=np.int32))
             kinds.append(str(curve.kind))
             types.append(f"{m}/{n}")
             ends.append("+".join(str(e) for e in getattr(curve, "ends", ())))
         for point in result.codimension_two:
-            c_x.append(float(point.inv_beta if default else point.x))
-            c_y.append(float(point.delta if default else point.y))
+            x, y = xy(point)
+            c_x.append(float(x))
+            c_y.append(float(y))
             c_type.append(f"{m}/{n}")
             c_kinds.append("+".join(sorted(point.kinds)))
 
@@ -607,7 +612,7 @@ def boundaries_dataset(curves_by_type, attrs, axes=("inv_beta", "delta")):
          "codim2_kinds": ("codim2", np.array(c_kinds, dtype=str))},
         attrs=dict(attrs))
     meta = dict(BOUNDARY_META)
-    if not default:
+    if tuple(axes) != ("inv_beta", "delta"):
         for name in ("inv_beta", "delta", "codim2_inv_beta", "codim2_delta"):
             del meta[name]
         for name in axes:

@@ -606,64 +606,29 @@ BOUNDARY_TOL = 1e-9
 
 
 def boundaries(entry, orbits_path, out, threads=None):
-    """Rule ``trace_boundaries``: the exact edges of every type's stable domain, seeded from
-    the entry's map (``orbits_path``), over the map's (1/beta, delta) box."""
-    if entry.get("plane"):
-        return plane_boundaries(entry, orbits_path, out, threads)
-    attrs = dict(provenance(entry), zeta=float(entry["zeta"]), eps=float(entry["eps"]),
-                 traced=1)
-    if entry.get("gap") is not None:
-        # the boundary tracer continues the closed-form (m/n) solutions: one wall only
-        attrs.update(_wall_attrs(*walls(entry, "orbits")), traced=0,
-                     not_traced="two walls: the edges are the map's cell edges")
-        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
-        return
-    seeds = datasets.orbit_map_result(io.load_dataset(orbits_path))
-    box = dict(inv_beta=(float(seeds["inv_beta"].min()), float(seeds["inv_beta"].max())),
-               delta=(float(seeds["delta"].min()), float(seeds["delta"].max())))
-    if float(entry["eps"]) == 0.0:
-        # every impact ends at rest on the wall: a flight's maximum is its start, and no
-        # boundary condition is regular there (domain_boundaries refuses eps = 0)
-        attrs.update(traced=0, not_traced="eps = 0: the edges are the map's cell edges")
-        io.write_dataset(datasets.boundaries_dataset({}, attrs), out)
-        return
-    import numba
-
-    from vibroimpact.orbits import domain_boundaries
-
-    if threads is not None:
-        numba.set_num_threads(int(threads))
-    curves = {}
-    types = [tuple(int(k) for k in t) for t in entry["types"]]
-    progress = Progress("boundaries", len(types), unit="types")
-    for m, n in types:
-        curves[(m, n)] = domain_boundaries(
-            m, n, float(entry["zeta"]), float(entry["eps"]), **box,
-            resolution=(seeds["inv_beta"].size, seeds["delta"].size), seed_map=seeds,
-            tol=BOUNDARY_TOL)
-        log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
-        lost = sum(c.ends.count("lost") for c in curves[(m, n)])
-        if lost:
-            log.warning("(%d/%d): %d curve ends lost: the edge of the stable domain has a gap "
-                        "there (the dataset's `ends` says which curves)", m, n, lost)
-        progress.advance()
-    io.write_dataset(datasets.boundaries_dataset(curves, attrs), out)
-
-
-def plane_boundaries(entry, orbits_path, out, threads=None):
-    """`boundaries` of an ``orbits`` entry with a plane: `plane_boundaries` of every type over
-    the map's box, seeded from the map; a two-wall entry, or one whose eps reaches 0, is
-    written untraced (``traced = 0``, ``not_traced`` says why), as over (1/beta, delta)."""
+    """Rule ``trace_boundaries``: the exact edges of every type's stable domain over the box
+    of the entry's map (``orbits_path``, whose pixel edges seed them), on its plane (the
+    paper's (1/beta_f, delta) unless it names one: `orbits.boundaries.plane_boundaries`,
+    over (1/beta_f, delta) `domain_boundaries` bit for bit). A two-wall entry, or one whose
+    eps reaches 0, is written untraced (``traced = 0``, ``not_traced`` says why)."""
     fixed = orbit_plane_fixed(entry)
-    axes = tuple(entry["plane"])
-    attrs = dict(provenance(entry), **fixed, axes=list(axes),
-                 fixed=json.dumps(fixed, sort_keys=True), traced=1)
+    axes = tuple(entry.get("plane") or ("inv_beta", "delta"))
+    if entry.get("plane"):
+        attrs = dict(provenance(entry), **fixed, axes=list(axes),
+                     fixed=json.dumps(fixed, sort_keys=True), traced=1)
+    else:       # the paper's plane: its attributes are those they always were
+        attrs = dict(provenance(entry), zeta=fixed["zeta"], eps=fixed["eps"], traced=1)
     seeds = io.load_dataset(orbits_path)
     box = {k: (float(seeds[k].min()), float(seeds[k].max())) for k in axes}
     why = None
     if entry.get("gap") is not None or "gap" in axes:
+        # the boundary tracer continues the closed-form (m/n) solutions: one wall only
         why = "two walls: the edges are the map's cell edges"
+        if not entry.get("plane"):
+            attrs.update(_wall_attrs(*walls(entry, "orbits")))
     elif fixed.get("eps", 1.0) == 0.0 or ("eps" in axes and box["eps"][0] <= 0.0):
+        # every impact ends at rest on the wall: a flight's maximum is its start, and no
+        # boundary condition is regular there (the tracer refuses eps = 0)
         why = "eps = 0 in the plane: the edges are the map's cell edges"
     if why is not None:
         attrs.update(traced=0, not_traced=why)
@@ -671,7 +636,7 @@ def plane_boundaries(entry, orbits_path, out, threads=None):
         return
     import numba
 
-    from vibroimpact.orbits.boundaries import plane_boundaries as trace_plane
+    from vibroimpact.orbits.boundaries import plane_boundaries
 
     if threads is not None:
         numba.set_num_threads(int(threads))
@@ -679,8 +644,8 @@ def plane_boundaries(entry, orbits_path, out, threads=None):
     types = [tuple(int(k) for k in t) for t in entry["types"]]
     progress = Progress("boundaries", len(types), unit="types")
     for m, n in types:
-        curves[(m, n)] = trace_plane(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]], fixed,
-                                     seed_map=seeds, tol=BOUNDARY_TOL)
+        curves[(m, n)] = plane_boundaries(m, n, axes[0], box[axes[0]], axes[1], box[axes[1]],
+                                          fixed, seed_map=seeds, tol=BOUNDARY_TOL)
         log.info("(%d/%d): %d curves", m, n, len(curves[(m, n)]))
         lost = sum(c.ends.count("lost") for c in curves[(m, n)])
         if lost:
