@@ -368,3 +368,47 @@ def test_the_checks_know_the_schemas_default_escape_cells():
     schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
     escape = schema["$defs"]["study"]["properties"]["escape"]["properties"]
     assert escape["cells"]["default"] == DEFAULT_ESCAPE_CELLS
+
+
+@pytest.mark.workflow
+@pytest.mark.parametrize("files", [[], ["config/examples/clearance.yaml"],
+                                   ["config/examples/planes.yaml"],
+                                   ["config/examples/impact_law.yaml"]])
+def test_every_file_a_build_writes_is_a_product_the_plan_and_make_stale_know(tmp_path, files):
+    """Every file a build of the config writes (a dry run of every job, forced) is a product
+    of the one table (`targets.PRODUCTS`, `targets.product_of`), a file made beside one
+    (`targets.TWINS`) or an intermediate another job of the build reads (a tile, a level);
+    the plan's files (`targets.needed_files`) are exactly its products; `make stale` lists
+    none of them on a finished tree, and lists an earlier figure and report of each drawn
+    entry beside them."""
+    from helpers import make_workdir, scheduled_jobs
+    from vibroimpact.pipeline import stale, targets
+
+    work = make_workdir(tmp_path / "work")
+    config_file = files[0] if files else "config/config.yaml"
+    jobs = scheduled_jobs(work, "-F", config=config_file)
+    written = {p for job in jobs for p in job["output"]}
+    read = {p for job in jobs for p in job["input"]}
+
+    def main(path):                 # a twin's product, or the path itself
+        suffix = next((s for s in targets.TWINS if path.endswith(s)), None)
+        return path if suffix is None else path[:-len(suffix)] + targets.TWINS[suffix]
+
+    products = {p for p in written if targets.product_of(main(p))[0] is not None}
+    orphans = sorted(p for p in written - products if p not in read)
+    assert not orphans, f"written, of no kind of targets.PRODUCTS, read by no job: {orphans}"
+    config, plan = configuration.load(root=ROOT, user_files=[ROOT / f for f in files])
+    needed = targets.needed_files(config, plan.drawn)
+    assert {main(p) for p in products} == needed
+    assert {targets.product_of(p)[0] for p in needed} >= {"figure", "report"}
+    for rel in written:
+        (work / rel).parent.mkdir(parents=True, exist_ok=True)
+        (work / rel).touch()
+    assert stale.stale_files(config, plan.drawn, work) == []
+    old = [targets.product("figure", owner=name, figure="fig99") for name in plan.drawn["studies"]]
+    old += [targets.product("report", owner=f"orbits/{name}", report="earlier")
+            for name in plan.drawn["orbits"]]
+    for rel in old:
+        (work / rel).parent.mkdir(parents=True, exist_ok=True)
+        (work / rel).touch()
+    assert stale.stale_files(config, plan.drawn, work) == sorted(old)

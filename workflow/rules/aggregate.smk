@@ -7,7 +7,7 @@ rule aggregate_events:
     input:
         tiles("events"),
     output:
-        "results/datasets/{study}_events.nc",
+        targets.product("events", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -32,7 +32,7 @@ rule aggregate_spectra:
         tiles=tiles("spectra"),
         noise=study_noise,
     output:
-        "results/datasets/{study}_spectra.nc",
+        targets.product("spectra", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -56,7 +56,7 @@ rule aggregate_map:
     input:
         tiles("map"),
     output:
-        "results/datasets/{study}_map.nc",
+        targets.product("map", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -81,7 +81,7 @@ rule aggregate_escape:
     input:
         escape_levels,
     output:
-        "results/datasets/{study}_escape.nc",
+        targets.product("escape", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

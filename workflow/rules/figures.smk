@@ -19,12 +19,12 @@ rule draw_figure:
         # in `snakemake --report`, once: under `paper` when it is a paper figure (its copy
         # results/figures/figNN.png is not marked), else in its study's or orbits entry's
         png=report(
-            "results/figures/{owner}/{fig}.png",
+            targets.product("figure", owner="{owner}", figure="{fig}"),
             caption="../report/figure.rst",
             category=figure_report_category,
             labels=figure_report_labels,
         ),
-        pdf="results/figures/{owner}/{fig}.pdf",
+        pdf=targets.product("figure", owner="{owner}", figure="{fig}", twin=".pdf"),
     log:
         "results/logs/draw_figure/{owner}/{fig}.log",
     threads: 1
@@ -50,8 +50,9 @@ rule copy_paper_figure:
     input:
         unpack(paper_figure_source),
     output:
-        png="results/figures/{paper_fig}.png",  # in the report as its source (draw_figure)
-        pdf="results/figures/{paper_fig}.pdf",
+        # in the report as its source (draw_figure)
+        png=targets.product("top_figure", figure="{paper_fig}"),
+        pdf=targets.product("top_figure", figure="{paper_fig}", twin=".pdf"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

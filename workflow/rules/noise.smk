@@ -1,7 +1,7 @@
 rule generate_noise:
     """The seeded noise record of `noises[{noise}]`: force samples and their spectrum."""
     output:
-        "results/noise/{noise}.nc",
+        targets.product("noise", noise="{noise}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

@@ -52,7 +52,7 @@ rule aggregate_orbits:
     input:
         orbit_tiles,
     output:
-        "results/orbits/{orbits}.nc",
+        targets.product("orbits", name="{orbits}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -76,7 +76,7 @@ rule solve_map_orbits:
     input:
         unpack(map_orbits_inputs),
     output:
-        "results/datasets/{study}_map_orbits.nc",
+        targets.product("map_orbits", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -97,9 +97,9 @@ rule solve_map_orbits:
 rule trace_boundaries:
     """The exact edges of the stable domains of orbits entry {orbits}, seeded from its map."""
     input:
-        "results/orbits/{orbits}.nc",
+        targets.product("orbits", name="{orbits}"),
     output:
-        "results/orbits/{orbits}_boundaries.nc",
+        targets.product("boundaries", name="{orbits}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -147,8 +147,8 @@ rule aggregate_attractors:
     input:
         attractor_tiles,
     output:
-        basins="results/orbits/{orbits}_basins.nc",
-        lyapunov="results/orbits/{orbits}_lyapunov.nc",
+        basins=targets.product("basins", name="{orbits}"),
+        lyapunov=targets.product("lyapunov", name="{orbits}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

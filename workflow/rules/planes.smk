@@ -31,8 +31,8 @@ rule aggregate_plane_attractors:
     input:
         plane_attractor_tiles,
     output:
-        basins="results/datasets/{study}_basins.nc",
-        lyapunov="results/datasets/{study}_lyapunov.nc",
+        basins=targets.product("plane_basins", name="{study}"),
+        lyapunov=targets.product("plane_lyapunov", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

@@ -24,7 +24,7 @@ rule map_predictors:
     input:
         unpack(predictors_inputs),
     output:
-        "results/datasets/{study}_predictors.nc",
+        targets.product("predictors", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -59,11 +59,11 @@ rule study_report:
     input:
         unpack(study_report_inputs),
     output:
-        ipynb="results/reports/{study}/{report}.ipynb",
-        html="results/reports/{study}/{report}.html",
+        ipynb=targets.product("report", owner="{study}", report="{report}", twin=".ipynb"),
+        html=targets.product("report", owner="{study}", report="{report}"),
         # in `snakemake --report` without its images: the report holds each figure once
         summary=report(
-            "results/reports/{study}/{report}.summary.html",
+            targets.product("report", owner="{study}", report="{report}", twin=".summary.html"),
             caption="../report/report.rst",
             category="{study}",
             labels={"figure": "report: {report}"},
@@ -92,10 +92,17 @@ rule orbits_report:
     input:
         unpack(orbits_report_inputs),
     output:
-        ipynb="results/reports/orbits/{orbits}/periodic_motions.ipynb",
-        html="results/reports/orbits/{orbits}/periodic_motions.html",
+        ipynb=targets.product(
+            "report", owner="orbits/{orbits}", report="periodic_motions", twin=".ipynb"
+        ),
+        html=targets.product("report", owner="orbits/{orbits}", report="periodic_motions"),
         summary=report(
-            "results/reports/orbits/{orbits}/periodic_motions.summary.html",
+            targets.product(
+                "report",
+                owner="orbits/{orbits}",
+                report="periodic_motions",
+                twin=".summary.html",
+            ),
             caption="../report/report.rst",
             category="orbits/{orbits}",
             labels={"figure": "report: periodic motions"},
@@ -124,10 +131,12 @@ rule validation_report:
     input:
         unpack(validation_report_inputs),
     output:
-        ipynb="results/reports/validation/{vreport}.ipynb",
-        html="results/reports/validation/{vreport}.html",
+        ipynb=targets.product("report", owner="validation", report="{vreport}", twin=".ipynb"),
+        html=targets.product("report", owner="validation", report="{vreport}"),
         summary=report(
-            "results/reports/validation/{vreport}.summary.html",
+            targets.product(
+                "report", owner="validation", report="{vreport}", twin=".summary.html"
+            ),
             caption="../report/report.rst",
             category="validation",
             labels={"figure": "report: {vreport}"},

@@ -51,7 +51,7 @@ rule simulate_trace:
     input:
         noise=study_noise,
     output:
-        "results/traces/{study}.nc",
+        targets.product("trace", name="{study}"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

@@ -13,12 +13,12 @@ rule draw_sweep:
         sweep_inputs,
     output:
         png=report(
-            "results/figures/{sweep}/sweep.png",
+            targets.product("sweep_figure", name="{sweep}"),
             caption="../report/sweep.rst",
             category="{sweep}",
             labels={"figure": "sweep"},
         ),
-        pdf="results/figures/{sweep}/sweep.pdf",
+        pdf=targets.product("sweep_figure", name="{sweep}", twin=".pdf"),
     conda:
         "../envs/vibroimpact.yaml"
     log:

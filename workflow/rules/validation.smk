@@ -9,7 +9,7 @@
 rule measure_work_precision:
     """The work-precision run: the simulator against its peers."""
     output:
-        "results/validation/work_precision.nc",
+        targets.VALIDATION_FIGURES["work_precision"],
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -31,7 +31,7 @@ rule measure_work_precision:
 rule sample_stress_families:
     """A seeded sample of the stress families (config validation.stress.size)."""
     output:
-        "results/validation/stress_sample.nc",
+        targets.VALIDATION_FIGURES["stress"],
     conda:
         "../envs/vibroimpact.yaml"
     log:
@@ -56,12 +56,12 @@ rule draw_validation_figure:
         lookup(dpath="{validation_fig}", within=VALIDATION_FIGURES),
     output:
         png=report(
-            "results/figures/{validation_fig}.png",
+            targets.product("top_figure", figure="{validation_fig}"),
             caption="../report/validation_figure.rst",
             category="validation",
             labels={"figure": "{validation_fig}"},
         ),
-        pdf="results/figures/{validation_fig}.pdf",
+        pdf=targets.product("top_figure", figure="{validation_fig}", twin=".pdf"),
     wildcard_constraints:
         validation_fig="|".join(VALIDATION_FIGURES),
     log:

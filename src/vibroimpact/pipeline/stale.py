@@ -21,11 +21,6 @@ from vibroimpact.pipeline import targets
 
 __all__ = ["stale_files", "owned_datasets", "main"]
 
-#: Files made beside an output (a figure's PDF beside its PNG, a report's notebook and its
-#: rendering without images beside its HTML): current when that output is.
-_TWINS = {".pdf": ".png", ".ipynb": ".html", ".summary.html": ".html"}
-
-
 def owned_datasets(section):
     """The path patterns of the datasets an entry of ``section`` (``"studies"`` or
     ``"orbits"``) may own, from the one table of them (`targets.DATASETS`): a study's under
@@ -55,24 +50,26 @@ def stale_files(config, drawn, root="."):
         return [tuple(pattern.format(name=name).rsplit("/", 1))
                 for pattern in owned_datasets(section)]
 
+    def folders(owner):             # its figures' and its reports' (`targets.PRODUCTS`)
+        return [(targets.product(kind, owner=owner, figure="*", report="*").rsplit("/", 1)[0],
+                 "*") for kind in ("figure", "report")]
+
     for name in drawn["studies"]:
-        places += [(f"results/figures/{name}", "*"), (f"results/reports/{name}", "*")]
-        places += datasets("studies", name)
+        places += folders(name) + datasets("studies", name)
     for name in drawn["orbits"]:
-        places += [(f"results/figures/orbits/{name}", "*"),
-                   (f"results/reports/orbits/{name}", "*")]
-        places += datasets("orbits", name)
+        places += folders(f"orbits/{name}") + datasets("orbits", name)
     for name in config.get("sweeps", {}):
         if set(config["sweeps"][name]["studies"]) <= drawn["studies"]:
-            places.append((f"results/figures/{name}", "sweep.*"))
+            folder, png = targets.product("sweep_figure", name=name).rsplit("/", 1)
+            places.append((folder, png.rsplit(".", 1)[0] + ".*"))
     stale = set()
     for folder, pattern in places:
         for path in (root / folder).glob(pattern):
             if not path.is_file():
                 continue
             rel = path.relative_to(root).as_posix()
-            suffix = next((s for s in _TWINS if rel.endswith(s)), "")
-            twin = rel[:len(rel) - len(suffix)] + _TWINS[suffix] if suffix else rel
+            suffix = next((s for s in targets.TWINS if rel.endswith(s)), "")
+            twin = rel[:len(rel) - len(suffix)] + targets.TWINS[suffix] if suffix else rel
             if twin not in needed:
                 stale.add(rel)
     return sorted(stale)

@@ -10,19 +10,29 @@ names}`` of the entries whose figures ``rule all`` draws. Paths are relative to 
 directory, but for the workflow's own files among the report rules' inputs
 (:data:`WORKFLOW_INPUTS`), relative to its folder; no Snakemake, no numerics.
 """
+import functools
+import re
+
 from vibroimpact.pipeline import figures
-from vibroimpact.pipeline.config.sweeps import sweep_figures
+from vibroimpact.pipeline.config.sweeps import drawn_sweeps
 from vibroimpact.reports.arguments import study_report_kind
 
-__all__ = ["DATASETS", "WORKFLOW_INPUTS", "VALIDATION_FIGURES", "figure_names", "figure_inputs",
+__all__ = ["PRODUCTS", "TWINS", "product", "product_of", "DATASETS", "WORKFLOW_INPUTS",
+           "VALIDATION_FIGURES", "figure_names", "figure_inputs",
            "paper_figure_source", "study_datasets", "attractor_datasets",
            "predictors_inputs", "map_orbits_inputs",
            "study_report_inputs", "maps_over", "orbits_report_inputs",
            "validation_report_inputs", "sweep_inputs", "sweep_targets", "validation_targets",
            "report_targets", "all_targets", "needed_files", "rule_inputs"]
 
-#: Where each dataset a figure can read lives ({name}: the owner; {noise}: its noise record).
-DATASETS = {
+#: Every kind of product a build makes and where it lives: the one table the rules' outputs
+#: (workflow/rules/*.smk), the plan's files (`needed_files`), `make stale`
+#: (`vibroimpact.pipeline.stale`) and the reports' inputs are formatted from. ``{name}``: the
+#: owner (a study, an orbits entry, a sweep, a validation dataset); ``{owner}``: a study's
+#: name or ``orbits/<name>`` (their figures and reports); ``{noise}``: a noise record;
+#: ``{figure}``, ``{report}``: a figure target (``fig13-1``) or a report's notebook. A new kind
+#: is one row here (and the rule that makes it).
+PRODUCTS = {
     "noise": "results/noise/{noise}.nc",
     "trace": "results/traces/{name}.nc",
     "spectra": "results/datasets/{name}_spectra.nc",
@@ -40,7 +50,58 @@ DATASETS = {
     # a plane study's (attractors block): the harmonic force alone over its plane
     "plane_basins": "results/datasets/{name}_basins.nc",
     "plane_lyapunov": "results/datasets/{name}_lyapunov.nc",
+    # the validation targets' datasets (work-precision run, stress sample)
+    "validation": "results/validation/{name}.nc",
+    "figure": "results/figures/{owner}/{figure}.png",
+    # a paper figure's copy, and a validation figure: at the top of results/figures/
+    "top_figure": "results/figures/{figure}.png",
+    "sweep_figure": "results/figures/{name}/sweep.png",
+    "report": "results/reports/{owner}/{report}.html",
 }
+
+#: The kinds of `PRODUCTS` that are datasets a figure can read.
+DATASETS = {kind: pattern for kind, pattern in PRODUCTS.items()
+            if kind not in ("validation", "figure", "top_figure", "sweep_figure", "report")}
+
+
+#: Files made beside a product, current when it is: ``{twin's suffix: product's suffix}`` (a
+#: figure's PDF beside its PNG, a report's notebook and its rendering without images beside
+#: its HTML).
+TWINS = {".pdf": ".png", ".ipynb": ".html", ".summary.html": ".html"}
+
+
+def product(kind, *, twin=None, **fields):
+    """The path of a product of ``kind`` (`PRODUCTS`) with its fields filled, or of its
+    ``twin`` (a suffix of `TWINS`: ``".pdf"`` beside a figure); a rule passes its wildcards
+    (``product("events", name="{study}")``) to get its output's pattern."""
+    path = PRODUCTS[kind].format(**fields)
+    return path if twin is None else path[:-len(TWINS[twin])] + twin
+
+
+@functools.cache
+def _matchers():
+    """``[(kind, regex)]`` of `PRODUCTS`, the most specific pattern (most fixed characters)
+    first: ``{name}.nc`` also matches ``{name}_boundaries.nc``, ``{owner}/{figure}.png`` also
+    ``{name}/sweep.png``. A field is one path segment but ``{owner}`` (``orbits/<name>``)."""
+    def regex(pattern):
+        parts = re.split(r"\{(\w+)\}", pattern)
+        return re.compile("".join(
+            re.escape(p) if i % 2 == 0 else
+            f"(?P<{p}>(?:orbits/)?[^/]+)" if p == "owner" else f"(?P<{p}>[^/]+)"
+            for i, p in enumerate(parts)) + r"\Z")
+
+    fixed = lambda kind: len(re.sub(r"\{\w+\}", "", PRODUCTS[kind]))
+    return [(kind, regex(PRODUCTS[kind])) for kind in sorted(PRODUCTS, key=fixed, reverse=True)]
+
+
+def product_of(path):
+    """``(kind, fields)`` of a product's ``path`` (`PRODUCTS` read backwards), or
+    ``(None, {})`` for a path of no kind (a tile, a log)."""
+    for kind, regex in _matchers():
+        match = regex.match(path)
+        if match:
+            return kind, match.groupdict()
+    return None, {}
 
 #: The inputs of the report rules that are the workflow's own files, not results: their paths
 #: are relative to the workflow's folder (``workflow/`` of a checkout), which the rules prefix.
@@ -48,8 +109,8 @@ WORKFLOW_INPUTS = ("notebook", "campaign")
 
 #: Each validation figure and the dataset it draws.
 VALIDATION_FIGURES = {
-    "work_precision": "results/validation/work_precision.nc",
-    "stress": "results/validation/stress_sample.nc",
+    "work_precision": product("validation", name="work_precision"),
+    "stress": product("validation", name="stress_sample"),
 }
 
 
@@ -88,7 +149,8 @@ def paper_figure_source(config, paper_fig):
     section = "orbits" if figures.FIGURES[paper_fig]["owner"] == "orbits" else "studies"
     owner = f"orbits/{name}" if section == "orbits" else name
     target = figures.paper_target(config[section][name], paper_fig)
-    return {ext: f"results/figures/{owner}/{target}.{ext}" for ext in ("png", "pdf")}
+    png = product("figure", owner=owner, figure=target)
+    return {"png": png, "pdf": png[:-len(".png")] + ".pdf"}
 
 
 def study_datasets(config, name):
@@ -145,8 +207,7 @@ def predictors_inputs(config, name):
 
 def _predictors_of(map_path):
     """The predictors dataset of the study whose map is ``map_path``."""
-    name = map_path[len("results/datasets/"):-len("_map.nc")]
-    return DATASETS["predictors"].format(name=name)
+    return product("predictors", name=product_of(map_path)[1]["name"])
 
 
 def study_report_inputs(config, study, report=None):
@@ -165,7 +226,7 @@ def study_report_inputs(config, study, report=None):
         for dataset, path in {**study_datasets(config, name),
                               **attractor_datasets(config, name)}.items():
             inputs.setdefault(dataset, path)
-        shown += [f"results/figures/{name}/{f}.png"
+        shown += [product("figure", owner=name, figure=f)
                   for f in figures.figure_targets(config["studies"][name])]
     # the predictors of the map's P, computed once for every report that shows the map (the
     # harmonic report reads them; the random-force report has no such table)
@@ -190,7 +251,7 @@ def orbits_report_inputs(config, drawn, name):
     entry = config["orbits"][name]
     inputs = {"notebook": "notebooks/periodic_motions.ipynb",
               "orbits": DATASETS["orbits"].format(name=name),
-              "figures": [f"results/figures/orbits/{name}/{f}.png"
+              "figures": [product("figure", owner=f"orbits/{name}", figure=f)
                           for f in figures.figure_targets(entry)]}
     for path in maps_over(config, drawn, name):
         inputs["map"] = path
@@ -210,11 +271,11 @@ def validation_report_inputs(vreport):
     if vreport == "performance":
         return {"notebook": "notebooks/performance.ipynb",
                 "work_precision": VALIDATION_FIGURES["work_precision"],
-                "figures": ["results/figures/work_precision.png"]}
+                "figures": [product("top_figure", figure="work_precision")]}
     return {"notebook": "notebooks/stability.ipynb",
             "stress": VALIDATION_FIGURES["stress"],
             "campaign": "notebooks/stress_campaign.csv",
-            "figures": ["results/figures/stress.png"]}
+            "figures": [product("top_figure", figure="stress")]}
 
 
 def sweep_inputs(config, sweep):
@@ -231,22 +292,23 @@ def sweep_inputs(config, sweep):
 
 def sweep_targets(config, drawn):
     """The side-by-side figure of every sweep whose studies are all drawn."""
-    return sweep_figures(config, drawn)
+    return [product("sweep_figure", name=name) for name in drawn_sweeps(config, drawn)]
 
 
 def validation_targets():
     """``results/figures/work_precision.png`` and ``stress.png``."""
-    return [f"results/figures/{name}.png" for name in VALIDATION_FIGURES]
+    return [product("top_figure", figure=name) for name in VALIDATION_FIGURES]
 
 
 def report_targets(config, drawn):
     """The HTML report of every drawn study and orbits entry, and the validation reports."""
-    targets = [f"results/reports/{name}/{study_report_kind(config['studies'][name])}.html"
+    targets = [product("report", owner=name, report=study_report_kind(config["studies"][name]))
                for name in sorted(drawn["studies"])]
-    targets += [f"results/reports/orbits/{name}/periodic_motions.html"
+    targets += [product("report", owner=f"orbits/{name}", report="periodic_motions")
                 for name in sorted(drawn["orbits"])]
     if config["validation"]["build"]:
-        targets += [f"results/reports/validation/{r}.html" for r in ("performance", "stability")]
+        targets += [product("report", owner="validation", report=r)
+                    for r in ("performance", "stability")]
     return targets
 
 
@@ -254,13 +316,13 @@ def all_targets(config, drawn):
     """The figures and reports of ``rule all``: of the drawn entries (with ``paper: false``,
     only the user's file's own), the paper figures' copies, the sweeps' figures and the
     validation targets when ``validation.build``."""
-    targets = [f"results/figures/{fig}.png" for fig in sorted(drawn["paper_figures"])]
+    targets = [product("top_figure", figure=fig) for fig in sorted(drawn["paper_figures"])]
     for name in sorted(drawn["studies"]):
         entry = config["studies"][name]
-        targets += [f"results/figures/{name}/{f}.png" for f in figures.figure_targets(entry)]
+        targets += [product("figure", owner=name, figure=f) for f in figures.figure_targets(entry)]
     for name in sorted(drawn["orbits"]):
         entry = config["orbits"][name]
-        targets += [f"results/figures/orbits/{name}/{f}.png"
+        targets += [product("figure", owner=f"orbits/{name}", figure=f)
                     for f in figures.figure_targets(entry)]
     targets += sweep_targets(config, drawn)
     if config["validation"]["build"]:
@@ -279,27 +341,27 @@ def rule_inputs(config, drawn, path):
     """The files under results/ that the rule making ``path`` reads, for the rules above the
     datasets (figures, copies, sweeps, reports) and the boundary curves; [] for a dataset
     made from tiles or a record (the plan costs those per entry)."""
-    parts = path.split("/")
-    if parts[:2] == ["results", "figures"] and path.endswith(".png"):
-        stem = parts[-1][:-4]
-        if len(parts) == 3 and stem in VALIDATION_FIGURES:
-            return [VALIDATION_FIGURES[stem]]
-        if len(parts) == 3:
-            return [paper_figure_source(config, stem)["png"]]
-        if stem == "sweep" and len(parts) == 4:
-            return sweep_inputs(config, parts[2])
-        return figure_inputs(config, "/".join(parts[2:-1]), stem)
-    if parts[:3] == ["results", "reports", "validation"]:
-        return _flat(validation_report_inputs(parts[3].rsplit(".", 1)[0]))
-    if parts[:3] == ["results", "reports", "orbits"]:
-        return _flat(orbits_report_inputs(config, drawn, parts[3]))
-    if parts[:2] == ["results", "reports"]:
-        return _flat(study_report_inputs(config, parts[2], parts[3].rsplit(".", 1)[0]))
-    if path.startswith("results/datasets/") and path.endswith("_predictors.nc"):
-        return _flat(predictors_inputs(config, path[len("results/datasets/"):
-                                                    -len("_predictors.nc")]))
-    if path.startswith("results/orbits/") and path.endswith("_boundaries.nc"):
-        return [path[:-len("_boundaries.nc")] + ".nc"]
+    kind, fields = product_of(path)
+    if kind == "top_figure":            # a validation figure, or a paper figure's copy
+        fig = fields["figure"]
+        if fig in VALIDATION_FIGURES:
+            return [VALIDATION_FIGURES[fig]]
+        return [paper_figure_source(config, fig)["png"]]
+    if kind == "sweep_figure":
+        return sweep_inputs(config, fields["name"])
+    if kind == "figure":
+        return figure_inputs(config, fields["owner"], fields["figure"])
+    if kind == "report":
+        owner = fields["owner"]
+        if owner == "validation":
+            return _flat(validation_report_inputs(fields["report"]))
+        if owner.startswith("orbits/"):
+            return _flat(orbits_report_inputs(config, drawn, owner[len("orbits/"):]))
+        return _flat(study_report_inputs(config, owner, fields["report"]))
+    if kind == "predictors":
+        return _flat(predictors_inputs(config, fields["name"]))
+    if kind == "boundaries":
+        return [product("orbits", name=fields["name"])]
     return []
 
 

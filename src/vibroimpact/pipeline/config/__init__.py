@@ -32,11 +32,10 @@ from vibroimpact.pipeline.config.messages import _short  # noqa: F401 (how a val
 from vibroimpact.pipeline.config.plan import Plan, make_plan
 from vibroimpact.pipeline.study import Study
 from vibroimpact.pipeline.config.sweeps import (SWEEP_KEYS, Sweeps, drawn_sweeps,
-                                                expand_sweeps, sweep_figures, sweep_label,
-                                                sweep_labels)
+                                                expand_sweeps, sweep_label, sweep_labels)
 
 __all__ = ["ConfigError", "Plan", "Sweeps", "read_yaml", "compose", "expand_sweeps", "validate",
-           "check", "make_plan", "load", "drawn_sweeps", "sweep_figures", "sweep_label",
+           "check", "make_plan", "load", "drawn_sweeps", "sweep_label",
            "sweep_labels", "SECTIONS", "SWEEP_KEYS", "VERBOSE_ENV"]
 
 

@@ -225,24 +225,24 @@ def built_entries(config, own=None):
         if kinds:
             build["orbits"][name] = kinds
     for path in needed:
-        parts = path.split("/")
-        if path.startswith("results/noise/"):
-            build["noises"].add(parts[-1][:-3])
-        elif path.startswith("results/validation/"):
+        kind, fields = targets.product_of(path)
+        if kind == "noise":
+            build["noises"].add(fields["noise"])
+        elif kind == "validation":
             build["validation"].add(path)
-        elif parts[1] == "figures" and len(parts) == 3:
-            if parts[2][:-4] in targets.VALIDATION_FIGURES:
+        elif kind == "top_figure":      # a validation figure, or a paper figure's copy
+            if fields["figure"] in targets.VALIDATION_FIGURES:
                 build["validation"].add(path)
             else:
                 build["copies"] += 1
-        elif parts[1] == "figures" and parts[-1] == "sweep.png" and len(parts) == 4:
-            build["sweeps"].add(parts[2])
-        elif parts[1] == "figures":
-            owner = "/".join(parts[2:-1])
+        elif kind == "sweep_figure":
+            build["sweeps"].add(fields["name"])
+        elif kind == "figure":
+            owner = fields["owner"]
             build["figures"][owner] = build["figures"].get(owner, 0) + 1
-        elif parts[1] == "reports" and parts[2] == "validation":
+        elif kind == "report" and fields["owner"] == "validation":
             build["validation"].add(path)
-        elif parts[1] == "reports":
+        elif kind == "report":
             build["reports"] += 1
             if path.endswith(".html") and any(p.endswith("_map.nc") for p in
                                               targets.rule_inputs(config, drawn, path)):
@@ -455,9 +455,9 @@ def make_plan(config, own=None, *, results="results", studies=None):
 def _validation_runs_cpu_s(block, files):
     """CPU seconds of the validation runs among ``files`` (start-up excluded)."""
     cpu_s = 0.0
-    if "results/validation/work_precision.nc" in files:
+    if targets.VALIDATION_FIGURES["work_precision"] in files:
         cpu_s += costs.work_precision_cpu_s(block["work_precision"])
-    if "results/validation/stress_sample.nc" in files:
+    if targets.VALIDATION_FIGURES["stress"] in files:
         cpu_s += costs.stress_cpu_s(block["stress"])
     return cpu_s
 

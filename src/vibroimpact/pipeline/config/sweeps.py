@@ -3,8 +3,8 @@
 :func:`expand_sweeps` turns such a study into one ordinary study per combination of the
 listed values, so everything after it (the schema, the checks, the plan, the workflow) sees
 ordinary studies; :class:`Sweeps` restates an error about a generated study in the words of
-the user's file (the sweep and its combination). :func:`drawn_sweeps` and
-:func:`sweep_figures` give the side-by-side figure of each sweep that ``rule all`` draws.
+the user's file (the sweep and its combination). :func:`drawn_sweeps` gives the sweeps whose
+side-by-side figure ``rule all`` draws (`vibroimpact.pipeline.targets.sweep_targets`).
 """
 import copy
 from dataclasses import dataclass, field
@@ -16,7 +16,7 @@ from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems, _
 from vibroimpact.pipeline.study import PLANE_PARAMETERS
 
 __all__ = ["SWEEP_KEYS", "NOISE_KEYS", "Sweeps", "expand_sweeps", "sweep_label", "sweep_labels",
-           "drawn_sweeps", "sweep_figures", "Member", "sweep_members"]
+           "drawn_sweeps", "Member", "sweep_members"]
 
 #: Study keys a list of values sweeps, in the order of the product: the first key varies
 #: slowest, the last fastest (nested loops), so ``eps: [a, b]`` with ``rms: [c, d]`` gives
@@ -369,7 +369,3 @@ def drawn_sweeps(config, drawn):
     return sorted(name for name, sweep in config.get("sweeps", {}).items()
                   if set(sweep["studies"]) <= drawn["studies"])
 
-
-def sweep_figures(config, drawn):
-    """``results/figures/<sweep>/sweep.png`` of every sweep :func:`drawn_sweeps` gives."""
-    return [f"results/figures/{name}/sweep.png" for name in drawn_sweeps(config, drawn)]
