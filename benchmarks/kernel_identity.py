@@ -13,7 +13,16 @@ with ``np.save`` (one ``.npy`` per field and case):
   ``x'`` recorded every 7 samples;
 - ``periodic_orbits``: (1/1), (2/1), (1/2), (2/2), (3/1) on a 4 x 4 grid of (1/beta, delta),
   inadmissible solutions included, eps = 0.5 and 0;
-- ``orbit_map``: the default types on a 5 x 6 grid (the parallel map kernel).
+- ``orbit_map``: the default types on a 5 x 6 grid (the parallel map kernel);
+- ``attractor_map``: a 2 x 2 grid of (1/beta, delta), 8 starts a cell, one wall and two
+  (the attractor kernels over the simulator, every array of the result);
+- ``periodic_motions``: the shooting solver from its default starts, n = 1 and 2, one wall and
+  two, each under Newton's law and under a restitution falling with the speed
+  (``speed_scale``); every field of every motion found, and the skipped seeds.
+
+The attractor and shooting cases, and one simulate case, are at 1/beta = 1.148, where
+CPython's ``math.hypot`` and numba's (the C library's) give the harmonic gain q two values:
+each caller of :func:`vibroimpact.impact.parameters.parameters` keeps the one it always used.
 
 Usage::
 
@@ -42,6 +51,8 @@ SIM_FIELDS = ("impact_step", "impact_offset", "impact_velocity", "stick_start", 
               "grid_time", "a", "v")
 SIM_SCALARS = ("n_steps", "n_impacts", "n_chatter", "contact_time", "t_end", "x_end", "v_end",
                "stuck_end", "stuck_since", "n_collisions")
+#: A 1/beta where CPython's and the C library's hypot give two values of q (simulate_cases).
+Q_ROUNDING_INV_BETA = 1.148
 ORBIT_FIELDS = ("tau0", "intervals", "velocities", "multipliers", "jacobian", "lam", "margin",
                 "admissible")
 
@@ -61,6 +72,11 @@ def simulate_cases():
         for eps in (0.5, 0.0):
             cases[f"mixed_d{delta:+.1f}_e{eps:.1f}"] = dict(
                 eps=eps, delta=delta, noise=0.29 * noise, amplitude=1.0, beta=1.0 / 2.5)
+    # 1/beta = 1.148 (zeta = 0.05): CPython's math.hypot and the C library's round the
+    # harmonic gain q = 1 / |1 - beta^2 + 2 i zeta beta| apart there (by an ulp), so these
+    # cases fail if a caller of the parameter builder changes the hypot it uses
+    cases["harmonic_q_rounding"] = dict(eps=0.5, delta=0.0, noise=None, amplitude=1.0,
+                                        beta=1.0 / Q_ROUNDING_INV_BETA, t_end=3000.0)
     cases["partial_last_step"] = dict(eps=0.5, delta=-0.5, noise=noise[:50_002],
                                       t_end=(50_000 + 0.37) * DT)
     # a second wall below the mass (the generic step, both walls' frames)
@@ -78,6 +94,25 @@ def orbit_points():
 
 
 ORBIT_TYPES = ((1, 1), (2, 1), (1, 2), (2, 2), (3, 1))
+
+ATTRACTOR_CASES = {"one_wall": {}, "two_walls": dict(clearance=3.0, eps_lower=0.7)}
+MOTION_FIELDS = ("state", "phase0_states", "impact_time", "impact_wall", "impact_velocity",
+                 "monodromy", "multipliers", "lam", "S", "stable", "margin", "admissible",
+                 "grazing", "residual")
+
+
+def motion_cases():
+    """{name: the Model of a periodic_motions case}."""
+    from vibroimpact.model import Model
+
+    beta = 1.0 / Q_ROUNDING_INV_BETA
+    return {
+        "one_wall": Model.paper(ZETA, 0.5, 0.5, 1.0, beta),
+        "one_wall_speed_scale": Model.paper(ZETA, 0.5, 0.5, 1.0, beta, speed_scale=2.0),
+        "two_walls": Model.paper(ZETA, 0.5, 1.0, 1.0, beta, gap=2.0, eps_lower=0.7),
+        "two_walls_speed_scale": Model.paper(ZETA, 0.5, 1.0, 1.0, beta, gap=2.0, eps_lower=0.7,
+                                             speed_scale=3.0, speed_scale_lower=1.5),
+    }
 
 
 def save(out):
@@ -109,7 +144,28 @@ def save(out):
     grid = orbit_map(np.linspace(0.6, 3.0, 5), np.linspace(-1.0, 2.0, 6))
     for key, value in grid.items():
         np.save(out / f"map.{key}.npy", np.asarray(value))
-    print("orbit_map: 5 x 6 grid, default types")
+    print("orbit_map: 5 x 6 grid, default types", flush=True)
+    from vibroimpact import attractor_map, periodic_motions
+
+    for name, walls in ATTRACTOR_CASES.items():
+        res = attractor_map(np.array([Q_ROUNDING_INV_BETA, 2.0]), np.array([0.0, 0.5]), ZETA,
+                            0.5, types=((1, 1), (2, 1)), n_starts=8, max_time=300.0, seed=1,
+                            gap=(0.0, 3.0), **walls)
+        for key, value in res.items():
+            np.save(out / f"att.{name}.{key}.npy", np.asarray(value))
+        print(f"attractor_map {name}: 2 x 2 grid, 8 starts a cell", flush=True)
+    for name, model in motion_cases().items():
+        found = periodic_motions(model, (1, 2))
+        np.save(out / f"mot.{name}.count.npy", np.array(len(found)))
+        for i, motion in enumerate(found):
+            for field in MOTION_FIELDS:
+                np.save(out / f"mot.{name}.m{i}_{field}.npy", np.asarray(getattr(motion, field)))
+        np.save(out / f"mot.{name}.skipped_seed.npy",
+                np.array([s.seed for s in found.skipped], dtype=float).reshape(-1, 2))
+        np.save(out / f"mot.{name}.skipped_kind.npy",
+                np.array([f"{s.n}:{s.kind}:{s.reason}" for s in found.skipped], dtype=str))
+        print(f"periodic_motions {name}: {len(found)} motions, {len(found.skipped)} skipped "
+              f"seeds", flush=True)
 
 
 def compare(dir_a, dir_b):
@@ -125,10 +181,12 @@ def compare(dir_a, dir_b):
         if not same:
             bad.append(f"differs: {name} ({a.dtype}{a.shape} vs {b.dtype}{b.shape})")
     cases = {n.rsplit(".", 2)[0] for n in names_a}
-    kinds = {k: sum(c.split(".")[0] == k for c in cases) for k in ("sim", "orb", "map")}
+    kinds = {k: sum(c.split(".")[0] == k for c in cases)
+             for k in ("sim", "orb", "map", "att", "mot")}
     print(f"{len(names_a & names_b)} arrays compared (np.array_equal, NaNs equal, same dtype and "
           f"shape): {kinds['sim']} simulate cases, {kinds['orb']} periodic_orbits calls, "
-          f"{kinds['map']} orbit_map grid")
+          f"{kinds['map']} orbit_map grid, {kinds['att']} attractor_map grids, "
+          f"{kinds['mot']} periodic_motions calls")
     for line in bad:
         print("  " + line)
     print("IDENTICAL" if not bad else f"{len(bad)} DIFFERENCES")

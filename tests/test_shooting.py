@@ -13,6 +13,7 @@ import pytest
 from vibroimpact import periodic_motions, periodic_orbits, simulate
 from vibroimpact.model import Model
 from vibroimpact.attractors import shooting
+from vibroimpact.impact.layout import P_DELTA
 
 ZETA, EPS = 0.05, 0.5           # config/config.yaml, orbits.harmonic (Fig. 16)
 TYPES = ((1, 1), (2, 1), (1, 2), (1, 3), (3, 1))
@@ -196,9 +197,9 @@ def test_grazing_is_not_jumped_over(depth):
     res = np.empty(3)
     stack = np.empty((shooting.STACK, 2))
     for above in (True, False):
-        P = shooting._parameters(model)
+        P = shooting._Flow(model, 1).P
         wall = x_max - depth if above else x_max + depth
-        P[shooting._UPPER] = wall
+        P[P_DELTA] = wall
         fit = shooting._fit(0.0, 0.0, 1.0, P)
         assert shooting._eval(length, *fit, P)[0] < wall - 1e-3
         shooting._first_contact(0.0, 0.0, 1.0, length, P, stack, res)
@@ -262,7 +263,7 @@ def test_derivative_bound_holds_on_random_flights():
     for _ in range(300):
         model = Model.paper(rng.uniform(0.01, 0.5), 0.5, 1.0, rng.uniform(-2, 2),
                             rng.uniform(0.2, 5))
-        P = shooting._parameters(model)
+        P = shooting._Flow(model, 1).P
         th0, c1, c2 = shooting._fit(rng.uniform(0, 20), rng.uniform(-3, 1), rng.uniform(-5, 5),
                                     P)
         lo, h = rng.uniform(0, 10), rng.uniform(0, 1.5)

@@ -23,13 +23,11 @@ from vibroimpact._kernel_cache import kernel_decorator
 from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
 from vibroimpact.impact import _jit as _impact_jit
 from vibroimpact.impact.layout import (BUFFER_FULL, FREE, N_COUNTERS, N_FTOT, N_PARAMS,
-                                       N_STATE, OK, P_A, P_AQ, P_BETA, P_BH_HI, P_BH_LO,
-                                       P_COS_BH, P_COS_PHI, P_DELTA, P_DT, P_EPS, P_INV_DT,
-                                       P_LAW_A, P_INV_OMEGA, P_M11, P_M12, P_M21, P_M22, P_OMEGA,
-                                       P_PHI, P_SIN_BH, P_SIN_PHI, P_ZETA, S_COS_PSI, S_MODE,
-                                       S_SIN_PSI, S_W, S_WV, STICK_LO, STICK_ON, STUCK,
-                                       STUCK_LO)
-from vibroimpact.impact.motion import phase, two_prod
+                                       N_STATE, OK, P_AQ, P_BETA, P_BH_HI, P_BH_LO, P_DELTA,
+                                       P_PHI, S_COS_PSI, S_MODE, S_SIN_PSI, S_W, S_WV, STICK_LO,
+                                       STICK_ON, STUCK, STUCK_LO)
+from vibroimpact.impact.motion import phase
+from vibroimpact.impact.parameters import parameters
 from vibroimpact.impact.stepping import run_steps
 from vibroimpact.impact.tolerances import STEP_HEADROOM
 from vibroimpact.orbits import _jit as _orbits_jit
@@ -298,60 +296,6 @@ def _keep_stable(cnt, sols, m, n, beta, delta, zeta, eps, clearance, stack, tmat
             orb_lnmu[ib, idd, t, ns] = m * math.log(lam)
         ns += 1
     n_stable[t, ib, idd] = ns
-
-
-@kernel
-def _params(zeta, eps, delta, h, beta, clearance, eps_lower):
-    """The simulator's parameter vector (:meth:`vibroimpact.impact.simulate.model_parameters`)
-    for A = 1: one wall when ``clearance`` is infinite, else twice the slots, the second half
-    the wall at ``delta - clearance`` in the mirrored frame ``x -> -x``."""
-    P1 = _params_upper(zeta, eps, delta, h, beta)
-    if not clearance < np.inf:
-        return P1
-    P = np.empty(2 * N_PARAMS)
-    P[:N_PARAMS] = P1
-    P[N_PARAMS:] = P1
-    P[N_PARAMS + P_EPS] = eps_lower
-    P[N_PARAMS + P_DELTA] = -(delta - clearance)
-    P[N_PARAMS + P_A] = -P1[P_A]
-    P[N_PARAMS + P_AQ] = -P1[P_AQ]
-    return P
-
-
-@kernel
-def _params_upper(zeta, eps, delta, h, beta):
-    """The wall at ``delta``'s slots of :func:`_params`."""
-    P = np.empty(N_PARAMS)
-    omega = math.sqrt(1.0 - zeta * zeta)
-    q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
-    phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
-    E = math.exp(-zeta * h)
-    C = math.cos(omega * h)
-    S = math.sin(omega * h)
-    bh_hi, bh_lo = two_prod(beta, h)
-    P[P_ZETA] = zeta
-    P[P_OMEGA] = omega
-    P[P_EPS] = eps
-    P[P_DELTA] = delta
-    P[P_DT] = h
-    P[P_A] = 1.0
-    P[P_BETA] = beta
-    P[P_AQ] = q
-    P[P_PHI] = phi
-    P[P_COS_PHI] = math.cos(phi)
-    P[P_SIN_PHI] = math.sin(phi)
-    P[P_BH_HI] = bh_hi
-    P[P_BH_LO] = bh_lo
-    P[P_M11] = E * (C + zeta * S / omega)
-    P[P_M12] = E * S / omega
-    P[P_M21] = -E * S / omega
-    P[P_M22] = E * (C - zeta * S / omega)
-    P[P_INV_DT] = 1.0 / h
-    P[P_INV_OMEGA] = 1.0 / omega
-    P[P_COS_BH] = math.cos(beta * h)
-    P[P_SIN_BH] = math.sin(beta * h)
-    P[P_LAW_A] = 0.0          # Newton's law: the attractor maps take eps alone
-    return P
 
 
 @kernel
@@ -705,7 +649,10 @@ def _run_start(beta, delta, zeta, eps, clearance, eps_lower, theta, x0, v0, max_
     omega = math.sqrt(1.0 - zeta * zeta)
     lower = delta - clearance                   # -inf with one wall
     h, k0, t0 = start_step(beta, theta)
-    P = _params(zeta, eps, delta, h, beta, clearance, eps_lower)
+    # the C library's hypot in the harmonic gain, as these kernels have always had it
+    # (vibroimpact.impact.parameters.parameters); Newton's law at both walls, force sin(beta tau)
+    P = parameters(zeta, h, 1.0, beta, math.hypot(1.0 - beta * beta, 2.0 * zeta * beta), eps,
+                   delta, 0.0, 2 if clearance < np.inf else 1, eps_lower, lower, 0.0)
     q = P[P_AQ]
     psi0 = phase(k0, 0.0, P[P_BH_HI], P[P_BH_LO], beta) - P[P_PHI]
     state = np.empty(N_STATE)

@@ -54,12 +54,16 @@ from vibroimpact import _checks
 from vibroimpact._kernel_cache import kernel_decorator
 from vibroimpact._law import (LAW_MODULES, rebound_derivative, rebound_ratio,
                               rebound_velocity)
+from vibroimpact.impact.layout import (N_PARAMS, P_A, P_AQ, P_BETA, P_DELTA, P_EPS, P_LAW_A,
+                                       P_OMEGA, P_PHI, P_ZETA)
+from vibroimpact.impact.parameters import parameters
 from vibroimpact.model import Model
 
 __all__ = ["PeriodicMotion", "SkippedSeed", "MotionSet", "periodic_motions"]
 
-kernel = kernel_decorator(njit, __file__, ("shooting.py",) + tuple(f"../{m}" for m in LAW_MODULES),
-                          error_model="numpy")
+#: Stamped with the simulator's layout too: the kernels read its slot constants.
+kernel = kernel_decorator(njit, __file__, ("shooting.py", "../impact/layout.py")
+                          + tuple(f"../{m}" for m in LAW_MODULES), error_model="numpy")
 
 # --- thresholds, each with its reason ---------------------------------------------------------
 #: Critical-point search: initial bracket in radians of the fastest of beta and wd (x' has
@@ -116,27 +120,19 @@ DEFAULT_STARTS = 12
 
 # status codes of the flow kernel
 OK, CHATTER = 0, 1
-# parameter vector slots
-_ZETA, _WD, _AQ, _BETA, _PHI, _UPPER, _LOWER, _EPS_U, _EPS_L, _A, _LAW_U, _LAW_L = range(12)
-
-
-def _parameters(model):
-    zeta, beta, amp = model.zeta, model.beta, model.amplitude
-    wd = math.sqrt(1.0 - zeta * zeta)
-    q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
-    phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
-    eps_l = model.eps_lower if model.n_walls == 2 else 0.0
-    a_l = model.walls[1].law.a if model.n_walls == 2 else 0.0
-    return np.array([zeta, wd, amp * q, beta, phi, model.delta, model.lower, model.eps,
-                     eps_l, amp, model.walls[0].law.a, a_l])
+# The kernels read the simulator's parameter vector (vibroimpact.impact.layout), always with
+# both halves (_Flow): the wall above the mass in the first N_PARAMS slots, the wall below in
+# the next, mirrored (x -> -x), so that its position is -P[N_PARAMS + P_DELTA] (-inf with one
+# wall) and its restitution and law are P[N_PARAMS + P_EPS], P[N_PARAMS + P_LAW_A]; the
+# kernels work in the lab frame and read the force (P_A, P_AQ) from the first half.
 
 
 # --- kernels ----------------------------------------------------------------------------------
 @kernel
 def _fit(t0, x0, v0, P):
     """Phase of the particular solution at ``t0`` and the free response's ``(c1, c2)``."""
-    zeta, wd, aq, beta = P[_ZETA], P[_WD], P[_AQ], P[_BETA]
-    th0 = beta * t0 - P[_PHI]
+    zeta, wd, aq, beta = P[P_ZETA], P[P_OMEGA], P[P_AQ], P[P_BETA]
+    th0 = beta * t0 - P[P_PHI]
     c1 = x0 - aq * math.sin(th0)
     c2 = (v0 - aq * beta * math.cos(th0) + zeta * c1) / wd
     return th0, c1, c2
@@ -145,7 +141,7 @@ def _fit(t0, x0, v0, P):
 @kernel
 def _eval(s, th0, c1, c2, P):
     """``x, x', x'', x'''`` at ``s`` after the flight's start."""
-    zeta, wd, aq, beta = P[_ZETA], P[_WD], P[_AQ], P[_BETA]
+    zeta, wd, aq, beta = P[P_ZETA], P[P_OMEGA], P[P_AQ], P[P_BETA]
     e = math.exp(-zeta * s)
     cw = math.cos(wd * s)
     sw = math.sin(wd * s)
@@ -189,7 +185,7 @@ def _root(lo, hi, wall, sgn, th0, c1, c2, P):
 @kernel
 def _piece(s_prev, x_prev, s_c, x_c, th0, c1, c2, P):
     """Contact on the monotone piece ``[s_prev, s_c]``: ``(s, wall)`` or ``(s_c, -1)``."""
-    upper, lower = P[_UPPER], P[_LOWER]
+    upper, lower = P[P_DELTA], -P[N_PARAMS + P_DELTA]
     if x_c > x_prev and x_c >= upper:
         if x_prev >= upper:
             return s_prev, 0
@@ -212,7 +208,7 @@ def _bound(k, lo, h, th0, gamma0, amp, P):
     resonance the forced and free parts nearly cancel, and this bound stays near ``|x^(k)|``
     where the sum of their amplitudes would be many times larger.
     """
-    zeta, wd, aq, beta = P[_ZETA], P[_WD], P[_AQ], P[_BETA]
+    zeta, wd, aq, beta = P[P_ZETA], P[P_OMEGA], P[P_AQ], P[P_BETA]
     f = aq * beta ** k
     g = amp * math.exp(-zeta * lo)
     rho = math.atan2(wd, -zeta)
@@ -230,8 +226,8 @@ def _first_contact(t0, x0, v0, length, P, stack, res):
     interior extremum before the contact (``inf`` if none). See the module docstring.
     """
     th0, c1, c2 = _fit(t0, x0, v0, P)
-    wd, beta = P[_WD], P[_BETA]
-    upper, lower = P[_UPPER], P[_LOWER]
+    wd, beta = P[P_OMEGA], P[P_BETA]
+    upper, lower = P[P_DELTA], -P[N_PARAMS + P_DELTA]
     amp = math.hypot(c1, c2)              # amplitude of every derivative of the free part
     gamma0 = math.atan2(c1, c2)           # free part: amp e^{-zeta s} sin(wd s + gamma0)
     n0 = max(MIN_BRACKETS, int(math.ceil(length * max(beta, wd) / PHASE_STEP)))
@@ -334,7 +330,7 @@ def advance(t0, t1, x, v, P, M, ev_t, ev_w, ev_u, stack, out):
     velocity, lab frame). ``out = (x, v, margin, n_impacts, status)``; status ``CHATTER`` when
     an impact is slower than ``CHATTER_SPEED`` or the buffers are full.
     """
-    zeta, wd, amp, beta = P[_ZETA], P[_WD], P[_A], P[_BETA]
+    zeta, wd, amp, beta = P[P_ZETA], P[P_OMEGA], P[P_A], P[P_BETA]
     res = np.empty(3)
     t = t0
     n_ev = 0
@@ -357,9 +353,10 @@ def advance(t0, t1, x, v, P, M, ev_t, ev_w, ev_u, stack, out):
         if abs(u) < CHATTER_SPEED or n_ev >= ev_t.size:
             status = CHATTER
             break
-        eps = P[_EPS_U] if wall == 0 else P[_EPS_L]
-        law_a = P[_LAW_U] if wall == 0 else P[_LAW_L]
-        pos = P[_UPPER] if wall == 0 else P[_LOWER]
+        half = 0 if wall == 0 else N_PARAMS
+        eps = P[half + P_EPS]
+        law_a = P[half + P_LAW_A]
+        pos = P[P_DELTA] if wall == 0 else -P[N_PARAMS + P_DELTA]
         t = t + s
         f = amp * math.sin(beta * t)
         a_minus = f - 2.0 * zeta * u - pos
@@ -393,7 +390,19 @@ class _Flow:
     """The exact flow of one model over whole forcing periods, with its buffers."""
 
     def __init__(self, model, n):
-        self.P = _parameters(model)
+        zeta, beta = model.zeta, model.beta
+        two = model.n_walls == 2
+        # The simulator's vector, with both halves whatever the walls (one wall: the wall below
+        # at -inf with restitution and law 0, which no flight reaches); CPython's math.hypot in
+        # the harmonic gain, as this solver has always had it (see parameters). The step is 1:
+        # the flow is exact between impacts and samples no force record, so the slots of the
+        # step (P_DT, P_INV_DT, P_BH_*, P_M*, P_COS_BH, P_SIN_BH) are filled but never read,
+        # and a unit step keeps them finite.
+        self.P = parameters(zeta, 1.0, model.amplitude, beta,
+                            math.hypot(1.0 - beta * beta, 2.0 * zeta * beta), model.eps,
+                            model.delta, model.walls[0].law.a, 2,
+                            model.eps_lower if two else 0.0, model.lower,
+                            model.walls[1].law.a if two else 0.0)
         self.upper, self.lower = model.delta, model.lower
         self.tf = 2.0 * math.pi / model.beta
         cap = MAX_IMPACTS_PER_PERIOD * n

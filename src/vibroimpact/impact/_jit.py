@@ -7,7 +7,7 @@ from vibroimpact._law import LAW_MODULES
 
 #: The modules the compiled kernels are made of (constants included; the impact law of
 #: :mod:`vibroimpact._law`, which a kernel calls as ``rebound_velocity(eps, u)``, too).
-KERNEL_MODULES = ("tolerances.py", "layout.py", "motion.py", "events.py", "stepping.py") + tuple(
-    f"../{m}" for m in LAW_MODULES)
+KERNEL_MODULES = ("tolerances.py", "layout.py", "motion.py", "events.py", "stepping.py",
+                  "parameters.py") + tuple(f"../{m}" for m in LAW_MODULES)
 
 kernel = kernel_decorator(njit, __file__, KERNEL_MODULES, error_model="numpy")

@@ -6,6 +6,7 @@ moved or added in one place and not the other fails at once). They are plain mod
 ints: numba reads them as compile-time constants, so ``P[P_DELTA]`` costs what ``P[3]`` did.
 
 - ``P``: the parameter vector (float64, built by
+  :func:`vibroimpact.impact.parameters.parameters`; from a model,
   :func:`vibroimpact.impact.simulate.model_parameters`);
 - ``c``: the segment tuple returned by :func:`vibroimpact.impact.motion.segment`;
 - ``state``: the kernel's state at a sample point (float64, kept by the driver between calls);
@@ -119,7 +120,7 @@ WALL_LO = 4
 
 # the two walls: the parameter vector ``P`` holds N_PARAMS slots per wall, the upper wall's
 # (the paper's, at x = delta) first; the lower wall's half is that wall in the mirrored frame
-# x -> -x (vibroimpact.impact.simulate.model_parameters), so every search serves both walls.
+# x -> -x (vibroimpact.impact.parameters.parameters), so every search serves both walls.
 # In the event buffers the wall is the sign of ``imp_u`` (the lab-frame velocity x' at the
 # impact: > 0 at the upper wall, < 0 at the lower) and the kind of a sticking event:
 STICK_OFF = 0.0      # release from the upper wall

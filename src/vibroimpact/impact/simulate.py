@@ -15,6 +15,7 @@ import numpy as np
 from vibroimpact import _checks
 from vibroimpact.impact import kernels
 from vibroimpact.impact.hops import pressed_flights
+from vibroimpact.impact.parameters import parameters
 from vibroimpact.model import Model
 from vibroimpact.stats.collisions import (DEFAULT_REBOUND_FLOOR, MIN_REBOUND_FLOOR, Collisions,
                                           close_open_phase, group_collisions)
@@ -389,38 +390,18 @@ def model_parameters(model, dt):
     before models existed. Two walls: twice as many; the second half is the lower wall
     seen in the mirrored frame ``x -> -x`` (force and harmonic amplitude negated, wall
     at ``-(delta - gap)`` hit from below, its own restitution), so that every search of
-    :mod:`vibroimpact.impact.events` serves both walls unchanged.
+    :mod:`vibroimpact.impact.events` serves both walls unchanged. The vector is
+    :func:`vibroimpact.impact.parameters.parameters` of the model's numbers, with CPython's
+    ``math.hypot`` in the harmonic gain, as this vector has always had it (see there).
     """
     dt = _checks.real("dt", dt, low=0.0, low_open=True)
-    zeta, beta, amplitude = model.zeta, model.beta, model.amplitude
-    omega = math.sqrt(1.0 - zeta * zeta)
-    q = 1.0 / math.hypot(1.0 - beta * beta, 2.0 * zeta * beta)
-    phi = math.atan2(2.0 * zeta * beta, 1.0 - beta * beta)
-    E = math.exp(-zeta * dt)
-    C, S = math.cos(omega * dt), math.sin(omega * dt)
-    bh_hi, bh_lo = kernels.two_prod(beta, dt)
-    P = np.empty(kernels.N_PARAMS * model.n_walls)
-    P[[kernels.P_ZETA, kernels.P_OMEGA, kernels.P_EPS, kernels.P_DELTA, kernels.P_DT]] = (
-        zeta, omega, model.eps, model.delta, dt)
-    P[[kernels.P_A, kernels.P_BETA, kernels.P_AQ, kernels.P_PHI]] = (
-        amplitude, beta, amplitude * q, phi)
-    P[[kernels.P_COS_PHI, kernels.P_SIN_PHI]] = math.cos(phi), math.sin(phi)
-    P[[kernels.P_BH_HI, kernels.P_BH_LO]] = bh_hi, bh_lo
-    P[[kernels.P_M11, kernels.P_M12, kernels.P_M21, kernels.P_M22]] = (
-        E * (C + zeta * S / omega), E * S / omega, -E * S / omega,
-        E * (C - zeta * S / omega))
-    P[[kernels.P_INV_DT, kernels.P_INV_OMEGA, kernels.P_COS_BH, kernels.P_SIN_BH]] = (
-        1.0 / dt, 1.0 / omega, math.cos(beta * dt), math.sin(beta * dt))
-    P[kernels.P_LAW_A] = model.walls[0].law.a
-    if model.n_walls == 2:
-        n = kernels.N_PARAMS
-        P[n:] = P[:n]
-        P[n + kernels.P_EPS] = model.eps_lower
-        P[n + kernels.P_LAW_A] = model.walls[1].law.a
-        P[n + kernels.P_DELTA] = -model.lower
-        P[n + kernels.P_A] = -amplitude
-        P[n + kernels.P_AQ] = -P[kernels.P_AQ]
-    return P
+    zeta, beta = model.zeta, model.beta
+    two = model.n_walls == 2
+    lower = model.walls[1] if two else None
+    return parameters(zeta, dt, model.amplitude, beta,
+                      math.hypot(1.0 - beta * beta, 2.0 * zeta * beta), model.eps, model.delta,
+                      model.walls[0].law.a, model.n_walls, lower.eps if two else 0.0,
+                      lower.position if two else -math.inf, lower.law.a if two else 0.0)
 
 
 def split_steps(t_end, dt):
