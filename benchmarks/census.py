@@ -358,8 +358,8 @@ ROWS = [
      "(Name or Attribute)", "items"),
     ("5. two-wall branches", two_wall_branches, total,
      "if/elif/ternary tests naming " + "/".join(sorted(TWO_WALL_WORDS)) + " (Name, attribute "
-     "not called as a method, or string key: x['k'], x.get('k'), 'k' in x, getattr/hasattr)",
-     "top"),
+     "not called as a method, or string key: x['k'], x.get('k'), 'k' in x, getattr/hasattr); "
+     "comprehension filters and while loops not counted", "top"),
     ("   files with them", two_wall_branches, count_items,
      "files holding at least one such test", None),
     ("6. plane branches", plane_branches, total,
