@@ -189,6 +189,10 @@ CASES = [
        "studies.random.law_lower", "give studies.random.gap > 0"),
     _c("law_under_closed_form_orbits", M + ("law",), {"speed_scale": 0.5},
        "studies.motion_map.figures", "the shooting solver takes any law"),
+    _c("orbits_law_with_attractors", O + ("law",), {"speed_scale": 0.5},
+       "orbits.harmonic.attractors", "leave attractors out"),
+    _c("orbits_law_under_fig15_vs_fig16", O + ("law",), {"speed_scale": 0.5},
+       "studies.motion_map.figures[1].orbits", "an `orbits` entry without law"),
     # --- noise records ---------------------------------------------------------------------
     _c("n_samples_huge", N + ("n_samples",), 10_000_000_000, "limits.max_disk_gb",
        "raise limits.max_disk_gb"),

@@ -303,3 +303,74 @@ def test_every_header_names_the_law():
 
     attrs = _law_attrs({"speed_scale": math.inf, "speed_scale_lower": 2.0})
     assert "speed_scale" not in attrs and attrs["speed_scale_lower"] == 2.0
+
+
+def test_the_shooting_map_under_a_vanishing_law_is_the_closed_forms():
+    """Fig. 16 by the shooting solver (`attractors.plane.orbit_plane` with a law) against the
+    closed form (no law) on a 2 x 3 grid: at speed_scale = 1e12 the restitution differs from
+    eps by at most 1e-12 relative at the impact speeds here (u < 5), so the stable domains
+    agree cell for cell and lam to 1e-9 (the multiplier's sensitivity to eps is O(1)); at
+    speed_scale = 0.5 the law's map differs, and each of its cells is `periodic_motions`'
+    own motion at that cell."""
+    from vibroimpact.attractors.plane import orbit_plane
+
+    ib, d = [0.9, 1.2], [0.0, 0.5, 1.0]
+    fixed, types = dict(zeta=ZETA, eps=0.5), [(1, 1), (2, 1)]
+    closed = orbit_plane("inv_beta", ib, "delta", d, fixed, types)
+    shot = orbit_plane("inv_beta", ib, "delta", d, fixed, types, speed_scale=1e12)
+    assert closed.attrs["solver"] != "periodic_motions" == shot.attrs["solver"]
+    assert (closed["n_stable"].values > 0).sum() >= 4
+    np.testing.assert_array_equal(closed["n_stable"].values > 0, shot["n_stable"].values > 0)
+    both = closed["n_stable"].values > 0
+    np.testing.assert_allclose(shot["lam"].values[both], closed["lam"].values[both],
+                               rtol=0, atol=1e-9)
+    soft = orbit_plane("inv_beta", ib, "delta", d, fixed, types, speed_scale=0.5)
+    assert soft.attrs["speed_scale"] == 0.5 and soft.attrs["n_walls"] == 1
+    stable = soft["n_stable"].values > 0
+    assert stable.any() and np.nanmax(np.abs(soft["lam"].values - closed["lam"].values)) > 0.1
+    t, i, j = np.argwhere(stable)[0]
+    model = Model.paper(ZETA, 0.5, d[j], 1.0, 1.0 / ib[i], speed_scale=0.5)
+    m, n = types[t]
+    lam = min(mo.lam for mo in periodic_motions(model, n).motions
+              if (mo.m, mo.n) == (m, n) and mo.admissible and mo.stable)
+    assert soft["lam"].values[t, i, j] == lam
+
+
+def test_an_orbits_entry_with_a_law_is_the_shooting_solvers(tmp_path):
+    """`law` on an orbits entry: its tiles are the shooting rule's (study.shooting, the plan
+    and the rule's folder), its boundary curves are not traced (they continue Newton's closed
+    form), and a period the shooting map does not solve for is refused by name."""
+    from vibroimpact.pipeline import config as configuration
+    from vibroimpact.pipeline.study import shooting
+
+    from helpers import ROOT
+
+    config, plan = configuration.load(
+        root=ROOT, user_files=[ROOT / "config" / "examples" / "impact_law.yaml"])
+    assert shooting(config["orbits"]["soft_wall_orbits"])
+    assert not shooting(config["orbits"]["newton_wall_orbits"])
+    rows = {row.key: row.rules for row in plan.rows}
+    assert "solve_clearance_orbit_tile" in rows["orbits.soft_wall_orbits"]
+    assert "solve_orbit_tile" in rows["orbits.newton_wall_orbits"]
+    small = dict(config["orbits"]["soft_wall_orbits"], inv_beta=[0.9, 1.2], delta=[0.5, 1.0],
+                 tile_rows=2)
+    from vibroimpact.attractors.plane import orbit_plane
+    from vibroimpact.pipeline import tasks
+
+    with pytest.raises(ValueError, match="solve_clearance_orbit_tile"):
+        tasks.orbit_tile(small, 0, tmp_path / "tile.nc")        # the closed form's rule
+    tasks.orbit_tile(small, 0, tmp_path / "tile.nc", solver=orbit_plane)
+    tasks.aggregate_orbits(small, [tmp_path / "tile.nc"], tmp_path / "soft.nc")
+    tasks.boundaries(small, tmp_path / "soft.nc", tmp_path / "soft_boundaries.nc")
+    import xarray as xr
+
+    orbits = xr.load_dataset(tmp_path / "soft.nc")
+    assert orbits.attrs["speed_scale"] == 0.5 and "impact_law" in orbits.attrs
+    assert (orbits["n_stable"].values > 0).any()
+    curves = xr.load_dataset(tmp_path / "soft_boundaries.nc")
+    assert curves.attrs["traced"] == 0 and "impact law" in curves.attrs["not_traced"]
+    entry = dict(config["orbits"]["soft_wall_orbits"], types=[[1, 1], [1, 5]])
+    user = {"paper": False, "orbits": {"soft": entry}}
+    with pytest.raises(configuration.ConfigError, match=r"orbits\.soft\.types\[1\].*"
+                       r"1 <= n <= 4"):
+        configuration.load(user, root=ROOT)

@@ -24,6 +24,7 @@ from vibroimpact.pipeline.study import (
     attractor_rows,
     orbit_rows,
     plane_attractor_rows,
+    shooting,
 )
 from vibroimpact.reports import arguments
 
@@ -181,11 +182,11 @@ def tiles(kind):
 
 
 def orbit_tiles(wildcards):
-    """The tiles of orbits entry ``{orbits}`` (a two-wall entry's: rule
-    ``solve_clearance_orbit_tile``'s)."""
+    """The tiles of orbits entry ``{orbits}`` (the shooting solver's, two walls or an impact
+    law: rule ``solve_clearance_orbit_tile``'s)."""
     entry = config["orbits"][wildcards.orbits]
     _, n = orbit_rows(entry)
-    tiles = "clearance_tiles" if entry.get("gap") is not None else "tiles"
+    tiles = "clearance_tiles" if shooting(entry) else "tiles"
     return [f"results/orbits/{wildcards.orbits}/{tiles}/{t}.nc" for t in range(n)]
 
 

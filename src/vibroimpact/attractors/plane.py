@@ -1,10 +1,11 @@
-"""Fig. 16 over any plane, with one wall or two.
+"""Fig. 16 over any plane, with one wall or two, under any impact law.
 
 `orbit_plane` here is `vibroimpact.orbits.plane.orbit_plane` (same call, same dataset) that
-also solves a layout with a second wall: Newton shooting on the exact flow
-(`vibroimpact.attractors.shooting.periodic_motions`) at every cell, seeded by starts the
-simulator settles. It lives on this floor because the shooting solver does (it runs the
-simulator); a one-wall plane is handed to the closed form below, which loads no simulator.
+also solves a layout with a second wall, or walls whose restitution falls with the impact
+speed: Newton shooting on the exact flow (`vibroimpact.attractors.shooting.periodic_motions`)
+at every cell, seeded by starts the simulator settles. It lives on this floor because the
+shooting solver does (it runs the simulator); one wall under Newton's law is handed to the
+closed form below, which loads no simulator.
 
 With two walls the motions found are those whose basin the grid of starts meets (every stable
 one in practice, docs/model.md 8.8); an unstable motion is found only when Newton happens to
@@ -14,53 +15,70 @@ scaling needed: the flow is exact at any A).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from vibroimpact.attractors.shooting import periodic_motions
 from vibroimpact.model import Model
 from vibroimpact.orbits import plane as one_wall
-from vibroimpact.orbits.plane import NOISE_PARAMETERS, TWO_WALL_PARAMETERS
+from vibroimpact.orbits.plane import (HARMONIC_PARAMETERS, NOISE_PARAMETERS,
+                                      TWO_WALL_PARAMETERS)
 
 __all__ = ["orbit_plane", "attractor_plane"]
 
 
 def orbit_plane(x_name, x_values, y_name, y_values, fixed, types=((1, 1), (2, 1), (1, 2)), *,
-                progress=None):
-    """Existence and stability of periodic impact motions over any plane, any wall layout.
+                speed_scale=math.inf, speed_scale_lower=None, progress=None):
+    """Existence and stability of periodic impact motions over any plane, any wall layout,
+    any impact law.
 
     The parameters and the result are those of `vibroimpact.orbits.plane.orbit_plane`; with
     ``gap`` on an axis or in `fixed` (a second wall at ``delta - gap``, restitution
     ``eps_lower``, default eps) the types are ``(m_upper, m_lower, n)`` triples or names
-    ``"(1,1)/1"`` and every cell is solved by `periodic_motions` for the types' n; the
-    dataset's ``solver`` is ``"periodic_motions"`` and ``n_walls`` 2. Without a second wall
-    the call is the one-wall closed form's, unchanged. ``progress(k)``: as ``k`` more cells
-    are solved.
+    ``"(1,1)/1"``. ``speed_scale`` (and ``speed_scale_lower``, the second wall's) make a
+    wall's restitution fall with the impact speed (`vibroimpact.model.Restitution`); ``inf``
+    is Newton's law. With a second wall or such a law every cell is solved by
+    `periodic_motions` for the types' n (one wall: a type ``(m, n)`` is the motion of m
+    impacts in n periods); the dataset's ``solver`` is ``"periodic_motions"``. One wall
+    under Newton's law is the closed form's call, unchanged. ``progress(k)``: as ``k`` more
+    cells are solved.
     """
     xs, ys, fixed_, parsed, two_walls = one_wall.check_plane(x_name, x_values, y_name,
                                                              y_values, fixed, types)
-    if not two_walls:
+    laws = {} if speed_scale == math.inf and speed_scale_lower is None else dict(
+        speed_scale=speed_scale, speed_scale_lower=speed_scale_lower)
+    if not two_walls and not laws:
         return one_wall.orbit_plane(x_name, x_values, y_name, y_values, fixed, types,
                                     progress=progress)
     shape = (len(parsed), xs.size, ys.size)
     out = one_wall.empty(shape)
-    ns = sorted({key[2] for _, key in parsed})
+    ns = sorted({key[-1] for _, key in parsed})
     on_plane = (x_name, y_name)
+    names = TWO_WALL_PARAMETERS if two_walls else HARMONIC_PARAMETERS
     for i in range(xs.size):
         for j in range(ys.size):
             p = {k: one_wall.value_at(k, i, j, x_name, xs, y_name, ys, fixed_)
-                 for k in TWO_WALL_PARAMETERS if k != "eps_lower"}
-            eps_lower = (one_wall.value_at("eps_lower", i, j, x_name, xs, y_name, ys, fixed_)
-                         if "eps_lower" in on_plane or "eps_lower" in fixed_ else p["eps"])
+                 for k in names if k != "eps_lower"}
+            walls = {}
+            if two_walls:
+                walls = dict(gap=p["gap"], eps_lower=(
+                    one_wall.value_at("eps_lower", i, j, x_name, xs, y_name, ys, fixed_)
+                    if "eps_lower" in on_plane or "eps_lower" in fixed_ else p["eps"]))
             model = Model.paper(p["zeta"], p["eps"], p["delta"], p["amplitude"],
-                                1.0 / p["inv_beta"], gap=p["gap"], eps_lower=eps_lower)
+                                1.0 / p["inv_beta"], **walls, **laws)
             motions = periodic_motions(model, ns).motions
-            for t, (label, _) in enumerate(parsed):
-                found = [mo for mo in motions if mo.name == label]
+            for t, (label, key) in enumerate(parsed):
+                # two walls: the name "(m_upper,m_lower)/n"; one: m impacts in n periods
+                found = [mo for mo in motions if (mo.name == label if two_walls
+                                                  else (mo.m, mo.n) == key)]
                 one_wall.classify(out, (t, i, j), found, [mo.admissible for mo in found])
         if progress is not None:
             progress(ys.size)
-    return one_wall.plane_dataset(x_name, xs, y_name, ys, fixed_, parsed,
-                                  one_wall.finish(out), "periodic_motions", n_walls=2)
+    ds = one_wall.plane_dataset(x_name, xs, y_name, ys, fixed_, parsed, one_wall.finish(out),
+                                "periodic_motions", n_walls=2 if two_walls else 1)
+    ds.attrs.update({k: float(v) for k, v in laws.items() if v is not None})
+    return ds
 
 
 #: The two parameters `vibroimpact.attractor_map` runs over in one call (its grid).

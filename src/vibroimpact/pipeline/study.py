@@ -77,8 +77,9 @@ ORBIT_JOB_KEYS = {
     # ``plane`` and ``amplitude``: absent from an entry over (inv_beta, delta), so its jobs'
     # params are those they always were
     "orbits": ("zeta", "eps", "inv_beta", "delta", "types", "tile_rows", "plane",
-               "amplitude") + _WALLS,
-    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types", "plane", "amplitude") + _WALLS,
+               "amplitude") + _WALLS + _LAWS,
+    "boundaries": ("zeta", "eps", "inv_beta", "delta", "types", "plane", "amplitude") + _WALLS
+    + _LAWS,
     "attractors": ("zeta", "eps", "types", "attractors") + _WALLS,
 }
 
@@ -368,6 +369,16 @@ def laws(entry, where):
             raise ValueError(f"{where}.{key}.speed_scale must be > 0, got {scale!r}")
         out[field] = scale
     return out
+
+
+def shooting(entry):
+    """Whether an ``orbits`` entry's map is the shooting solver's (`periodic_motions`: a second
+    wall, or an impact law other than Newton's) rather than the one-wall closed form's: its
+    tiles' rule (``solve_clearance_orbit_tile``, else ``solve_orbit_tile``), their cost and
+    their folder follow."""
+    plane = entry.get("plane") or ()
+    return (entry.get("gap") is not None or "gap" in plane
+            or any(entry.get(k) is not None for k in _LAWS))
 
 
 def walls(entry, where):

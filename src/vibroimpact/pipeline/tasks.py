@@ -21,7 +21,7 @@ from vibroimpact.pipeline.provenance import config_text, provenance
 from vibroimpact.pipeline.study import (Study, attractor_rows, escape_samples, escape_seed,
                                         grid_size, grid_values, map_cap_steps, orbit_rows,
                                         orbit_tiled_axis, plane_attractor_rows,
-                                        laws, walls)
+                                        laws, shooting, walls)
 
 log = logging.getLogger("vibroimpact")
 
@@ -527,20 +527,25 @@ def orbit_tile(entry, tile, out, threads=None, solver=None):
     of the periodic motions of an ``orbits`` entry on some rows of its plane (the paper's
     (1/beta_f, delta) unless it names one; rows strided over the tiles, `orbit_rows`).
 
-    One wall on the paper's plane is Fig. 16's closed form (`vibroimpact.orbits.orbit_map`,
-    its rows in ``threads`` numba threads); any other plane, and a second wall, is
-    ``solver(x_name, x_values, y_name, y_values, fixed, types, progress=...)``: by default
-    `vibroimpact.orbits.plane.orbit_plane` (the one-wall closed form); the two-wall rule's
-    script gives `vibroimpact.attractors.plane.orbit_plane` (any wall layout: the shooting
-    solver, seeded by the simulator). The script passes it so that the one-wall tiles' code
-    reaches no simulator (their code digest, `pipeline.provenance.code_closure`).
+    One wall under Newton's law on the paper's plane is Fig. 16's closed form
+    (`vibroimpact.orbits.orbit_map`, its rows in ``threads`` numba threads); any other plane,
+    a second wall or an impact law (`study.shooting`) is ``solver(x_name, x_values, y_name,
+    y_values, fixed, types, progress=...)``: by default `vibroimpact.orbits.plane.orbit_plane`
+    (the one-wall closed form); the shooting rule's script gives
+    `vibroimpact.attractors.plane.orbit_plane` (any wall layout, any law: the shooting
+    solver, seeded by the simulator). The script passes it so that the closed form's tiles'
+    code reaches no simulator (their code digest, `pipeline.provenance.code_closure`).
     """
     import numba
 
     if threads is not None:
         numba.set_num_threads(int(threads))
-    if entry.get("plane") or entry.get("gap") is not None:
+    if entry.get("plane") or shooting(entry):
         if solver is None:
+            if shooting(entry):
+                raise ValueError("an orbits entry with a second wall or an impact law is "
+                                 "the shooting solver's: rule solve_clearance_orbit_tile "
+                                 "gives it (vibroimpact.attractors.plane.orbit_plane)")
             from vibroimpact.orbits.plane import orbit_plane as solver
         io.write_dataset(_plane_tile(entry, tile, solver), out)
         return
@@ -581,13 +586,15 @@ def _plane_tile(entry, tile, orbit_plane):
     values = {k: grid_values(entry[k]) for k in (x_name, y_name)}
     values[orbit_tiled_axis(entry)] = rows[tile::n_tiles]
     progress = Progress(f"orbit tile {tile}", values[x_name].size * values[y_name].size)
+    impact_laws = laws(entry, "orbits")         # none under Newton's law
     ds = orbit_plane(x_name, values[x_name], y_name, values[y_name], orbit_plane_fixed(entry),
                      types=[tuple(int(k) for k in t) for t in entry["types"]],
-                     progress=progress.advance)
+                     progress=progress.advance, **impact_laws)
     ds.attrs.update(provenance(entry), reason_codes="0 stable, 1 no solution, 2 inadmissible, "
                                                     "3 unstable")
     if entry.get("gap") is not None and "gap" not in (x_name, y_name):
         ds.attrs.update(_wall_attrs(*walls(entry, "orbits")))
+    ds.attrs.update(_law_attrs(impact_laws))
     return ds
 
 
@@ -609,8 +616,9 @@ def boundaries(entry, orbits_path, out, threads=None):
     """Rule ``trace_boundaries``: the exact edges of every type's stable domain over the box
     of the entry's map (``orbits_path``, whose pixel edges seed them), on its plane (the
     paper's (1/beta_f, delta) unless it names one: `orbits.boundaries.plane_boundaries`,
-    over (1/beta_f, delta) `domain_boundaries` bit for bit). A two-wall entry, or one whose
-    eps reaches 0, is written untraced (``traced = 0``, ``not_traced`` says why)."""
+    over (1/beta_f, delta) `domain_boundaries` bit for bit). A two-wall entry, one under an
+    impact law other than Newton's, or one whose eps reaches 0, is written untraced
+    (``traced = 0``, ``not_traced`` says why)."""
     fixed = orbit_plane_fixed(entry)
     axes = tuple(entry.get("plane") or ("inv_beta", "delta"))
     if entry.get("plane"):
@@ -626,6 +634,10 @@ def boundaries(entry, orbits_path, out, threads=None):
         why = "two walls: the edges are the map's cell edges"
         if not entry.get("plane"):
             attrs.update(_wall_attrs(*walls(entry, "orbits")))
+    elif laws(entry, "orbits"):
+        # the tracer continues the closed-form solutions of Newton's law
+        why = "an impact law other than Newton's: the edges are the map's cell edges"
+        attrs.update(_law_attrs(laws(entry, "orbits")))
     elif fixed.get("eps", 1.0) == 0.0 or ("eps" in axes and box["eps"][0] <= 0.0):
         # every impact ends at rest on the wall: a flight's maximum is its start, and no
         # boundary condition is regular there (the tracer refuses eps = 0)

@@ -15,7 +15,7 @@ from vibroimpact._plane import dataset_axes
 from vibroimpact.plotting._common import (_attr, _header, _nearest, _same_system, _styled,
                                           _system_text, axis_label, custom_plane,
                                           motion_title, on_plane, plane_axes, plane_caption,
-                                          plane_fixed)
+                                          plane_fixed, speed_law)
 from vibroimpact.plotting.maps import (MAP_TEXT_SIZE, S_LEVELS, TYPE_COLORS, cell_edges,
                                        cell_outline, label_contours)
 
@@ -403,6 +403,7 @@ def fig16(orbits, boundaries=None):
     xe, ye = cell_edges(x), cell_edges(y)
     overview = axes[0]
     two_walls = any(str(t).startswith("(") for t in types)
+    law = speed_law(orbits)
     reasons = TWO_WALL_REASONS if two_walls else REASONS
     reason_cmap = ListedColormap([REASONS[c][0] for c in sorted(REASONS)])
     shaded, regions, panels = None, [], {}
@@ -425,7 +426,9 @@ def fig16(orbits, boundaries=None):
                                vmax=100.0, rasterized=True)
         if stable.any():
             m, m_lower, n = _type_counts(name)
-            cplx = complex_multipliers(sel, m, n, m_lower) & stable
+            # under a speed-dependent law det T is no closed form in eps: no such edge
+            cplx = (np.zeros_like(stable) if law else
+                    complex_multipliers(sel, m, n, m_lower) & stable)
             real = np.where(cplx, np.nan, S).T
             if np.isfinite(real).any():
                 lines = ax.contour(x, y, real, levels=S_LEVELS, colors="k", linewidths=0.5)
@@ -481,9 +484,10 @@ def fig16(orbits, boundaries=None):
                               **CODIM2_STYLE))
     restitution = (r"(\varepsilon^{m_u}\varepsilon_l^{m_l})^{1/m}" if two_walls
                    else r"\varepsilon")
-    handles += [Line2D([], [], color="0.1", lw=0.9, ls=":",
-                       label=r"edge of complex multipliers (inside: $S = 100(1 - "
-                             rf"{restitution} e^{{-\zeta z/m}})$, no contours)")]
+    if not law:
+        handles += [Line2D([], [], color="0.1", lw=0.9, ls=":",
+                           label=r"edge of complex multipliers (inside: $S = 100(1 - "
+                                 rf"{restitution} e^{{-\zeta z/m}})$, no contours)")]
     if shaded is not None:
         fig.colorbar(shaded, ax=axes[1:].tolist(), label=axis_label(orbits["S"]), shrink=0.8,
                      ticks=np.arange(0, 101, 10))

@@ -20,7 +20,7 @@ from vibroimpact.pipeline import figures
 from vibroimpact.pipeline.config.messages import ConfigError, _num, _Problems
 from vibroimpact.pipeline.study import (NOISE_PARAMETERS, PLANE_PARAMETERS, escape_samples,
                                         grid_decimals, grid_size, grid_values, map_cap_steps,
-                                        noise_record)
+                                        noise_record, shooting)
 
 __all__ = ["GRID_RTOL", "check"]
 
@@ -255,6 +255,12 @@ def _check_orbits_item(config, name, entry, at, fig, item, problems):
                      "an `orbits` entry (none defined)")
         return
     other = config["orbits"][orbits]
+    law = next((k for k in ("law", "law_lower") if other.get(k) is not None), None)
+    if law is not None:
+        problems.add(f"{at}.orbits", orbits, f"orbits.{orbits}.{law} is an impact law other "
+                     f"than Newton's, and {fig} compares the map with the closed-form orbits "
+                     f"of Newton's law at its cells", f"an `orbits` entry without {law}")
+        return
     if entry.get("plane") or other.get("plane"):
         _check_orbits_item_plane(name, entry, at, orbits, other, problems)
     else:
@@ -970,12 +976,13 @@ def _check_orbits(config, name, entry, problems, limits):
         problems.add(where, name, "ends like a dataset an orbits entry derives "
                      "(results/orbits/<name>_basins.nc ...)",
                      f"a name not ending in {', '.join(DERIVED_SUFFIXES)}")
+    _check_laws(where, entry, problems)
     if entry.get("plane"):
         if not _check_orbits_plane(where, entry, problems, limits):
             return
         two_walls = entry.get("gap") is not None
-        if two_walls:
-            _check_two_wall_orbits(where, entry, problems)
+        if shooting(entry):
+            _check_shooting_orbits(where, entry, problems)
     else:
         for key in ("zeta", "eps", "eps_lower", "gap", "amplitude", "inv_beta", "delta"):
             fixed_only = key not in ("inv_beta", "delta")
@@ -993,8 +1000,8 @@ def _check_orbits(config, name, entry, problems, limits):
                          "(A = 1)", "leave it out, or give the entry a `plane` (A is then "
                          "fixed or an axis)")
         two_walls = _check_walls(where, entry, problems)
-        if two_walls:
-            _check_two_wall_orbits(where, entry, problems)
+        if shooting(entry):
+            _check_shooting_orbits(where, entry, problems)
         grids = {"inv_beta": _grid(problems, f"{where}.inv_beta", entry["inv_beta"],
                                    limits["max_orbit_cells"], positive=True),
                  "delta": _grid(problems, f"{where}.delta", entry["delta"],
@@ -1097,19 +1104,24 @@ def _check_orbits_plane(where, entry, problems, limits):
     return ok
 
 
-#: Periods n the two-wall orbit map solves for (the shooting solver's cost grows with n).
+#: Periods n the shooting solver's orbit map solves for (its cost grows with n).
 MAX_SHOOTING_N = 4
 
 
-def _check_two_wall_orbits(where, entry, problems):
-    """A two-wall ``orbits`` entry: triples of at most `MAX_SHOOTING_N` periods with an
-    impact, fig16 only (no attractors block: its kernels' workflow job knows one wall)."""
+def _check_shooting_orbits(where, entry, problems):
+    """An ``orbits`` entry the shooting solver maps (`study.shooting`: a second wall or an
+    impact law): types of at most `MAX_SHOOTING_N` periods with an impact, fig16 only (no
+    attractors block: its kernels' workflow job knows one wall under Newton's law)."""
     for j, t in enumerate(entry["types"]):
         if len(t) == 3 and not (1 <= t[2] <= MAX_SHOOTING_N and t[0] + t[1] >= 1):
             problems.add(f"{where}.types[{j}]", t, "a two-wall type the shooting map does not "
                          "solve for", f"[m_upper, m_lower, n] with m_upper + m_lower >= 1 and "
                          f"1 <= n <= {MAX_SHOOTING_N}")
-    if entry.get("attractors"):
+        elif len(t) == 2 and not 1 <= t[1] <= MAX_SHOOTING_N:
+            problems.add(f"{where}.types[{j}]", t, "a type the shooting map (an entry with an "
+                         "impact law) does not solve for", f"[m, n] with 1 <= n <= "
+                         f"{MAX_SHOOTING_N}")
+    if entry.get("attractors") and entry.get("gap") is not None:
         problems.add(f"{where}.attractors", None, "basins and Lyapunov exponents of a "
                      "two-wall entry are not a workflow job yet", "leave the attractors "
                      "block out of an entry with gap")

@@ -8,7 +8,7 @@ which the rules' ``resources:`` call). The costs were measured on the default bu
 """
 import math
 
-from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps
+from vibroimpact.pipeline.study import escape_samples, grid_values, map_cap_steps, shooting
 
 __all__ = ["record_steps", "map_steps", "plane_cap_steps", "plane_map_cpu_s", "study_steps",
            "simulate_cpu_s",
@@ -315,10 +315,10 @@ def orbit_cpu_s(cells, types):
 def orbit_plane_cpu_s(entry, cells):
     """CPU seconds of an ``orbits`` entry's map over its ``plane`` of ``cells`` cells: along
     delta the map's branch following (`orbit_cpu_s`); a plane without delta solves each cell
-    alone (`ORBIT_CELL_S` a type: the global scan, the finer m = 3 one included); two walls
-    the shooting solver (`SHOOTING_CELL_S` a cell)."""
+    alone (`ORBIT_CELL_S` a type: the global scan, the finer m = 3 one included); two walls or
+    an impact law the shooting solver (`SHOOTING_CELL_S` a cell)."""
     types = len(entry["types"])
-    if entry.get("gap") is not None or "gap" in entry["plane"]:
+    if shooting(entry):
         return cells * SHOOTING_CELL_S
     if "delta" in entry["plane"]:
         return orbit_cpu_s(cells, types)

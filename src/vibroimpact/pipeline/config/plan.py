@@ -21,7 +21,7 @@ from vibroimpact.pipeline.config.costs import (COMPILE_S, FIGURE_BYTES, FIGURE_J
                                                VALIDATION_FIGURE_S, VALIDATION_RULES)
 from vibroimpact.pipeline.config.messages import ConfigError, _num
 from vibroimpact.pipeline.study import (Study, attractor_rows, grid_size, orbit_plane_cells,
-                                        orbit_rows, plane_attractor_rows)
+                                        orbit_rows, plane_attractor_rows, shooting)
 
 __all__ = ["Plan", "Row", "make_plan", "built_entries", "WHOLE_MACHINE_RULES"]
 
@@ -377,8 +377,8 @@ def make_plan(config, own=None, *, results="results", studies=None):
             cells = orbit_plane_cells(entry)
             row.orbit_cells += cells
             row.bytes += 2 * cells * len(entry["types"]) * 34
-            # a clearance between two walls: the shooting solver's rule (common.smk)
-            tile_rule = ("solve_clearance_orbit_tile" if entry.get("gap") is not None
+            # two walls or an impact law: the shooting solver's rule (common.smk)
+            tile_rule = ("solve_clearance_orbit_tile" if shooting(entry)
                          else "solve_orbit_tile")
             if entry.get("plane"):
                 work = costs.orbit_plane_cpu_s(entry, cells)
