@@ -914,14 +914,14 @@ def _density_figure(events, i_beta, var, title, params, density_delta=None, line
         ax.set_ylim(0.0, 1.08 * drawn.top if drawn.top > 0.0 else 1.0)
     for ax in axes:
         ax.set_xlim(edges[0], drawn.x_end if drawn.x_end > edges[0] else edges[-1])
-        ax.set_ylabel(axis_label(ds[var]))
-    axes[-1].set_xlabel(axis_label(ds[x]))
+        ax.set_ylabel(_restitution_note(ds, axis_label(ds[var])))
+    axes[-1].set_xlabel(_restitution_note(ds, axis_label(ds[x])))
     if linear:
         _panel_tag(axes[0], "(a) log scale")
         _panel_tag(axes[1], "(b) linear scale")
     if zoom is not None:
         axes[1].set_xlim(edges[0], min(float(zoom), axes[0].get_xlim()[1]))
-        axes[0].set_xlabel(axis_label(ds[x]))
+        axes[0].set_xlabel(_restitution_note(ds, axis_label(ds[x])))
         _panel_tag(axes[0], "(a) every bin drawn")
         _panel_tag(axes[1], f"(b) the bulk, up to {_num(axes[1].get_xlim()[1])}")
     title_text = _density_rule_text(ds, index, drawn)
@@ -1082,13 +1082,18 @@ def _events_params(events, i_beta, drawn=tuple(COLLISION_QUANTITIES)):
     if "n_collisions" not in events:
         return line
     return line + "\n" + ";  ".join([COLLISION_NOTE]
-                                    + [_two_wall_note(events, COLLISION_QUANTITIES[name])
+                                    + [_restitution_note(events, COLLISION_QUANTITIES[name])
                                        for name in drawn])
 
 
-def _two_wall_note(ds, text):
-    """A quantity's definition with its wall's restitution ``eps_w`` when there are two."""
-    return text.replace(r"\varepsilon u", r"\varepsilon_w u") if two_wall_dataset(ds) else text
+def _restitution_note(ds, text):
+    """A quantity's definition or label with the restitution each rebound had: its wall's
+    ``eps_w`` when there are two, ``eps(u)`` under a law whose restitution falls with the
+    speed; unchanged for one wall under Newton's law."""
+    symbol = r"\varepsilon_w" if two_wall_dataset(ds) else r"\varepsilon"
+    if speed_law(ds):
+        symbol += r"(u)\,"
+    return text.replace(r"\varepsilon u", symbol + " u")
 
 
 # --------------------------------------------------------------------------------------------

@@ -8,8 +8,9 @@ from matplotlib.patches import Patch
 from vibroimpact.plotting._common import (
     CONFIDENCE, FEW_IMPACTS, SPECTRUM_BETA_MAX, STOP_BAND_LEVEL, _attr, _density_figure,
     _events_params, _figure, _header, _headroom, _num, _padded, _panel_tag, _psd_label, _require,
-    _density_deltas, _response_spectra, _spectrum_text, _styled, _trace_figure, axis_label,
-    family_styles, no_collision_text, note_on_axes, speed_law, t_quantile)
+    _restitution_note, _density_deltas, _response_spectra, _spectrum_text, _styled,
+    _trace_figure, axis_label, family_styles, no_collision_text, note_on_axes, speed_law,
+    t_quantile)
 from vibroimpact.plotting.walls import two_walls, wall_density_figure, wall_means_figure
 from vibroimpact.model import rebound_velocity
 from vibroimpact.stats.theory import (
@@ -390,7 +391,7 @@ def fig09(events, envelope="auto"):
         if np.isfinite(d_c):
             span = ax.axvspan(d_c, delta.max(), color="0.85", lw=0, zorder=0)
             span.set_gid("no_collision")
-        ax.set_ylabel(axis_label(ds[f"{name}_mean"]))
+        ax.set_ylabel(_restitution_note(ds, axis_label(ds[f"{name}_mean"])))
     axes[0].set_ylim(bottom=0.0)
     if "v_after_mean_lo" in ds and enough.any():
         # the intervals of a handful of collisions run off the axis (they are that wide)

@@ -16,7 +16,7 @@ from dataclasses import replace
 from vibroimpact.plotting._common import (
     SPARSE_TEXT, _beyond_text, _bin_edges, _density_deltas, _density_log_limits,
     _density_rule_text, _draw_densities, _events_params, _figure, _header, _num, _panel_tag,
-    _require, _two_wall_note, axis_label, note_on_axes)
+    _require, _restitution_note, axis_label, note_on_axes)
 
 #: How the figures name each wall (the ``wall`` coordinate's values).
 WALL_NAMES = {"upper": "upper wall, x = $\\delta$ (hit from below)",
@@ -119,7 +119,7 @@ def wall_density_figure(events, i_beta, quantity, title, density_delta=None):
         ax.set_ylabel(_density_label(quantity))
         _panel_tag(ax, WALL_NAMES.get(wall, wall))
     axes[0].set_xlim(edges[0], x_end if x_end > edges[0] else edges[-1])
-    axes[-1].set_xlabel(_two_wall_note(events, axis_label(ds[x])))    # eps_w u
+    axes[-1].set_xlabel(_restitution_note(events, axis_label(ds[x])))    # eps_w u
     # one title for both walls: a merged run drawn at either wall is explained
     rule = _density_rule_text(views[0], index, replace(
         drawn_any[0], any_run=any(d.any_run for d in drawn_any)))
