@@ -27,8 +27,9 @@ REASONS = {
     2: ("0.84", "crosses\nthe wall", "solutions cross the wall: eq. (13) violated"),
     3: ("#f4b6b6", "unstable", "solutions unstable: eq. (22) violated (the paper's U)"),
 }
-#: With two walls the motions come from Newton shooting seeded by settled starts
-#: (`vibroimpact.orbits.shooting`): code 1 says none was found, not that none exists.
+#: With two walls, or under an impact law, the motions come from Newton shooting seeded by
+#: settled starts (`vibroimpact.attractors.shooting`): code 1 says none was found, not that
+#: none exists.
 TWO_WALL_REASONS = {**REASONS, 1: ("white", "none found",
                                    "no motion of the type found from the settled starts")}
 #: Text colour of each reason's region words (dark enough on its own fill).
@@ -404,7 +405,8 @@ def fig16(orbits, boundaries=None):
     overview = axes[0]
     two_walls = any(str(t).startswith("(") for t in types)
     law = speed_law(orbits)
-    reasons = TWO_WALL_REASONS if two_walls else REASONS
+    shot = orbits.attrs.get("solver") == "periodic_motions"     # the shooting solver's map
+    reasons = TWO_WALL_REASONS if two_walls or shot else REASONS
     reason_cmap = ListedColormap([REASONS[c][0] for c in sorted(REASONS)])
     shaded, regions, panels = None, [], {}
     for i, name in enumerate(types):
