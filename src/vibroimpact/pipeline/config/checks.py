@@ -474,15 +474,9 @@ def _check_study(config, name, entry, problems, limits, unforced):
                          if harmonic else np.array([1.0]))
     trace_inv_beta = (entry.get("trace") or {}).get("inv_beta")
     if harmonic:
-        shortest = dt / (2 * math.pi)       # a forcing period of one sample step
         for key, values in (("inv_beta", grids["inv_beta"]),
                             ("trace.inv_beta", [trace_inv_beta] if trace_inv_beta else None)):
-            fast = [float(v) for v in (values if values is not None else []) if v < shortest]
-            if fast:
-                problems.add(f"{where}.{key}", fast[0], f"a forcing period 2 pi/beta_f shorter "
-                             f"than the sample step dt = {_num(dt)} of noises.{entry['noise']} "
-                             f"(the pressed mass would stick and release many times a step)",
-                             f"1/beta_f >= dt/(2 pi) = {shortest:.6g}")
+            _check_forcing_period(where, entry, key, values, dt, problems)
     amplitude_swept = "amplitude" in entry.get("sweep", {}).get("values", {})
     if not harmonic and not amplitude_swept:
         # keys of the harmonic force a random study would silently ignore
@@ -557,16 +551,7 @@ def _check_study(config, name, entry, problems, limits, unforced):
                              _grid_text(grids["delta"]))
     _check_motions(where, entry, two_walls, problems)
     if "map" in uses and harmonic and grids["inv_beta"] is not None:
-        spec = entry["map"]
-        try:        # the cap of the longest forcing period (the job's own check, at parse time)
-            map_cap_steps(n, dt, transient, int(spec["max_periods"]),
-                          1.0 / float(grids["inv_beta"].max()), where=f"{where}.map.max_periods")
-        except ValueError as err:
-            problems.append(f"{err} in noises.{entry['noise']}")
-        if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
-            problems.add(f"{where}.map.min_time", spec["min_time"],
-                         f"transient + min_time is beyond the record ({record})",
-                         f"0 < min_time <= {tau - transient:.6g}")
+        _check_map_record(where, entry, grids["inv_beta"], n, dt, tau, problems)
     if "map" in uses and harmonic:
         _plane(problems, where, grids, "fig15")
     if entry.get("escape"):
@@ -575,6 +560,38 @@ def _check_study(config, name, entry, problems, limits, unforced):
         _check_figures(config, "studies", name, entry, problems, grids)
     resolved.update(grids)
     return resolved
+
+def _check_forcing_period(where, entry, key, values, dt, problems):
+    """A forcing period ``2 pi / beta_f`` (``values`` of 1/beta_f under ``key``) no shorter
+    than the noise record's sample step; True when it holds."""
+    shortest = dt / (2 * math.pi)       # a forcing period of one sample step
+    fast = [float(v) for v in (values if values is not None else []) if v < shortest]
+    if fast:
+        problems.add(f"{where}.{key}", fast[0], f"a forcing period 2 pi/beta_f shorter than the "
+                     f"sample step dt = {_num(dt)} of noises.{entry['noise']} (the pressed mass "
+                     f"would stick and release many times a step)",
+                     f"1/beta_f >= dt/(2 pi) = {shortest:.6g}")
+    return not fast
+
+
+def _check_map_record(where, entry, inv_beta, n, dt, tau, problems):
+    """A map's records (a study on the paper's plane or on its own): the cap of its longest
+    forcing period within the noise record of ``n`` samples (the job's own check, at parse
+    time), ``transient + map.min_time`` inside it, and batches of the shortest cell's record
+    (``map.min_time``) long enough."""
+    spec, transient = entry["map"], float(entry["transient"])
+    try:
+        map_cap_steps(n, dt, transient, int(spec["max_periods"]), 1.0 / float(inv_beta.max()),
+                      where=f"{where}.map.max_periods")
+    except ValueError as err:
+        problems.append(f"{err} in noises.{entry['noise']}")
+    if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
+        problems.add(f"{where}.map.min_time", spec["min_time"], f"transient + min_time is beyond "
+                     f"the record (the record of noises.{entry['noise']} ends at tau = "
+                     f"{tau:.6g})", f"0 < min_time <= {tau - transient:.6g}")
+    _check_batches(where, entry, float(spec["min_time"]), dt, problems,
+                   record="a map cell's shortest, map.min_time", longer="a map.min_time")
+
 
 def _check_report_with(config, name, entry, problems):
     """``report_with``: other studies of the config (not itself, nor its sweep's own)."""
@@ -779,23 +796,9 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
     for key in ("inv_beta", "delta"):
         if key not in grids:
             grids[key] = np.array([float(entry[key])])
-    if float(grids["inv_beta"].min()) < dt / (2 * math.pi):
-        problems.add(f"{where}.inv_beta", float(grids["inv_beta"].min()), "a forcing period "
-                     f"2 pi/beta_f shorter than the sample step dt = {_num(dt)}",
-                     f"1/beta_f >= dt/(2 pi) = {dt / (2 * math.pi):.6g}")
+    if not _check_forcing_period(where, entry, "inv_beta", grids["inv_beta"], dt, problems):
         return None
-    spec = entry["map"]
-    try:
-        map_cap_steps(n, dt, transient, int(spec["max_periods"]),
-                      1.0 / float(grids["inv_beta"].max()), where=f"{where}.map.max_periods")
-    except ValueError as err:
-        problems.append(f"{err} in noises.{entry['noise']}")
-    if transient + float(spec["min_time"]) > tau * (1 + 1e-9):
-        problems.add(f"{where}.map.min_time", spec["min_time"], "transient + min_time is "
-                     f"beyond the record (tau <= {tau:.6g})",
-                     f"0 < min_time <= {tau - transient:.6g}")
-    _check_batches(where, entry, float(spec["min_time"]), dt, problems,
-                   record="a map cell's shortest, map.min_time", longer="a map.min_time")
+    _check_map_record(where, entry, grids["inv_beta"], n, dt, tau, problems)
     for key in plane:
         if grids[key].size < 2:
             problems.add(f"{where}.{key}", entry[key], f"fig15 draws contours over the "
