@@ -104,3 +104,17 @@ def test_batch_statistics_and_their_lag1_warning(record, caplog):
     assert drift["v_after_lag1"] > 2 / np.sqrt(20) and drift["interval_lag1"] > 2 / np.sqrt(20)
     messages = [r.getMessage() for r in caplog.records]
     assert len(messages) == 2 and all("lag-1" in m and "delta=0.5" in m for m in messages)
+
+
+def test_a_cell_takes_the_cells_model_and_says_so(record):
+    """The cells take a `Model` (the study's, resolved once): a tuple of numbers in its place
+    is refused with the call that makes one."""
+    for call in (lambda m: cells.event_statistics(record, NOISE.dt, m, bins=BINS),
+                 lambda m: cells.spectra_statistics(record, NOISE.dt, m, nperseg=256),
+                 lambda m: cells.trace(record, NOISE.dt, m, t_end=10.0),
+                 lambda m: cells.motion_map_cell(record, NOISE.dt, m, transient=10.0),
+                 lambda m: cells.escape_cell(record, NOISE.dt, m, transient=10.0,
+                                             record_length=100.0)):
+        with pytest.raises(ValueError, match=r"model must be a vibroimpact\.model\.Model "
+                                             r"\(e\.g\. Model\.paper"):
+            call((0.05, 0.5, 0.0))

@@ -87,6 +87,15 @@ def cell_model(params):
                        1.0 / p.pop("inv_beta"), **p)
 
 
+def _model(model):
+    """``model`` itself, once it is a `Model`: the cells take the cell's resolved model
+    (`study_model`, `cell_model`, or `Model.paper` of its parameters)."""
+    if not isinstance(model, Model):
+        raise ValueError(f"model must be a vibroimpact.model.Model (e.g. Model.paper(zeta, "
+                         f"eps, delta, amplitude, beta_f)), got {type(model).__name__}")
+    return model
+
+
 def _loose(model):
     """The model as the keywords of `audit_moments` (``beta_f`` its forcing frequency)."""
     params = model.params()
@@ -183,6 +192,7 @@ def event_statistics(noise, dt, model, *, transient=0.0, t_end=None, bins,
     a warning on the ``vibroimpact`` logger: the batches are then too short for an honest
     error.
     """
+    model = _model(model)
     t_end = _record_end(noise, dt, t_end)
     if not 0.0 <= transient < t_end:
         raise ValueError(f"transient must lie in [0, t_end = {t_end!r}), got {transient!r}")
@@ -603,6 +613,7 @@ def spectra_statistics(noise, dt, model, *, transient=0.0, t_end=None, nperseg=4
         the line it is). ``model`` as in `event_statistics`; a(tau) is measured from the
         wall at delta whatever the walls.
     """
+    model = _model(model)
     t_end = _record_end(noise, dt, t_end)
     skip = int(math.ceil(transient / dt - 1e-9))
     batches = None
@@ -639,6 +650,7 @@ def trace(noise, dt, model, *, t_end):
 
     ``t_end`` longer than the noise record raises ValueError.
     """
+    model = _model(model)
     t_end = _record_end(noise, dt, t_end)
     res = next(iter(simulate_model_chunks(model, noise, dt, t_end=t_end, record_every=1,
                                           chunk_size=int(math.ceil(t_end / dt)) + 1)))
@@ -734,7 +746,7 @@ def motion_map_cell(noise, dt, model, *, transient, motions=stats.DEFAULT_MOTION
     """
     from vibroimpact import tally     # compiled: the jobs that group collisions load it
 
-    beta_f = model.beta
+    beta_f = _model(model).beta
     n_cap = map_cap_steps(len(noise), dt, transient, max_periods, beta_f)
     n_next = min(n_cap, int(math.ceil((transient + min_time) / dt - 1e-9)))
     two = model.n_walls == 2
@@ -858,7 +870,7 @@ def escape_cell(noise, dt, model, *, transient, record_length, motions=stats.DEF
         raise ValueError(f"record_length = {record_length!r} after the transient "
                          f"{transient!r} needs {n_end + 1} samples at dt = {dt!r}, the record "
                          f"holds {len(noise)}")
-    beta_f = model.beta
+    beta_f = _model(model).beta
     events = _EventRecord(dt, noise, model)
     two = model.n_walls == 2
     k = 0
