@@ -592,6 +592,8 @@ def _plane_tile(entry, tile, orbit_plane):
                      progress=progress.advance, **impact_laws)
     ds.attrs.update(provenance(entry), reason_codes="0 stable, 1 no solution, 2 inadmissible, "
                                                     "3 unstable")
+    if not entry.get("plane"):      # the paper's plane: named by no attribute, as Fig. 16's
+        del ds.attrs["axes"], ds.attrs["fixed"]
     if entry.get("gap") is not None and "gap" not in (x_name, y_name):
         ds.attrs.update(_wall_attrs(*walls(entry, "orbits")))
     ds.attrs.update(_law_attrs(impact_laws))
