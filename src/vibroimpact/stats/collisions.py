@@ -351,7 +351,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     Collisions
         ``wall`` holds each collision's wall (all 0 with one wall).
     """
-    step, offset, u, start, end, dt, eps, floor, pressed, wall = _checked(
+    step, offset, u, start, end, dt, eps, floor, pressed, wall = group_arguments(
         impact_step, impact_offset, impact_velocity, stick_start, stick_end, dt=dt, eps=eps,
         floor=floor, pressed=pressed, rule=rule, wall=wall, stick_wall=stick_wall,
         eps_lower=eps_lower)
@@ -359,7 +359,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     if rule == "rebounds" and n and not np.any(eps * u >= floor):
         n = 0
     if n == 0:
-        return _no_collisions(floor, dt)
+        return no_collisions(floor, dt)
     t = step * dt + offset
     # the first sticking phase that begins at or after each impact, and whether it begins
     # before the next impact
@@ -397,8 +397,8 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
                       rebounds, stuck, stick_time, duration, floor, dt, wall[first])
 
 
-def _checked(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *, dt, eps,
-             floor, pressed, rule, wall, stick_wall, eps_lower):
+def group_arguments(impact_step, impact_offset, impact_velocity, stick_start, stick_end, *,
+                    dt, eps, floor, pressed, rule, wall, stick_wall, eps_lower):
     """`group_collisions`'s arguments as arrays, checked: ``(step, offset, u, start, end, dt,
     eps, floor, pressed, wall)``, ``eps`` per impact where a second wall has its own
     restitution (else the float), ``wall`` int8."""
@@ -450,7 +450,7 @@ def _restitution(eps, shape):
     return eps
 
 
-def _no_collisions(floor, dt):
+def no_collisions(floor, dt):
     """The `Collisions` of a record without any."""
     e_i, e_f = np.empty(0, np.int64), np.empty(0)
     return Collisions(e_i, e_i.copy(), e_i.copy(), e_f, e_f.copy(), e_f.copy(), e_i.copy(),

@@ -30,10 +30,10 @@ def motion_key(motion) -> str:
     """The name of a motion: ``"1/1"`` for ``(1, 1)`` (m collisions per n forcing periods,
     whatever the wall), ``"(1,1)/1"`` for ``(1, 1, 1)`` (one collision at each wall per
     forcing period: ``(m_upper, m_lower, n)``, two walls)."""
-    return _motion_key(_check_motions([motion])[0])
+    return _motion_key(checked_motions([motion])[0])
 
 
-def _check_motions(motions, walls=None):
+def checked_motions(motions, walls=None):
     """Motions as tuples: ``(m, n)`` (m collisions per n periods, any wall) or
     ``(m_upper, m_lower, n)`` (a two-wall motion: that many at each wall); the latter need
     ``walls`` (the wall of each collision) when classifying (``walls`` not None here)."""
@@ -57,7 +57,7 @@ def _check_motions(motions, walls=None):
     return tuple(out)
 
 
-def _length(motion):
+def motion_length(motion):
     """Collisions (intervals) of one group of the motion."""
     return motion[0] + motion[1] if len(motion) == 3 else motion[0]
 
@@ -66,7 +66,7 @@ def _match_masks(ratio: np.ndarray, window: float, motions, walls=None) -> np.nd
     """match[i, j]: intervals j .. j+m_i-1 form motion i (see `classify_impact_intervals`)."""
     match = np.zeros((len(motions), ratio.size), dtype=bool)
     for i, motion in enumerate(motions):
-        m, n = _length(motion), motion[-1]
+        m, n = motion_length(motion), motion[-1]
         if ratio.size < m:
             continue
         if m == 1:
@@ -128,7 +128,7 @@ def classify_impact_intervals(ratio, window: float = DEFAULT_MOTION_WINDOW,
     return _classify(ratio, window, motions, walls)[0]
 
 
-def _walls(walls, n):
+def checked_walls(walls, n):
     """The walls of the intervals' first collisions as int8 (None stays None)."""
     if walls is None:
         return None
@@ -145,12 +145,12 @@ def _classify(ratio, window, motions, walls=None):
     """Labels (as `classify_impact_intervals`) and the first interval of each one's group."""
     ratio = np.asarray(ratio, dtype=float)
     _checks.real("window", window, low=0.0, high=0.5, low_open=True)
-    walls = _walls(walls, ratio.size)
-    motions = _check_motions(motions, walls=walls is not None)
+    walls = checked_walls(walls, ratio.size)
+    motions = checked_motions(motions, walls=walls is not None)
     match = _match_masks(ratio, window, motions, walls)
     labels = np.full(ratio.size, -1, dtype=np.int64)
     group = np.arange(ratio.size)
-    lengths = np.array([_length(m) for m in motions])
+    lengths = np.array([motion_length(m) for m in motions])
     candidates = np.flatnonzero(match.any(axis=0))
     first = np.argmax(match[:, candidates], axis=0)       # the first motion matching there
     if (lengths == 1).all():
@@ -262,7 +262,7 @@ def impact_motion_probabilities(intervals, beta: float, window: float = DEFAULT_
     pipeline's definition (docs/figures.md, "The probability of an impact motion").
     """
     intervals = np.asarray(intervals, dtype=float)
-    motions = _check_motions(motions, walls=walls is not None)
+    motions = checked_motions(motions, walls=walls is not None)
     covered = float(intervals.sum())
     if total_time is None:
         total_time = covered
@@ -371,12 +371,12 @@ def motion_statistics(impact_time, intervals, beta: float, t_start: float, t_sto
     to forget its type; a record with few switches between motions (`n_switches`) violates
     that, and its error is then too small (the workflow marks such cells).
     """
-    return _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, motions,
-                              n_batches, stuck, walls, _labelled, _at_edges)
+    return motion_statistics_with(impact_time, intervals, beta, t_start, t_stop, window,
+                                  motions, n_batches, stuck, walls, _labelled, _at_edges)
 
 
-def _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, motions,
-                       n_batches, stuck, walls, labelled, at_edges):
+def motion_statistics_with(impact_time, intervals, beta, t_start, t_stop, window, motions,
+                           n_batches, stuck, walls, labelled, at_edges):
     """`motion_statistics` with its two passes over the intervals given: ``labelled(ratio,
     window, motions, walls, stuck) -> (labels, classes, n_switches)`` (`_labelled`) and
     ``at_edges(t, z, classes, n_classes, edges) -> (n_classes, B + 1)`` (`_at_edges`); the
@@ -385,7 +385,7 @@ def _motion_statistics(impact_time, intervals, beta, t_start, t_stop, window, mo
     z = np.asarray(intervals, dtype=float)
     if walls is not None:
         walls = np.asarray(walls)[: z.size]
-    motions = _check_motions(motions, walls=walls is not None)
+    motions = checked_motions(motions, walls=walls is not None)
     n_batches = _checks.integer("n_batches", n_batches, low=2)
     duration = float(t_stop) - float(t_start)
     if not duration > 0.0:
@@ -437,16 +437,16 @@ def _at_edges(t, z, classes, n_classes, edges):
 
 def _batch_stderr(t, z, classes, n_classes, t_start, duration, n_batches, at_edges=_at_edges):
     """Batch-means standard error of each class's covered fraction (`motion_statistics`)."""
-    edges = _batch_edges(t_start, duration, n_batches)
-    return _stderr_of_covered(at_edges(t, z, classes, n_classes, edges), duration, n_batches)
+    edges = batch_edges(t_start, duration, n_batches)
+    return stderr_of_covered(at_edges(t, z, classes, n_classes, edges), duration, n_batches)
 
 
-def _batch_edges(t_start, duration, n_batches):
+def batch_edges(t_start, duration, n_batches):
     """The edges of the B stretches of `_batch_stderr`."""
     return t_start + duration * np.arange(n_batches + 1) / n_batches
 
 
-def _stderr_of_covered(covered, duration, n_batches):
+def stderr_of_covered(covered, duration, n_batches):
     """`_batch_stderr` from the time each class covered up to each edge (`_at_edges`)."""
     # in Fortran order, as the fancy-indexed ``cover[:, j]`` makes it: the standard deviation
     # below sums each class's batches in the order the stored maps were built with

@@ -44,13 +44,13 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
     from vibroimpact.stats import collisions as _collisions
     from vibroimpact.tally import kernels
 
-    step, offset, u, start, end, dt, eps, floor, pressed, wall = _collisions._checked(
+    step, offset, u, start, end, dt, eps, floor, pressed, wall = _collisions.group_arguments(
         impact_step, impact_offset, impact_velocity, stick_start, stick_end, dt=dt, eps=eps,
         floor=floor, pressed=pressed, rule=rule, wall=wall, stick_wall=stick_wall,
         eps_lower=eps_lower)
     n = step.size
     if n == 0:
-        return _collisions._no_collisions(floor, dt)
+        return _collisions.no_collisions(floor, dt)
     eps = np.full(n, eps) if np.ndim(eps) == 0 else np.ascontiguousarray(eps, dtype=float)
     t0 = -np.inf if after is None else float(after)
     pressed = (np.ascontiguousarray(pressed, dtype=np.bool_) if rule == "physical"
@@ -60,7 +60,7 @@ def group_collisions(impact_step, impact_offset, impact_velocity, stick_start, s
         np.ascontiguousarray(start), np.ascontiguousarray(end), dt, eps, floor, pressed,
         _collisions.RULES.index(rule), np.ascontiguousarray(wall), t0)
     if rule == "rebounds" and n_counted == 0:     # no rebound reaches the floor: no event
-        return _collisions._no_collisions(floor, dt)
+        return _collisions.no_collisions(floor, dt)
     first, impact_collision, step, offset, time, u, rebounds, stuck, stick_time, duration, \
         wall = fields
     return _collisions.Collisions(first, impact_collision, step, offset, time, u, rebounds,
@@ -73,8 +73,9 @@ def motion_statistics(impact_time, intervals, beta, t_start, t_stop, *,
     """``stats.motion_statistics``: the same arguments, checks and result, bit for bit."""
     from vibroimpact.stats import motions as _motions
 
-    return _motions._motion_statistics(impact_time, intervals, beta, t_start, t_stop, window,
-                                       motions, n_batches, stuck, walls, _labelled, _at_edges)
+    return _motions.motion_statistics_with(impact_time, intervals, beta, t_start, t_stop,
+                                           window, motions, n_batches, stuck, walls, _labelled,
+                                           _at_edges)
 
 
 class MotionTally:
@@ -108,10 +109,10 @@ class MotionTally:
         self.beta = _checks.real("beta", beta, low=0.0, low_open=True)
         self.scale = self.beta / (2.0 * np.pi)      # as `stats.interval_ratio`
         self.window = _checks.real("window", window, low=0.0, high=0.5, low_open=True)
-        self.motions = _motions._check_motions(motions, walls=bool(walls))
+        self.motions = _motions.checked_motions(motions, walls=bool(walls))
         self.n_batches = _checks.integer("n_batches", n_batches, low=2)
         self.walls = bool(walls)
-        self.lengths = np.array([_motions._length(m) for m in self.motions], dtype=np.int64)
+        self.lengths = np.array([_motions.motion_length(m) for m in self.motions], dtype=np.int64)
         self.periods = np.array([m[-1] for m in self.motions], dtype=np.int64)
         self.lowers = np.array([m[1] if len(m) == 3 else -1 for m in self.motions],
                                dtype=np.int64)
@@ -144,12 +145,12 @@ class MotionTally:
         duration = float(t_stop) - float(t_start)
         if not duration > 0.0:
             raise ValueError(f"t_stop must be > t_start, got [{t_start!r}, {t_stop!r}]")
-        edges = _motions._batch_edges(float(t_start), duration, self.n_batches)
+        edges = _motions.batch_edges(float(t_start), duration, self.n_batches)
         z, labels, switches, covered, gathered, bounds = self._pass(
             time, step, offset, dt, stuck, walls, edges)
         probability = self._fractions(gathered, bounds, duration)
         m = len(self.motions)
-        stderr = (_motions._stderr_of_covered(covered, duration, self.n_batches) if z.size
+        stderr = (_motions.stderr_of_covered(covered, duration, self.n_batches) if z.size
                   else np.zeros(2 * m))
         return _motions.MotionStatistics(probability[:m], stderr[:m], switches, labels,
                                          probability[m:], stderr[m:])
@@ -256,14 +257,14 @@ def _labelled(ratio, window, motions, walls, stuck):
 
     ratio = np.ascontiguousarray(ratio, dtype=float)
     window = _checks.real("window", window, low=0.0, high=0.5, low_open=True)
-    walls = _motions._walls(walls, ratio.size)
-    motions = _motions._check_motions(motions, walls=walls is not None)
+    walls = _motions.checked_walls(walls, ratio.size)
+    motions = _motions.checked_motions(motions, walls=walls is not None)
     if stuck is not None:
         stuck = np.asarray(stuck, dtype=bool)
         if stuck.shape != ratio.shape:
             raise ValueError(f"stuck must hold one flag per interval ({ratio.size}), got "
                              f"shape {stuck.shape}")
-    lengths = np.array([_motions._length(m) for m in motions], dtype=np.int64)
+    lengths = np.array([_motions.motion_length(m) for m in motions], dtype=np.int64)
     periods = np.array([m[-1] for m in motions], dtype=np.int64)
     lowers = np.array([m[1] if len(m) == 3 else -1 for m in motions], dtype=np.int64)
     return kernels.label(
