@@ -630,16 +630,17 @@ def boundaries(entry, orbits_path, out, threads=None):
         attrs = dict(provenance(entry), zeta=fixed["zeta"], eps=fixed["eps"], traced=1)
     seeds = io.load_dataset(orbits_path)
     box = {k: (float(seeds[k].min()), float(seeds[k].max())) for k in axes}
+    impact_laws = laws(entry, "orbits")         # none under Newton's law
     why = None
     if entry.get("gap") is not None or "gap" in axes:
         # the boundary tracer continues the closed-form (m/n) solutions: one wall only
         why = "two walls: the edges are the map's cell edges"
         if not entry.get("plane"):
             attrs.update(_wall_attrs(*walls(entry, "orbits")))
-    elif laws(entry, "orbits"):
+    elif impact_laws:
         # the tracer continues the closed-form solutions of Newton's law
         why = "an impact law other than Newton's: the edges are the map's cell edges"
-        attrs.update(_law_attrs(laws(entry, "orbits")))
+        attrs.update(_law_attrs(impact_laws))
     elif fixed.get("eps", 1.0) == 0.0 or ("eps" in axes and box["eps"][0] <= 0.0):
         # every impact ends at rest on the wall: a flight's maximum is its start, and no
         # boundary condition is regular there (the tracer refuses eps = 0)
