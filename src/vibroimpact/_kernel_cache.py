@@ -11,6 +11,30 @@ Nothing here imports numba: the decorator is handed numba's ``njit``.
 import hashlib
 from pathlib import Path
 
+#: The files the compiled impact law is made of (:mod:`vibroimpact._law`), relative to the
+#: package's root (``src/vibroimpact``).
+LAW_MODULES = ("model.py", "_law.py")
+
+#: The modules each kernel package's compiled kernels are made of (constants and the impact
+#: law included), relative to the package's root: the simulator's (``impact``) and the orbit
+#: solver's (``orbits``) decorators stamp their kernels with theirs, and a package whose
+#: kernels inline both (the attractors) with the two.
+KERNEL_MODULES = {
+    "impact": tuple(f"impact/{m}" for m in (
+        "tolerances.py", "layout.py", "motion.py", "events.py", "stepping.py",
+        "parameters.py")) + LAW_MODULES,
+    "orbits": tuple(f"orbits/{m}" for m in (
+        "tolerances.py", "flight.py", "linalg.py", "newton.py", "solutions.py", "m1.py",
+        "intervals.py", "scan_m2.py", "scan_m3.py", "solve.py", "domain_map.py",
+        "boundaries_kernels.py")) + LAW_MODULES,
+}
+
+
+def package_modules(*packages):
+    """The kernel modules of ``packages`` (keys of :data:`KERNEL_MODULES`) as names relative
+    to a module one folder below the root, for :func:`kernel_decorator`'s ``modules``."""
+    return tuple(f"../{m}" for package in packages for m in KERNEL_MODULES[package])
+
 
 def sources_digest(anchor, modules):
     """SHA-256 of the files ``modules`` (names of ``.py`` files beside ``anchor``), in order."""

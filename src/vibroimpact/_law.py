@@ -11,10 +11,7 @@ that an edit of the law recompiles its callers.
 from numba import njit
 
 from vibroimpact import model
-from vibroimpact._kernel_cache import kernel_decorator
-
-#: The files the compiled law is made of, relative to this package's root (``src/vibroimpact``).
-LAW_MODULES = ("model.py", "_law.py")
+from vibroimpact._kernel_cache import LAW_MODULES, kernel_decorator
 
 _kernel = kernel_decorator(njit, __file__, LAW_MODULES, error_model="numpy")
 

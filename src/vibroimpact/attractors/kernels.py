@@ -19,9 +19,8 @@ import math
 from numba import njit, prange
 import numpy as np
 
-from vibroimpact._kernel_cache import kernel_decorator
+from vibroimpact._kernel_cache import kernel_decorator, package_modules
 from vibroimpact._law import rebound_derivative, rebound_ratio, rebound_velocity
-from vibroimpact.impact import _jit as _impact_jit
 from vibroimpact.impact.layout import (BUFFER_FULL, FREE, N_COUNTERS, N_FTOT, N_PARAMS,
                                        N_STATE, OK, P_AQ, P_BETA, P_BH_HI, P_BH_LO, P_DELTA,
                                        P_PHI, S_COS_PSI, S_MODE, S_SIN_PSI, S_W, S_WV, STICK_LO,
@@ -30,7 +29,6 @@ from vibroimpact.impact.motion import phase
 from vibroimpact.impact.parameters import parameters
 from vibroimpact.impact.stepping import run_steps
 from vibroimpact.impact.tolerances import STEP_HEADROOM
-from vibroimpact.orbits import _jit as _orbits_jit
 from vibroimpact.orbits.flight import (flight_max, harmonic_constants, lam_of, monodromy,
                                       orbit_margin, propagator)
 from vibroimpact.orbits.intervals import fill_interval_system, start_from_intervals
@@ -46,8 +44,7 @@ from vibroimpact.orbits.tolerances import (ADMISSIBLE_TOL, FLIGHT_STACK, M3_CIRC
 #: these kernels inline (:mod:`vibroimpact._kernel_cache`): an edit of any recompiles them.
 kernel = kernel_decorator(
     njit, __file__,
-    ("kernels.py",) + tuple(f"../orbits/{m}" for m in _orbits_jit.KERNEL_MODULES)
-    + tuple(f"../impact/{m}" for m in _impact_jit.KERNEL_MODULES),
+    ("kernels.py",) + package_modules("orbits", "impact"),
     error_model="numpy")
 
 # --- constants ------------------------------------------------------------------------------
