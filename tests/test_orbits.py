@@ -325,6 +325,33 @@ def test_invalid_input_names_the_argument(kwargs, name):
         periodic_orbits(**args)
 
 
+def test_a_model_gives_the_loose_call_bit_for_bit_and_any_other_law_is_refused():
+    """``model=`` is the loose call (every field of every orbit equal to the bit); a model the
+    closed form does not solve (second wall, speed-dependent law, amplitude other than 1) is
+    refused in one line that names ``periodic_motions``, and so is a call giving both."""
+    from vibroimpact import Model
+    for m, n, ib, d in ((1, 1, 1.1, 0.5), (2, 1, 2.0, -0.5), (1, 2, 0.7, 0.5)):
+        loose = periodic_orbits(m, n, 1 / ib, d, ZETA, EPS, include_inadmissible=True)
+        shared = periodic_orbits(m, n, model=Model.paper(ZETA, EPS, d, 1.0, 1 / ib),
+                                 include_inadmissible=True)
+        assert len(loose) == len(shared) >= 1
+        for a, b in zip(loose, shared):
+            for f in dataclasses.fields(a):
+                np.testing.assert_array_equal(getattr(a, f.name), getattr(b, f.name))
+    for model, what in ((Model.paper(ZETA, EPS, 0.5, 1.0, 0.9, gap=2.0), "second wall"),
+                        (Model.paper(ZETA, EPS, 0.5, 1.0, 0.9, speed_scale=3.0), "speed"),
+                        (Model.paper(ZETA, EPS, 0.5, 2.0, 0.9), "amplitude 2.0")):
+        with pytest.raises(ValueError, match=f"{what}.*periodic_motions") as err:
+            periodic_orbits(1, 1, model=model)
+        assert "\n" not in str(err.value)
+    with pytest.raises(TypeError, match="not both.*zeta"):
+        periodic_orbits(1, 1, zeta=ZETA, model=Model.paper(ZETA, EPS, 0.5, 1.0, 0.9))
+    with pytest.raises(TypeError, match="missing eps"):
+        periodic_orbits(1, 1, 0.9, 0.5, ZETA)
+    with pytest.raises(TypeError, match="vibroimpact.Model"):
+        periodic_orbits(1, 1, model=dict(zeta=ZETA))
+
+
 def test_m_above_three_not_supported():
     with pytest.raises(NotImplementedError, match="m"):
         periodic_orbits(4, 1, 1.0, 0.0, ZETA, EPS)

@@ -62,9 +62,11 @@ import numpy as np
 
 from vibroimpact import _checks
 from vibroimpact._limits import MAX_M
+from vibroimpact.model import Model
 from vibroimpact.orbits import kernels as ok
 
-__all__ = ["PeriodicOrbit", "periodic_orbits", "orbit_map", "Reason", "REASON_CODES"]
+__all__ = ["PeriodicOrbit", "periodic_orbits", "closed_form", "orbit_map", "Reason",
+           "REASON_CODES"]
 
 #: Rows per thread in one call of `orbit_map`'s kernel, between two reports of its progress:
 #: Fig. 16's 141 x 226 map takes ~11 CPU-s, ~0.08 s a row, so a block is ~0.3 s on 2 idle
@@ -200,6 +202,22 @@ def _validate(m, n, beta, delta, zeta, eps):
     return m, n, beta, delta, _checks.zeta(zeta), _checks.eps(eps)
 
 
+def closed_form(model, solver="periodic_orbits"):
+    """``(beta, delta, zeta, eps)`` of a `vibroimpact.Model` the closed form solves: one wall
+    under Newton's law and the force ``sin(beta tau)`` (amplitude 1). Any other model is
+    refused in one line that names the solver that takes it (`periodic_motions`)."""
+    if not isinstance(model, Model):
+        raise TypeError(f"model must be a vibroimpact.Model, got {type(model).__name__}")
+    other = ([f"a second wall (gap {model.gap!r})"] if model.n_walls == 2 else []) + (
+        [] if model.newton else ["a restitution that falls with the impact speed"]) + (
+        [] if model.amplitude == 1.0 else [f"amplitude {model.amplitude!r}"])
+    if other:
+        raise ValueError(f"{solver} is the closed form of one wall under Newton's law and the "
+                         f"force sin(beta tau); this model has {' and '.join(other)}: "
+                         f"vibroimpact.periodic_motions(model, n) solves it")
+    return model.beta, model.delta, model.zeta, model.eps
+
+
 def _raw_solutions(m, n, beta, delta, zeta, eps):
     """Rows ``(tau_0..tau_{m-1}, u_0..u_{m-1})`` of every solution of eqs. (10)-(11)."""
     sols = np.empty((ok.MAX_SOLUTIONS, 2 * m + 1))     # the last column: uncertainty
@@ -240,7 +258,8 @@ def _make_orbit(y, m, n, beta, delta, zeta, eps):
     )
 
 
-def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False):
+def periodic_orbits(m, n, beta=None, delta=None, zeta=None, eps=None, *, model=None,
+                    include_inadmissible=False):
     """Every (m/n) periodic impact motion at one parameter point (paper section 4).
 
     Parameters
@@ -255,6 +274,10 @@ def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False)
         Damping ratio in (0, 1).
     eps : float
         Restitution coefficient in [0, 1].
+    model : vibroimpact.Model, optional
+        The parameter point as a model, in place of ``beta, delta, zeta, eps``: one wall under
+        Newton's law, amplitude 1 (`closed_form`; any other is refused, naming
+        `vibroimpact.periodic_motions`, which solves it).
     include_inadmissible : bool, optional
         Also return solutions whose flights cross the wall (``admissible=False``).
 
@@ -280,7 +303,30 @@ def periodic_orbits(m, n, beta, delta, zeta, eps, *, include_inadmissible=False)
     (True, 0.3539, 2.1048)
     >>> bool(np.isclose(np.linalg.det(orbit.jacobian), 0.5**2 * np.exp(-2 * 0.05 * orbit.period)))
     True
+
+    The same point as a model; a second wall is the shooting solver's:
+
+    >>> from vibroimpact import Model
+    >>> (same,) = periodic_orbits(1, 1, model=Model.paper(0.05, 0.5, 0.5, 1.0, 1 / 1.1))
+    >>> (same.tau0, same.lam) == (orbit.tau0, orbit.lam)
+    True
+    >>> two_walls = Model.paper(0.05, 0.5, 0.5, 1.0, 1 / 1.1, gap=2.0)
+    >>> periodic_orbits(1, 1, model=two_walls)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: periodic_orbits is ... a second wall (gap 2.0): vibroimpact.periodic_motions(...
     """
+    loose = dict(beta=beta, delta=delta, zeta=zeta, eps=eps)
+    if model is not None:
+        given = [k for k, v in loose.items() if v is not None]
+        if given:
+            raise TypeError(f"periodic_orbits takes a model or beta, delta, zeta, eps, not "
+                            f"both (got model and {', '.join(given)})")
+        beta, delta, zeta, eps = closed_form(model)
+    elif None in loose.values():
+        missing = [k for k, v in loose.items() if v is None]
+        raise TypeError(f"periodic_orbits needs beta, delta, zeta and eps (or model=): "
+                        f"missing {', '.join(missing)}")
     m, n, beta, delta, zeta, eps = _validate(m, n, beta, delta, zeta, eps)
     orbits = [_make_orbit(y, m, n, beta, delta, zeta, eps)
               for y in _raw_solutions(m, n, beta, delta, zeta, eps)]
