@@ -89,17 +89,26 @@ def sobol_starts(n_starts, gap, velocity, seed):
     return u, theta, g, v0
 
 
-def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf, eps_lower=None):
+def kernel_walls(clearance, eps, eps_lower):
+    """The kernels' ``(clearance, eps_lower)`` (float): no second wall (``clearance`` None,
+    the one spelling above the kernels) is a wall at infinite distance with ``eps``."""
+    if clearance is None:
+        return math.inf, float(eps)
+    return float(clearance), float(eps if eps_lower is None else eps_lower)
+
+
+def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=None, eps_lower=None):
     """Stable admissible solver orbits per cell and type (arrays of
     :func:`kernels.cell_orbits`): ``n_stable (n_rows, nb, nd)``, and per cell, row and orbit
-    the phases, approach velocities, intervals and ``ln max|mu|``. One wall: a row per type.
-    With a finite ``clearance``, the rows of the wall above (the orbits that stay above the
-    wall below), then those of the wall below: the one-wall orbits of the mirrored frame
-    ``x -> -x``, play ``clearance - delta`` and restitution ``eps_lower``, that stay below
-    the wall above (the mirror image of a cell holds the same numbers the other way round)."""
+    the phases, approach velocities, intervals and ``ln max|mu|``. One wall (``clearance``
+    None): a row per type. With a ``clearance``, the rows of the wall above (the orbits that
+    stay above the wall below), then those of the wall below: the one-wall orbits of the
+    mirrored frame ``x -> -x``, play ``clearance - delta`` and restitution ``eps_lower``, that
+    stay below the wall above (the mirror image of a cell holds the same numbers the other way
+    round)."""
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
     walls = [(delta, eps)]
-    if clearance < math.inf:
+    if clearance is not None:
         walls.append((clearance - delta, eps if eps_lower is None else eps_lower))
     shape = (nb, nd, len(walls) * nt, ak.K_ORBITS, ak.M_COLS)
     n_stable = np.zeros((len(walls) * nt, nb, nd), np.int64)
@@ -113,7 +122,8 @@ def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=math.inf, eps_low
         lnmu_w = np.full(shape[:2] + (nt, ak.K_ORBITS), np.nan)
         with numba.parallel_chunksize(1):       # rows handed out as threads come free
             ak.cell_orbits(inv_beta, np.ascontiguousarray(plays), types, float(zeta),
-                           float(eps_w), *arrays, lnmu_w, float(clearance), rows)
+                           float(eps_w), *arrays, lnmu_w,
+                           kernel_walls(clearance, eps, eps_lower)[0], rows)
         n_stable[part] = arrays[0]
         for full, got in zip((oph, ou, oz, lnmu), arrays[1:] + [lnmu_w]):
             full[:, :, part] = got
@@ -389,11 +399,12 @@ def attractor_map(inv_beta, delta, zeta, eps, types=DEFAULT_TYPES, *, n_starts=6
 
 
 def _validate_walls(clearance, eps_lower, eps, gap):
-    """``(clearance, eps_lower)`` for the kernels: ``(inf, eps)`` with one wall."""
+    """``(clearance, eps_lower)`` checked: ``(None, None)`` with one wall, ``eps_lower``
+    defaulting to ``eps`` with two."""
     if clearance is None:
         if eps_lower is not None:
             raise ValueError("eps_lower needs a second wall: give clearance as well")
-        return math.inf, eps
+        return None, None
     clearance = _checks.real("clearance", clearance, low=0.0, low_open=True)
     eps_lower = eps if eps_lower is None else _checks.eps(eps_lower, "eps_lower")
     if gap[1] > clearance:
@@ -403,7 +414,7 @@ def _validate_walls(clearance, eps_lower, eps, gap):
 
 
 def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity, max_time,
-                     match_tol, seed, *, clearance=math.inf, eps_lower=None, progress=None):
+                     match_tol, seed, *, clearance=None, eps_lower=None, progress=None):
     """Every start of every cell (validated input); the kernels' raw per-start records
     ``outf (n, N_F)``, ``outi (n, N_I)`` (start ``i`` of cell ``c = ib nd + id`` at row
     ``c n_starts + i``), the starts, the solver orbits and the kernels' times."""
@@ -433,8 +444,8 @@ def _simulate_starts(inv_beta, delta, zeta, eps, types, n_starts, gap, velocity,
     # progress: a start's numbers are its own (its buffers are reset, whatever ran before on
     # them), so the blocks give one call's numbers bit for bit
     per_block = max(1, BLOCK_STARTS // n_starts) * n_starts
-    args = (float(zeta), float(eps), float(clearance),
-            float(eps if eps_lower is None else eps_lower), float(max_time), float(match_tol),
+    args = (float(zeta), float(eps), *kernel_walls(clearance, eps, eps_lower),
+            float(max_time), float(match_tol),
             np.tile(types, (n_walls, 1)), nt, np.ascontiguousarray(orb_n),
             oph.reshape(shape), ou.reshape(shape), oz.reshape(shape))
     for lo in range(0, n, per_block):
@@ -463,6 +474,7 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
     ``(step, offset, velocity)`` of the first start, run serially (tests, brute force)."""
     types = _types(types)
     clearance, eps_lower = _validate_walls(clearance, eps_lower, eps, (0.0, 0.0))
+    walls = kernel_walls(clearance, eps, eps_lower)
     ib = np.array([float(inv_beta)])
     dd = np.array([float(delta)])
     n_stable, oph, ou, oz, _ = stable_orbits(ib, dd, types, zeta, eps, clearance, eps_lower)
@@ -475,13 +487,13 @@ def _starts_at_cell(inv_beta, delta, zeta, eps, theta, x0, v0, types=DEFAULT_TYP
     orb_n = np.ascontiguousarray(n_stable[:, 0, 0])
     if trace:
         tk, ts, tu = np.zeros(trace, np.int64), np.full(trace, np.nan), np.full(trace, np.nan)
-        ak.trace_start(1.0 / ib[0], dd[0], float(zeta), float(eps), clearance, eps_lower,
+        ak.trace_start(1.0 / ib[0], dd[0], float(zeta), float(eps), *walls,
                        theta[0], x0[0], v0[0],
                        float(max_time), float(match_tol), rows, types.shape[0], orb_n,
                        oph[0, 0], ou[0, 0], oz[0, 0], outf[0], outi[0], tk, ts, tu)
         return outf[:1], outi[:1], (tk, ts, tu)
     ak.run_starts(np.repeat(1.0 / ib, 1), dd, np.zeros(n, np.int64), theta, x0, v0,
-                  float(zeta), float(eps), clearance, eps_lower, float(max_time),
+                  float(zeta), float(eps), *walls, float(max_time),
                   float(match_tol), rows, types.shape[0],
                   orb_n[None, :], oph[0], ou[0], oz[0], min(n, 8 * numba.get_num_threads()),
                   outf, outi)
