@@ -431,9 +431,39 @@ def _check_motions(where, entry, two_walls, problems):
 
 
 def _check_study(config, name, entry, problems, limits, unforced):
+    """The checks of a study, over the paper's ``(1/beta_f, delta)`` grid or over its ``plane``
+    (any two parameters): one prelude (the grids' shapes, the walls and their laws, the
+    reports, the noise record), then the statistics each accepts: events, spectra, densities
+    and the map over the paper's grid (`_check_grid_statistics`), the map alone over a plane
+    (`_check_plane_statistics`). Returns the study's grids (those of a plane: its axes', and
+    the fixed ``inv_beta``, ``delta`` as one-value arrays) or None."""
     where = f"studies.{name}"
-    if entry.get("plane") is not None:
-        return _check_plane_study(config, name, entry, problems, limits, unforced)
+    plane = None if entry.get("plane") is None else list(entry["plane"])
+    if plane is None:
+        _refuse_plane_attractors(where, entry, problems)
+        if not _grid_shapes(where, entry, problems):
+            return None
+    else:
+        grids, ok = _plane_axes(where, entry, plane, problems, limits, unforced)
+    two_walls = _check_walls(where, entry, problems)
+    _check_laws(where, entry, problems)
+    _check_report_with(config, name, entry, problems)
+    if plane is not None:
+        _refuse_event_keys(where, entry, plane, problems)
+    if entry["noise"] not in config["noises"]:
+        problems.add(f"{where}.noise", entry["noise"], "no such noise record",
+                     ", ".join(sorted(config["noises"])))
+        return None
+    record = noise_record(config["noises"][entry["noise"]])
+    if plane is None:
+        return _check_grid_statistics(config, name, entry, problems, limits, unforced,
+                                      two_walls, record)
+    return _check_plane_statistics(config, name, entry, problems, plane, grids, ok, two_walls,
+                                   record)
+
+
+def _refuse_plane_attractors(where, entry, problems):
+    """A study's attractors block needs a plane (an orbits entry's is the paper's plane)."""
     if entry.get("attractors"):
         # an orbits entry's attractors block is one-wall only: with a gap, a plane is the way
         other = ("a `plane: [x, y]` in the study (with the second wall: e.g. plane: "
@@ -442,6 +472,11 @@ def _check_study(config, name, entry, problems, limits, unforced):
                  "(the paper's (1/beta_f, delta) plane)")
         problems.add(f"{where}.attractors", None, "basins and Lyapunov exponents of a study "
                      "run over its plane, and this study has none", other)
+
+
+def _grid_shapes(where, entry, problems):
+    """Over the paper's grid: ``inv_beta`` and ``delta`` grids, every other parameter a number
+    (an axis needs a plane). False with the problems recorded."""
     shapes_ok = True
     for key in PLANE_PARAMETERS:        # a grid where a number is due: axes need a plane
         if key in ("inv_beta", "delta"):
@@ -456,15 +491,15 @@ def _check_study(config, name, entry, problems, limits, unforced):
                          "naming it", f"a number, or `plane: [{key}, delta]` (say) to map over "
                          f"it")
     if not shapes_ok:
-        return None
-    two_walls = _check_walls(where, entry, problems)
-    _check_laws(where, entry, problems)
-    _check_report_with(config, name, entry, problems)
-    if entry["noise"] not in config["noises"]:
-        problems.add(f"{where}.noise", entry["noise"], "no such noise record",
-                     ", ".join(sorted(config["noises"])))
-        return None
-    n, dt, tau = noise_record(config["noises"][entry["noise"]])
+        return False
+    return True
+
+
+def _check_grid_statistics(config, name, entry, problems, limits, unforced, two_walls, record):
+    """The statistics of a study over the paper's grid (events, spectra, densities, trace,
+    map, escape, figures) on its noise ``record`` ``(n, dt, tau)``; its grids or None."""
+    where = f"studies.{name}"
+    n, dt, tau = record
     record = f"the record of noises.{entry['noise']} ends at tau = {tau:.6g}"
     grids = {"delta": _grid(problems, f"{where}.delta", entry["delta"], limits["max_cells"])}
     resolved = {}       # the grids, and the spectra's plays: what the study resolves to
@@ -688,13 +723,9 @@ def _axis_grid(problems, where, spec, max_cells, bounds):
         return None
     return values
 
-def _check_plane_study(config, name, entry, problems, limits, unforced):
-    """The checks of a study with a ``plane``: its two axes are grids of values in their
-    bounds, every other parameter a number, only map figures (Fig. 16 not over a noise
-    parameter), the record long enough for the map's cap. Returns its grids (the axes', and
-    the fixed ``inv_beta``, ``delta`` as one-value arrays) or None."""
-    where = f"studies.{name}"
-    plane = list(entry["plane"])
+def _plane_axes(where, entry, plane, problems, limits, unforced):
+    """A plane's two axes: grids of values in their bounds, every other parameter a number,
+    the harmonic force present. ``(grids, ok)``."""
     grids, ok = {}, True
     for key in plane:
         spec = entry.get(key)
@@ -744,21 +775,25 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
         problems.add(f"{where}.amplitude", entry["amplitude"], "a study with a plane draws "
                      "its map, which needs the harmonic force", "amplitude != 0")
         ok = False
-    if "gap" not in plane:
-        _check_walls(where, entry, problems)
-    _check_laws(where, entry, problems)
-    two_walls = entry.get("gap") is not None
-    _check_report_with(config, name, entry, problems)
+    return grids, ok
+
+
+def _refuse_event_keys(where, entry, plane, problems):
+    """Keys the event statistics alone read, in a study that draws its map alone."""
     for key, default in _EVENT_ONLY.items():
         if entry.get(key, default) != default:
             problems.add(f"{where}.{key}", entry[key], f"read by the event statistics only, "
                          f"and a study with a plane ({plane}) draws its map alone (each cell "
                          f"run to its own target or cap: map)", f"leave {key} out, or put it "
                          f"in a study without a plane")
-    if entry["noise"] not in config["noises"]:
-        problems.add(f"{where}.noise", entry["noise"], "no such noise record",
-                     ", ".join(sorted(config["noises"])))
-        return None
+
+
+def _check_plane_statistics(config, name, entry, problems, plane, grids, ok, two_walls, record):
+    """The statistics of a study with a ``plane`` on its noise ``record`` ``(n, dt, tau)``:
+    only map figures (Fig. 16 not over a noise parameter), the record long enough for the
+    map's cap. Returns its grids or None."""
+    where = f"studies.{name}"
+    n, dt, tau = record
     if entry.get("spectra"):
         problems.add(f"{where}.spectra", None, f"a study with a plane ({plane}) has no "
                      "spectra: they run at plays of the (1/beta_f, delta) grid (Figs. 6, "
@@ -784,7 +819,6 @@ def _check_plane_study(config, name, entry, problems, limits, unforced):
     _check_motions(where, entry, two_walls, problems)
     if entry.get("attractors"):
         ok &= _check_plane_attractors(where, entry, plane, grids, problems)
-    n, dt, tau = noise_record(config["noises"][entry["noise"]])
     transient = float(entry["transient"])
     if transient >= tau:
         problems.add(f"{where}.transient", transient, "leaves no record for the statistics "
