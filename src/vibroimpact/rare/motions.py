@@ -49,6 +49,15 @@ extinct; the fit ``ln T`` linear in ``1 / rms^2`` through the three brute-force 
 extrapolates to ~24000), the cost brute force would need for the same interval (~35
 residences of ~2e6 steps): no gain yet. At rms 0.12 it degrades too (7e7 +- 4e7 from 10
 runs, 3 extinct, 4e7 steps): a coordinate for the lowest levels is still open.
+
+The other escape cells, with :class:`PredictedDeviation` (100 clones, 10 runs) against brute
+force, ``radius_a = 0.25`` (forcing periods): the (2/1) motion at 1/beta_f = 1.1, delta =
+0.1 (``radius_b = 0.9``) 54.0 +- 3.9 against 47.2 +- 5.5 (rms 0.29) and 234 +- 47 against
+196 +- 14 (0.25); the (1/2) motion at 1/beta_f = 1.2, delta = 2.5 (``radius_b = 1.2``: its
+deviations under noise are larger, and with 0.9 it lasts 9 periods at rms 0.29) 90 +- 8
+against 82 +- 5 (0.25) and 213 +- 30 against 223 +- 21 (0.22). At these levels brute force
+is the cheaper of the two (the (2/1) at rms 0.22: brute force 908 +- 170 from 1.4e6 steps,
+splitting 553 +- 300 from 2.1e6).
 """
 from __future__ import annotations
 
