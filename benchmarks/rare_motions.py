@@ -1,7 +1,7 @@
 """Residence in the (1/1) motion of the escape cell [1.1, 1.0]: splitting against brute force
 with the same A and B (vibroimpact.rare.motions), value, interval and cost in sample steps.
 
-    python benchmarks/rare_motions.py ams RMS [--coordinate predicted|distance|forecast]
+    python benchmarks/rare_motions.py ams RMS [--coordinate predicted|distance|forecast|margin]
                                            [--clones N] [--runs R] [--seed S]
     python benchmarks/rare_motions.py brute RMS [--periods P] [--seed S]
 
@@ -25,7 +25,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("mode", choices=["ams", "brute"])
     ap.add_argument("rms", type=float)
-    ap.add_argument("--coordinate", choices=["predicted", "distance", "forecast"],
+    ap.add_argument("--coordinate", choices=["predicted", "distance", "forecast", "margin"],
                     default="predicted")
     ap.add_argument("--clones", type=int, default=100)
     ap.add_argument("--runs", type=int, default=10)
