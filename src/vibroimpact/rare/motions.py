@@ -48,7 +48,24 @@ nine decades). :class:`Forecast`, read between the strobes, gives 103 +- 10 (0.2
 extinct; the fit ``ln T`` linear in ``1 / rms^2`` through the three brute-force levels
 extrapolates to ~24000), the cost brute force would need for the same interval (~35
 residences of ~2e6 steps): no gain yet. At rms 0.12 it degrades too (7e7 +- 4e7 from 10
-runs, 3 extinct, 4e7 steps): a coordinate for the lowest levels is still open.
+runs, 3 extinct, 4e7 steps).
+
+:class:`ForecastMargin` is the coordinate for weak noise: the forecast's margin to B in units
+of the noise the rest of the period can still add, so that readings at different phases
+compare. With 100 clones and 10 runs (``python benchmarks/rare_motions.py ams RMS
+--coordinate margin``), no run extinct at any level:
+
+- 17.1 +- 0.6 (rms 0.29, the slow test's) and 114 +- 20 (0.22, 1.7e7 steps), against brute
+  force's 16.0 +- 0.35 and 108 +- 4;
+- 33300 +- 4300 (0.15, 2.4e7 steps, the runs' ``p`` within 0.7 decades), where brute force
+  spends ~2.3e6 steps a residence, so ~1.4e8 for the same 13 % (59 residences);
+- 5.6e6 +- 1.9e6 (0.12, 2.8e7 steps, the runs' ``p`` within 1.4 decades);
+- 2.5e9 +- 1.8e9 (0.10, 3.0e7 steps): a relative error of 72 % from 10 runs, for one
+  residence that brute force would need ~1.7e11 steps to see once.
+
+From rms 0.15 to 0.10 the cost grows by 30 % while the residence grows by five decades. ``ln T`` against
+``1 / rms^2`` has the slope 0.205 from rms 0.15 to 0.12 and 0.200 from 0.12 to 0.10 (0.25
+from 0.18, brute force, to 0.15).
 
 The other escape cells, with :class:`PredictedDeviation` (100 clones, 10 runs) against brute
 force, ``radius_a = 0.25`` (forcing periods): the (2/1) motion at 1/beta_f = 1.1, delta =
