@@ -64,8 +64,8 @@ compare. With 100 clones and 10 runs (``python benchmarks/rare_motions.py ams RM
   residence that brute force would need ~1.7e11 steps to see once.
 
 From rms 0.15 to 0.10 the cost grows by 30 % while the residence grows by five decades.
-``ln T`` against ``1 / rms^2`` has the slope 0.205 from rms 0.15 to 0.12 and 0.200 from 0.12 to 0.10 (0.25
-from 0.18, brute force, to 0.15).
+``ln T`` against ``1 / rms^2`` has the slope 0.205 from rms 0.15 to 0.12 and 0.200 from 0.12
+to 0.10 (0.25 from 0.18, brute force, to 0.15).
 
 The other escape cells, with :class:`PredictedDeviation` (100 clones, 10 runs) against brute
 force, ``radius_a = 0.25`` (forcing periods): the (2/1) motion at 1/beta_f = 1.1, delta =
