@@ -122,8 +122,9 @@ def test_the_spread_is_the_variance_the_new_innovations_give_the_wall_free_oscil
     """``forecast_spread`` (scipy's first-order-hold response) against the exact simulator: the
     impulse response through ``vibroimpact.simulate`` with the wall out of reach gives the
     same ``c(m)`` to 1e-9 of ``c(n)`` (the simulator's x = delta - a rounds at 1e-15 of
-    delta: the first samples' tiny responses are not resolved relatively), and 4000 runs of random innovations give its variance within 5
-    standard errors of the Monte Carlo (the sum over innovations is the variance)."""
+    delta: the first samples' tiny responses are not resolved relatively), and 4000 runs of
+    random innovations give its variance within 5 standard errors of the Monte Carlo (the sum
+    over innovations is the variance)."""
     spec = noise.NoiseSpec("band_limited", 0.22, 0.1, 4.0)
     force = ForceFilter(spec)
     n = 70
