@@ -74,7 +74,11 @@ force, ``radius_a = 0.25`` (forcing periods): the (2/1) motion at 1/beta_f = 1.1
 deviations under noise are larger, and with 0.9 it lasts 9 periods at rms 0.29) 90 +- 8
 against 82 +- 5 (0.25) and 213 +- 30 against 223 +- 21 (0.22). At these levels brute force
 is the cheaper of the two (the (2/1) at rms 0.22: brute force 908 +- 170 from 1.4e6 steps,
-splitting 553 +- 300 from 2.1e6).
+splitting 553 +- 300 from 2.1e6). Lower down, with :class:`ForecastMargin` (``python
+benchmarks/rare_motions.py ams RMS --motion M --coordinate margin``): the (1/2) motion
+4.96e7 +- 2.2e7 at rms 0.10 (5.2e7 steps, no run extinct); the (2/1) motion at rms 0.13 lost
+6 of 10 runs (1.4e10 +- 1.3e10 from 2.1e7 steps, not an estimate to use): for it the margin
+is not yet the coordinate.
 """
 from __future__ import annotations
 
