@@ -323,7 +323,7 @@ def periodic_orbits(m, n, beta=None, delta=None, zeta=None, eps=None, *, model=N
             raise TypeError(f"periodic_orbits takes a model or beta, delta, zeta, eps, not "
                             f"both (got model and {', '.join(given)})")
         beta, delta, zeta, eps = closed_form(model)
-    elif None in loose.values():
+    elif any(v is None for v in loose.values()):
         missing = [k for k, v in loose.items() if v is None]
         raise TypeError(f"periodic_orbits needs beta, delta, zeta and eps (or model=): "
                         f"missing {', '.join(missing)}")
