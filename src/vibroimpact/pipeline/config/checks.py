@@ -490,9 +490,7 @@ def _grid_shapes(where, entry, problems):
             problems.add(f"{where}.{key}", entry[key], "a grid, and this study has no plane "
                          "naming it", f"a number, or `plane: [{key}, delta]` (say) to map over "
                          f"it")
-    if not shapes_ok:
-        return False
-    return True
+    return shapes_ok
 
 
 def _check_grid_statistics(config, name, entry, problems, limits, unforced, two_walls, record):
@@ -722,6 +720,7 @@ def _axis_grid(problems, where, spec, max_cells, bounds):
         problems.add(where, spec, f"holds {_num(bad[0])}", allowed)
         return None
     return values
+
 
 def _plane_axes(where, entry, plane, problems, limits, unforced):
     """A plane's two axes: grids of values in their bounds, every other parameter a number,
