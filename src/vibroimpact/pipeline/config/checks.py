@@ -445,7 +445,9 @@ def _check_study(config, name, entry, problems, limits, unforced):
             return None
     else:
         grids, ok = _plane_axes(where, entry, plane, problems, limits, unforced)
-    two_walls = _check_walls(where, entry, problems)
+    if plane is None or "gap" not in plane:    # an axis gap is its plane's to check
+        _check_walls(where, entry, problems)
+    two_walls = entry.get("gap") is not None
     _check_laws(where, entry, problems)
     _check_report_with(config, name, entry, problems)
     if plane is not None:
