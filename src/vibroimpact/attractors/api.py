@@ -107,9 +107,10 @@ def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=None, eps_lower=N
     stay below the wall above (the mirror image of a cell holds the same numbers the other way
     round)."""
     nb, nd, nt = inv_beta.size, delta.size, types.shape[0]
+    kernel_clearance, kernel_eps_lower = kernel_walls(clearance, eps, eps_lower)
     walls = [(delta, eps)]
     if clearance is not None:
-        walls.append((clearance - delta, eps if eps_lower is None else eps_lower))
+        walls.append((clearance - delta, kernel_eps_lower))
     shape = (nb, nd, len(walls) * nt, ak.K_ORBITS, ak.M_COLS)
     n_stable = np.zeros((len(walls) * nt, nb, nd), np.int64)
     oph, ou, oz = np.zeros(shape), np.zeros(shape), np.zeros(shape)
@@ -122,8 +123,7 @@ def stable_orbits(inv_beta, delta, types, zeta, eps, clearance=None, eps_lower=N
         lnmu_w = np.full(shape[:2] + (nt, ak.K_ORBITS), np.nan)
         with numba.parallel_chunksize(1):       # rows handed out as threads come free
             ak.cell_orbits(inv_beta, np.ascontiguousarray(plays), types, float(zeta),
-                           float(eps_w), *arrays, lnmu_w,
-                           kernel_walls(clearance, eps, eps_lower)[0], rows)
+                           float(eps_w), *arrays, lnmu_w, kernel_clearance, rows)
         n_stable[part] = arrays[0]
         for full, got in zip((oph, ou, oz, lnmu), arrays[1:] + [lnmu_w]):
             full[:, :, part] = got
